@@ -1,0 +1,104 @@
+//! The standalone demo host as a library: scene setup shared by the `host_demo` binary and the
+//! integration tests, so that what the tests check is what the demo shows.
+
+pub mod output;
+pub mod render;
+
+use glam::{Mat4, Vec3};
+use passes::{Draw, FrameInputs, Geometry, PassError};
+use rhi::Device;
+use scene::{Camera, DirectionalLight, Scene};
+
+/// A scene with its camera and light, ready to render.
+#[derive(Debug, Clone)]
+pub struct View {
+    /// The geometry.
+    pub scene: Scene,
+    /// The camera.
+    pub camera: Camera,
+    /// The light.
+    pub light: DirectionalLight,
+    /// Frame width in pixels.
+    pub width: u32,
+    /// Frame height in pixels.
+    pub height: u32,
+}
+
+impl View {
+    /// Frames `scene` automatically: the camera looks at it from a slanted elevated direction and a slanted
+    /// directional light shines on it.
+    pub fn framed(scene: Scene, width: u32, height: u32) -> Self {
+        let aspect = width as f32 / height.max(1) as f32;
+        let camera = Camera::frame(&scene.bounds(), aspect);
+        Self {
+            scene,
+            camera,
+            light: DirectionalLight::slanted(),
+            width,
+            height,
+        }
+    }
+
+    /// Camera and light matrices of the frame.
+    pub fn frame_inputs(&self) -> FrameInputs {
+        let bounds = self.scene.bounds();
+        let aspect = self.width as f32 / self.height as f32;
+        FrameInputs {
+            view: self.camera.view(),
+            proj: self.camera.proj(aspect),
+            camera_position: self.camera.position,
+            light_direction: self.light.direction,
+            light_view_proj: self.light.view_proj(&bounds),
+            light_origin: bounds.center(),
+        }
+    }
+
+    /// Uploads the scene: one draw per object, identity transforms.
+    pub fn upload(&self, device: &Device) -> Result<Geometry, PassError> {
+        let positions: Vec<f32> = self
+            .scene
+            .positions
+            .iter()
+            .flat_map(|p| p.to_array())
+            .collect();
+        let draws: Vec<Draw> = self
+            .scene
+            .objects
+            .iter()
+            .map(|o| Draw {
+                first_index: o.first_triangle * 3,
+                index_count: o.triangle_count * 3,
+                model: Mat4::IDENTITY,
+            })
+            .collect();
+        Geometry::upload(device, &positions, &self.scene.indices, &draws)
+    }
+}
+
+/// Parses "x,y,z" into a vector.
+pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let [x, y, z] = parts.as_slice() else {
+        return Err(format!("expected x,y,z but got '{s}'"));
+    };
+    let f = |v: &str| {
+        v.parse::<f32>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("'{v}' is not a finite number"))
+    };
+    Ok(Vec3::new(f(x)?, f(y)?, f(z)?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_vectors() {
+        assert_eq!(parse_vec3("1, 2,3").unwrap(), Vec3::new(1.0, 2.0, 3.0));
+        assert!(parse_vec3("1,2").is_err());
+        assert!(parse_vec3("1,nan,2").is_err());
+        assert!(parse_vec3("a,b,c").is_err());
+    }
+}

@@ -1,0 +1,158 @@
+//! `host_demo`: the standalone demo of hybrid ray-traced shadows.
+
+use anyhow::{bail, Context, Result};
+use clap::{Parser, Subcommand};
+use glam::Vec3;
+use host_demo::render::{parse_faces, parse_raster, render_to_folder, RenderOptions};
+use host_demo::{parse_vec3, View};
+use passes::{FaceMode, PrimitiveMapConfig, RasterRequest};
+use rhi::{Device, DeviceDesc};
+use scene::{Camera, DirectionalLight};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    version,
+    about = "Hybrid ray-traced shadows (deep primitive map) — standalone demo host"
+)]
+struct Cli {
+    /// Vulkan device whose name contains this (e.g. llvmpipe, NVIDIA); default: the best GPU, else lavapipe.
+    #[arg(long, global = true, env = "HRTS_DEVICE")]
+    device: Option<String>,
+    /// Enable Vulkan validation layers (also HRTS_VALIDATION=1); any validation error fails the run.
+    #[arg(long, global = true)]
+    validation: bool,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render one view: G-buffer, primitive map, ray-traced shadows; writes EXR/PNG/JSON and prints GPU timings.
+    Render(RenderArgs),
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// OBJ file to load (default: the built-in procedural scene).
+    #[arg(long)]
+    obj: Option<PathBuf>,
+    /// Do not add a ground plane under an OBJ model.
+    #[arg(long)]
+    no_ground: bool,
+    /// Output folder.
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+    /// Frame width in pixels.
+    #[arg(long, default_value_t = 1280)]
+    width: u32,
+    /// Frame height in pixels.
+    #[arg(long, default_value_t = 720)]
+    height: u32,
+    /// Direction the light travels, "x,y,z" (default: slanted, about 30° from vertical).
+    #[arg(long, value_parser = parse_vec3)]
+    light_dir: Option<Vec3>,
+    /// Camera position "x,y,z" (default: framed automatically).
+    #[arg(long, value_parser = parse_vec3)]
+    camera_pos: Option<Vec3>,
+    /// Camera target "x,y,z" (default: the scene centre).
+    #[arg(long, value_parser = parse_vec3)]
+    camera_target: Option<Vec3>,
+    /// Primitive map size N (N×N texels).
+    #[arg(long, default_value_t = 1024)]
+    map_size: u32,
+    /// Primitive map depth d (triangles per texel).
+    #[arg(long, default_value_t = 32)]
+    map_depth: u32,
+    /// Faces stored: both (open geometry) or front (closed meshes only).
+    #[arg(long, default_value = "both", value_parser = parse_faces)]
+    faces: FaceMode,
+    /// Conservative raster path: auto, hw or sw.
+    #[arg(long, default_value = "auto", value_parser = parse_raster)]
+    raster: RasterRequest,
+    /// Frames to render (timings are medians over all but the first).
+    #[arg(long, default_value_t = 5)]
+    frames: u32,
+}
+
+fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
+    if args.width == 0 || args.height == 0 {
+        bail!("--width and --height must be positive");
+    }
+    let scene = match &args.obj {
+        Some(path) => {
+            let s = scene::load_obj(path)?;
+            if args.no_ground {
+                s
+            } else {
+                s.with_ground_plane()
+            }
+        }
+        None => scene::procedural_default(),
+    };
+    let mut view = View::framed(scene, args.width, args.height);
+    if let Some(d) = args.light_dir {
+        view.light =
+            DirectionalLight::new(d).context("--light-dir must be a non-zero finite vector")?;
+    }
+    if args.camera_pos.is_some() || args.camera_target.is_some() {
+        let bounds = view.scene.bounds();
+        let position = args.camera_pos.unwrap_or(view.camera.position);
+        let target = args.camera_target.unwrap_or(bounds.center());
+        if (position - target).length() == 0.0 {
+            bail!("camera position and target coincide");
+        }
+        let forward = (target - position).normalize();
+        let up = if forward.cross(Vec3::Y).length() < 1e-3 {
+            Vec3::Z
+        } else {
+            Vec3::Y
+        };
+        view.camera = Camera {
+            position,
+            target,
+            up,
+            ..view.camera
+        };
+    }
+    let mut desc = DeviceDesc::from_env();
+    desc.validation |= cli.validation;
+    if cli.device.is_some() {
+        desc.device_filter = cli.device.clone();
+    }
+    let device = Device::new_headless(&desc)?;
+    let options = RenderOptions {
+        map: PrimitiveMapConfig {
+            size: args.map_size,
+            depth: args.map_depth,
+            faces: args.faces,
+            raster: args.raster,
+        },
+        frames: args.frames,
+    };
+    render_to_folder(&device, &view, &options, &args.out)?;
+    let errors = device.validation().errors();
+    if errors > 0 {
+        bail!(
+            "{errors} Vulkan validation errors (first: {:?})",
+            device.validation().messages().first()
+        );
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Render(args) => render(&cli, args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,49 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// Prim buffer build: transforms a draw's indexed triangles to world space and stores them at
+// draw-call offset + primitive id (the seed's "hash draw call ID with SV_PrimitiveID").
+#include "triangle.glsl"
+#include "prim_buffer_push.glsl"
+
+layout(local_size_x = 64) in;
+layout(set = 0, binding = 0) readonly buffer Vertices { float vertices[]; };
+layout(set = 0, binding = 1) readonly buffer Indices { uint indices[]; };
+layout(set = 0, binding = 2) writeonly buffer Prims { Triangle tris[]; };
+layout(push_constant) uniform Push { PrimBufferPush pc; };
+
+bool fetch(uint index, out vec4 world) {
+    uint base = pc.vertex_offset + index * pc.vertex_stride;
+    if (index >= pc.vertex_count || base + 2u >= uint(vertices.length())) {
+        world = vec4(0.0, 0.0, 0.0, 1.0);
+        return false;
+    }
+    vec3 p = vec3(vertices[base], vertices[base + 1u], vertices[base + 2u]);
+    world = vec4((pc.model * vec4(p, 1.0)).xyz, 1.0);
+    return true;
+}
+
+void main() {
+    uint prim = gl_GlobalInvocationID.x;
+    uint slot = pc.prim_offset + prim;
+    if (prim >= pc.triangle_count || slot >= uint(tris.length())) {
+        return;
+    }
+    Triangle t;
+    bool valid = true;
+    for (uint k = 0u; k < 3u; ++k) {
+        uint i = pc.first_index + prim * 3u + k;
+        bool ok = i < uint(indices.length());
+        vec4 w = vec4(0.0, 0.0, 0.0, 1.0);
+        if (ok) {
+            ok = fetch(indices[i], w);
+        }
+        valid = valid && ok;
+        t.v[k] = w;
+    }
+    if (!valid) {
+        // Out-of-range indices give a zero-area triangle: never rasterized, never hit.
+        t.v[1] = t.v[0];
+        t.v[2] = t.v[0];
+    }
+    tris[slot] = t;
+}

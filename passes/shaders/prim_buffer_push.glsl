@@ -1,0 +1,12 @@
+// Mirrors passes::gpu_types::PrimBufferPush (96 bytes).
+struct PrimBufferPush {
+    mat4 model;             // object -> world
+    uint first_index;       // first index of the draw in the index buffer
+    uint triangle_count;    // triangles in the draw
+    uint prim_offset;       // draw-call offset: prim buffer slot of the draw's first triangle
+    uint vertex_stride;     // in floats
+    uint vertex_offset;     // in floats, position of vertex 0
+    uint vertex_count;      // vertices addressable by the draw (indices >= this are rejected)
+    uint pad0;
+    uint pad1;
+};

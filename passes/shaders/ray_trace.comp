@@ -1,0 +1,135 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// Per-pixel shadow ray through the deep primitive map.
+//
+// Numerics (see README "Numerical design"):
+// - The receiver point P is rebuilt from depth relative to the camera, then offset along its geometric
+//   normal by a bound on its own error: a fraction of the pixel footprint (depth interpolation and vertex
+//   snapping move P by less than that) plus a relative float bound of the coordinates. No world-space bias.
+// - Ray/triangle test: watertight (Woop, Benthin, Wald 2013), two-sided, no epsilons. Edge functions are
+//   `precise` so that a shared edge gives exactly opposite values in both triangles: a ray through an edge
+//   or vertex of a closed mesh always hits at least one triangle. Zero-determinant (degenerate or
+//   edge-on) triangles are rejected without dividing.
+// - Overflowed texels (count > d) are traced exhaustively against the whole prim buffer: exact, slower.
+#include "triangle.glsl"
+#include "ray_trace_constants.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(set = 0, binding = 0) uniform Constants { RayTraceConstants k; };
+layout(set = 0, binding = 1) uniform sampler2D depth_tex;
+layout(set = 0, binding = 2) uniform sampler2D normal_tex;
+layout(set = 0, binding = 3, r32ui) uniform readonly uimage2D count_map;
+layout(set = 0, binding = 4, r32ui) uniform readonly uimage2DArray index_map;
+layout(set = 0, binding = 5) readonly buffer Prims { Triangle tris[]; };
+layout(set = 0, binding = 6, r32f) uniform writeonly image2D visibility;
+layout(set = 0, binding = 7, r32f) uniform writeonly image2D blocker;
+
+// Ray in Woop's sheared space.
+int kx, ky, kz;
+float sx, sy, sz;
+vec3 origin;
+
+void setup_ray(vec3 o, vec3 d) {
+    vec3 ad = abs(d);
+    kz = (ad.x > ad.y) ? ((ad.x > ad.z) ? 0 : 2) : ((ad.y > ad.z) ? 1 : 2);
+    kx = (kz + 1) % 3;
+    ky = (kx + 1) % 3;
+    sx = d[kx] / d[kz];
+    sy = d[ky] / d[kz];
+    sz = 1.0 / d[kz];
+    origin = o;
+}
+
+// Returns the hit distance along the ray, or -1.
+float intersect(Triangle t) {
+    precise vec3 a = t.v[0].xyz - origin;
+    precise vec3 b = t.v[1].xyz - origin;
+    precise vec3 c = t.v[2].xyz - origin;
+    precise float ax = a[kx] - sx * a[kz];
+    precise float ay = a[ky] - sy * a[kz];
+    precise float bx = b[kx] - sx * b[kz];
+    precise float by = b[ky] - sy * b[kz];
+    precise float cx = c[kx] - sx * c[kz];
+    precise float cy = c[ky] - sy * c[kz];
+    precise float u = cx * by - cy * bx;
+    precise float v = ax * cy - ay * cx;
+    precise float w = bx * ay - by * ax;
+    if ((u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)) {
+        return -1.0;
+    }
+    precise float det = u + v + w;
+    if (det == 0.0) {
+        return -1.0;
+    }
+    precise float tt = u * (sz * a[kz]) + v * (sz * b[kz]) + w * (sz * c[kz]);
+    float dist = tt / det;
+    return dist > 0.0 ? dist : -1.0;
+}
+
+void consider(uint index, inout float nearest) {
+    if (index < uint(tris.length())) {
+        float d = intersect(tris[index]);
+        if (d > 0.0 && d < nearest) {
+            nearest = d;
+        }
+    }
+}
+
+void write(ivec2 px, float vis, float bd) {
+    imageStore(visibility, px, vec4(vis));
+    imageStore(blocker, px, vec4(bd));
+}
+
+void main() {
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (px.x >= int(k.dims.x) || px.y >= int(k.dims.y)) {
+        return;
+    }
+    float depth = texelFetch(depth_tex, px, 0).r;
+    vec4 normal = texelFetch(normal_tex, px, 0);
+    if (depth <= 0.0 || normal.w == 0.0) {
+        write(px, 1.0, -1.0);   // background: lit, no blocker
+        return;
+    }
+    vec2 ndc = (vec2(px) + 0.5) / vec2(k.dims.xy) * 2.0 - 1.0;
+    vec4 h = k.inv_view_proj_rel * vec4(ndc, depth, 1.0);
+    vec3 rel = h.xyz / h.w;
+    vec3 p = k.camera_pos.xyz + rel;
+    vec3 to_light = -k.light_dir.xyz;
+    vec3 n = normal.xyz;
+    if (dot(n, to_light) <= 0.0) {
+        write(px, 0.0, 0.0);    // the visible side faces away from the light
+        return;
+    }
+    float dist = length(rel);
+    vec3 ap = abs(p);
+    float magnitude = max(max(ap.x, ap.y), ap.z) + dist;
+    float delta = dist * k.offset.x * k.offset.y + magnitude * k.offset.z;
+    vec3 o = p + n * delta;
+    setup_ray(o, to_light);
+
+    vec4 lc = k.light_view_proj_rel * vec4(o - k.light_origin.xyz, 1.0);
+    vec2 uv = (lc.xy / lc.w * 0.5 + 0.5) * float(k.dims.z);
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThanEqual(uv, vec2(float(k.dims.z))))) {
+        write(px, 1.0, -1.0);   // outside the light's map: no recorded occluder
+        return;
+    }
+    ivec2 texel = ivec2(uv);
+    uint count = imageLoad(count_map, texel).r;
+    float nearest = 1.0 / 0.0;
+    if (count <= k.dims.w) {
+        for (uint i = 0u; i < count; ++i) {
+            consider(imageLoad(index_map, ivec3(texel, int(i))).r, nearest);
+        }
+    } else {
+        uint total = uint(tris.length());
+        for (uint i = 0u; i < total; ++i) {
+            consider(i, nearest);
+        }
+    }
+    if (isinf(nearest)) {
+        write(px, 1.0, -1.0);
+    } else {
+        write(px, 0.0, nearest);
+    }
+}

@@ -1,0 +1,11 @@
+// Mirrors passes::gpu_types::RayTraceConstants (224 bytes).
+struct RayTraceConstants {
+    mat4 inv_view_proj_rel;     // inverse(proj * view) with the camera at the origin
+    mat4 light_view_proj_rel;   // light view-projection relative to light_origin
+    vec4 camera_pos;            // xyz
+    vec4 light_origin;          // xyz
+    vec4 light_dir;             // xyz: direction the light travels (unit)
+    uvec4 dims;                 // screen width, height, primitive map N, d
+    vec4 offset;                // x: radians per pixel, y: offset in pixels, z: relative float bound
+    uvec4 misc;                 // x: 1 = front-only map (for the report), yzw unused
+};

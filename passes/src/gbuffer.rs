@@ -1,0 +1,113 @@
+//! G-buffer for the demo host: world position, camera-facing geometric normal, reversed-Z depth.
+//!
+//! Reads: prim buffer. Writes: position, normal, depth.
+
+use crate::gpu_types::GBufferPush;
+use crate::{shader, PassError};
+use rhi::{
+    BindGroup, BindingKind, Buffer, ColorTarget, CullMode, DepthState, DepthTarget, Device,
+    Encoder, Format, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, ImageUsage,
+    Resource,
+};
+
+/// G-buffer targets and the pass that fills them.
+pub struct GBufferPass {
+    pipeline: GraphicsPipeline,
+    group: BindGroup,
+    /// World position (xyz), w = 1 on geometry, 0 on background.
+    pub position: Image,
+    /// Geometric normal facing the camera (xyz), w = 1 on geometry.
+    pub normal: Image,
+    /// Reversed-Z depth (1 near, 0 far/background).
+    pub depth: Image,
+}
+
+impl GBufferPass {
+    /// Creates `width` x `height` targets.
+    pub fn new(
+        device: &Device,
+        prims: &Buffer,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, PassError> {
+        let color = |name| ImageDesc {
+            name,
+            format: Format::Rgba32Float,
+            width,
+            height,
+            layers: 1,
+            usage: ImageUsage::COLOR_TARGET | ImageUsage::SAMPLED | ImageUsage::COPY_SRC,
+        };
+        let position = device.create_image(&color("gbuffer position"))?;
+        let normal = device.create_image(&color("gbuffer normal"))?;
+        let depth = device.create_image(&ImageDesc {
+            name: "gbuffer depth",
+            format: Format::D32Float,
+            width,
+            height,
+            layers: 1,
+            usage: ImageUsage::DEPTH_TARGET | ImageUsage::SAMPLED | ImageUsage::COPY_SRC,
+        })?;
+        let pipeline = device.create_graphics_pipeline(&GraphicsPipelineDesc {
+            name: "gbuffer",
+            vertex: &shader("gbuffer.vert")?,
+            geometry: None,
+            fragment: &shader("gbuffer.frag")?,
+            bindings: &[BindingKind::StorageBuffer],
+            push_constant_size: std::mem::size_of::<GBufferPush>() as u32,
+            color_formats: &[Format::Rgba32Float, Format::Rgba32Float],
+            depth: Some(DepthState {
+                format: Format::D32Float,
+                write: true,
+                greater: true,
+            }),
+            cull: CullMode::None,
+            conservative_extra_overestimation: None,
+            depth_clamp: false,
+        })?;
+        let group = device.create_bind_group(pipeline.layout(), &[Resource::Buffer(prims)])?;
+        Ok(Self {
+            pipeline,
+            group,
+            position,
+            normal,
+            depth,
+        })
+    }
+
+    /// Records the pass; targets must be in `RenderTarget` / `DepthWrite` state.
+    pub fn record(
+        &self,
+        enc: &mut Encoder<'_>,
+        push: &GBufferPush,
+        triangle_count: u32,
+    ) -> Result<(), PassError> {
+        enc.begin_pass("gbuffer");
+        enc.begin_rendering(
+            (self.position.width(), self.position.height()),
+            &[
+                ColorTarget {
+                    image: &self.position,
+                    clear: [0.0; 4],
+                },
+                ColorTarget {
+                    image: &self.normal,
+                    clear: [0.0; 4],
+                },
+            ],
+            Some(DepthTarget {
+                image: &self.depth,
+                clear: 0.0,
+            }),
+        );
+        enc.draw(
+            &self.pipeline,
+            &self.group,
+            bytemuck::bytes_of(push),
+            triangle_count * 3,
+        )?;
+        enc.end_rendering();
+        enc.end_pass();
+        Ok(())
+    }
+}

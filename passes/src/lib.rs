@@ -1,0 +1,49 @@
+//! The render passes of hybrid ray-traced shadows (deep primitive map, after Jon Story, GDC 2015), each a
+//! short unit that declares what it reads and writes, and the demo frame that strings them together.
+
+mod error;
+pub mod gbuffer;
+pub mod gpu_types;
+pub mod prim_buffer;
+pub mod primitive_map;
+pub mod ray_trace;
+pub mod renderer;
+
+pub use error::PassError;
+pub use prim_buffer::{Draw, Geometry};
+pub use primitive_map::{
+    choose_raster_path, FaceMode, PrimitiveMapConfig, RasterPath, RasterRequest,
+};
+pub use renderer::{FrameImages, FrameInputs, FrameReport, ShadowRenderer};
+
+mod shaders {
+    include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
+}
+
+/// SPIR-V words of the embedded shader `name` (file name in `shaders/`).
+pub fn shader(name: &str) -> Result<Vec<u32>, PassError> {
+    let bytes = shaders::ALL
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, b)| *b)
+        .ok_or_else(|| PassError::InvalidConfig(format!("no embedded shader named {name}")))?;
+    Ok(bytemuck::pod_collect_to_vec(bytes))
+}
+
+/// Names of all embedded shader modules.
+pub fn shader_names() -> impl Iterator<Item = &'static str> {
+    shaders::ALL.iter().map(|(n, _)| *n)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn every_shader_is_spirv() {
+        let names: Vec<_> = super::shader_names().collect();
+        assert!(names.len() >= 9, "{names:?}");
+        for n in names {
+            let words = super::shader(n).unwrap();
+            assert_eq!(words[0], 0x0723_0203, "{n} lacks the SPIR-V magic number");
+        }
+    }
+}

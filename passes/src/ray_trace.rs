@@ -1,0 +1,125 @@
+//! Per-pixel shadow rays through the deep primitive map: visibility (1 = lit) and blocker distance.
+//!
+//! Reads: depth, normal, count map, index map, prim buffer, constants. Writes: visibility, blocker distance.
+
+use crate::gpu_types::RayTraceConstants;
+use crate::{shader, PassError};
+use bytemuck::Zeroable;
+use rhi::{
+    BindGroup, BindingKind, Buffer, BufferUsage, ComputePipeline, Device, Encoder, Format, Image,
+    ImageDesc, ImageUsage, Resource,
+};
+
+/// Ray-origin offset along the receiver's normal, in pixels of footprint at the receiver's distance.
+/// Depth interpolation and the rasterizer's sub-pixel vertex snapping move the rebuilt point by well under
+/// this, and an offset below a pixel can never show as peter-panning.
+pub const RAY_OFFSET_PIXELS: f32 = 1.0 / 64.0;
+
+/// Relative float bound added to the offset, times (max |coordinate| + camera distance): covers the f32
+/// rounding of the reconstruction and of the stored vertices (16 ulps).
+pub const RAY_OFFSET_FLOAT_BOUND: f32 = 16.0 * f32::EPSILON;
+
+/// Inputs of the ray trace.
+pub struct RayTraceInputs<'a> {
+    /// Reversed-Z depth (`ShaderResource` state).
+    pub depth: &'a Image,
+    /// Camera-facing geometric normal, w = 0 on background (`ShaderResource` state).
+    pub normal: &'a Image,
+    /// Count map (`UnorderedAccess`).
+    pub count: &'a Image,
+    /// Index map (`UnorderedAccess`).
+    pub indices: &'a Image,
+    /// Prim buffer.
+    pub prims: &'a Buffer,
+}
+
+/// The ray-trace pass and its outputs.
+pub struct RayTracePass {
+    pipeline: ComputePipeline,
+    group: BindGroup,
+    constants: Buffer,
+    /// `R32_SFLOAT` visibility, 1 = lit.
+    pub visibility: Image,
+    /// `R32_SFLOAT` distance from the ray origin to the nearest blocker; 0 where the receiver faces away
+    /// from the light, -1 where lit or background.
+    pub blocker_distance: Image,
+}
+
+impl RayTracePass {
+    /// Creates `width` x `height` outputs.
+    pub fn new(
+        device: &Device,
+        inputs: &RayTraceInputs<'_>,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, PassError> {
+        let out = |name| ImageDesc {
+            name,
+            format: Format::R32Float,
+            width,
+            height,
+            layers: 1,
+            usage: ImageUsage::STORAGE | ImageUsage::SAMPLED | ImageUsage::COPY_SRC,
+        };
+        let visibility = device.create_image(&out("rt visibility"))?;
+        let blocker_distance = device.create_image(&out("rt blocker distance"))?;
+        let constants = device.create_buffer_init(
+            "ray trace constants",
+            bytemuck::bytes_of(&RayTraceConstants::zeroed()),
+            BufferUsage::UNIFORM,
+        )?;
+        let pipeline = device.create_compute_pipeline(
+            "ray trace",
+            &shader("ray_trace.comp")?,
+            &[
+                BindingKind::UniformBuffer,
+                BindingKind::SampledImage,
+                BindingKind::SampledImage,
+                BindingKind::StorageImage,
+                BindingKind::StorageImage,
+                BindingKind::StorageBuffer,
+                BindingKind::StorageImage,
+                BindingKind::StorageImage,
+            ],
+            0,
+        )?;
+        let group = device.create_bind_group(
+            pipeline.layout(),
+            &[
+                Resource::Buffer(&constants),
+                Resource::Image(inputs.depth),
+                Resource::Image(inputs.normal),
+                Resource::Image(inputs.count),
+                Resource::Image(inputs.indices),
+                Resource::Buffer(inputs.prims),
+                Resource::Image(&visibility),
+                Resource::Image(&blocker_distance),
+            ],
+        )?;
+        Ok(Self {
+            pipeline,
+            group,
+            constants,
+            visibility,
+            blocker_distance,
+        })
+    }
+
+    /// Updates the constants (host-visible; call while no submitted frame uses them) and records the pass.
+    pub fn record(
+        &mut self,
+        enc: &mut Encoder<'_>,
+        constants: &RayTraceConstants,
+    ) -> Result<(), PassError> {
+        self.constants.write(0, bytemuck::bytes_of(constants))?;
+        enc.begin_pass("ray trace");
+        let groups = [
+            constants.dims.x.div_ceil(8),
+            constants.dims.y.div_ceil(8),
+            1,
+        ];
+        enc.dispatch(&self.pipeline, &self.group, &[], groups)?;
+        enc.end_pass();
+        Ok(())
+    }
+}

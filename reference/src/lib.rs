@@ -1,0 +1,38 @@
+//! Exact CPU reference for the hybrid ray-traced shadow renderer.
+//!
+//! Everything is computed in `f64` from the `f32` scene and matrices exactly as they
+//! are uploaded to the GPU, so that GPU results can be compared against it in
+//! tests:
+//!
+//! - [`reference_visibility`]: per-pixel light visibility of the camera-ray receiver
+//!   points, with pixels whose outcome hinges on an event within a tolerance of a
+//!   triangle edge or plane classified [`PixelClass::Ambiguous`];
+//! - [`conservative_texel_sets`]: the exact conservative set of triangles per texel
+//!   of a light-space grid (the "deep primitive map" of Jon Story's GDC 2015 talk on
+//!   hybrid ray-traced shadows).
+//!
+//! Both are built on [`intersect_watertight`] (Woop, Benthin and Wald's watertight
+//! ray/triangle test), exact orientation predicates, and a BVH over the scene
+//! ([`RefScene`]).
+//!
+//! Conventions: right-handed world with +Y up; Vulkan clip depth `[0, 1]`;
+//! framebuffer pixel `(x, y)` with `y = 0` the top row has its centre at NDC
+//! `((x + 0.5) / W * 2 - 1, (y + 0.5) / H * 2 - 1)` (NDC y = -1 is the top row). The
+//! camera projection is reversed-Z with an infinite far plane. A light direction is
+//! the direction the light travels. Visibility 1 means lit.
+
+mod exact;
+mod geometry;
+mod ref_scene;
+mod texels;
+mod visibility;
+
+#[cfg(test)]
+mod tests;
+
+pub use geometry::{intersect_watertight, line_segment_distance};
+pub use ref_scene::RefScene;
+pub use texels::{conservative_texel_sets, overlaps_texel_with_margin, FaceSelection, TexelSets};
+pub use visibility::{
+    reference_visibility, Light, PixelClass, VisibilityParams, VisibilityReference,
+};

@@ -1,0 +1,297 @@
+//! Pure mappings from the RHI's D3D12-flavoured notions to Vulkan. No GPU needed; unit-tested.
+
+use ash::vk;
+
+/// D3D12 conservative-rasterization tier (`D3D12_CONSERVATIVE_RASTERIZATION_TIER`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum ConservativeRasterTier {
+    /// No conservative rasterization.
+    NotSupported,
+    /// Overestimation uncertainty ≤ 1/2 px; degenerate triangles may be culled after snapping.
+    Tier1,
+    /// Uncertainty ≤ 1/256 px and post-snap degenerate triangles are rasterized.
+    Tier2,
+    /// Tier 2 plus inner-coverage input (`SV_InnerCoverage` ~ `FullyCoveredEXT`).
+    Tier3,
+}
+
+impl ConservativeRasterTier {
+    /// Short name used in reports ("none", "tier1", ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::NotSupported => "none",
+            Self::Tier1 => "tier1",
+            Self::Tier2 => "tier2",
+            Self::Tier3 => "tier3",
+        }
+    }
+}
+
+/// Maps `VkPhysicalDeviceConservativeRasterizationPropertiesEXT` (None = extension absent) to a D3D12 tier.
+///
+/// Tier 1 needs overestimation ≤ 1/2 px; Tier 2 also ≤ 1/256 px and `degenerateTrianglesRasterized`;
+/// Tier 3 also `fullyCoveredFragmentShaderInputVariable`.
+pub fn conservative_raster_tier(
+    props: Option<&vk::PhysicalDeviceConservativeRasterizationPropertiesEXT<'_>>,
+) -> ConservativeRasterTier {
+    let Some(p) = props else {
+        return ConservativeRasterTier::NotSupported;
+    };
+    let size = p.primitive_overestimation_size;
+    if !(0.0..=0.5).contains(&size) {
+        return ConservativeRasterTier::NotSupported;
+    }
+    if size > 1.0 / 256.0 || p.degenerate_triangles_rasterized == vk::FALSE {
+        return ConservativeRasterTier::Tier1;
+    }
+    if p.fully_covered_fragment_shader_input_variable == vk::FALSE {
+        return ConservativeRasterTier::Tier2;
+    }
+    ConservativeRasterTier::Tier3
+}
+
+/// D3D12-style resource state, used on both sides of a transition.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ResourceState {
+    /// Contents may be discarded.
+    Undefined,
+    /// UAV: read/write storage access from any shader stage.
+    UnorderedAccess,
+    /// SRV: sampled/read-only access from any shader stage.
+    ShaderResource,
+    /// Colour attachment.
+    RenderTarget,
+    /// Depth attachment, written.
+    DepthWrite,
+    /// Depth read-only (as attachment or sampled).
+    DepthRead,
+    /// Copy source.
+    CopySource,
+    /// Copy destination (also clears).
+    CopyDest,
+    /// Vertex or index buffer input.
+    VertexIndex,
+    /// Host read-back after GPU writes.
+    HostRead,
+}
+
+/// Shader stages the RHI's pipelines use; shader-access states are scoped to these.
+pub const SHADER_STAGES: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::from_raw(
+    vk::PipelineStageFlags2::VERTEX_SHADER.as_raw()
+        | vk::PipelineStageFlags2::GEOMETRY_SHADER.as_raw()
+        | vk::PipelineStageFlags2::FRAGMENT_SHADER.as_raw()
+        | vk::PipelineStageFlags2::COMPUTE_SHADER.as_raw(),
+);
+
+/// Vulkan scope of a resource state: (image layout, pipeline stages, access mask).
+pub fn state_scope(
+    state: ResourceState,
+) -> (vk::ImageLayout, vk::PipelineStageFlags2, vk::AccessFlags2) {
+    use vk::{AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
+    match state {
+        ResourceState::Undefined => (L::UNDEFINED, S::TOP_OF_PIPE, A::NONE),
+        ResourceState::UnorderedAccess => (
+            L::GENERAL,
+            SHADER_STAGES,
+            A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+        ),
+        ResourceState::ShaderResource => (
+            L::SHADER_READ_ONLY_OPTIMAL,
+            SHADER_STAGES,
+            A::SHADER_SAMPLED_READ | A::SHADER_STORAGE_READ | A::UNIFORM_READ,
+        ),
+        ResourceState::RenderTarget => (
+            L::COLOR_ATTACHMENT_OPTIMAL,
+            S::COLOR_ATTACHMENT_OUTPUT,
+            A::COLOR_ATTACHMENT_READ | A::COLOR_ATTACHMENT_WRITE,
+        ),
+        ResourceState::DepthWrite => (
+            L::DEPTH_ATTACHMENT_OPTIMAL,
+            S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
+            A::DEPTH_STENCIL_ATTACHMENT_READ | A::DEPTH_STENCIL_ATTACHMENT_WRITE,
+        ),
+        ResourceState::DepthRead => (
+            L::DEPTH_READ_ONLY_OPTIMAL,
+            S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS | SHADER_STAGES,
+            A::DEPTH_STENCIL_ATTACHMENT_READ | A::SHADER_SAMPLED_READ,
+        ),
+        ResourceState::CopySource => (L::TRANSFER_SRC_OPTIMAL, S::ALL_TRANSFER, A::TRANSFER_READ),
+        ResourceState::CopyDest => (L::TRANSFER_DST_OPTIMAL, S::ALL_TRANSFER, A::TRANSFER_WRITE),
+        ResourceState::VertexIndex => (
+            L::UNDEFINED,
+            S::VERTEX_INPUT,
+            A::VERTEX_ATTRIBUTE_READ | A::INDEX_READ,
+        ),
+        ResourceState::HostRead => (L::GENERAL, S::HOST, A::HOST_READ),
+    }
+}
+
+/// Whether a state's access mask contains writes (a transition from it must make them available).
+pub fn state_writes(state: ResourceState) -> bool {
+    matches!(
+        state,
+        ResourceState::UnorderedAccess
+            | ResourceState::RenderTarget
+            | ResourceState::DepthWrite
+            | ResourceState::CopyDest
+    )
+}
+
+/// The D3D12 UAV barrier (`D3D12_RESOURCE_BARRIER_TYPE_UAV` on all resources): orders storage writes
+/// before later storage reads/writes in any shader stage.
+pub fn uav_barrier() -> vk::MemoryBarrier2<'static> {
+    vk::MemoryBarrier2::default()
+        .src_stage_mask(SHADER_STAGES)
+        .src_access_mask(vk::AccessFlags2::SHADER_STORAGE_WRITE)
+        .dst_stage_mask(SHADER_STAGES)
+        .dst_access_mask(
+            vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+        )
+}
+
+/// Texel formats the RHI supports (DXGI name in the docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Format {
+    /// DXGI_FORMAT_R32_UINT.
+    R32Uint,
+    /// DXGI_FORMAT_R32_FLOAT.
+    R32Float,
+    /// DXGI_FORMAT_R32G32B32A32_FLOAT.
+    Rgba32Float,
+    /// DXGI_FORMAT_R8G8B8A8_UNORM.
+    Rgba8Unorm,
+    /// DXGI_FORMAT_D32_FLOAT.
+    D32Float,
+}
+
+impl Format {
+    /// The Vulkan format.
+    pub fn to_vk(self) -> vk::Format {
+        match self {
+            Self::R32Uint => vk::Format::R32_UINT,
+            Self::R32Float => vk::Format::R32_SFLOAT,
+            Self::Rgba32Float => vk::Format::R32G32B32A32_SFLOAT,
+            Self::Rgba8Unorm => vk::Format::R8G8B8A8_UNORM,
+            Self::D32Float => vk::Format::D32_SFLOAT,
+        }
+    }
+    /// Bytes per texel.
+    pub fn texel_size(self) -> u32 {
+        match self {
+            Self::Rgba32Float => 16,
+            _ => 4,
+        }
+    }
+    /// Whether this is a depth format.
+    pub fn is_depth(self) -> bool {
+        self == Self::D32Float
+    }
+    /// Image aspect of the format.
+    pub fn aspect(self) -> vk::ImageAspectFlags {
+        if self.is_depth() {
+            vk::ImageAspectFlags::DEPTH
+        } else {
+            vk::ImageAspectFlags::COLOR
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn props(
+        size: f32,
+        degenerate: bool,
+        covered: bool,
+    ) -> vk::PhysicalDeviceConservativeRasterizationPropertiesEXT<'static> {
+        vk::PhysicalDeviceConservativeRasterizationPropertiesEXT::default()
+            .primitive_overestimation_size(size)
+            .degenerate_triangles_rasterized(degenerate)
+            .fully_covered_fragment_shader_input_variable(covered)
+    }
+
+    #[test]
+    fn lavapipe_without_extension_has_no_tier() {
+        assert_eq!(
+            conservative_raster_tier(None),
+            ConservativeRasterTier::NotSupported
+        );
+    }
+
+    #[test]
+    fn h200_is_tier3() {
+        // Measured on an NVIDIA H200: 1/512 px overestimation, degenerates rasterized, fully-covered input.
+        let p = props(1.0 / 512.0, true, true);
+        assert_eq!(
+            conservative_raster_tier(Some(&p)),
+            ConservativeRasterTier::Tier3
+        );
+    }
+
+    #[test]
+    fn synthetic_tiers() {
+        assert_eq!(
+            conservative_raster_tier(Some(&props(0.5, false, false))),
+            ConservativeRasterTier::Tier1
+        );
+        assert_eq!(
+            conservative_raster_tier(Some(&props(0.25, true, true))),
+            ConservativeRasterTier::Tier1
+        );
+        assert_eq!(
+            conservative_raster_tier(Some(&props(1.0 / 256.0, false, true))),
+            ConservativeRasterTier::Tier1
+        );
+        assert_eq!(
+            conservative_raster_tier(Some(&props(1.0 / 256.0, true, false))),
+            ConservativeRasterTier::Tier2
+        );
+        assert_eq!(
+            conservative_raster_tier(Some(&props(0.0, true, true))),
+            ConservativeRasterTier::Tier3
+        );
+        assert_eq!(
+            conservative_raster_tier(Some(&props(0.75, true, true))),
+            ConservativeRasterTier::NotSupported
+        );
+        assert_eq!(
+            conservative_raster_tier(Some(&props(f32::NAN, true, true))),
+            ConservativeRasterTier::NotSupported
+        );
+    }
+
+    #[test]
+    fn tiers_are_ordered() {
+        assert!(ConservativeRasterTier::Tier3 > ConservativeRasterTier::Tier1);
+        assert!(ConservativeRasterTier::Tier1 > ConservativeRasterTier::NotSupported);
+    }
+
+    #[test]
+    fn uav_state_is_general_layout_with_storage_access() {
+        let (layout, stages, access) = state_scope(ResourceState::UnorderedAccess);
+        assert_eq!(layout, vk::ImageLayout::GENERAL);
+        assert!(stages.contains(vk::PipelineStageFlags2::COMPUTE_SHADER));
+        assert!(stages.contains(vk::PipelineStageFlags2::FRAGMENT_SHADER));
+        assert!(access.contains(vk::AccessFlags2::SHADER_STORAGE_WRITE));
+        assert!(state_writes(ResourceState::UnorderedAccess));
+        assert!(!state_writes(ResourceState::ShaderResource));
+    }
+
+    #[test]
+    fn uav_barrier_orders_storage_writes() {
+        let b = uav_barrier();
+        assert_eq!(b.src_access_mask, vk::AccessFlags2::SHADER_STORAGE_WRITE);
+        assert!(b
+            .dst_access_mask
+            .contains(vk::AccessFlags2::SHADER_STORAGE_READ));
+    }
+
+    #[test]
+    fn formats_map() {
+        assert_eq!(Format::D32Float.to_vk(), vk::Format::D32_SFLOAT);
+        assert!(Format::D32Float.is_depth());
+        assert_eq!(Format::Rgba32Float.texel_size(), 16);
+        assert_eq!(Format::R32Uint.aspect(), vk::ImageAspectFlags::COLOR);
+    }
+}

@@ -1,0 +1,607 @@
+//! Device creation (headless, self-owned) and adoption of an engine's Vulkan objects.
+
+use crate::caps::{
+    device_extensions, device_type_name, has_extension, read_capabilities, Capabilities,
+};
+use crate::error::{Result, RhiError, VkResultExt};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use std::ffi::{c_void, CStr};
+use std::mem::ManuallyDrop;
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::{Arc, Mutex};
+
+/// How to create a headless device.
+#[derive(Debug, Clone, Default)]
+pub struct DeviceDesc {
+    /// Enable `VK_LAYER_KHRONOS_validation`; device creation fails if the layer is missing.
+    pub validation: bool,
+    /// Only accept devices whose name contains this (case-insensitive), e.g. "llvmpipe" or "NVIDIA".
+    pub device_filter: Option<String>,
+}
+
+impl DeviceDesc {
+    /// Reads `HRTS_VALIDATION` (1/true enables validation) and `HRTS_DEVICE` (device-name filter).
+    pub fn from_env() -> Self {
+        let validation = std::env::var("HRTS_VALIDATION")
+            .map(|v| matches!(v.as_str(), "1" | "true" | "yes" | "on"))
+            .unwrap_or(false);
+        let device_filter = std::env::var("HRTS_DEVICE").ok().filter(|s| !s.is_empty());
+        Self {
+            validation,
+            device_filter,
+        }
+    }
+}
+
+/// Validation-layer messages seen so far on a device.
+#[derive(Debug, Default)]
+pub struct ValidationLog {
+    errors: AtomicU32,
+    warnings: AtomicU32,
+    messages: Mutex<Vec<String>>,
+}
+
+impl ValidationLog {
+    /// Number of validation errors reported.
+    pub fn errors(&self) -> u32 {
+        self.errors.load(Ordering::SeqCst)
+    }
+    /// Number of validation warnings reported.
+    pub fn warnings(&self) -> u32 {
+        self.warnings.load(Ordering::SeqCst)
+    }
+    /// The first messages (errors and warnings), for test failure output.
+    pub fn messages(&self) -> Vec<String> {
+        self.messages.lock().map(|m| m.clone()).unwrap_or_default()
+    }
+    fn record(&self, error: bool, text: String) {
+        if error {
+            self.errors.fetch_add(1, Ordering::SeqCst);
+            log::error!("validation: {text}");
+        } else {
+            self.warnings.fetch_add(1, Ordering::SeqCst);
+            log::warn!("validation: {text}");
+        }
+        if let Ok(mut m) = self.messages.lock() {
+            if m.len() < 64 {
+                m.push(text);
+            }
+        }
+    }
+}
+
+unsafe extern "system" fn debug_callback(
+    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
+    _types: vk::DebugUtilsMessageTypeFlagsEXT,
+    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
+    user: *mut c_void,
+) -> vk::Bool32 {
+    // SAFETY: `user` is the `ValidationLog` kept alive by `Shared` for the messenger's lifetime; `data` is
+    // valid for the duration of the callback per the Vulkan spec. No panic may unwind into the driver.
+    let _ = std::panic::catch_unwind(|| unsafe {
+        let log = &*(user as *const ValidationLog);
+        let text = if data.is_null() || (*data).p_message.is_null() {
+            String::from("(no message)")
+        } else {
+            CStr::from_ptr((*data).p_message)
+                .to_string_lossy()
+                .into_owned()
+        };
+        if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
+            log.record(true, text);
+        } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
+            log.record(false, text);
+        }
+    });
+    vk::FALSE
+}
+
+/// State shared by the device and every resource created from it.
+pub(crate) struct Shared {
+    pub(crate) _entry: ash::Entry,
+    pub(crate) instance: ash::Instance,
+    pub(crate) device: ash::Device,
+    pub(crate) queue: vk::Queue,
+    pub(crate) caps: Capabilities,
+    pub(crate) allocator: ManuallyDrop<Mutex<Allocator>>,
+    pub(crate) debug_utils: Option<ash::ext::debug_utils::Device>,
+    pub(crate) nearest_sampler: vk::Sampler,
+    messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    validation: Arc<ValidationLog>,
+    owned: bool,
+}
+
+impl Drop for Shared {
+    fn drop(&mut self) {
+        // SAFETY: every resource holds an Arc<Shared>, so none is alive now; the device is idle after the wait.
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            self.device.destroy_sampler(self.nearest_sampler, None);
+            ManuallyDrop::drop(&mut self.allocator);
+            if self.owned {
+                self.device.destroy_device(None);
+                if let Some((utils, messenger)) = self.messenger.take() {
+                    utils.destroy_debug_utils_messenger(messenger, None);
+                }
+                self.instance.destroy_instance(None);
+            }
+        }
+    }
+}
+
+/// A Vulkan device with a graphics+compute queue, a memory allocator and its capabilities.
+pub struct Device {
+    pub(crate) shared: Arc<Shared>,
+    command_pool: vk::CommandPool,
+}
+
+/// The engine's Vulkan objects handed to [`Device::adopt`]. The RHI never destroys them.
+pub struct AdoptDesc {
+    /// `vkGetInstanceProcAddr` of the engine's loader.
+    pub get_instance_proc_addr: vk::PFN_vkGetInstanceProcAddr,
+    /// The engine's instance (Vulkan 1.3).
+    pub instance: vk::Instance,
+    /// The physical device the engine's device was created from.
+    pub physical_device: vk::PhysicalDevice,
+    /// The engine's device; it must have Vulkan 1.3 `dynamicRendering` and `synchronization2` enabled.
+    pub device: vk::Device,
+    /// Family of the queue the plugin's command buffers are submitted to (graphics + compute).
+    pub queue_family_index: u32,
+    /// Index of that queue within its family.
+    pub queue_index: u32,
+    /// Device extensions the engine enabled.
+    pub enabled_extensions: Vec<String>,
+    /// Core features the engine enabled.
+    pub enabled_features: vk::PhysicalDeviceFeatures,
+    /// Whether the engine's instance enabled `VK_EXT_debug_utils` (per-pass labels are emitted if so).
+    pub debug_utils: bool,
+}
+
+const REQUIRED_API: u32 = vk::API_VERSION_1_3;
+
+struct Candidate {
+    pd: vk::PhysicalDevice,
+    name: String,
+    rank: u32,
+    family: u32,
+}
+
+impl Device {
+    /// Creates an instance and a device of its own: the best GPU if any passes selection, else a CPU device
+    /// such as lavapipe. Logs every device and why it was rejected.
+    pub fn new_headless(desc: &DeviceDesc) -> Result<Self> {
+        // SAFETY: loading the system Vulkan loader; the Entry keeps it loaded for the device's lifetime.
+        let entry = unsafe { ash::Entry::load() }.map_err(|e| RhiError::Loader(e.to_string()))?;
+        let validation_layer = c"VK_LAYER_KHRONOS_validation";
+        // SAFETY: plain enumeration calls on a loaded entry.
+        let layers = unsafe { entry.enumerate_instance_layer_properties() }
+            .call("vkEnumerateInstanceLayerProperties")?;
+        let inst_exts = unsafe { entry.enumerate_instance_extension_properties(None) }
+            .call("vkEnumerateInstanceExtensionProperties")?;
+        let has_layer = layers
+            .iter()
+            .any(|l| l.layer_name_as_c_str() == Ok(validation_layer));
+        if desc.validation && !has_layer {
+            return Err(RhiError::ValidationUnavailable);
+        }
+        let has_debug_utils = inst_exts
+            .iter()
+            .any(|e| e.extension_name_as_c_str() == Ok(ash::ext::debug_utils::NAME));
+        let app_name = c"hybrid-rt-shadows";
+        let app = vk::ApplicationInfo::default()
+            .application_name(app_name)
+            .engine_name(app_name)
+            .api_version(REQUIRED_API);
+        let layer_ptrs: Vec<*const std::ffi::c_char> = if desc.validation {
+            vec![validation_layer.as_ptr()]
+        } else {
+            vec![]
+        };
+        let ext_ptrs: Vec<*const std::ffi::c_char> = if has_debug_utils {
+            vec![ash::ext::debug_utils::NAME.as_ptr()]
+        } else {
+            vec![]
+        };
+        let validation = Arc::new(ValidationLog::default());
+        let mut messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+            .message_severity(
+                vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                    | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
+            )
+            .message_type(
+                vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                    | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                    | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+            )
+            .pfn_user_callback(Some(debug_callback))
+            .user_data(Arc::as_ptr(&validation) as *mut c_void);
+        let mut info = vk::InstanceCreateInfo::default()
+            .application_info(&app)
+            .enabled_layer_names(&layer_ptrs)
+            .enabled_extension_names(&ext_ptrs);
+        if desc.validation && has_debug_utils {
+            info = info.push_next(&mut messenger_info);
+        }
+        // SAFETY: all pointers in `info` outlive the call.
+        let instance = unsafe { entry.create_instance(&info, None) }.call("vkCreateInstance")?;
+        let messenger = if desc.validation && has_debug_utils {
+            let utils = ash::ext::debug_utils::Instance::new(&entry, &instance);
+            // SAFETY: `messenger_info` points at `validation`, which `Shared` keeps alive past the messenger.
+            let m = unsafe { utils.create_debug_utils_messenger(&messenger_info, None) }
+                .call("vkCreateDebugUtilsMessengerEXT")?;
+            Some((utils, m))
+        } else {
+            None
+        };
+        let destroy_instance =
+            |messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>| {
+                // SAFETY: nothing was created from the instance except the messenger, destroyed first.
+                unsafe {
+                    if let Some((u, m)) = messenger {
+                        u.destroy_debug_utils_messenger(m, None);
+                    }
+                    instance.destroy_instance(None);
+                }
+            };
+        let chosen = match select_physical_device(&instance, desc.device_filter.as_deref()) {
+            Ok(c) => c,
+            Err(e) => {
+                destroy_instance(messenger);
+                return Err(e);
+            }
+        };
+        log::info!("using Vulkan device '{}'", chosen.name);
+        let exts = device_extensions(&instance, chosen.pd);
+        let mut enable: Vec<&CStr> = Vec::new();
+        if has_extension(&exts, ash::ext::conservative_rasterization::NAME) {
+            enable.push(ash::ext::conservative_rasterization::NAME);
+        }
+        // SAFETY: `chosen.pd` was enumerated from `instance`.
+        let supported = unsafe { instance.get_physical_device_features(chosen.pd) };
+        let features = vk::PhysicalDeviceFeatures::default()
+            .geometry_shader(supported.geometry_shader == vk::TRUE)
+            .fragment_stores_and_atomics(true)
+            .vertex_pipeline_stores_and_atomics(
+                supported.vertex_pipeline_stores_and_atomics == vk::TRUE,
+            )
+            .depth_clamp(supported.depth_clamp == vk::TRUE)
+            .shader_float64(supported.shader_float64 == vk::TRUE);
+        let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
+            .dynamic_rendering(true)
+            .synchronization2(true);
+        let priorities = [1.0f32];
+        let queue_info = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(chosen.family)
+            .queue_priorities(&priorities)];
+        let enable_ptrs: Vec<*const std::ffi::c_char> = enable.iter().map(|n| n.as_ptr()).collect();
+        let dinfo = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queue_info)
+            .enabled_extension_names(&enable_ptrs)
+            .enabled_features(&features)
+            .push_next(&mut f13);
+        // SAFETY: the chained structs outlive the call; features were checked during selection.
+        let device = match unsafe { instance.create_device(chosen.pd, &dinfo, None) } {
+            Ok(d) => d,
+            Err(e) => {
+                destroy_instance(messenger);
+                return Err(RhiError::Vulkan {
+                    call: "vkCreateDevice",
+                    result: e,
+                });
+            }
+        };
+        let enabled: Vec<String> = enable
+            .iter()
+            .map(|n| n.to_string_lossy().into_owned())
+            .collect();
+        // SAFETY: queue 0 of `chosen.family` was requested above.
+        let queue = unsafe { device.get_device_queue(chosen.family, 0) };
+        Self::from_parts(PartsDesc {
+            entry,
+            instance,
+            physical: chosen.pd,
+            device,
+            queue,
+            queue_family: chosen.family,
+            enabled_extensions: enabled,
+            features,
+            has_debug_utils,
+            messenger,
+            validation,
+            owned: true,
+        })
+    }
+
+    /// Adopts an engine's instance, device and queue without owning them.
+    ///
+    /// # Safety
+    /// All handles must be valid, belong together, and outlive the returned `Device`; the device must have
+    /// been created with Vulkan 1.3 `dynamicRendering` and `synchronization2`, and the features and extensions
+    /// listed in `desc` must be exactly those enabled. The engine must externally synchronise queue access.
+    pub unsafe fn adopt(desc: AdoptDesc) -> Result<Self> {
+        let static_fn = ash::StaticFn {
+            get_instance_proc_addr: desc.get_instance_proc_addr,
+        };
+        // SAFETY: the caller guarantees the function pointer and handles are valid.
+        let entry = unsafe { ash::Entry::from_static_fn(static_fn.clone()) };
+        let instance = unsafe { ash::Instance::load(&static_fn, desc.instance) };
+        let device = unsafe { ash::Device::load(instance.fp_v1_0(), desc.device) };
+        let queue = unsafe { device.get_device_queue(desc.queue_family_index, desc.queue_index) };
+        Self::from_parts(PartsDesc {
+            entry,
+            instance,
+            physical: desc.physical_device,
+            device,
+            queue,
+            queue_family: desc.queue_family_index,
+            enabled_extensions: desc.enabled_extensions,
+            features: desc.enabled_features,
+            has_debug_utils: desc.debug_utils,
+            messenger: None,
+            validation: Arc::new(ValidationLog::default()),
+            owned: false,
+        })
+    }
+
+    fn from_parts(p: PartsDesc) -> Result<Self> {
+        // SAFETY: `p.physical` belongs to `p.instance`.
+        let families = unsafe {
+            p.instance
+                .get_physical_device_queue_family_properties(p.physical)
+        };
+        let ts_bits = families
+            .get(p.queue_family as usize)
+            .map_or(0, |f| f.timestamp_valid_bits);
+        let caps = read_capabilities(
+            &p.instance,
+            p.physical,
+            &p.enabled_extensions,
+            &p.features,
+            ts_bits,
+        );
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: p.instance.clone(),
+            device: p.device.clone(),
+            physical_device: p.physical,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        })
+        .map_err(|e| RhiError::Allocation {
+            name: "allocator".into(),
+            message: e.to_string(),
+        })?;
+        let sampler_info = vk::SamplerCreateInfo::default()
+            .mag_filter(vk::Filter::NEAREST)
+            .min_filter(vk::Filter::NEAREST)
+            .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE);
+        // SAFETY: valid device; the sampler is destroyed in `Shared::drop`.
+        let nearest_sampler =
+            unsafe { p.device.create_sampler(&sampler_info, None) }.call("vkCreateSampler")?;
+        let debug_utils = p
+            .has_debug_utils
+            .then(|| ash::ext::debug_utils::Device::new(&p.instance, &p.device));
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(p.queue_family)
+            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        // SAFETY: valid device and queue family.
+        let command_pool = unsafe { p.device.create_command_pool(&pool_info, None) }
+            .call("vkCreateCommandPool")?;
+        let shared = Arc::new(Shared {
+            _entry: p.entry,
+            instance: p.instance,
+            device: p.device,
+            queue: p.queue,
+            caps,
+            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            debug_utils,
+            nearest_sampler,
+            messenger: p.messenger,
+            validation: p.validation,
+            owned: p.owned,
+        });
+        Ok(Self {
+            shared,
+            command_pool,
+        })
+    }
+
+    /// The device's capabilities.
+    pub fn capabilities(&self) -> &Capabilities {
+        &self.shared.caps
+    }
+
+    /// Validation messages seen so far (empty unless validation is on).
+    pub fn validation(&self) -> &ValidationLog {
+        &self.shared.validation
+    }
+
+    /// Records commands with `record`, submits them and waits for completion.
+    pub fn submit_and_wait<R>(
+        &self,
+        record: impl FnOnce(&mut crate::Encoder<'_>) -> Result<R>,
+    ) -> Result<R> {
+        let d = &self.shared.device;
+        let alloc = vk::CommandBufferAllocateInfo::default()
+            .command_pool(self.command_pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        // SAFETY: the pool belongs to this device and is only used from `&self` calls that finish before
+        // returning; the command buffer is freed below on every path.
+        unsafe {
+            let cmd = d
+                .allocate_command_buffers(&alloc)
+                .call("vkAllocateCommandBuffers")?[0];
+            let result = (|| {
+                d.begin_command_buffer(
+                    cmd,
+                    &vk::CommandBufferBeginInfo::default()
+                        .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+                )
+                .call("vkBeginCommandBuffer")?;
+                let mut enc = crate::Encoder::new(self, cmd);
+                let r = record(&mut enc)?;
+                d.end_command_buffer(cmd).call("vkEndCommandBuffer")?;
+                let fence = d
+                    .create_fence(&vk::FenceCreateInfo::default(), None)
+                    .call("vkCreateFence")?;
+                let cmds = [cmd];
+                let submit = vk::SubmitInfo::default().command_buffers(&cmds);
+                let submitted = d
+                    .queue_submit(self.shared.queue, &[submit], fence)
+                    .call("vkQueueSubmit");
+                let waited = submitted.and_then(|_| {
+                    d.wait_for_fences(&[fence], true, u64::MAX)
+                        .call("vkWaitForFences")
+                });
+                d.destroy_fence(fence, None);
+                waited.map(|_| r)
+            })();
+            d.free_command_buffers(self.command_pool, &[cmd]);
+            result
+        }
+    }
+
+    /// Waits until the GPU is idle.
+    pub fn wait_idle(&self) -> Result<()> {
+        // SAFETY: valid device.
+        unsafe { self.shared.device.device_wait_idle() }.call("vkDeviceWaitIdle")
+    }
+}
+
+impl Drop for Device {
+    fn drop(&mut self) {
+        // SAFETY: command buffers from this pool are freed after each submission; the device is idle.
+        unsafe {
+            let _ = self.shared.device.device_wait_idle();
+            self.shared
+                .device
+                .destroy_command_pool(self.command_pool, None);
+        }
+    }
+}
+
+struct PartsDesc {
+    entry: ash::Entry,
+    instance: ash::Instance,
+    physical: vk::PhysicalDevice,
+    device: ash::Device,
+    queue: vk::Queue,
+    queue_family: u32,
+    enabled_extensions: Vec<String>,
+    features: vk::PhysicalDeviceFeatures,
+    has_debug_utils: bool,
+    messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    validation: Arc<ValidationLog>,
+    owned: bool,
+}
+
+/// Why a physical device cannot run the plugin, or None if it can.
+fn rejection_reason(
+    instance: &ash::Instance,
+    pd: vk::PhysicalDevice,
+    filter: Option<&str>,
+    name: &str,
+) -> Option<String> {
+    if let Some(f) = filter {
+        if !name.to_lowercase().contains(&f.to_lowercase()) {
+            return Some(format!("name does not match HRTS_DEVICE filter '{f}'"));
+        }
+    }
+    // SAFETY: `pd` was enumerated from `instance`.
+    let props = unsafe { instance.get_physical_device_properties(pd) };
+    if props.api_version < REQUIRED_API {
+        return Some(format!(
+            "Vulkan {}.{} < 1.3",
+            vk::api_version_major(props.api_version),
+            vk::api_version_minor(props.api_version)
+        ));
+    }
+    let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
+    // SAFETY: as above; the chain outlives the call.
+    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+    let core = f2.features;
+    let mut missing = Vec::new();
+    if f13.dynamic_rendering == vk::FALSE {
+        missing.push("dynamicRendering");
+    }
+    if f13.synchronization2 == vk::FALSE {
+        missing.push("synchronization2");
+    }
+    if core.fragment_stores_and_atomics == vk::FALSE {
+        missing.push("fragmentStoresAndAtomics");
+    }
+    if !missing.is_empty() {
+        return Some(format!("missing {}", missing.join(", ")));
+    }
+    None
+}
+
+fn select_physical_device(instance: &ash::Instance, filter: Option<&str>) -> Result<Candidate> {
+    // SAFETY: valid instance.
+    let pds =
+        unsafe { instance.enumerate_physical_devices() }.call("vkEnumeratePhysicalDevices")?;
+    let mut best: Option<Candidate> = None;
+    let mut report = Vec::new();
+    for pd in pds {
+        // SAFETY: `pd` was just enumerated.
+        let props = unsafe { instance.get_physical_device_properties(pd) };
+        let name = props
+            .device_name_as_c_str()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let kind = device_type_name(props.device_type);
+        // SAFETY: as above.
+        let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
+        let family = families.iter().position(|f| {
+            f.queue_flags
+                .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
+        });
+        let reason = rejection_reason(instance, pd, filter, &name).or_else(|| {
+            family
+                .is_none()
+                .then(|| "no graphics+compute queue".to_owned())
+        });
+        match (reason, family) {
+            (None, Some(family)) => {
+                let rank = match props.device_type {
+                    vk::PhysicalDeviceType::DISCRETE_GPU => 4,
+                    vk::PhysicalDeviceType::INTEGRATED_GPU => 3,
+                    vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+                    vk::PhysicalDeviceType::CPU => 1,
+                    _ => 0,
+                };
+                report.push(format!("'{name}' ({kind}): suitable, rank {rank}"));
+                if best.as_ref().is_none_or(|b| rank > b.rank) {
+                    best = Some(Candidate {
+                        pd,
+                        name,
+                        rank,
+                        family: family as u32,
+                    });
+                }
+            }
+            (reason, _) => {
+                let r = reason.unwrap_or_default();
+                log::info!("rejected Vulkan device '{name}' ({kind}): {r}");
+                report.push(format!("'{name}' ({kind}): rejected, {r}"));
+            }
+        }
+    }
+    for line in &report {
+        log::debug!("device selection: {line}");
+    }
+    best.ok_or_else(|| {
+        if report.is_empty() {
+            RhiError::NoDevice(
+                "no Vulkan devices found (install mesa-vulkan-drivers for lavapipe)".into(),
+            )
+        } else {
+            RhiError::NoDevice(report.join("; "))
+        }
+    })
+}

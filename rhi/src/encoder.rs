@@ -1,0 +1,527 @@
+//! Command recording with D3D12-flavoured barriers, per-pass debug labels and GPU timestamps.
+
+use crate::conv::{state_scope, uav_barrier, ResourceState};
+use crate::device::Device;
+use crate::error::{Result, RhiError, VkResultExt};
+use crate::pipeline::{BindGroup, ComputePipeline, GraphicsPipeline};
+use crate::resources::{subresource_range, Buffer, Image};
+use ash::vk;
+use std::sync::{Arc, Mutex};
+
+/// Records commands into a command buffer (the RHI's own, or an engine's).
+pub struct Encoder<'a> {
+    device: &'a Device,
+    cmd: vk::CommandBuffer,
+    timer: Option<GpuTimer>,
+    open_pass: Option<usize>,
+    render_extent: (u32, u32),
+}
+
+/// A barrier, in D3D12 terms.
+pub enum Barrier<'a> {
+    /// Orders storage (UAV) writes before later storage reads/writes, in every shader stage.
+    Uav,
+    /// Image state transition (layout change plus execution/memory dependency).
+    Image {
+        /// The image.
+        image: &'a Image,
+        /// State before.
+        before: ResourceState,
+        /// State after.
+        after: ResourceState,
+    },
+    /// Global memory dependency for buffers between two states.
+    Global {
+        /// State before.
+        before: ResourceState,
+        /// State after.
+        after: ResourceState,
+    },
+}
+
+/// Colour attachment of a render pass, cleared at the start.
+pub struct ColorTarget<'a> {
+    /// The image (in `RenderTarget` state).
+    pub image: &'a Image,
+    /// Clear value.
+    pub clear: [f32; 4],
+}
+
+/// Depth attachment of a render pass, cleared at the start.
+pub struct DepthTarget<'a> {
+    /// The image (in `DepthWrite` state).
+    pub image: &'a Image,
+    /// Clear depth.
+    pub clear: f32,
+}
+
+/// Timestamp queries bracketing named passes, resolved to milliseconds after the GPU finishes.
+/// Cloning shares the same queries.
+#[derive(Clone)]
+pub struct GpuTimer {
+    inner: Arc<TimerInner>,
+}
+
+struct TimerInner {
+    device: Arc<crate::device::Shared>,
+    pool: vk::QueryPool,
+    capacity: u32,
+    names: Mutex<Vec<String>>,
+    period_ns: f64,
+}
+
+/// GPU time of one pass.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PassTiming {
+    /// Pass name.
+    pub name: String,
+    /// GPU milliseconds between the pass's begin and end timestamps.
+    pub ms: f64,
+}
+
+impl Device {
+    /// Creates a timer for up to `max_passes` passes per recording. Fails if the queue has no timestamps.
+    pub fn create_timer(&self, max_passes: u32) -> Result<GpuTimer> {
+        if !self.shared.caps.timestamps {
+            return Err(RhiError::MissingFeature("timestamp queries".into()));
+        }
+        let info = vk::QueryPoolCreateInfo::default()
+            .query_type(vk::QueryType::TIMESTAMP)
+            .query_count(max_passes * 2);
+        // SAFETY: valid device; destroyed in Drop.
+        let pool = unsafe { self.shared.device.create_query_pool(&info, None) }
+            .call("vkCreateQueryPool")?;
+        Ok(GpuTimer {
+            inner: Arc::new(TimerInner {
+                device: self.shared.clone(),
+                pool,
+                capacity: max_passes,
+                names: Mutex::new(Vec::new()),
+                period_ns: f64::from(self.shared.caps.timestamp_period_ns),
+            }),
+        })
+    }
+}
+
+impl GpuTimer {
+    /// Reads the timings of the last recording; call after its submission has completed.
+    pub fn resolve(&self) -> Result<Vec<PassTiming>> {
+        let t = &self.inner;
+        let names = t.names.lock().map(|n| n.clone()).unwrap_or_default();
+        let n = names.len();
+        if n == 0 {
+            return Ok(Vec::new());
+        }
+        let mut data = vec![0u64; n * 2];
+        // SAFETY: queries 0..2n were written by the completed recording; WAIT makes the call block until ready.
+        unsafe {
+            t.device.device.get_query_pool_results(
+                t.pool,
+                0,
+                &mut data,
+                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+            )
+        }
+        .call("vkGetQueryPoolResults")?;
+        Ok(names
+            .iter()
+            .enumerate()
+            .map(|(i, name)| PassTiming {
+                name: name.clone(),
+                ms: data[2 * i + 1].saturating_sub(data[2 * i]) as f64 * t.period_ns * 1e-6,
+            })
+            .collect())
+    }
+}
+
+impl Drop for TimerInner {
+    fn drop(&mut self) {
+        // SAFETY: results were read after completion, or the recording was never submitted.
+        unsafe { self.device.device.destroy_query_pool(self.pool, None) };
+    }
+}
+
+impl<'a> Encoder<'a> {
+    pub(crate) fn new(device: &'a Device, cmd: vk::CommandBuffer) -> Self {
+        Self {
+            device,
+            cmd,
+            timer: None,
+            open_pass: None,
+            render_extent: (0, 0),
+        }
+    }
+
+    /// Wraps an engine's command buffer, which must be in the recording state, outside a render pass.
+    ///
+    /// # Safety
+    /// `command_buffer` must be a valid `VkCommandBuffer` of `device`'s `VkDevice` in the recording state,
+    /// used by no other thread while the encoder lives.
+    pub unsafe fn from_raw_handle(device: &'a Device, command_buffer: u64) -> Self {
+        Self::new(device, ash::vk::Handle::from_raw(command_buffer))
+    }
+
+    fn d(&self) -> &ash::Device {
+        &self.device.shared.device
+    }
+
+    /// Starts timing passes with `timer` (resets its queries; must be outside a render pass).
+    pub fn attach_timer(&mut self, timer: &GpuTimer) {
+        let t = &timer.inner;
+        if let Ok(mut names) = t.names.lock() {
+            names.clear();
+        }
+        // SAFETY: recording command buffer, outside a render pass; the pool belongs to this device.
+        unsafe {
+            self.d()
+                .cmd_reset_query_pool(self.cmd, t.pool, 0, t.capacity * 2)
+        };
+        self.timer = Some(timer.clone());
+    }
+
+    /// Opens a named pass: a debug label and a begin timestamp (when a timer is attached).
+    pub fn begin_pass(&mut self, name: &str) {
+        if let Some(utils) = &self.device.shared.debug_utils {
+            if let Ok(cname) = std::ffi::CString::new(name) {
+                let label = vk::DebugUtilsLabelEXT::default().label_name(&cname);
+                // SAFETY: recording command buffer; the label outlives the call.
+                unsafe { utils.cmd_begin_debug_utils_label(self.cmd, &label) };
+            }
+        }
+        let cmd = self.cmd;
+        if let Some(timer) = &self.timer {
+            let t = &timer.inner;
+            let Ok(mut names) = t.names.lock() else {
+                return;
+            };
+            let i = names.len() as u32;
+            if i < t.capacity {
+                names.push(name.to_owned());
+                // SAFETY: query 2i was reset by attach_timer.
+                unsafe {
+                    self.device.shared.device.cmd_write_timestamp2(
+                        cmd,
+                        vk::PipelineStageFlags2::ALL_COMMANDS,
+                        t.pool,
+                        2 * i,
+                    )
+                };
+                self.open_pass = Some(i as usize);
+            } else {
+                log::warn!("GPU timer full: pass '{name}' is not timed");
+                self.open_pass = None;
+            }
+        }
+    }
+
+    /// Closes the pass opened by [`Encoder::begin_pass`].
+    pub fn end_pass(&mut self) {
+        let cmd = self.cmd;
+        if let (Some(i), Some(timer)) = (self.open_pass.take(), &self.timer) {
+            // SAFETY: query 2i+1 was reset by attach_timer.
+            unsafe {
+                self.device.shared.device.cmd_write_timestamp2(
+                    cmd,
+                    vk::PipelineStageFlags2::ALL_COMMANDS,
+                    timer.inner.pool,
+                    2 * i as u32 + 1,
+                )
+            };
+        }
+        if let Some(utils) = &self.device.shared.debug_utils {
+            // SAFETY: matches the label begun in begin_pass.
+            unsafe { utils.cmd_end_debug_utils_label(cmd) };
+        }
+    }
+
+    /// Records barriers (synchronization2).
+    pub fn barriers(&mut self, barriers: &[Barrier<'_>]) {
+        let mut memory = Vec::new();
+        let mut images = Vec::new();
+        for b in barriers {
+            match b {
+                Barrier::Uav => memory.push(uav_barrier()),
+                Barrier::Global { before, after } => {
+                    let (_, ss, sa) = state_scope(*before);
+                    let (_, ds, da) = state_scope(*after);
+                    memory.push(
+                        vk::MemoryBarrier2::default()
+                            .src_stage_mask(ss)
+                            .src_access_mask(sa)
+                            .dst_stage_mask(ds)
+                            .dst_access_mask(da),
+                    );
+                }
+                Barrier::Image {
+                    image,
+                    before,
+                    after,
+                } => {
+                    let (ol, ss, sa) = state_scope(*before);
+                    let (nl, ds, da) = state_scope(*after);
+                    images.push(
+                        vk::ImageMemoryBarrier2::default()
+                            .src_stage_mask(ss)
+                            .src_access_mask(sa)
+                            .dst_stage_mask(ds)
+                            .dst_access_mask(da)
+                            .old_layout(ol)
+                            .new_layout(nl)
+                            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                            .image(image.raw)
+                            .subresource_range(subresource_range(image.format(), image.layers())),
+                    );
+                }
+            }
+        }
+        let dep = vk::DependencyInfo::default()
+            .memory_barriers(&memory)
+            .image_memory_barriers(&images);
+        // SAFETY: recording command buffer; every image is live.
+        unsafe { self.d().cmd_pipeline_barrier2(self.cmd, &dep) };
+    }
+
+    /// Clears all layers of an integer colour image (in `CopyDest` state) to `value`.
+    pub fn clear_uint(&mut self, image: &Image, value: u32) {
+        let clear = vk::ClearColorValue { uint32: [value; 4] };
+        let range = subresource_range(image.format(), image.layers());
+        // SAFETY: the image is in TRANSFER_DST_OPTIMAL (CopyDest) by contract.
+        unsafe {
+            self.d().cmd_clear_color_image(
+                self.cmd,
+                image.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &clear,
+                &[range],
+            )
+        };
+    }
+
+    /// Fills a buffer with a repeated `u32`.
+    pub fn fill_buffer(&mut self, buffer: &Buffer, value: u32) {
+        // SAFETY: whole-buffer fill of a live buffer with TRANSFER_DST usage.
+        unsafe {
+            self.d()
+                .cmd_fill_buffer(self.cmd, buffer.raw, 0, vk::WHOLE_SIZE, value)
+        };
+    }
+
+    /// Binds a compute pipeline and its resources and dispatches `groups` workgroups.
+    pub fn dispatch(
+        &mut self,
+        pipeline: &ComputePipeline,
+        group: &BindGroup,
+        push: &[u8],
+        groups: [u32; 3],
+    ) -> Result<()> {
+        check_push(push, pipeline.layout.push_constant_size)?;
+        let limit = self.device.shared.caps.max_compute_work_group_count;
+        if groups.iter().zip(limit).any(|(&g, l)| g > l) {
+            return Err(RhiError::Limit {
+                what: "dispatch size".into(),
+                value: groups.iter().copied().max().unwrap_or(0).into(),
+                limit: limit.iter().copied().min().unwrap_or(0).into(),
+            });
+        }
+        let d = self.d();
+        // SAFETY: live pipeline and set created for its layout; push size and group counts checked.
+        unsafe {
+            d.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::COMPUTE, pipeline.raw);
+            d.cmd_bind_descriptor_sets(
+                self.cmd,
+                vk::PipelineBindPoint::COMPUTE,
+                pipeline.layout.raw,
+                0,
+                &[group.set],
+                &[],
+            );
+            if !push.is_empty() {
+                d.cmd_push_constants(
+                    self.cmd,
+                    pipeline.layout.raw,
+                    vk::ShaderStageFlags::ALL,
+                    0,
+                    push,
+                );
+            }
+            d.cmd_dispatch(self.cmd, groups[0], groups[1], groups[2]);
+        }
+        Ok(())
+    }
+
+    /// Begins dynamic rendering over `extent` with cleared targets (none for UAV-only rasterization).
+    pub fn begin_rendering(
+        &mut self,
+        extent: (u32, u32),
+        colors: &[ColorTarget<'_>],
+        depth: Option<DepthTarget<'_>>,
+    ) {
+        let color_infos: Vec<_> = colors
+            .iter()
+            .map(|c| {
+                vk::RenderingAttachmentInfo::default()
+                    .image_view(c.image.view)
+                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                    .load_op(vk::AttachmentLoadOp::CLEAR)
+                    .store_op(vk::AttachmentStoreOp::STORE)
+                    .clear_value(vk::ClearValue {
+                        color: vk::ClearColorValue { float32: c.clear },
+                    })
+            })
+            .collect();
+        let depth_info = depth.map(|dt| {
+            vk::RenderingAttachmentInfo::default()
+                .image_view(dt.image.view)
+                .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue {
+                    depth_stencil: vk::ClearDepthStencilValue {
+                        depth: dt.clear,
+                        stencil: 0,
+                    },
+                })
+        });
+        let mut info = vk::RenderingInfo::default()
+            .render_area(vk::Rect2D {
+                offset: vk::Offset2D::default(),
+                extent: vk::Extent2D {
+                    width: extent.0,
+                    height: extent.1,
+                },
+            })
+            .layer_count(1)
+            .color_attachments(&color_infos);
+        if let Some(di) = depth_info.as_ref() {
+            info = info.depth_attachment(di);
+        }
+        self.render_extent = extent;
+        // SAFETY: attachments are live and in the stated layouts; the infos outlive the call.
+        unsafe { self.d().cmd_begin_rendering(self.cmd, &info) };
+    }
+
+    /// Ends dynamic rendering.
+    pub fn end_rendering(&mut self) {
+        // SAFETY: paired with begin_rendering.
+        unsafe { self.d().cmd_end_rendering(self.cmd) };
+    }
+
+    /// Draws `vertex_count` vertices (no vertex buffers: shaders pull them) over the whole render area.
+    pub fn draw(
+        &mut self,
+        pipeline: &GraphicsPipeline,
+        group: &BindGroup,
+        push: &[u8],
+        vertex_count: u32,
+    ) -> Result<()> {
+        check_push(push, pipeline.layout.push_constant_size)?;
+        let (w, h) = self.render_extent;
+        let d = self.d();
+        let viewport = vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: w as f32,
+            height: h as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        let scissor = vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent: vk::Extent2D {
+                width: w,
+                height: h,
+            },
+        };
+        // SAFETY: inside begin_rendering; pipeline and set are live and match; push size checked.
+        unsafe {
+            d.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.raw);
+            d.cmd_bind_descriptor_sets(
+                self.cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                pipeline.layout.raw,
+                0,
+                &[group.set],
+                &[],
+            );
+            if !push.is_empty() {
+                d.cmd_push_constants(
+                    self.cmd,
+                    pipeline.layout.raw,
+                    vk::ShaderStageFlags::ALL,
+                    0,
+                    push,
+                );
+            }
+            d.cmd_set_viewport(self.cmd, 0, &[viewport]);
+            d.cmd_set_scissor(self.cmd, 0, &[scissor]);
+            d.cmd_draw(self.cmd, vertex_count, 1, 0, 0);
+        }
+        Ok(())
+    }
+
+    /// Copies all layers of `image` (in `CopySource` state) tightly packed into `buffer`.
+    pub fn copy_image_to_buffer(&mut self, image: &Image, buffer: &Buffer) -> Result<()> {
+        if buffer.size() < image.byte_size() {
+            return Err(RhiError::InvalidArgument(format!(
+                "read-back buffer of {} bytes is smaller than the image ({} bytes)",
+                buffer.size(),
+                image.byte_size()
+            )));
+        }
+        let region = vk::BufferImageCopy::default()
+            .image_subresource(
+                vk::ImageSubresourceLayers::default()
+                    .aspect_mask(image.format().aspect())
+                    .mip_level(0)
+                    .base_array_layer(0)
+                    .layer_count(image.layers()),
+            )
+            .image_extent(vk::Extent3D {
+                width: image.width(),
+                height: image.height(),
+                depth: 1,
+            });
+        // SAFETY: sizes checked above; the image is in TRANSFER_SRC_OPTIMAL by contract.
+        unsafe {
+            self.d().cmd_copy_image_to_buffer(
+                self.cmd,
+                image.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                buffer.raw,
+                &[region],
+            )
+        };
+        Ok(())
+    }
+
+    /// Copies `src` into `dst` (whole `src`).
+    pub fn copy_buffer(&mut self, src: &Buffer, dst: &Buffer) -> Result<()> {
+        if dst.size() < src.size() {
+            return Err(RhiError::InvalidArgument(
+                "copy destination is smaller than the source".into(),
+            ));
+        }
+        let region = vk::BufferCopy {
+            src_offset: 0,
+            dst_offset: 0,
+            size: src.size(),
+        };
+        // SAFETY: sizes checked; both buffers live with the right usages.
+        unsafe {
+            self.d()
+                .cmd_copy_buffer(self.cmd, src.raw, dst.raw, &[region])
+        };
+        Ok(())
+    }
+}
+
+fn check_push(push: &[u8], declared: u32) -> Result<()> {
+    if push.len() as u64 > u64::from(declared) || push.len() % 4 != 0 {
+        return Err(RhiError::InvalidArgument(format!(
+            "push constants of {} bytes do not fit the layout's {declared} bytes",
+            push.len()
+        )));
+    }
+    Ok(())
+}

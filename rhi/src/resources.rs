@@ -1,0 +1,471 @@
+//! Buffers and images, with memory from gpu-allocator and UAV (storage) / SRV (sampled) views.
+
+use crate::conv::Format;
+use crate::device::{Device, Shared};
+use crate::error::{Result, RhiError, VkResultExt};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+pub use gpu_allocator::MemoryLocation;
+use std::sync::Arc;
+
+macro_rules! usage_flags {
+    ($(#[$doc:meta])* $name:ident { $($(#[$fdoc:meta])* $flag:ident = $bit:expr),* $(,)? }) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+        pub struct $name(u32);
+        impl $name {
+            $($(#[$fdoc])* pub const $flag: Self = Self(1 << $bit);)*
+            /// Whether all bits of `other` are set.
+            pub fn contains(self, other: Self) -> bool { self.0 & other.0 == other.0 }
+        }
+        impl std::ops::BitOr for $name {
+            type Output = Self;
+            fn bitor(self, rhs: Self) -> Self { Self(self.0 | rhs.0) }
+        }
+    };
+}
+
+usage_flags!(
+    /// How a buffer is used.
+    BufferUsage {
+        /// UAV / SRV structured buffer (storage buffer).
+        STORAGE = 0,
+        /// Constant buffer.
+        UNIFORM = 1,
+        /// Vertex buffer.
+        VERTEX = 2,
+        /// Index buffer.
+        INDEX = 3,
+        /// Copy source.
+        COPY_SRC = 4,
+        /// Copy destination.
+        COPY_DST = 5,
+    }
+);
+
+usage_flags!(
+    /// How an image is used.
+    ImageUsage {
+        /// SRV: sampled in shaders.
+        SAMPLED = 0,
+        /// UAV: storage image.
+        STORAGE = 1,
+        /// Render target.
+        COLOR_TARGET = 2,
+        /// Depth-stencil target.
+        DEPTH_TARGET = 3,
+        /// Copy source.
+        COPY_SRC = 4,
+        /// Copy destination (and clears).
+        COPY_DST = 5,
+    }
+);
+
+/// Pure mapping of [`BufferUsage`] to Vulkan usage flags.
+pub fn buffer_usage_to_vk(u: BufferUsage) -> vk::BufferUsageFlags {
+    let mut f = vk::BufferUsageFlags::empty();
+    let map = [
+        (BufferUsage::STORAGE, vk::BufferUsageFlags::STORAGE_BUFFER),
+        (BufferUsage::UNIFORM, vk::BufferUsageFlags::UNIFORM_BUFFER),
+        (BufferUsage::VERTEX, vk::BufferUsageFlags::VERTEX_BUFFER),
+        (BufferUsage::INDEX, vk::BufferUsageFlags::INDEX_BUFFER),
+        (BufferUsage::COPY_SRC, vk::BufferUsageFlags::TRANSFER_SRC),
+        (BufferUsage::COPY_DST, vk::BufferUsageFlags::TRANSFER_DST),
+    ];
+    for (ours, theirs) in map {
+        if u.contains(ours) {
+            f |= theirs;
+        }
+    }
+    f
+}
+
+/// Pure mapping of [`ImageUsage`] to Vulkan usage flags.
+pub fn image_usage_to_vk(u: ImageUsage) -> vk::ImageUsageFlags {
+    let mut f = vk::ImageUsageFlags::empty();
+    let map = [
+        (ImageUsage::SAMPLED, vk::ImageUsageFlags::SAMPLED),
+        (ImageUsage::STORAGE, vk::ImageUsageFlags::STORAGE),
+        (
+            ImageUsage::COLOR_TARGET,
+            vk::ImageUsageFlags::COLOR_ATTACHMENT,
+        ),
+        (
+            ImageUsage::DEPTH_TARGET,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+        ),
+        (ImageUsage::COPY_SRC, vk::ImageUsageFlags::TRANSFER_SRC),
+        (ImageUsage::COPY_DST, vk::ImageUsageFlags::TRANSFER_DST),
+    ];
+    for (ours, theirs) in map {
+        if u.contains(ours) {
+            f |= theirs;
+        }
+    }
+    f
+}
+
+/// A GPU buffer. Host-visible buffers (`CpuToGpu`, `GpuToCpu`) are persistently mapped.
+pub struct Buffer {
+    shared: Arc<Shared>,
+    pub(crate) raw: vk::Buffer,
+    allocation: Option<Allocation>,
+    size: u64,
+}
+
+/// A 2D image or 2D array image with one view over all layers.
+pub struct Image {
+    shared: Arc<Shared>,
+    pub(crate) raw: vk::Image,
+    pub(crate) view: vk::ImageView,
+    allocation: Option<Allocation>,
+    format: Format,
+    width: u32,
+    height: u32,
+    layers: u32,
+}
+
+/// Description of an image.
+#[derive(Debug, Clone)]
+pub struct ImageDesc<'a> {
+    /// Debug name.
+    pub name: &'a str,
+    /// Texel format.
+    pub format: Format,
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// Array layers; 1 gives a plain 2D view, more a 2D-array view.
+    pub layers: u32,
+    /// Usage.
+    pub usage: ImageUsage,
+}
+
+impl Device {
+    /// Creates a buffer of `size` bytes. Storage buffers are checked against `maxStorageBufferRange`.
+    pub fn create_buffer(
+        &self,
+        name: &str,
+        size: u64,
+        usage: BufferUsage,
+        location: MemoryLocation,
+    ) -> Result<Buffer> {
+        if size == 0 {
+            return Err(RhiError::InvalidArgument(format!(
+                "buffer {name} has size 0"
+            )));
+        }
+        let limit = self.shared.caps.max_storage_buffer_range;
+        if usage.contains(BufferUsage::STORAGE) && size > limit {
+            return Err(RhiError::Limit {
+                what: format!("storage buffer {name}"),
+                value: size,
+                limit,
+            });
+        }
+        let d = &self.shared.device;
+        let info = vk::BufferCreateInfo::default()
+            .size(size)
+            .usage(buffer_usage_to_vk(usage))
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        // SAFETY: valid device and create info; the buffer is destroyed in Drop (or below on failure).
+        let raw = unsafe { d.create_buffer(&info, None) }.call("vkCreateBuffer")?;
+        // SAFETY: `raw` is a live buffer of this device.
+        let requirements = unsafe { d.get_buffer_memory_requirements(raw) };
+        let allocation = self
+            .allocate(name, requirements, location, true)
+            .and_then(|a| {
+                // SAFETY: the allocation satisfies `requirements` and is not bound elsewhere.
+                unsafe { d.bind_buffer_memory(raw, a.memory(), a.offset()) }
+                    .call("vkBindBufferMemory")
+                    .map(|_| a)
+            });
+        let allocation = match allocation {
+            Ok(a) => a,
+            Err(e) => {
+                // SAFETY: `raw` is unused.
+                unsafe { d.destroy_buffer(raw, None) };
+                return Err(e);
+            }
+        };
+        self.set_name(vk::ObjectType::BUFFER, ash::vk::Handle::as_raw(raw), name);
+        Ok(Buffer {
+            shared: self.shared.clone(),
+            raw,
+            allocation: Some(allocation),
+            size,
+        })
+    }
+
+    /// Creates a buffer in `CpuToGpu` memory filled with `data`.
+    pub fn create_buffer_init(
+        &self,
+        name: &str,
+        data: &[u8],
+        usage: BufferUsage,
+    ) -> Result<Buffer> {
+        let mut b = self.create_buffer(name, data.len() as u64, usage, MemoryLocation::CpuToGpu)?;
+        b.write(0, data)?;
+        Ok(b)
+    }
+
+    /// Creates an image (2D, or 2D array when `layers > 1`), checked against the device limits.
+    pub fn create_image(&self, desc: &ImageDesc<'_>) -> Result<Image> {
+        let caps = &self.shared.caps;
+        if desc.width == 0 || desc.height == 0 || desc.layers == 0 {
+            return Err(RhiError::InvalidArgument(format!(
+                "image {} has a zero dimension",
+                desc.name
+            )));
+        }
+        for (what, value, limit) in [
+            ("width", desc.width, caps.max_image_dimension_2d),
+            ("height", desc.height, caps.max_image_dimension_2d),
+            ("layers", desc.layers, caps.max_image_array_layers),
+        ] {
+            if value > limit {
+                return Err(RhiError::Limit {
+                    what: format!("image {} {what}", desc.name),
+                    value: value.into(),
+                    limit: limit.into(),
+                });
+            }
+        }
+        let d = &self.shared.device;
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(desc.format.to_vk())
+            .extent(vk::Extent3D {
+                width: desc.width,
+                height: desc.height,
+                depth: 1,
+            })
+            .mip_levels(1)
+            .array_layers(desc.layers)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(image_usage_to_vk(desc.usage))
+            .sharing_mode(vk::SharingMode::EXCLUSIVE)
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        // SAFETY: valid device and create info; destroyed in Drop or below on failure.
+        let raw = unsafe { d.create_image(&info, None) }.call("vkCreateImage")?;
+        // SAFETY: `raw` is a live image of this device.
+        let requirements = unsafe { d.get_image_memory_requirements(raw) };
+        let allocation = self
+            .allocate(desc.name, requirements, MemoryLocation::GpuOnly, false)
+            .and_then(|a| {
+                // SAFETY: the allocation satisfies `requirements`.
+                unsafe { d.bind_image_memory(raw, a.memory(), a.offset()) }
+                    .call("vkBindImageMemory")
+                    .map(|_| a)
+            });
+        let allocation = match allocation {
+            Ok(a) => a,
+            Err(e) => {
+                // SAFETY: `raw` is unused.
+                unsafe { d.destroy_image(raw, None) };
+                return Err(e);
+            }
+        };
+        let view_type = if desc.layers > 1 {
+            vk::ImageViewType::TYPE_2D_ARRAY
+        } else {
+            vk::ImageViewType::TYPE_2D
+        };
+        let view_info = vk::ImageViewCreateInfo::default()
+            .image(raw)
+            .view_type(view_type)
+            .format(desc.format.to_vk())
+            .subresource_range(subresource_range(desc.format, desc.layers));
+        // SAFETY: `raw` is bound to memory; the view is destroyed before the image.
+        let view = match unsafe { d.create_image_view(&view_info, None) } {
+            Ok(v) => v,
+            Err(e) => {
+                // SAFETY: `raw` is unused; the allocation is returned to the allocator.
+                unsafe { d.destroy_image(raw, None) };
+                if let Ok(mut a) = self.shared.allocator.lock() {
+                    let _ = a.free(allocation);
+                }
+                return Err(RhiError::Vulkan {
+                    call: "vkCreateImageView",
+                    result: e,
+                });
+            }
+        };
+        self.set_name(
+            vk::ObjectType::IMAGE,
+            ash::vk::Handle::as_raw(raw),
+            desc.name,
+        );
+        Ok(Image {
+            shared: self.shared.clone(),
+            raw,
+            view,
+            allocation: Some(allocation),
+            format: desc.format,
+            width: desc.width,
+            height: desc.height,
+            layers: desc.layers,
+        })
+    }
+
+    fn allocate(
+        &self,
+        name: &str,
+        requirements: vk::MemoryRequirements,
+        location: MemoryLocation,
+        linear: bool,
+    ) -> Result<Allocation> {
+        let mut alloc = self
+            .shared
+            .allocator
+            .lock()
+            .map_err(|_| RhiError::Allocation {
+                name: name.into(),
+                message: "allocator mutex poisoned".into(),
+            })?;
+        alloc
+            .allocate(&AllocationCreateDesc {
+                name,
+                requirements,
+                location,
+                linear,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
+            .map_err(|e| RhiError::Allocation {
+                name: name.into(),
+                message: e.to_string(),
+            })
+    }
+
+    pub(crate) fn set_name(&self, ty: vk::ObjectType, handle: u64, name: &str) {
+        let (Some(utils), Ok(cname)) = (&self.shared.debug_utils, std::ffi::CString::new(name))
+        else {
+            return;
+        };
+        let mut info = vk::DebugUtilsObjectNameInfoEXT::default().object_name(&cname);
+        info.object_type = ty;
+        info.object_handle = handle;
+        // SAFETY: `handle` is a live object of type `ty` on this device; naming is advisory.
+        let _ = unsafe { utils.set_debug_utils_object_name(&info) };
+    }
+}
+
+pub(crate) fn subresource_range(format: Format, layers: u32) -> vk::ImageSubresourceRange {
+    vk::ImageSubresourceRange::default()
+        .aspect_mask(format.aspect())
+        .base_mip_level(0)
+        .level_count(1)
+        .base_array_layer(0)
+        .layer_count(layers)
+}
+
+impl Buffer {
+    /// Size in bytes.
+    pub fn size(&self) -> u64 {
+        self.size
+    }
+
+    /// Writes `data` at `offset` into a host-visible buffer.
+    pub fn write(&mut self, offset: u64, data: &[u8]) -> Result<()> {
+        let size = self.size;
+        let slice = self
+            .allocation
+            .as_mut()
+            .and_then(|a| a.mapped_slice_mut())
+            .ok_or_else(|| RhiError::InvalidArgument("buffer is not host-visible".into()))?;
+        let end = offset
+            .checked_add(data.len() as u64)
+            .filter(|&e| e <= size)
+            .ok_or_else(|| {
+                RhiError::InvalidArgument(format!(
+                    "write of {} bytes at {offset} exceeds {size}",
+                    data.len()
+                ))
+            })?;
+        slice[offset as usize..end as usize].copy_from_slice(data);
+        Ok(())
+    }
+
+    /// The contents of a host-visible buffer (read after the GPU work that wrote it has completed).
+    pub fn read(&self) -> Result<&[u8]> {
+        self.allocation
+            .as_ref()
+            .and_then(|a| a.mapped_slice())
+            .map(|s| &s[..self.size as usize])
+            .ok_or_else(|| RhiError::InvalidArgument("buffer is not host-visible".into()))
+    }
+}
+
+impl Image {
+    /// Texel format.
+    pub fn format(&self) -> Format {
+        self.format
+    }
+    /// Width in texels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+    /// Height in texels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+    /// Array layers.
+    pub fn layers(&self) -> u32 {
+        self.layers
+    }
+    /// Bytes needed to read back all layers tightly packed.
+    pub fn byte_size(&self) -> u64 {
+        u64::from(self.width)
+            * u64::from(self.height)
+            * u64::from(self.layers)
+            * u64::from(self.format.texel_size())
+    }
+}
+
+impl Drop for Buffer {
+    fn drop(&mut self) {
+        // SAFETY: callers wait for GPU work using this buffer before dropping it (submit_and_wait does).
+        unsafe { self.shared.device.destroy_buffer(self.raw, None) };
+        if let (Some(a), Ok(mut alloc)) = (self.allocation.take(), self.shared.allocator.lock()) {
+            let _ = alloc.free(a);
+        }
+    }
+}
+
+impl Drop for Image {
+    fn drop(&mut self) {
+        // SAFETY: as for Buffer; the view is destroyed before its image.
+        unsafe {
+            self.shared.device.destroy_image_view(self.view, None);
+            self.shared.device.destroy_image(self.raw, None);
+        }
+        if let (Some(a), Ok(mut alloc)) = (self.allocation.take(), self.shared.allocator.lock()) {
+            let _ = alloc.free(a);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn usage_maps_to_vulkan() {
+        let b = buffer_usage_to_vk(BufferUsage::STORAGE | BufferUsage::COPY_SRC);
+        assert_eq!(
+            b,
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC
+        );
+        let i = image_usage_to_vk(ImageUsage::STORAGE | ImageUsage::SAMPLED);
+        assert_eq!(
+            i,
+            vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::SAMPLED
+        );
+        assert_eq!(
+            image_usage_to_vk(ImageUsage::default()),
+            vk::ImageUsageFlags::empty()
+        );
+    }
+}

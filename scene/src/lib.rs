@@ -1,0 +1,30 @@
+//! Scene geometry for the hybrid ray-traced shadows demo.
+//!
+//! - [`Scene`]: a world-space triangle soup with shared vertices and named draw ranges
+//!   ([`Object`]s), validated by [`Scene::validate`];
+//! - [`load_obj`]: Wavefront OBJ loading that rejects malformed, non-finite and out-of-range
+//!   content with a [`SceneError`] naming the file, and never panics;
+//! - [`procedural_default`]: the built-in demo scene of shadow-mapping trouble makers;
+//! - [`Camera`] and [`DirectionalLight`]: view and projection matrices that frame a scene.
+//!
+//! Conventions: right-handed world in metres with +Y up; triangles wind counter-clockwise seen
+//! from their front side; a light direction is the unit vector along which the light travels;
+//! projections follow Vulkan (depth range `[0, 1]`, no y flip in the matrices).
+
+pub use glam;
+
+mod aabb;
+mod camera;
+mod error;
+mod light;
+mod obj;
+mod procedural;
+mod scene;
+
+pub use aabb::Aabb;
+pub use camera::Camera;
+pub use error::SceneError;
+pub use light::DirectionalLight;
+pub use obj::load_obj;
+pub use procedural::procedural_default;
+pub use scene::{Object, Scene};
