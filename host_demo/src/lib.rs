@@ -7,7 +7,7 @@ pub mod render;
 use glam::{Mat4, Vec3};
 use passes::{Draw, FrameInputs, Geometry, PassError};
 use rhi::Device;
-use scene::{Camera, DirectionalLight, Scene};
+use scene::{Aabb, Camera, DirectionalLight, Scene};
 
 /// A scene with its camera and light, ready to render.
 #[derive(Debug, Clone)]
@@ -25,11 +25,11 @@ pub struct View {
 }
 
 impl View {
-    /// Frames `scene` automatically: the camera looks at it from a slanted elevated direction and a slanted
-    /// directional light shines on it.
+    /// Frames `scene` automatically: the camera looks at its objects (the ground plane aside) from a slanted
+    /// elevated direction, and a slanted directional light shines on it.
     pub fn framed(scene: Scene, width: u32, height: u32) -> Self {
         let aspect = width as f32 / height.max(1) as f32;
-        let camera = Camera::frame(&scene.bounds(), aspect);
+        let camera = Camera::frame(&focus_bounds(&scene), aspect);
         Self {
             scene,
             camera,
@@ -74,6 +74,25 @@ impl View {
         Geometry::upload(device, &positions, &self.scene.indices, &draws)
     }
 }
+
+/// Bounds of every object but one named "ground" (all of the scene if that is all there is).
+pub fn focus_bounds(scene: &Scene) -> Aabb {
+    let mut b = Aabb::empty();
+    for o in scene.objects.iter().filter(|o| o.name != GROUND) {
+        for t in o.first_triangle..o.first_triangle + o.triangle_count {
+            for v in scene.triangle(t as usize) {
+                b.extend(v);
+            }
+        }
+    }
+    if b.min.cmple(b.max).all() {
+        b
+    } else {
+        scene.bounds()
+    }
+}
+
+const GROUND: &str = "ground";
 
 /// Parses "x,y,z" into a vector.
 pub fn parse_vec3(s: &str) -> Result<Vec3, String> {

@@ -128,6 +128,7 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
             depth: args.map_depth,
             faces: args.faces,
             raster: args.raster,
+            guard_layer: false,
         },
         frames: args.frames,
     };

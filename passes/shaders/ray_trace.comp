@@ -14,6 +14,9 @@
 #include "triangle.glsl"
 #include "ray_trace_constants.glsl"
 
+#define CONSIDER1(i) if ((i) < total) { consider((i), nearest); }
+#define CONSIDER4(i) CONSIDER1(i) CONSIDER1((i) + 1u) CONSIDER1((i) + 2u) CONSIDER1((i) + 3u)
+
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform Constants { RayTraceConstants k; };
 layout(set = 0, binding = 1) uniform sampler2D depth_tex;
@@ -122,9 +125,11 @@ void main() {
             consider(imageLoad(index_map, ivec3(texel, int(i))).r, nearest);
         }
     } else {
-        uint total = uint(tris.length());
-        for (uint i = 0u; i < total; ++i) {
-            consider(i, nearest);
+        // Unrolled 16x by hand: llvmpipe (lavapipe) silently ends a shader's loops after 65535 iterations
+        // in total, which would drop every triangle past that index; unrolled, its cap is 1M triangles.
+        uint total = min(k.misc.y, uint(tris.length()));
+        for (uint base = 0u; base < total; base += 16u) {
+            CONSIDER4(base) CONSIDER4(base + 4u) CONSIDER4(base + 8u) CONSIDER4(base + 12u)
         }
     }
     if (isinf(nearest)) {

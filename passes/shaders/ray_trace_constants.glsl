@@ -7,5 +7,5 @@ struct RayTraceConstants {
     vec4 light_dir;             // xyz: direction the light travels (unit)
     uvec4 dims;                 // screen width, height, primitive map N, d
     vec4 offset;                // x: radians per pixel, y: offset in pixels, z: relative float bound
-    uvec4 misc;                 // x: 1 = front-only map (for the report), yzw unused
+    uvec4 misc;                 // x: 1 = front-only map, y: triangles in the prim buffer, zw unused
 };

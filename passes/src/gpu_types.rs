@@ -82,7 +82,7 @@ pub struct RayTraceConstants {
     pub dims: UVec4,
     /// x: radians per pixel, y: ray-origin offset in pixels, z: relative float bound.
     pub offset: Vec4,
-    /// x: front-only map flag.
+    /// x: front-only map flag, y: triangles in the prim buffer.
     pub misc: UVec4,
 }
 

@@ -12,7 +12,7 @@ pub mod renderer;
 pub use error::PassError;
 pub use prim_buffer::{Draw, Geometry};
 pub use primitive_map::{
-    choose_raster_path, FaceMode, PrimitiveMapConfig, RasterPath, RasterRequest,
+    choose_raster_path, FaceMode, PrimitiveMapConfig, RasterPath, RasterRequest, GUARD_VALUE,
 };
 pub use renderer::{FrameImages, FrameInputs, FrameReport, ShadowRenderer};
 

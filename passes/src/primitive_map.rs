@@ -95,7 +95,13 @@ pub struct PrimitiveMapConfig {
     pub faces: FaceMode,
     /// Raster path request.
     pub raster: RasterRequest,
+    /// Allocate one extra index layer past d, filled with `GUARD_VALUE` every frame, that no pass may
+    /// write: tests read it back to prove overflow never writes out of bounds. Costs N² u32 and a clear.
+    pub guard_layer: bool,
 }
+
+/// Value of every index slot cleared in guard mode (never a valid prim-buffer index).
+pub const GUARD_VALUE: u32 = u32::MAX;
 
 impl Default for PrimitiveMapConfig {
     /// The talk's 1K×1K×32.
@@ -105,6 +111,7 @@ impl Default for PrimitiveMapConfig {
             depth: 32,
             faces: FaceMode::Both,
             raster: RasterRequest::Auto,
+            guard_layer: false,
         }
     }
 }
@@ -118,7 +125,8 @@ impl PrimitiveMapConfig {
                 self.size, caps.max_image_dimension_2d
             )));
         }
-        if self.depth == 0 || self.depth > caps.max_image_array_layers {
+        if self.depth == 0 || self.depth + u32::from(self.guard_layer) > caps.max_image_array_layers
+        {
             return Err(PassError::InvalidConfig(format!(
                 "primitive map depth {} must be in 1..={}",
                 self.depth, caps.max_image_array_layers
@@ -129,7 +137,10 @@ impl PrimitiveMapConfig {
 
     /// Bytes of the count map plus the index map.
     pub fn memory_bytes(&self) -> u64 {
-        u64::from(self.size) * u64::from(self.size) * 4 * (1 + u64::from(self.depth))
+        u64::from(self.size)
+            * u64::from(self.size)
+            * 4
+            * (1 + u64::from(self.depth + u32::from(self.guard_layer)))
     }
 }
 
@@ -180,7 +191,7 @@ impl PrimitiveMap {
         ))?;
         let indices = device.create_image(&uint_image(
             "prim index map",
-            config.depth,
+            config.depth + u32::from(config.guard_layer),
             ImageUsage::STORAGE | ImageUsage::COPY_DST | ImageUsage::COPY_SRC,
         ))?;
         let occupancy = device.create_image(&ImageDesc {
@@ -276,10 +287,14 @@ impl PrimitiveMap {
         self.path
     }
 
-    /// Clears the count map (must be in `CopyDest` state) and the statistics.
+    /// Clears the count map and the statistics (and, in guard mode, the index map to `GUARD_VALUE`);
+    /// count and index maps must be in `CopyDest` state.
     pub fn record_clear(&self, enc: &mut Encoder<'_>) {
         enc.begin_pass("primitive map clear");
         enc.clear_uint(&self.count, 0);
+        if self.config.guard_layer {
+            enc.clear_uint(&self.indices, GUARD_VALUE);
+        }
         enc.fill_buffer(&self.stats, 0);
         enc.end_pass();
     }

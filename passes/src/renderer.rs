@@ -182,7 +182,7 @@ impl ShadowRenderer {
                 RAY_OFFSET_FLOAT_BOUND,
                 0.0,
             ),
-            misc: UVec4::new(map_push.front_only, 0, 0, 0),
+            misc: UVec4::new(map_push.front_only, self.geometry.triangle_count(), 0, 0),
         };
         let gpush = GBufferPush {
             view_proj_rel,
@@ -230,7 +230,7 @@ impl ShadowRenderer {
                 Barrier::Image {
                     image: &map.indices,
                     before: S::Undefined,
-                    after: S::UnorderedAccess,
+                    after: S::CopyDest,
                 },
                 Barrier::Image {
                     image: &map.occupancy,
@@ -253,6 +253,11 @@ impl ShadowRenderer {
             enc.barriers(&[
                 Barrier::Image {
                     image: &map.count,
+                    before: S::CopyDest,
+                    after: S::UnorderedAccess,
+                },
+                Barrier::Image {
+                    image: &map.indices,
                     before: S::CopyDest,
                     after: S::UnorderedAccess,
                 },

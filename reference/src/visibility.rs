@@ -59,6 +59,9 @@ pub struct VisibilityParams {
     pub light: Light,
     /// Tolerance in world units for shadow-ray events and camera z-fighting.
     pub tolerance: f64,
+    /// Added to `tolerance` per world unit of distance from the camera to the receiver: a fraction of the
+    /// pixel footprint, which bounds how far a rasterizer's depth moves the receiver point.
+    pub tolerance_per_distance: f64,
     /// Tolerance in pixels for camera rays passing near triangle edges
     /// (e.g. 1/64).
     pub pixel_tolerance: f64,
@@ -244,6 +247,7 @@ fn shade_pixel(
         });
     };
     let position = origin + dir * t_hit;
+    let tolerance = tolerance + t_hit * dir_length * params.tolerance_per_distance.max(0.0);
     let mut pixel = Pixel {
         class: PixelClass::Ambiguous,
         blocker_distance: f64::NAN,

@@ -51,6 +51,7 @@ fn target_size_runs_fast() {
             direction: DVec3::new(0.4, -1.0, -0.3).normalize(),
         },
         tolerance: 1e-4,
+        tolerance_per_distance: 0.0,
         pixel_tolerance: 1.0 / 64.0,
     };
     let start = Instant::now();

@@ -36,6 +36,7 @@ fn params(camera: Vec3, light: Light) -> VisibilityParams {
         camera_position: camera,
         light,
         tolerance: 1e-4,
+        tolerance_per_distance: 0.0,
         pixel_tolerance: 1.0 / 64.0,
     }
 }
@@ -252,6 +253,7 @@ fn receivers_next_to_blocker_edges_are_ambiguous() {
     let scene = RefScene::new(&mesh.scene());
     let params = VisibilityParams {
         tolerance: 0.05,
+        tolerance_per_distance: 0.0,
         ..params(Vec3::new(6.0, 10.0, 8.0), oblique_light())
     };
     let result = reference_visibility(&scene, &params);
@@ -328,6 +330,7 @@ fn uncertain_nearer_events_hide_the_blocker_distance() {
     let camera = Vec3::new(12.0, 1.5, 0.0);
     let params = VisibilityParams {
         tolerance: 0.2,
+        tolerance_per_distance: 0.0,
         light: Light::Directional {
             direction: -DVec3::Y,
         },
