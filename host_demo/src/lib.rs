@@ -1,6 +1,7 @@
 //! The standalone demo host as a library: scene setup shared by the `host_demo` binary and the
 //! integration tests, so that what the tests check is what the demo shows.
 
+pub mod accuracy;
 pub mod output;
 pub mod render;
 
@@ -49,11 +50,10 @@ impl View {
             camera_position: self.camera.position,
             light_direction: self.light.direction,
             light_view_proj: self.light.view_proj(&bounds),
-            light_origin: bounds.center(),
         }
     }
 
-    /// Uploads the scene: one draw per object, identity transforms.
+    /// Uploads the scene: one draw per object, identity transforms, frame origin at the centre of its bounds.
     pub fn upload(&self, device: &Device) -> Result<Geometry, PassError> {
         let positions: Vec<f32> = self
             .scene
@@ -71,7 +71,13 @@ impl View {
                 model: Mat4::IDENTITY,
             })
             .collect();
-        Geometry::upload(device, &positions, &self.scene.indices, &draws)
+        Geometry::upload(
+            device,
+            &positions,
+            &self.scene.indices,
+            &draws,
+            self.scene.bounds().center().as_dvec3(),
+        )
     }
 }
 

@@ -1,6 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// G-buffer: world position and the exact geometric normal of the visible triangle, facing the camera.
+// G-buffer: frame-relative position and the exact geometric normal of the visible triangle, facing the camera.
 #include "triangle.glsl"
 #include "gbuffer_push.glsl"
 

@@ -11,5 +11,5 @@ layout(location = 0) out vec3 out_world;
 void main() {
     vec3 p = tris[gl_VertexIndex / 3].v[gl_VertexIndex % 3].xyz;
     out_world = p;
-    gl_Position = pc.light_view_proj_rel * vec4(p - pc.origin.xyz, 1.0);
+    gl_Position = pc.light_view_proj * vec4(p, 1.0);
 }

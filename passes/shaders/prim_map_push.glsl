@@ -1,7 +1,6 @@
-// Mirrors passes::gpu_types::PrimMapPush (112 bytes).
+// Mirrors passes::gpu_types::PrimMapPush (96 bytes).
 struct PrimMapPush {
-    mat4 light_view_proj_rel;   // light view-projection relative to `origin`
-    vec4 origin;                // xyz: world origin of light_view_proj_rel
+    mat4 light_view_proj;       // light view-projection in the frame (origin-relative) coordinates
     vec4 to_light;              // xyz: direction towards the light (directional)
     uint size;                  // N
     uint depth;                 // d

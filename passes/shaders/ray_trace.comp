@@ -3,9 +3,11 @@
 // Per-pixel shadow ray through the deep primitive map.
 //
 // Numerics (see README "Numerical design"):
-// - The receiver point P is rebuilt from depth relative to the camera, then offset along its geometric
-//   normal by a bound on its own error: a fraction of the pixel footprint (depth interpolation and vertex
-//   snapping move P by less than that) plus a relative float bound of the coordinates. No world-space bias.
+// - Everything is in frame coordinates (relative to an origin near the scene), so precision does not
+//   depend on where the scene sits in the world. The receiver point P is rebuilt from depth relative to
+//   the camera, then offset along its geometric normal by a bound on its own error: a fraction of the
+//   pixel footprint (depth interpolation and vertex snapping move P by less than that) plus a few ulps
+//   of |P| (the rounding of camera + offset). No world-space bias.
 // - Ray/triangle test: watertight (Woop, Benthin, Wald 2013), two-sided, no epsilons. Edge functions are
 //   `precise` so that a shared edge gives exactly opposite values in both triangles: a ray through an edge
 //   or vertex of a closed mesh always hits at least one triangle. Zero-determinant (degenerate or
@@ -104,14 +106,12 @@ void main() {
         write(px, 0.0, 0.0);    // the visible side faces away from the light
         return;
     }
-    float dist = length(rel);
     vec3 ap = abs(p);
-    float magnitude = max(max(ap.x, ap.y), ap.z) + dist;
-    float delta = dist * k.offset.x * k.offset.y + magnitude * k.offset.z;
+    float delta = length(rel) * k.offset.x * k.offset.y + max(max(ap.x, ap.y), ap.z) * k.offset.z;
     vec3 o = p + n * delta;
     setup_ray(o, to_light);
 
-    vec4 lc = k.light_view_proj_rel * vec4(o - k.light_origin.xyz, 1.0);
+    vec4 lc = k.light_view_proj * vec4(o, 1.0);
     vec2 uv = (lc.xy / lc.w * 0.5 + 0.5) * float(k.dims.z);
     if (any(lessThan(uv, vec2(0.0))) || any(greaterThanEqual(uv, vec2(float(k.dims.z))))) {
         write(px, 1.0, -1.0);   // outside the light's map: no recorded occluder

@@ -1,11 +1,11 @@
-// Mirrors passes::gpu_types::RayTraceConstants (224 bytes).
+// Mirrors passes::gpu_types::RayTraceConstants (208 bytes). Positions are in frame coordinates
+// (relative to the geometry's frame origin).
 struct RayTraceConstants {
     mat4 inv_view_proj_rel;     // inverse(proj * view) with the camera at the origin
-    mat4 light_view_proj_rel;   // light view-projection relative to light_origin
-    vec4 camera_pos;            // xyz
-    vec4 light_origin;          // xyz
+    mat4 light_view_proj;       // light view-projection in frame coordinates
+    vec4 camera_pos;            // xyz: camera in frame coordinates
     vec4 light_dir;             // xyz: direction the light travels (unit)
     uvec4 dims;                 // screen width, height, primitive map N, d
-    vec4 offset;                // x: radians per pixel, y: offset in pixels, z: relative float bound
+    vec4 offset;                // x: radians per pixel, y: offset in pixels, z: relative float bound of |P|
     uvec4 misc;                 // x: 1 = front-only map, y: triangles in the prim buffer, zw unused
 };

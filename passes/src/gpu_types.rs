@@ -40,7 +40,7 @@ pub struct PrimBufferPush {
 pub struct GBufferPush {
     /// proj * view with the camera at the origin.
     pub view_proj_rel: Mat4,
-    /// Camera position (xyz).
+    /// Camera position in frame coordinates (xyz).
     pub camera_pos: Vec4,
 }
 
@@ -48,10 +48,8 @@ pub struct GBufferPush {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub struct PrimMapPush {
-    /// Light view-projection relative to `origin`.
-    pub light_view_proj_rel: Mat4,
-    /// Origin of `light_view_proj_rel` (xyz).
-    pub origin: Vec4,
+    /// Light view-projection in frame coordinates.
+    pub light_view_proj: Mat4,
     /// Direction towards the light (xyz).
     pub to_light: Vec4,
     /// Map size N.
@@ -70,17 +68,15 @@ pub struct PrimMapPush {
 pub struct RayTraceConstants {
     /// inverse(proj * view) with the camera at the origin.
     pub inv_view_proj_rel: Mat4,
-    /// Light view-projection relative to `light_origin`.
-    pub light_view_proj_rel: Mat4,
-    /// Camera position (xyz).
+    /// Light view-projection in frame coordinates.
+    pub light_view_proj: Mat4,
+    /// Camera position in frame coordinates (xyz).
     pub camera_pos: Vec4,
-    /// Origin of `light_view_proj_rel` (xyz).
-    pub light_origin: Vec4,
     /// Direction the light travels (xyz, unit).
     pub light_dir: Vec4,
     /// Screen width, height, map N, d.
     pub dims: UVec4,
-    /// x: radians per pixel, y: ray-origin offset in pixels, z: relative float bound.
+    /// x: radians per pixel, y: ray-origin offset in pixels, z: relative float bound of |P|.
     pub offset: Vec4,
     /// x: front-only map flag, y: triangles in the prim buffer.
     pub misc: UVec4,
@@ -115,11 +111,11 @@ const _: () = {
     assert!(std::mem::size_of::<PrimBufferPush>() == 96);
     assert!(std::mem::offset_of!(PrimBufferPush, first_index) == 64);
     assert!(std::mem::size_of::<GBufferPush>() == 80);
-    assert!(std::mem::size_of::<PrimMapPush>() == 112);
-    assert!(std::mem::offset_of!(PrimMapPush, size) == 96);
-    assert!(std::mem::size_of::<RayTraceConstants>() == 224);
-    assert!(std::mem::offset_of!(RayTraceConstants, dims) == 176);
-    assert!(std::mem::offset_of!(RayTraceConstants, offset) == 192);
+    assert!(std::mem::size_of::<PrimMapPush>() == 96);
+    assert!(std::mem::offset_of!(PrimMapPush, size) == 80);
+    assert!(std::mem::size_of::<RayTraceConstants>() == 208);
+    assert!(std::mem::offset_of!(RayTraceConstants, dims) == 160);
+    assert!(std::mem::offset_of!(RayTraceConstants, offset) == 176);
     assert!(std::mem::size_of::<OccupancyPush>() == 8);
     assert!(std::mem::size_of::<MapStats>() == 16);
 };

@@ -1,10 +1,11 @@
-//! Prim buffer build: world-space triangles at `draw_call_offset + primitive_id`.
+//! Prim buffer build: triangles in frame coordinates (world minus the frame origin) at
+//! `draw_call_offset + primitive_id`.
 //!
 //! Reads: vertex buffer, index buffer. Writes: prim buffer.
 
 use crate::gpu_types::{GpuTriangle, PrimBufferPush};
 use crate::{shader, PassError};
-use glam::Mat4;
+use glam::{DMat4, DVec3, Mat4};
 use rhi::{
     BindGroup, BindingKind, Buffer, BufferUsage, ComputePipeline, Device, Encoder, MemoryLocation,
     Resource,
@@ -28,17 +29,28 @@ pub struct Geometry {
     vertex_count: u32,
     draws: Vec<Draw>,
     triangle_count: u32,
+    origin: DVec3,
 }
 
 impl Geometry {
     /// Uploads positions (xyz packed) and a triangle-list index buffer, validating every draw.
+    ///
+    /// `origin` is the frame origin, a world point near the geometry: the prim buffer and every pass work
+    /// in coordinates relative to it (transforms are rebased in f64), so precision does not depend on
+    /// where the scene sits in the world.
     pub fn upload(
         device: &Device,
         positions: &[f32],
         indices: &[u32],
         draws: &[Draw],
+        origin: DVec3,
     ) -> Result<Self, PassError> {
-        if positions.is_empty() || positions.len() % 3 != 0 {
+        if !origin.is_finite() {
+            return Err(PassError::InvalidGeometry(
+                "the frame origin is not finite".into(),
+            ));
+        }
+        if positions.is_empty() || !positions.len().is_multiple_of(3) {
             return Err(PassError::InvalidGeometry(
                 "positions must be a non-empty list of xyz triples".into(),
             ));
@@ -59,7 +71,7 @@ impl Geometry {
         let mut triangle_count = 0u32;
         for (n, d) in draws.iter().enumerate() {
             let end = u64::from(d.first_index) + u64::from(d.index_count);
-            if d.index_count % 3 != 0 || end > indices.len() as u64 {
+            if !d.index_count.is_multiple_of(3) || end > indices.len() as u64 {
                 return Err(PassError::InvalidGeometry(format!(
                     "draw {n} does not cover whole triangles of the index buffer"
                 )));
@@ -87,7 +99,13 @@ impl Geometry {
             vertex_count,
             draws: draws.to_vec(),
             triangle_count,
+            origin,
         })
+    }
+
+    /// The frame origin (world coordinates).
+    pub fn origin(&self) -> DVec3 {
+        self.origin
     }
 
     /// Total triangles over all draws (= prim buffer length).
@@ -148,8 +166,9 @@ impl PrimBufferPass {
             if count == 0 {
                 continue;
             }
+            let model = (DMat4::from_translation(-geometry.origin) * d.model.as_dmat4()).as_mat4();
             let push = PrimBufferPush {
-                model: d.model,
+                model,
                 first_index: d.first_index,
                 triangle_count: count,
                 prim_offset: offset,

@@ -15,9 +15,9 @@ use rhi::{
 /// this, and an offset below a pixel can never show as peter-panning.
 pub const RAY_OFFSET_PIXELS: f32 = 1.0 / 64.0;
 
-/// Relative float bound added to the offset, times (max |coordinate| + camera distance): covers the f32
-/// rounding of the reconstruction and of the stored vertices (16 ulps).
-pub const RAY_OFFSET_FLOAT_BOUND: f32 = 16.0 * f32::EPSILON;
+/// Relative float bound added to the offset, times the largest frame coordinate of the receiver: covers
+/// the rounding of camera + reconstructed offset, and of the stored vertices (4 ulps).
+pub const RAY_OFFSET_FLOAT_BOUND: f32 = 4.0 * f32::EPSILON;
 
 /// Inputs of the ray trace.
 pub struct RayTraceInputs<'a> {

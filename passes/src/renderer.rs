@@ -24,10 +24,8 @@ pub struct FrameInputs {
     pub camera_position: Vec3,
     /// Direction the light travels (unit).
     pub light_direction: Vec3,
-    /// Orthographic light view-projection enclosing the scene.
+    /// Orthographic light view-projection enclosing the scene (world coordinates).
     pub light_view_proj: Mat4,
-    /// A world point near the scene (e.g. its centre); matrices are rebased on it to keep f32 precision.
-    pub light_origin: Vec3,
 }
 
 /// What the frame did.
@@ -43,7 +41,7 @@ pub struct FrameReport {
 
 /// Everything the frame produced, read back to the host. Row-major, y = 0 at the top.
 pub struct FrameImages {
-    /// World position, w = 1 on geometry.
+    /// World position (frame origin added back in f64), w = 1 on geometry.
     pub position: Vec<[f32; 4]>,
     /// Camera-facing normal, w = 1 on geometry.
     pub normal: Vec<[f32; 4]>,
@@ -75,8 +73,9 @@ pub struct ShadowRenderer {
     height: u32,
 }
 
-fn rebased(m: Mat4, origin: DVec3) -> Mat4 {
-    (m.as_dmat4() * DMat4::from_translation(origin)).as_mat4()
+/// `m * translation(origin)` in f64: `m` applied to coordinates relative to `origin`.
+fn rebased(m: Mat4, origin: DVec3) -> DMat4 {
+    m.as_dmat4() * DMat4::from_translation(origin)
 }
 
 impl ShadowRenderer {
@@ -141,13 +140,12 @@ impl ShadowRenderer {
         inputs: &FrameInputs,
     ) -> Result<FrameReport, PassError> {
         let cam = inputs.camera_position.as_dvec3();
-        let view_proj_rel = rebased(inputs.proj * inputs.view, cam);
-        let inv_view_proj_rel =
-            (inputs.proj.as_dmat4() * inputs.view.as_dmat4() * DMat4::from_translation(cam))
-                .inverse()
-                .as_mat4();
-        let origin = inputs.light_origin.as_dvec3();
-        let light_rel = rebased(inputs.light_view_proj, origin);
+        let camera_rel = inputs.proj.as_dmat4() * rebased(inputs.view, cam);
+        let view_proj_rel = camera_rel.as_mat4();
+        let inv_view_proj_rel = camera_rel.inverse().as_mat4();
+        let origin = self.geometry.origin();
+        let light_rel = rebased(inputs.light_view_proj, origin).as_mat4();
+        let camera_frame = (cam - origin).as_vec3();
         let dir = inputs.light_direction.normalize();
         if !dir.is_finite()
             || !view_proj_rel.is_finite()
@@ -161,8 +159,7 @@ impl ShadowRenderer {
         let radians_per_pixel = 2.0 / (inputs.proj.y_axis.y * self.height as f32);
         let cfg = *self.map.config();
         let map_push = PrimMapPush {
-            light_view_proj_rel: light_rel,
-            origin: inputs.light_origin.extend(1.0),
+            light_view_proj: light_rel,
             to_light: (-dir).extend(0.0),
             size: cfg.size,
             depth: cfg.depth,
@@ -171,9 +168,8 @@ impl ShadowRenderer {
         };
         let rt = RayTraceConstants {
             inv_view_proj_rel,
-            light_view_proj_rel: light_rel,
-            camera_pos: inputs.camera_position.extend(1.0),
-            light_origin: inputs.light_origin.extend(1.0),
+            light_view_proj: light_rel,
+            camera_pos: camera_frame.extend(1.0),
             light_dir: dir.extend(0.0),
             dims: UVec4::new(self.width, self.height, cfg.size, cfg.depth),
             offset: Vec4::new(
@@ -186,7 +182,7 @@ impl ShadowRenderer {
         };
         let gpush = GBufferPush {
             view_proj_rel,
-            camera_pos: inputs.camera_position.extend(1.0),
+            camera_pos: camera_frame.extend(1.0),
         };
         let tris = self.geometry.triangle_count();
         let build_prims = !self.prims_built;
@@ -360,7 +356,10 @@ impl ShadowRenderer {
         })?;
         let bytes = |i: usize| buffers[i].read();
         Ok(FrameImages {
-            position: bytemuck::pod_collect_to_vec(bytes(0)?),
+            position: to_world(
+                bytemuck::pod_collect_to_vec(bytes(0)?),
+                self.geometry.origin(),
+            ),
             normal: bytemuck::pod_collect_to_vec(bytes(1)?),
             depth: bytemuck::pod_collect_to_vec(bytes(2)?),
             visibility: bytemuck::pod_collect_to_vec(bytes(3)?),
@@ -381,4 +380,12 @@ fn into_rhi(e: PassError) -> rhi::RhiError {
         PassError::Rhi(r) => r,
         other => rhi::RhiError::InvalidArgument(other.to_string()),
     }
+}
+
+fn to_world(mut frame: Vec<[f32; 4]>, origin: DVec3) -> Vec<[f32; 4]> {
+    for p in frame.iter_mut().filter(|p| p[3] != 0.0) {
+        let w = DVec3::new(p[0].into(), p[1].into(), p[2].into()) + origin;
+        [p[0], p[1], p[2]] = w.as_vec3().to_array();
+    }
+    frame
 }

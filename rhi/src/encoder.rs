@@ -517,7 +517,7 @@ impl<'a> Encoder<'a> {
 }
 
 fn check_push(push: &[u8], declared: u32) -> Result<()> {
-    if push.len() as u64 > u64::from(declared) || push.len() % 4 != 0 {
+    if push.len() as u64 > u64::from(declared) || !push.len().is_multiple_of(4) {
         return Err(RhiError::InvalidArgument(format!(
             "push constants of {} bytes do not fit the layout's {declared} bytes",
             push.len()

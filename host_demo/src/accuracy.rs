@@ -1,0 +1,197 @@
+//! Accuracy of a rendered frame against the exact CPU reference, as counts: primitive-map texel lists
+//! against exact conservative binning, and ray-traced visibility against exact visibility.
+
+use crate::View;
+use passes::{FrameImages, PrimitiveMapConfig};
+use reference::{
+    conservative_texel_sets, overlaps_texel_with_margin, reference_visibility, FaceSelection,
+    Light, PixelClass, RefScene, VisibilityParams,
+};
+
+/// Margin (texels) within which an extra primitive-map entry is legitimate: the software path accepts
+/// texels grown by 1/512 texel; allow the f32 projection error on top.
+pub const EXTRA_MARGIN_TEXELS: f64 = 1.0 / 256.0;
+
+/// Outcome of comparing a GPU primitive map with the exact conservative sets.
+#[derive(Debug, Default, PartialEq, Eq)]
+pub struct MapComparison {
+    /// Texels compared (not overflowed).
+    pub texels: usize,
+    /// Required triangles absent from a texel's list.
+    pub missing: usize,
+    /// Entries beyond the exact set but within `EXTRA_MARGIN_TEXELS` of the texel.
+    pub extra_within_margin: usize,
+    /// Entries out of range, duplicated, or not touching the texel even with the margin.
+    pub garbage: usize,
+    /// Texels whose count exceeded d (their lists are checked for garbage only).
+    pub overflowed: usize,
+}
+
+/// Compares every texel's list with the exact conservative set.
+pub fn compare_map(
+    rs: &RefScene,
+    view: &View,
+    config: &PrimitiveMapConfig,
+    images: &FrameImages,
+    faces: FaceSelection,
+) -> MapComparison {
+    let inputs = view.frame_inputs();
+    let n = config.size;
+    let d = config.depth as usize;
+    let sets =
+        conservative_texel_sets(rs, inputs.light_view_proj, inputs.light_direction, n, faces);
+    let tri_count = rs.triangle_count() as u32;
+    let plane = (n * n) as usize;
+    let mut c = MapComparison::default();
+    for y in 0..n {
+        for x in 0..n {
+            let t = (y * n + x) as usize;
+            let count = images.counts[t] as usize;
+            let stored: Vec<u32> = (0..count.min(d))
+                .map(|s| images.indices[s * plane + t])
+                .collect();
+            let mut sorted = stored.clone();
+            sorted.sort_unstable();
+            sorted.dedup();
+            c.garbage += stored.len() - sorted.len();
+            let exact = sets.texel(x, y);
+            for &i in &sorted {
+                if i >= tri_count {
+                    c.garbage += 1;
+                } else if exact.binary_search(&i).is_err() {
+                    if overlaps_texel_with_margin(
+                        rs,
+                        inputs.light_view_proj,
+                        n,
+                        i,
+                        x,
+                        y,
+                        EXTRA_MARGIN_TEXELS,
+                    ) {
+                        c.extra_within_margin += 1;
+                    } else {
+                        c.garbage += 1;
+                    }
+                }
+            }
+            if count > d {
+                c.overflowed += 1;
+                continue;
+            }
+            c.texels += 1;
+            c.missing += exact
+                .iter()
+                .filter(|i| sorted.binary_search(i).is_err())
+                .count();
+        }
+    }
+    c
+}
+
+/// Outcome of comparing GPU visibility with the exact reference.
+#[derive(Debug, Default)]
+pub struct VisibilityComparison {
+    /// Pixels compared.
+    pub pixels: usize,
+    /// Pixels the reference classes as near an edge/plane within tolerance (not compared).
+    pub near_edge: usize,
+    /// Lit/shadowed/background disagreements outside near-edge pixels.
+    pub mismatches: usize,
+    /// Exact shadowed pixels.
+    pub shadowed: usize,
+    /// Shadowed pixels with a certain nearest blocker whose GPU distance differs by more than the bound.
+    pub blocker_mismatches: usize,
+    /// Largest blocker-distance error seen (world units).
+    pub max_blocker_error: f64,
+    /// NaN or Inf in GPU visibility or blocker distance.
+    pub non_finite: usize,
+    /// First mismatching pixels, for failure messages.
+    pub examples: Vec<(u32, u32, &'static str, f32)>,
+}
+
+/// Tolerance of the reference per unit of camera distance: 1/16 of the pixel footprint — four times the
+/// GPU's ray-origin offset, and above the receiver displacement of 1/512-pixel vertex snapping down to
+/// view angles of a few degrees.
+pub fn tolerance_per_distance(view: &View) -> f64 {
+    2.0 * (view.camera.fov_y_radians as f64 / 2.0).tan() / view.height as f64 / 16.0
+}
+
+/// Absolute floor of the reference tolerance: 64 f32 ulps of the scene's largest coordinate.
+pub fn absolute_tolerance(view: &View) -> f64 {
+    let b = view.scene.bounds();
+    let magnitude = b.min.abs().max(b.max.abs()).max_element() as f64;
+    64.0 * f64::from(f32::EPSILON) * magnitude
+}
+
+/// Compares GPU visibility and blocker distance with the exact reference.
+pub fn compare_visibility(
+    rs: &RefScene,
+    view: &View,
+    images: &FrameImages,
+) -> VisibilityComparison {
+    let inputs = view.frame_inputs();
+    let tolerance = absolute_tolerance(view);
+    let per_distance = tolerance_per_distance(view);
+    let params = VisibilityParams {
+        width: view.width,
+        height: view.height,
+        view_proj: inputs.proj * inputs.view,
+        camera_position: inputs.camera_position,
+        light: Light::Directional {
+            direction: inputs.light_direction.as_dvec3(),
+        },
+        tolerance,
+        tolerance_per_distance: per_distance,
+        pixel_tolerance: 1.0 / 128.0,
+    };
+    let r = reference_visibility(rs, &params);
+    let mut c = VisibilityComparison::default();
+    let far = (view.camera.position - view.scene.bounds().center()).length() as f64
+        + view.scene.bounds().radius() as f64;
+    let bd_bound = 4.0 * (tolerance + far * per_distance);
+    for (i, class) in r.class.iter().enumerate() {
+        let (x, y) = (i as u32 % view.width, i as u32 / view.width);
+        let vis = images.visibility[i];
+        let bd = images.blocker_distance[i];
+        c.pixels += 1;
+        if !vis.is_finite() || !bd.is_finite() {
+            c.non_finite += 1;
+        }
+        let expected = match class {
+            PixelClass::Ambiguous => {
+                c.near_edge += 1;
+                continue;
+            }
+            PixelClass::Background | PixelClass::Lit => 1.0,
+            PixelClass::Shadowed => {
+                c.shadowed += 1;
+                0.0
+            }
+        };
+        if vis != expected {
+            c.mismatches += 1;
+            if c.examples.len() < 8 {
+                let what = match class {
+                    PixelClass::Background => "background",
+                    PixelClass::Lit => "lit",
+                    _ => "shadowed",
+                };
+                c.examples.push((x, y, what, vis));
+            }
+            continue;
+        }
+        let ref_bd = r.blocker_distance[i];
+        if *class == PixelClass::Shadowed && ref_bd.is_finite() && ref_bd > 0.0 {
+            let err = (f64::from(bd) - ref_bd).abs();
+            c.max_blocker_error = c.max_blocker_error.max(err);
+            if err > bd_bound.max(ref_bd * 1e-4) {
+                c.blocker_mismatches += 1;
+                if c.examples.len() < 8 {
+                    c.examples
+                        .push((x, y, "blocker distance", bd - ref_bd as f32));
+                }
+            }
+        }
+    }
+    c
+}
