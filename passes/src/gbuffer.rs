@@ -10,11 +10,9 @@ use rhi::{
     Resource,
 };
 
-/// G-buffer targets and the pass that fills them.
-pub struct GBufferPass {
-    pipeline: GraphicsPipeline,
-    group: BindGroup,
-    /// World position (xyz), w = 1 on geometry, 0 on background.
+/// The G-buffer's images.
+pub struct GBufferTargets {
+    /// World position in frame coordinates (xyz), w = 1 on geometry, 0 on background.
     pub position: Image,
     /// Geometric normal facing the camera (xyz), w = 1 on geometry.
     pub normal: Image,
@@ -22,14 +20,9 @@ pub struct GBufferPass {
     pub depth: Image,
 }
 
-impl GBufferPass {
+impl GBufferTargets {
     /// Creates `width` x `height` targets.
-    pub fn new(
-        device: &Device,
-        prims: &Buffer,
-        width: u32,
-        height: u32,
-    ) -> Result<Self, PassError> {
+    pub fn new(device: &Device, width: u32, height: u32) -> Result<Self, PassError> {
         let color = |name| ImageDesc {
             name,
             format: Format::Rgba32Float,
@@ -38,16 +31,30 @@ impl GBufferPass {
             layers: 1,
             usage: ImageUsage::COLOR_TARGET | ImageUsage::SAMPLED | ImageUsage::COPY_SRC,
         };
-        let position = device.create_image(&color("gbuffer position"))?;
-        let normal = device.create_image(&color("gbuffer normal"))?;
-        let depth = device.create_image(&ImageDesc {
-            name: "gbuffer depth",
-            format: Format::D32Float,
-            width,
-            height,
-            layers: 1,
-            usage: ImageUsage::DEPTH_TARGET | ImageUsage::SAMPLED | ImageUsage::COPY_SRC,
-        })?;
+        Ok(Self {
+            position: device.create_image(&color("gbuffer position"))?,
+            normal: device.create_image(&color("gbuffer normal"))?,
+            depth: device.create_image(&ImageDesc {
+                name: "gbuffer depth",
+                format: Format::D32Float,
+                width,
+                height,
+                layers: 1,
+                usage: ImageUsage::DEPTH_TARGET | ImageUsage::SAMPLED | ImageUsage::COPY_SRC,
+            })?,
+        })
+    }
+}
+
+/// The G-buffer pass over the prim buffer.
+pub struct GBufferPass {
+    pipeline: GraphicsPipeline,
+    group: BindGroup,
+}
+
+impl GBufferPass {
+    /// Creates the pass rasterizing `prims` into targets of [`GBufferTargets`].
+    pub fn new(device: &Device, prims: &Buffer) -> Result<Self, PassError> {
         let pipeline = device.create_graphics_pipeline(&GraphicsPipelineDesc {
             name: "gbuffer",
             vertex: &shader("gbuffer.vert")?,
@@ -66,37 +73,32 @@ impl GBufferPass {
             depth_clamp: false,
         })?;
         let group = device.create_bind_group(pipeline.layout(), &[Resource::Buffer(prims)])?;
-        Ok(Self {
-            pipeline,
-            group,
-            position,
-            normal,
-            depth,
-        })
+        Ok(Self { pipeline, group })
     }
 
     /// Records the pass; targets must be in `RenderTarget` / `DepthWrite` state.
     pub fn record(
         &self,
         enc: &mut Encoder<'_>,
+        targets: &GBufferTargets,
         push: &GBufferPush,
         triangle_count: u32,
     ) -> Result<(), PassError> {
         enc.begin_pass("gbuffer");
         enc.begin_rendering(
-            (self.position.width(), self.position.height()),
+            (targets.position.width(), targets.position.height()),
             &[
                 ColorTarget {
-                    image: &self.position,
+                    image: &targets.position,
                     clear: [0.0; 4],
                 },
                 ColorTarget {
-                    image: &self.normal,
+                    image: &targets.normal,
                     clear: [0.0; 4],
                 },
             ],
             Some(DepthTarget {
-                image: &self.depth,
+                image: &targets.depth,
                 clear: 0.0,
             }),
         );

@@ -8,13 +8,15 @@ pub mod prim_buffer;
 pub mod primitive_map;
 pub mod ray_trace;
 pub mod renderer;
+pub mod shadow_pipeline;
 
 pub use error::PassError;
 pub use prim_buffer::{Draw, Geometry};
 pub use primitive_map::{
     choose_raster_path, FaceMode, PrimitiveMapConfig, RasterPath, RasterRequest, GUARD_VALUE,
 };
-pub use renderer::{FrameImages, FrameInputs, FrameReport, ShadowRenderer};
+pub use renderer::{FrameImages, ShadowRenderer};
+pub use shadow_pipeline::{FrameInputs, FrameReport, ShadowInputs, ShadowPipeline};
 
 mod shaders {
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));

@@ -1,43 +1,14 @@
-//! The demo host's frame: prim buffer → G-buffer → primitive map → ray trace → occupancy, with GPU
-//! timings, map statistics and read-back of every output.
+//! The demo host's frame: prim buffer → G-buffer → [`ShadowPipeline`], submitted and waited for, with
+//! read-back of every output.
 
-use crate::gbuffer::GBufferPass;
-use crate::gpu_types::{GBufferPush, MapStats, PrimMapPush, RayTraceConstants};
-use crate::prim_buffer::{Geometry, PrimBufferPass};
-use crate::primitive_map::{FaceMode, PrimitiveMap, PrimitiveMapConfig, RasterPath};
-use crate::ray_trace::{RayTraceInputs, RayTracePass, RAY_OFFSET_FLOAT_BOUND, RAY_OFFSET_PIXELS};
+use crate::gbuffer::{GBufferPass, GBufferTargets};
+use crate::gpu_types::GBufferPush;
+use crate::prim_buffer::Geometry;
+use crate::primitive_map::PrimitiveMapConfig;
+use crate::shadow_pipeline::{FrameInputs, FrameReport, ShadowInputs, ShadowPipeline};
 use crate::PassError;
-use glam::{DMat4, DVec3, Mat4, UVec4, Vec3, Vec4};
-use rhi::{
-    Barrier, Buffer, BufferUsage, Device, GpuTimer, Image, MemoryLocation, PassTiming,
-    ResourceState as S,
-};
-
-/// Camera and light of one frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FrameInputs {
-    /// World to view.
-    pub view: Mat4,
-    /// View to clip: reversed Z (depth 1 at the near plane, 0 at infinity), Vulkan conventions.
-    pub proj: Mat4,
-    /// Camera position in world space.
-    pub camera_position: Vec3,
-    /// Direction the light travels (unit).
-    pub light_direction: Vec3,
-    /// Orthographic light view-projection enclosing the scene (world coordinates).
-    pub light_view_proj: Mat4,
-}
-
-/// What the frame did.
-#[derive(Debug, Clone, PartialEq)]
-pub struct FrameReport {
-    /// GPU time per pass (the prim buffer pass appears only on frames that rebuilt it).
-    pub timings: Vec<PassTiming>,
-    /// The raster path used.
-    pub raster_path: RasterPath,
-    /// Primitive-map statistics (overflow, occupancy).
-    pub stats: MapStats,
-}
+use glam::DVec3;
+use rhi::{Barrier, BufferUsage, Device, Image, MemoryLocation, ResourceState as S};
 
 /// Everything the frame produced, read back to the host. Row-major, y = 0 at the top.
 pub struct FrameImages {
@@ -49,7 +20,7 @@ pub struct FrameImages {
     pub depth: Vec<f32>,
     /// Ray-traced visibility (1 = lit).
     pub visibility: Vec<f32>,
-    /// Blocker distance (see [`RayTracePass::blocker_distance`]).
+    /// Blocker distance (see [`crate::ray_trace::RayTracePass::blocker_distance`]).
     pub blocker_distance: Vec<f32>,
     /// Occupancy view, N×N RGBA8.
     pub occupancy: Vec<[u8; 4]>,
@@ -59,23 +30,11 @@ pub struct FrameImages {
     pub indices: Vec<u32>,
 }
 
-/// Owns the passes and resources of the demo frame.
+/// The demo frame: a G-buffer of its own plus the engine-facing [`ShadowPipeline`].
 pub struct ShadowRenderer {
-    geometry: Geometry,
-    prim_buffer: PrimBufferPass,
+    targets: GBufferTargets,
     gbuffer: GBufferPass,
-    map: PrimitiveMap,
-    ray: RayTracePass,
-    timer: GpuTimer,
-    stats_readback: Buffer,
-    prims_built: bool,
-    width: u32,
-    height: u32,
-}
-
-/// `m * translation(origin)` in f64: `m` applied to coordinates relative to `origin`.
-fn rebased(m: Mat4, origin: DVec3) -> DMat4 {
-    m.as_dmat4() * DMat4::from_translation(origin)
+    pipeline: ShadowPipeline,
 }
 
 impl ShadowRenderer {
@@ -92,45 +51,23 @@ impl ShadowRenderer {
                 "frame size must be non-zero".into(),
             ));
         }
-        let prim_buffer = PrimBufferPass::new(device, &geometry)?;
-        let gbuffer = GBufferPass::new(device, prim_buffer.prims(), width, height)?;
-        let map = PrimitiveMap::new(device, prim_buffer.prims(), map_config)?;
-        let ray = RayTracePass::new(
-            device,
-            &RayTraceInputs {
-                depth: &gbuffer.depth,
-                normal: &gbuffer.normal,
-                count: &map.count,
-                indices: &map.indices,
-                prims: prim_buffer.prims(),
-            },
-            width,
-            height,
-        )?;
-        let timer = device.create_timer(16)?;
-        let stats_readback = device.create_buffer(
-            "stats read-back",
-            std::mem::size_of::<MapStats>() as u64,
-            BufferUsage::COPY_DST,
-            MemoryLocation::GpuToCpu,
-        )?;
+        let targets = GBufferTargets::new(device, width, height)?;
+        let inputs = ShadowInputs {
+            depth: &targets.depth,
+            normal: &targets.normal,
+        };
+        let pipeline = ShadowPipeline::new(device, geometry, &inputs, map_config)?;
+        let gbuffer = GBufferPass::new(device, pipeline.prims())?;
         Ok(Self {
-            geometry,
-            prim_buffer,
+            targets,
             gbuffer,
-            map,
-            ray,
-            timer,
-            stats_readback,
-            prims_built: false,
-            width,
-            height,
+            pipeline,
         })
     }
 
-    /// The primitive map.
-    pub fn primitive_map(&self) -> &PrimitiveMap {
-        &self.map
+    /// The engine-facing pipeline.
+    pub fn pipeline(&self) -> &ShadowPipeline {
+        &self.pipeline
     }
 
     /// Renders one frame and waits for it.
@@ -139,170 +76,61 @@ impl ShadowRenderer {
         device: &Device,
         inputs: &FrameInputs,
     ) -> Result<FrameReport, PassError> {
-        let cam = inputs.camera_position.as_dvec3();
-        let camera_rel = inputs.proj.as_dmat4() * rebased(inputs.view, cam);
-        let view_proj_rel = camera_rel.as_mat4();
-        let inv_view_proj_rel = camera_rel.inverse().as_mat4();
-        let origin = self.geometry.origin();
-        let light_rel = rebased(inputs.light_view_proj, origin).as_mat4();
-        let camera_frame = (cam - origin).as_vec3();
-        let dir = inputs.light_direction.normalize();
-        if !dir.is_finite()
-            || !view_proj_rel.is_finite()
-            || !inv_view_proj_rel.is_finite()
-            || !light_rel.is_finite()
-        {
-            return Err(PassError::InvalidConfig(
-                "camera or light matrices are not finite or invertible".into(),
-            ));
-        }
-        let radians_per_pixel = 2.0 / (inputs.proj.y_axis.y * self.height as f32);
-        let cfg = *self.map.config();
-        let map_push = PrimMapPush {
-            light_view_proj: light_rel,
-            to_light: (-dir).extend(0.0),
-            size: cfg.size,
-            depth: cfg.depth,
-            front_only: u32::from(cfg.faces == FaceMode::FrontOnly),
-            pad: 0,
-        };
-        let rt = RayTraceConstants {
-            inv_view_proj_rel,
-            light_view_proj: light_rel,
-            camera_pos: camera_frame.extend(1.0),
-            light_dir: dir.extend(0.0),
-            dims: UVec4::new(self.width, self.height, cfg.size, cfg.depth),
-            offset: Vec4::new(
-                radians_per_pixel,
-                RAY_OFFSET_PIXELS,
-                RAY_OFFSET_FLOAT_BOUND,
-                0.0,
-            ),
-            misc: UVec4::new(map_push.front_only, self.geometry.triangle_count(), 0, 0),
-        };
-        let gpush = GBufferPush {
+        let (view_proj_rel, camera_frame) = self.pipeline.camera_in_frame(inputs)?;
+        let push = GBufferPush {
             view_proj_rel,
             camera_pos: camera_frame.extend(1.0),
         };
-        let tris = self.geometry.triangle_count();
-        let build_prims = !self.prims_built;
+        let tris = self.pipeline.geometry().triangle_count();
         let Self {
-            geometry,
-            prim_buffer,
+            targets,
             gbuffer,
-            map,
-            ray,
-            timer,
-            stats_readback,
-            ..
+            pipeline,
         } = self;
         device.submit_and_wait(|enc| {
-            enc.attach_timer(timer);
-            if build_prims {
-                prim_buffer.record(enc, geometry).map_err(into_rhi)?;
-                enc.barriers(&[Barrier::Uav]);
-            }
+            pipeline.begin_frame(enc).map_err(into_rhi)?;
             enc.barriers(&[
                 Barrier::Image {
-                    image: &gbuffer.position,
+                    image: &targets.position,
                     before: S::Undefined,
                     after: S::RenderTarget,
                 },
                 Barrier::Image {
-                    image: &gbuffer.normal,
+                    image: &targets.normal,
                     before: S::Undefined,
                     after: S::RenderTarget,
                 },
                 Barrier::Image {
-                    image: &gbuffer.depth,
+                    image: &targets.depth,
                     before: S::Undefined,
                     after: S::DepthWrite,
                 },
-                Barrier::Image {
-                    image: &map.count,
-                    before: S::Undefined,
-                    after: S::CopyDest,
-                },
-                Barrier::Image {
-                    image: &map.indices,
-                    before: S::Undefined,
-                    after: S::CopyDest,
-                },
-                Barrier::Image {
-                    image: &map.occupancy,
-                    before: S::Undefined,
-                    after: S::UnorderedAccess,
-                },
-                Barrier::Image {
-                    image: &ray.visibility,
-                    before: S::Undefined,
-                    after: S::UnorderedAccess,
-                },
-                Barrier::Image {
-                    image: &ray.blocker_distance,
-                    before: S::Undefined,
-                    after: S::UnorderedAccess,
-                },
             ]);
-            gbuffer.record(enc, &gpush, tris).map_err(into_rhi)?;
-            map.record_clear(enc);
+            gbuffer
+                .record(enc, targets, &push, tris)
+                .map_err(into_rhi)?;
             enc.barriers(&[
                 Barrier::Image {
-                    image: &map.count,
-                    before: S::CopyDest,
-                    after: S::UnorderedAccess,
-                },
-                Barrier::Image {
-                    image: &map.indices,
-                    before: S::CopyDest,
-                    after: S::UnorderedAccess,
-                },
-                Barrier::Global {
-                    before: S::CopyDest,
-                    after: S::UnorderedAccess,
-                },
-            ]);
-            map.record_raster(enc, &map_push, tris).map_err(into_rhi)?;
-            enc.barriers(&[
-                Barrier::Uav,
-                Barrier::Image {
-                    image: &gbuffer.normal,
+                    image: &targets.normal,
                     before: S::RenderTarget,
                     after: S::ShaderResource,
                 },
                 Barrier::Image {
-                    image: &gbuffer.depth,
+                    image: &targets.depth,
                     before: S::DepthWrite,
                     after: S::ShaderResource,
                 },
             ]);
-            ray.record(enc, &rt).map_err(into_rhi)?;
-            map.record_occupancy(enc).map_err(into_rhi)?;
-            enc.barriers(&[Barrier::Global {
-                before: S::UnorderedAccess,
-                after: S::CopySource,
-            }]);
-            enc.copy_buffer(&map.stats, stats_readback)?;
-            enc.barriers(&[Barrier::Global {
-                before: S::CopyDest,
-                after: S::HostRead,
-            }]);
-            Ok(())
+            pipeline.record(enc, inputs).map_err(into_rhi)
         })?;
-        self.prims_built = true;
-        let stats: MapStats = bytemuck::pod_read_unaligned(self.stats_readback.read()?);
-        Ok(FrameReport {
-            timings: self.timer.resolve()?,
-            raster_path: self.map.path(),
-            stats,
-        })
+        self.pipeline.report()
     }
 
     /// Reads back the last frame's outputs (the index map only if `with_indices`).
     pub fn read_back(&self, device: &Device, with_indices: bool) -> Result<FrameImages, PassError> {
-        let g = &self.gbuffer;
-        let m = &self.map;
-        let r = &self.ray;
+        let g = &self.targets;
+        let m = self.pipeline.primitive_map();
+        let r = self.pipeline.ray_trace();
         let mut list: Vec<(&Image, S)> = vec![
             (&g.position, S::RenderTarget),
             (&g.normal, S::ShaderResource),
@@ -355,11 +183,9 @@ impl ShadowRenderer {
             Ok(())
         })?;
         let bytes = |i: usize| buffers[i].read();
+        let origin = self.pipeline.geometry().origin();
         Ok(FrameImages {
-            position: to_world(
-                bytemuck::pod_collect_to_vec(bytes(0)?),
-                self.geometry.origin(),
-            ),
+            position: to_world(bytemuck::pod_collect_to_vec(bytes(0)?), origin),
             normal: bytemuck::pod_collect_to_vec(bytes(1)?),
             depth: bytemuck::pod_collect_to_vec(bytes(2)?),
             visibility: bytemuck::pod_collect_to_vec(bytes(3)?),
