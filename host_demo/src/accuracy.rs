@@ -2,7 +2,8 @@
 //! against exact conservative binning, and ray-traced visibility against exact visibility.
 
 use crate::View;
-use passes::{FrameImages, PrimitiveMapConfig};
+use glam::DVec3;
+use passes::{FrameImages, FrameInputs, PrimitiveMapConfig};
 use reference::{
     conservative_texel_sets, overlaps_texel_with_margin, reference_visibility, FaceSelection,
     Light, PixelClass, RefScene, VisibilityParams,
@@ -27,7 +28,7 @@ pub struct MapComparison {
     pub overflowed: usize,
 }
 
-/// Compares every texel's list with the exact conservative set.
+/// Compares every texel's list with the exact conservative set, for the light matrix fitted to the view.
 pub fn compare_map(
     rs: &RefScene,
     view: &View,
@@ -35,11 +36,27 @@ pub fn compare_map(
     images: &FrameImages,
     faces: FaceSelection,
 ) -> MapComparison {
-    let inputs = view.frame_inputs();
+    compare_map_with(rs, &view.frame_inputs(), config, images, faces)
+}
+
+/// [`compare_map`] for the light matrix and direction of `inputs` (e.g. a light matrix that is not fitted
+/// to the scene).
+pub fn compare_map_with(
+    rs: &RefScene,
+    inputs: &FrameInputs,
+    config: &PrimitiveMapConfig,
+    images: &FrameImages,
+    faces: FaceSelection,
+) -> MapComparison {
     let n = config.size;
     let d = config.depth as usize;
-    let sets =
-        conservative_texel_sets(rs, inputs.light_view_proj, inputs.light_direction, n, faces);
+    let sets = conservative_texel_sets(
+        rs,
+        inputs.light.view_proj(),
+        inputs.light.direction(),
+        n,
+        faces,
+    );
     let tri_count = rs.triangle_count() as u32;
     let plane = (n * n) as usize;
     let mut c = MapComparison::default();
@@ -61,7 +78,7 @@ pub fn compare_map(
                 } else if exact.binary_search(&i).is_err() {
                     if overlaps_texel_with_margin(
                         rs,
-                        inputs.light_view_proj,
+                        inputs.light.view_proj(),
                         n,
                         i,
                         x,
@@ -95,6 +112,8 @@ pub struct VisibilityComparison {
     pub pixels: usize,
     /// Pixels the reference classes as near an edge/plane within tolerance (not compared).
     pub near_edge: usize,
+    /// Per pixel (row-major): whether it is near an edge.
+    pub near_edge_mask: Vec<bool>,
     /// Lit/shadowed/background disagreements outside near-edge pixels.
     pub mismatches: usize,
     /// Exact shadowed pixels.
@@ -116,10 +135,13 @@ pub fn tolerance_per_distance(view: &View) -> f64 {
     2.0 * (view.camera.fov_y_radians as f64 / 2.0).tan() / view.height as f64 / 16.0
 }
 
-/// Absolute floor of the reference tolerance: 64 f32 ulps of the scene's largest coordinate.
+/// Absolute floor of the reference tolerance: 64 f32 ulps of the largest frame coordinate. The passes work
+/// relative to the centre of the scene (the frame origin) and to the camera, so what matters is the scene's
+/// radius and the camera's distance from its centre, not where the scene sits in the world.
 pub fn absolute_tolerance(view: &View) -> f64 {
     let b = view.scene.bounds();
-    let magnitude = b.min.abs().max(b.max.abs()).max_element() as f64;
+    let from_center = (view.camera.position - b.center()).length();
+    let magnitude = f64::from(b.radius().max(from_center));
     64.0 * f64::from(f32::EPSILON) * magnitude
 }
 
@@ -132,20 +154,26 @@ pub fn compare_visibility(
     let inputs = view.frame_inputs();
     let tolerance = absolute_tolerance(view);
     let per_distance = tolerance_per_distance(view);
+    // The passes compose the camera matrices in f64 relative to the camera; so does the reference, with the
+    // rays starting at the view matrix's own eye.
+    let view_matrix = inputs.view.as_dmat4();
     let params = VisibilityParams {
         width: view.width,
         height: view.height,
-        view_proj: inputs.proj * inputs.view,
-        camera_position: inputs.camera_position,
+        view_proj: inputs.proj.as_dmat4() * view_matrix,
+        camera_position: view_matrix.inverse().transform_point3(DVec3::ZERO),
         light: Light::Directional {
-            direction: inputs.light_direction.as_dvec3(),
+            direction: inputs.light.direction().as_dvec3(),
         },
         tolerance,
         tolerance_per_distance: per_distance,
         pixel_tolerance: 1.0 / 128.0,
     };
     let r = reference_visibility(rs, &params);
-    let mut c = VisibilityComparison::default();
+    let mut c = VisibilityComparison {
+        near_edge_mask: vec![false; r.class.len()],
+        ..VisibilityComparison::default()
+    };
     let far = (view.camera.position - view.scene.bounds().center()).length() as f64
         + view.scene.bounds().radius() as f64;
     let bd_bound = 4.0 * (tolerance + far * per_distance);
@@ -160,6 +188,7 @@ pub fn compare_visibility(
         let expected = match class {
             PixelClass::Ambiguous => {
                 c.near_edge += 1;
+                c.near_edge_mask[i] = true;
                 continue;
             }
             PixelClass::Background | PixelClass::Lit => 1.0,

@@ -2,11 +2,14 @@
 //! integration tests, so that what the tests check is what the demo shows.
 
 pub mod accuracy;
+pub mod compare;
+pub mod hardcases;
+pub mod images;
 pub mod output;
 pub mod render;
 
 use glam::{Mat4, Vec3};
-use passes::{Draw, FrameInputs, Geometry, PassError};
+use passes::{Draw, FrameInputs, Geometry, Light, PassError};
 use rhi::Device;
 use scene::{Aabb, Camera, DirectionalLight, Scene};
 
@@ -48,8 +51,10 @@ impl View {
             view: self.camera.view(),
             proj: self.camera.proj(aspect),
             camera_position: self.camera.position,
-            light_direction: self.light.direction,
-            light_view_proj: self.light.view_proj(&bounds),
+            light: Light::Directional {
+                direction: self.light.direction,
+                view_proj: self.light.view_proj(&bounds),
+            },
         }
     }
 

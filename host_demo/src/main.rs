@@ -31,6 +31,11 @@ struct Cli {
 enum Command {
     /// Render one view: G-buffer, primitive map, ray-traced shadows; writes EXR/PNG/JSON and prints GPU timings.
     Render(RenderArgs),
+    /// Run the hard numerical cases against the exact reference and print a table; fails if any case fails.
+    Hardcases(host_demo::hardcases::HardcasesArgs),
+    /// The talk's side-by-sides on one view (shadow map 3K/8K, ray traced x64/x32, PCSS, hybrid standard and
+    /// shrinking): labelled composite PNG, the individual pictures and a caption file.
+    Compare(host_demo::compare::CompareArgs),
 }
 
 #[derive(clap::Args)]
@@ -74,6 +79,8 @@ struct RenderArgs {
     /// Frames to render (timings are medians over all but the first).
     #[arg(long, default_value_t = 5)]
     frames: u32,
+    #[command(flatten)]
+    soft: host_demo::render::SoftShadowArgs,
 }
 
 fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
@@ -131,6 +138,7 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
             guard_layer: false,
         },
         frames: args.frames,
+        soft: args.soft.clone(),
     };
     render_to_folder(&device, &view, &options, &args.out)?;
     let errors = device.validation().errors();
@@ -148,6 +156,12 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Render(args) => render(&cli, args),
+        Command::Hardcases(args) => {
+            host_demo::hardcases::run_cli(cli.device.clone(), cli.validation, args)
+        }
+        Command::Compare(args) => {
+            host_demo::compare::run_cli(cli.device.clone(), cli.validation, args)
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

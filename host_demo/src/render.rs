@@ -1,13 +1,67 @@
-//! `host_demo render`: one view of a scene through every pass, written to a folder.
+//! `host_demo render`: one view of a scene through every pass its plan runs, written to a folder.
 
+use crate::images::lerp_factor_preview;
 use crate::output::{shade_preview, write_exr_rgba, write_exr_scalar, write_png};
-use crate::View;
+use crate::{focus_bounds, View};
 use anyhow::{Context, Result};
-use passes::{FaceMode, FrameReport, PrimitiveMapConfig, RasterRequest, ShadowRenderer};
+use passes::{
+    FaceMode, FrameReport, HybridConfig, PassStatus, PcssConfig, PenumbraFilter,
+    PrimitiveMapConfig, RasterRequest, ResourceId, ResourceSet, ShadowConfig, ShadowMapConfig,
+    ShadowMode, ShadowRenderer,
+};
 use rhi::Device;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
+
+/// Soft-shadow and hybrid options of the command line (defaults: the talk's hybrid with FXAA, 3K shadow
+/// map, shrinking PCSS).
+#[derive(Debug, Clone, clap::Args)]
+pub struct SoftShadowArgs {
+    /// Shadow mode of the light: none, hard (ray traced), soft (PCSS) or hybrid.
+    #[arg(long, default_value = "hybrid", value_parser = parse_mode)]
+    pub mode: ShadowMode,
+    /// Turn off FXAA over the ray-traced shadow.
+    #[arg(long)]
+    pub no_antialiasing: bool,
+    /// Shadow map size (square).
+    #[arg(long, default_value_t = 3072)]
+    pub shadow_map_size: u32,
+    /// PCSS penumbra filter: shrinking or standard.
+    #[arg(long, default_value = "shrinking", value_parser = parse_filter)]
+    pub filter: PenumbraFilter,
+    /// Angular radius of the directional light in radians (PCSS light size).
+    #[arg(long, default_value_t = 0.02)]
+    pub angular_radius: f32,
+    /// PCSS blocker-search taps.
+    #[arg(long, default_value_t = 16)]
+    pub search_taps: u32,
+    /// PCSS PCF taps.
+    #[arg(long, default_value_t = 32)]
+    pub pcf_taps: u32,
+    /// Hybrid WSS, world-space scale (default: the bounding radius of the scene's objects, ground aside).
+    #[arg(long)]
+    pub wss: Option<f32>,
+    /// Hybrid PHS, percentage of hard shadow.
+    #[arg(long, default_value_t = 4.0)]
+    pub phs: f32,
+}
+
+impl Default for SoftShadowArgs {
+    fn default() -> Self {
+        Self {
+            mode: ShadowMode::Hybrid,
+            no_antialiasing: false,
+            shadow_map_size: 3072,
+            filter: PenumbraFilter::Shrinking,
+            angular_radius: 0.02,
+            search_taps: 16,
+            pcf_taps: 32,
+            wss: None,
+            phs: 4.0,
+        }
+    }
+}
 
 /// Options of a render besides the view.
 #[derive(Debug, Clone)]
@@ -16,6 +70,64 @@ pub struct RenderOptions {
     pub map: PrimitiveMapConfig,
     /// Frames rendered; timings are medians over the frames after the first.
     pub frames: u32,
+    /// Shadow mode, shadow map, PCSS and hybrid settings.
+    pub soft: SoftShadowArgs,
+}
+
+/// The world-space scale of a view's model: the bounding radius of its objects (the ground plane
+/// aside), at least a millimetre.
+pub fn default_world_space_scale(view: &View) -> f32 {
+    focus_bounds(&view.scene).radius().max(1e-3)
+}
+
+impl RenderOptions {
+    /// The pipeline configuration: the plan's final output plus every intermediate the demo writes.
+    pub fn shadow_config(&self, view: &View) -> ShadowConfig {
+        let s = &self.soft;
+        ShadowConfig {
+            mode: s.mode,
+            antialiasing: !s.no_antialiasing,
+            static_geometry: true,
+            // Every frame re-renders the light-space maps, so that their timings are medians too.
+            static_light: false,
+            map: self.map,
+            shadow_map: ShadowMapConfig {
+                size: s.shadow_map_size,
+                ..ShadowMapConfig::default()
+            },
+            pcss: PcssConfig {
+                angular_radius: s.angular_radius,
+                blocker_search_taps: s.search_taps,
+                pcf_taps: s.pcf_taps,
+                filter: s.filter,
+                ..PcssConfig::default()
+            },
+            hybrid: HybridConfig {
+                world_space_scale: s.wss.unwrap_or_else(|| default_world_space_scale(view)),
+                hard_shadow_percentage: s.phs,
+            },
+            extra_outputs: demo_outputs(s.mode),
+        }
+    }
+}
+
+/// What the demo writes for a mode: the ray trace and its blocker distance wherever the mode has them, the
+/// shadow-map views wherever it has a shadow map, the hybrid's parts in hybrid mode.
+fn demo_outputs(mode: ShadowMode) -> ResourceSet {
+    use ResourceId as R;
+    match mode {
+        ShadowMode::None => ResourceSet::EMPTY,
+        ShadowMode::Hard => ResourceSet::of(&[R::RtVisibility, R::BlockerDistance]),
+        ShadowMode::Soft => ResourceSet::of(&[R::ShadowMapVisibility, R::Pcss]),
+        ShadowMode::Hybrid => ResourceSet::of(&[
+            R::RtVisibility,
+            R::BlockerDistance,
+            R::ShadowMapVisibility,
+            R::Pcss,
+            R::LerpFactor,
+            R::Hybrid,
+        ]),
+    }
 }
 
 #[derive(Serialize)]
@@ -47,6 +159,40 @@ struct MapJson {
 }
 
 #[derive(Serialize)]
+struct SoftJson {
+    mode: &'static str,
+    antialiasing: bool,
+    shadow_map_size: u32,
+    filter: &'static str,
+    angular_radius: f32,
+    blocker_search_taps: u32,
+    pcf_taps: u32,
+    world_space_scale: f32,
+    hard_shadow_percentage: f32,
+}
+
+#[derive(Serialize)]
+struct PassJson {
+    pass: &'static str,
+    ran: bool,
+    reason: Option<&'static str>,
+}
+
+#[derive(Serialize)]
+struct ResourceJson {
+    resource: &'static str,
+    bytes: u64,
+}
+
+#[derive(Serialize)]
+struct PlanJson {
+    output: &'static str,
+    passes: Vec<PassJson>,
+    resources: Vec<ResourceJson>,
+    total_bytes: u64,
+}
+
+#[derive(Serialize)]
 struct DeviceJson {
     name: String,
     driver: String,
@@ -62,8 +208,11 @@ struct FrameJson {
     camera: CameraJson,
     light: LightJson,
     primitive_map: MapJson,
+    shadows: SoftJson,
+    plan: PlanJson,
     frames: u32,
     gpu_ms: BTreeMap<String, f64>,
+    gpu_ms_notes: BTreeMap<String, &'static str>,
     device: DeviceJson,
 }
 
@@ -96,6 +245,24 @@ pub fn median_timings(reports: &[FrameReport]) -> BTreeMap<String, f64> {
         .collect()
 }
 
+/// Name of the derived timing row of the talk's tables.
+pub const PCSS_PLUS_RAY_TRACE: &str = "PCSS + Ray Trace";
+
+/// Adds the talk's derived row: "PCSS + Ray Trace" is the sum of the medians of the two passes (they are
+/// separate dispatches), present when both ran. Returns the notes explaining derived rows.
+pub fn add_derived_rows(timings: &mut BTreeMap<String, f64>) -> BTreeMap<String, &'static str> {
+    let mut notes = BTreeMap::new();
+    if let (Some(p), Some(r)) = (timings.get("PCSS"), timings.get("ray trace")) {
+        let sum = p + r;
+        timings.insert(PCSS_PLUS_RAY_TRACE.to_owned(), sum);
+        notes.insert(
+            PCSS_PLUS_RAY_TRACE.to_owned(),
+            "sum of the medians of the PCSS and ray trace passes",
+        );
+    }
+    notes
+}
+
 /// Renders `view`, writes every output into `out`, prints the timing table, and returns the last report.
 pub fn render_to_folder(
     device: &Device,
@@ -105,7 +272,8 @@ pub fn render_to_folder(
 ) -> Result<FrameReport> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let geometry = view.upload(device).context("uploading the scene")?;
-    let mut renderer = ShadowRenderer::new(device, geometry, view.width, view.height, options.map)
+    let config = options.shadow_config(view);
+    let mut renderer = ShadowRenderer::new(device, geometry, view.width, view.height, config)
         .context("creating the shadow passes")?;
     let inputs = view.frame_inputs();
     let mut reports = Vec::new();
@@ -116,25 +284,46 @@ pub fn render_to_folder(
     let (w, h, n) = (view.width, view.height, options.map.size);
     write_exr_rgba(&out.join("position.exr"), w, h, &images.position)?;
     write_exr_rgba(&out.join("normal.exr"), w, h, &images.normal)?;
-    write_exr_scalar(&out.join("rt_visibility.exr"), w, h, &images.visibility)?;
-    write_exr_scalar(
-        &out.join("blocker_distance.exr"),
-        w,
-        h,
-        &images.blocker_distance,
-    )?;
-    write_png(&out.join("occupancy.png"), n, n, &images.occupancy)?;
+    let scalars = [
+        ("rt_visibility.exr", &images.visibility),
+        ("blocker_distance.exr", &images.blocker_distance),
+        ("rt_fxaa.exr", &images.antialiased),
+        ("shadow_map.exr", &images.shadow_map_visibility),
+        ("pcss.exr", &images.pcss),
+        ("lerp_factor.exr", &images.lerp_factor),
+        ("hybrid.exr", &images.hybrid),
+        ("final.exr", &images.output),
+    ];
+    for (name, values) in scalars {
+        if !values.is_empty() {
+            write_exr_scalar(&out.join(name), w, h, values)?;
+        }
+    }
+    if !images.occupancy.is_empty() {
+        write_png(&out.join("occupancy.png"), n, n, &images.occupancy)?;
+    }
+    if !images.lerp_factor.is_empty() {
+        write_png(
+            &out.join("lerp_factor.png"),
+            w,
+            h,
+            &lerp_factor_preview(&images.normal, &images.lerp_factor, &images.visibility),
+        )?;
+    }
+    let to_light = -view.light.direction;
     write_png(
         &out.join("preview.png"),
         w,
         h,
-        &shade_preview(&images.normal, &images.visibility, -view.light.direction),
+        &shade_preview(&images.normal, &images.output, to_light),
     )?;
 
     let report = reports.last().cloned().context("no frame rendered")?;
-    let timings = median_timings(&reports);
+    let mut timings = median_timings(&reports);
+    let notes = add_derived_rows(&mut timings);
     let caps = device.capabilities();
     let stats = report.stats;
+    let s = &options.soft;
     let json = FrameJson {
         width: w,
         height: h,
@@ -145,9 +334,9 @@ pub fn render_to_folder(
             position: inputs.camera_position.to_array(),
         },
         light: LightJson {
-            r#type: "directional",
-            direction: inputs.light_direction.to_array(),
-            view_proj: inputs.light_view_proj.to_cols_array(),
+            r#type: inputs.light.kind_name(),
+            direction: inputs.light.direction().to_array(),
+            view_proj: inputs.light.view_proj().to_cols_array(),
         },
         primitive_map: MapJson {
             size: n,
@@ -164,8 +353,21 @@ pub fn render_to_folder(
             stored_entries: stats.stored_entries,
             memory_bytes: options.map.memory_bytes(),
         },
+        shadows: SoftJson {
+            mode: s.mode.name(),
+            antialiasing: !s.no_antialiasing,
+            shadow_map_size: s.shadow_map_size,
+            filter: filter_name(s.filter),
+            angular_radius: s.angular_radius,
+            blocker_search_taps: s.search_taps,
+            pcf_taps: s.pcf_taps,
+            world_space_scale: config.hybrid.world_space_scale,
+            hard_shadow_percentage: config.hybrid.hard_shadow_percentage,
+        },
+        plan: plan_json(&report),
         frames: options.frames.max(1),
         gpu_ms: timings.clone(),
+        gpu_ms_notes: notes.clone(),
         device: DeviceJson {
             name: caps.device_name.clone(),
             driver: caps.driver.clone(),
@@ -194,9 +396,26 @@ pub fn render_to_folder(
         stats.overflowed_texels,
         stats.max_count
     );
+    println!(
+        "shadows: {} (FXAA {}), shadow map {}x{}, PCSS {} filter {}+{} taps, WSS {:.3}, PHS {}",
+        s.mode.name(),
+        if s.no_antialiasing { "off" } else { "on" },
+        s.shadow_map_size,
+        s.shadow_map_size,
+        filter_name(s.filter),
+        s.search_taps,
+        s.pcf_taps,
+        config.hybrid.world_space_scale,
+        config.hybrid.hard_shadow_percentage
+    );
+    print_plan(&report);
     println!("{:<28} {:>10}", "pass", "GPU ms");
     for (name, ms) in &timings {
-        println!("{name:<28} {ms:>10.3}");
+        let note = notes
+            .get(name)
+            .map(|n| format!("  ({n})"))
+            .unwrap_or_default();
+        println!("{name:<28} {ms:>10.3}{note}");
     }
     println!(
         "(medians over {} frames after the first; outputs in {})",
@@ -204,6 +423,65 @@ pub fn render_to_folder(
         out.display()
     );
     Ok(report)
+}
+
+fn plan_json(report: &FrameReport) -> PlanJson {
+    PlanJson {
+        output: report.output.name(),
+        passes: report
+            .passes
+            .iter()
+            .map(|&(pass, status)| PassJson {
+                pass: pass.name(),
+                ran: status == PassStatus::Ran,
+                reason: match status {
+                    PassStatus::Ran => None,
+                    PassStatus::Skipped(r) => Some(r.describe()),
+                },
+            })
+            .collect(),
+        resources: report
+            .resources
+            .iter()
+            .map(|r| ResourceJson {
+                resource: r.resource.name(),
+                bytes: r.bytes,
+            })
+            .collect(),
+        total_bytes: report.total_bytes(),
+    }
+}
+
+/// Prints which passes ran in the last frame, which were skipped and why, and the memory of each
+/// resource.
+pub fn print_plan(report: &FrameReport) {
+    println!("frame plan (last frame), output: {}", report.output.name());
+    for &(pass, status) in &report.passes {
+        match status {
+            PassStatus::Ran => println!("  ran      {}", pass.name()),
+            PassStatus::Skipped(r) => println!("  skipped  {} ({})", pass.name(), r.describe()),
+        }
+    }
+    for r in &report.resources {
+        println!(
+            "  {:<24} {:>10.2} MB",
+            r.resource.name(),
+            r.bytes as f64 / (1024.0 * 1024.0)
+        );
+    }
+    println!(
+        "  {:<24} {:>10.2} MB",
+        "total",
+        report.total_bytes() as f64 / (1024.0 * 1024.0)
+    );
+}
+
+/// "standard" or "shrinking".
+pub fn filter_name(f: PenumbraFilter) -> &'static str {
+    match f {
+        PenumbraFilter::Standard => "standard",
+        PenumbraFilter::Shrinking => "shrinking",
+    }
 }
 
 /// Parses the raster request of the command line.
@@ -222,5 +500,52 @@ pub fn parse_faces(s: &str) -> Result<FaceMode, String> {
         "both" => Ok(FaceMode::Both),
         "front" => Ok(FaceMode::FrontOnly),
         _ => Err(format!("unknown face mode '{s}' (both, front)")),
+    }
+}
+
+/// Parses a shadow mode.
+pub fn parse_mode(s: &str) -> Result<ShadowMode, String> {
+    match s {
+        "none" => Ok(ShadowMode::None),
+        "hard" => Ok(ShadowMode::Hard),
+        "soft" => Ok(ShadowMode::Soft),
+        "hybrid" => Ok(ShadowMode::Hybrid),
+        _ => Err(format!(
+            "unknown shadow mode '{s}' (none, hard, soft, hybrid)"
+        )),
+    }
+}
+
+/// Parses a penumbra filter.
+pub fn parse_filter(s: &str) -> Result<PenumbraFilter, String> {
+    match s {
+        "standard" => Ok(PenumbraFilter::Standard),
+        "shrinking" => Ok(PenumbraFilter::Shrinking),
+        _ => Err(format!(
+            "unknown penumbra filter '{s}' (standard, shrinking)"
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_modes_and_filters() {
+        assert_eq!(parse_mode("soft").unwrap(), ShadowMode::Soft);
+        assert!(parse_mode("medium").is_err());
+        assert_eq!(parse_filter("standard").unwrap(), PenumbraFilter::Standard);
+        assert!(parse_filter("wide").is_err());
+    }
+
+    #[test]
+    fn derived_row_is_the_sum() {
+        let mut t = BTreeMap::from([("PCSS".to_owned(), 1.5), ("ray trace".to_owned(), 0.25)]);
+        let notes = add_derived_rows(&mut t);
+        assert_eq!(t[PCSS_PLUS_RAY_TRACE], 1.75);
+        assert!(notes.contains_key(PCSS_PLUS_RAY_TRACE));
+        let mut only = BTreeMap::from([("ray trace".to_owned(), 0.25)]);
+        assert!(add_derived_rows(&mut only).is_empty());
     }
 }

@@ -158,5 +158,5 @@ fn render_writes_every_output() {
     assert_eq!(json["primitive_map"]["raster_path"], "software");
     assert!(json["primitive_map"]["overflowed_texels"].is_u64());
     assert!(json["gpu_ms"]["ray trace"].as_f64().unwrap() > 0.0);
-    assert!(json["device"]["name"].as_str().unwrap().len() > 0);
+    assert!(!json["device"]["name"].as_str().unwrap().is_empty());
 }

@@ -15,8 +15,8 @@ void main() {
     vec3 c = cross(t.v[1].xyz - t.v[0].xyz, t.v[2].xyz - t.v[0].xyz);
     float len = length(c);
     vec3 n = len > 0.0 ? c / len : vec3(0.0);
-    // Counter-clockwise (OBJ) front faces are front-facing; flip so the normal faces the camera.
-    if (!gl_FrontFacing) {
+    // Face the camera, decided geometrically (independent of winding and projection handedness).
+    if (dot(n, -rel_pos) < 0.0) {
         n = -n;
     }
     out_position = vec4(rel_pos + pc.camera_pos.xyz, 1.0);

@@ -32,10 +32,15 @@ void main() {
     bool valid = true;
     for (uint k = 0u; k < 3u; ++k) {
         uint i = pc.first_index + prim * 3u + k;
-        bool ok = i < uint(indices.length());
+        uint word = pc.index_16bit != 0u ? i / 2u : i;
+        bool ok = word < uint(indices.length());
         vec4 w = vec4(0.0, 0.0, 0.0, 1.0);
         if (ok) {
-            ok = fetch(indices[i], w);
+            uint index = indices[word];
+            if (pc.index_16bit != 0u) {
+                index = (i & 1u) != 0u ? index >> 16u : index & 0xFFFFu;
+            }
+            ok = fetch(index, w);
         }
         valid = valid && ok;
         t.v[k] = w;

@@ -13,6 +13,11 @@
 //   or vertex of a closed mesh always hits at least one triangle. Zero-determinant (degenerate or
 //   edge-on) triangles are rejected without dividing.
 // - Overflowed texels (count > d) are traced exhaustively against the whole prim buffer: exact, slower.
+// - Directional light: the ray runs along -light_dir without end. Spot light: the ray runs from the offset
+//   origin to the light position and only hits before it count (t < distance). The texel is the ray
+//   origin's under the light's projection: orthographic or perspective, every point of the shadow ray
+//   projects into that texel, because the ray is parallel to the projection direction or passes through
+//   the centre of projection.
 #include "triangle.glsl"
 #include "ray_trace_constants.glsl"
 
@@ -100,7 +105,8 @@ void main() {
     vec4 h = k.inv_view_proj_rel * vec4(ndc, depth, 1.0);
     vec3 rel = h.xyz / h.w;
     vec3 p = k.camera_pos.xyz + rel;
-    vec3 to_light = -k.light_dir.xyz;
+    bool spot = k.light_pos.w != 0.0;
+    vec3 to_light = spot ? k.light_pos.xyz - p : -k.light_dir.xyz;
     vec3 n = normal.xyz;
     if (dot(n, to_light) <= 0.0) {
         write(px, 0.0, 0.0);    // the visible side faces away from the light
@@ -109,9 +115,25 @@ void main() {
     vec3 ap = abs(p);
     float delta = length(rel) * k.offset.x * k.offset.y + max(max(ap.x, ap.y), ap.z) * k.offset.z;
     vec3 o = p + n * delta;
-    setup_ray(o, to_light);
+    // Hits count only before t_max: the light position for a spot light, nowhere for a directional one.
+    float t_max = 1.0 / 0.0;
+    vec3 dir = to_light;
+    if (spot) {
+        vec3 d = k.light_pos.xyz - o;
+        t_max = length(d);
+        if (!(t_max > 0.0)) {
+            write(px, 1.0, -1.0);   // the receiver is at the emitter
+            return;
+        }
+        dir = d / t_max;
+    }
+    setup_ray(o, dir);
 
     vec4 lc = k.light_view_proj * vec4(o, 1.0);
+    if (!(lc.w > 0.0)) {
+        write(px, 1.0, -1.0);   // behind a spot light: outside its frustum
+        return;
+    }
     vec2 uv = (lc.xy / lc.w * 0.5 + 0.5) * float(k.dims.z);
     if (any(lessThan(uv, vec2(0.0))) || any(greaterThanEqual(uv, vec2(float(k.dims.z))))) {
         write(px, 1.0, -1.0);   // outside the light's map: no recorded occluder
@@ -119,7 +141,7 @@ void main() {
     }
     ivec2 texel = ivec2(uv);
     uint count = imageLoad(count_map, texel).r;
-    float nearest = 1.0 / 0.0;
+    float nearest = t_max;
     if (count <= k.dims.w) {
         for (uint i = 0u; i < count; ++i) {
             consider(imageLoad(index_map, ivec3(texel, int(i))).r, nearest);
@@ -132,9 +154,9 @@ void main() {
             CONSIDER4(base) CONSIDER4(base + 4u) CONSIDER4(base + 8u) CONSIDER4(base + 12u)
         }
     }
-    if (isinf(nearest)) {
-        write(px, 1.0, -1.0);
-    } else {
+    if (nearest < t_max) {
         write(px, 0.0, nearest);
+    } else {
+        write(px, 1.0, -1.0);
     }
 }

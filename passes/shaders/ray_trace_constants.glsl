@@ -1,4 +1,4 @@
-// Mirrors passes::gpu_types::RayTraceConstants (208 bytes). Positions are in frame coordinates
+// Mirrors passes::gpu_types::RayTraceConstants (224 bytes). Positions are in frame coordinates
 // (relative to the geometry's frame origin).
 struct RayTraceConstants {
     mat4 inv_view_proj_rel;     // inverse(proj * view) with the camera at the origin
@@ -8,4 +8,5 @@ struct RayTraceConstants {
     uvec4 dims;                 // screen width, height, primitive map N, d
     vec4 offset;                // x: radians per pixel, y: offset in pixels, z: relative float bound of |P|
     uvec4 misc;                 // x: 1 = front-only map, y: triangles in the prim buffer, zw unused
+    vec4 light_pos;             // spot light: xyz position in frame coordinates, w = 1; directional: w = 0
 };

@@ -5,9 +5,8 @@
 use crate::gpu_types::GBufferPush;
 use crate::{shader, PassError};
 use rhi::{
-    BindGroup, BindingKind, Buffer, ColorTarget, CullMode, DepthState, DepthTarget, Device,
-    Encoder, Format, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, ImageUsage,
-    Resource,
+    BindGroup, BindingKind, Buffer, ColorTarget, DepthState, DepthTarget, Device, Encoder, Format,
+    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, ImageUsage, Resource,
 };
 
 /// The G-buffer's images.
@@ -68,7 +67,6 @@ impl GBufferPass {
                 write: true,
                 greater: true,
             }),
-            cull: CullMode::None,
             conservative_extra_overestimation: None,
             depth_clamp: false,
         })?;

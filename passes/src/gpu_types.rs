@@ -30,8 +30,10 @@ pub struct PrimBufferPush {
     pub vertex_offset: u32,
     /// Addressable vertices.
     pub vertex_count: u32,
+    /// 1 for packed u16 indices, 0 for u32.
+    pub index_16bit: u32,
     /// Padding.
-    pub pad: [u32; 2],
+    pub pad: u32,
 }
 
 /// Push constants of the G-buffer (`gbuffer_push.glsl`).
@@ -80,6 +82,8 @@ pub struct RayTraceConstants {
     pub offset: Vec4,
     /// x: front-only map flag, y: triangles in the prim buffer.
     pub misc: UVec4,
+    /// Spot light: position in frame coordinates (xyz), w = 1; directional light: w = 0.
+    pub light_pos: Vec4,
 }
 
 /// Push constants of the occupancy view (`occupancy.comp`).
@@ -106,6 +110,88 @@ pub struct MapStats {
     pub stored_entries: u32,
 }
 
+/// A light in frame coordinates, as light-space passes read it (`light.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct GpuLight {
+    /// View-projection of frame coordinates.
+    pub view_proj: Mat4,
+    /// Its inverse.
+    pub inv_view_proj: Mat4,
+    /// Linear depth of NDC `c = (x, y, d, 1)` is `dot(lin_num, c) / dot(lin_den, c)` (world units along
+    /// the light axis).
+    pub lin_num: Vec4,
+    /// See `lin_num`.
+    pub lin_den: Vec4,
+    /// Spot: position in frame coordinates, w = 1. Directional: zero.
+    pub position: Vec4,
+    /// Unit direction of travel (directional) or view axis (spot), w = 0.
+    pub direction: Vec4,
+    /// x: world size of a shadow-map texel (directional) or that size per unit of linear depth (spot);
+    /// y: emitter size (tangent of the angular radius, or radius); z: shadow-map size; w: 0 directional,
+    /// 1 spot.
+    pub params: Vec4,
+}
+
+/// Push constants of the shadow-map raster (`shadow_map.vert`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct ShadowMapPush {
+    /// Light view-projection of frame coordinates.
+    pub light_view_proj: Mat4,
+}
+
+/// Constants of PCSS and of the classic shadow-map test (`pcss_constants.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct PcssConstants {
+    /// inverse(proj * view) with the camera at the origin.
+    pub inv_view_proj_rel: Mat4,
+    /// Camera position in frame coordinates (xyz), w: radians per pixel.
+    pub camera_pos: Vec4,
+    /// Screen width, height, shadow-map size, mode (0 PCSS standard, 1 PCSS shrinking, 2 classic test).
+    pub dims: UVec4,
+    /// x: blocker-search taps, y: PCF taps.
+    pub taps: UVec4,
+    /// x: largest blocker-search radius, y: smallest and z: largest filter radius (texels).
+    pub radii: Vec4,
+    /// x, y: classic test constant and slope bias (texels); z: receiver-plane tolerance (texels of
+    /// slope); w: constant tolerance (texels of world size).
+    pub bias: Vec4,
+    /// The light.
+    pub light: GpuLight,
+}
+
+/// Push constants of FXAA (`fxaa.comp`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct FxaaPush {
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Longest edge search, in steps.
+    pub max_steps: u32,
+    /// Padding.
+    pub pad: u32,
+    /// x: relative contrast threshold, y: absolute contrast threshold, z: sub-pixel amount, w: unused.
+    pub params: Vec4,
+}
+
+/// Push constants of the lerp factor and the blend (`lerp_factor.comp`, `hybrid_blend.comp`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct HybridPush {
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// WSS: world-space scale.
+    pub world_space_scale: f32,
+    /// PHS: percentage of hard shadow.
+    pub hard_shadow_percentage: f32,
+}
+
 const _: () = {
     assert!(std::mem::size_of::<GpuTriangle>() == 48);
     assert!(std::mem::size_of::<PrimBufferPush>() == 96);
@@ -113,9 +199,17 @@ const _: () = {
     assert!(std::mem::size_of::<GBufferPush>() == 80);
     assert!(std::mem::size_of::<PrimMapPush>() == 96);
     assert!(std::mem::offset_of!(PrimMapPush, size) == 80);
-    assert!(std::mem::size_of::<RayTraceConstants>() == 208);
+    assert!(std::mem::size_of::<RayTraceConstants>() == 224);
+    assert!(std::mem::offset_of!(RayTraceConstants, light_pos) == 208);
     assert!(std::mem::offset_of!(RayTraceConstants, dims) == 160);
     assert!(std::mem::offset_of!(RayTraceConstants, offset) == 176);
     assert!(std::mem::size_of::<OccupancyPush>() == 8);
     assert!(std::mem::size_of::<MapStats>() == 16);
+    assert!(std::mem::size_of::<GpuLight>() == 208);
+    assert!(std::mem::offset_of!(GpuLight, params) == 192);
+    assert!(std::mem::size_of::<ShadowMapPush>() == 64);
+    assert!(std::mem::size_of::<PcssConstants>() == 352);
+    assert!(std::mem::offset_of!(PcssConstants, light) == 144);
+    assert!(std::mem::size_of::<FxaaPush>() == 32);
+    assert!(std::mem::size_of::<HybridPush>() == 16);
 };

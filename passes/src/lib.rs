@@ -2,21 +2,38 @@
 //! short unit that declares what it reads and writes, and the demo frame that strings them together.
 
 mod error;
+pub mod frame_plan;
+pub mod fxaa;
 pub mod gbuffer;
 pub mod gpu_types;
+pub mod hybrid;
+pub mod light;
+pub mod pcss;
 pub mod prim_buffer;
 pub mod primitive_map;
 pub mod ray_trace;
 pub mod renderer;
+mod screen_pass;
+pub mod shadow_map;
 pub mod shadow_pipeline;
 
 pub use error::PassError;
-pub use prim_buffer::{Draw, Geometry};
+pub use frame_plan::{
+    FramePlan, PassId, PassStatus, PenumbraFilter, PlanRequest, ResourceId, ResourceSet,
+    ShadowMode, SkipReason,
+};
+pub use hybrid::HybridConfig;
+pub use light::Light;
+pub use pcss::PcssConfig;
+pub use prim_buffer::{Draw, Geometry, IndexFormat, IndexLayout, VertexLayout};
 pub use primitive_map::{
     choose_raster_path, FaceMode, PrimitiveMapConfig, RasterPath, RasterRequest, GUARD_VALUE,
 };
 pub use renderer::{FrameImages, ShadowRenderer};
-pub use shadow_pipeline::{FrameInputs, FrameReport, ShadowInputs, ShadowPipeline};
+pub use shadow_map::ShadowMapConfig;
+pub use shadow_pipeline::{
+    FrameInputs, FrameReport, ResourceReport, ShadowConfig, ShadowInputs, ShadowPipeline,
+};
 
 mod shaders {
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));

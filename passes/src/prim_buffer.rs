@@ -22,11 +22,53 @@ pub struct Draw {
     pub model: Mat4,
 }
 
-/// Triangle geometry on the GPU: packed float3 positions, u32 indices, draws.
+/// Index element type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum IndexFormat {
+    /// 16-bit indices.
+    U16,
+    /// 32-bit indices.
+    U32,
+}
+
+impl IndexFormat {
+    fn bytes(self) -> u64 {
+        match self {
+            Self::U16 => 2,
+            Self::U32 => 4,
+        }
+    }
+}
+
+/// Where positions are in a vertex buffer: `R32G32B32_SFLOAT` at `offset + i * stride` bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct VertexLayout {
+    /// Byte offset of vertex 0 (multiple of 4).
+    pub offset: u64,
+    /// Byte stride (multiple of 4, at least 12).
+    pub stride: u32,
+    /// Number of vertices.
+    pub count: u32,
+}
+
+/// Where indices are in an index buffer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct IndexLayout {
+    /// Byte offset of index 0 (multiple of the index size; for 16-bit indices a multiple of 4).
+    pub offset: u64,
+    /// Element type.
+    pub format: IndexFormat,
+    /// Number of indices.
+    pub count: u32,
+}
+
+/// Triangle geometry on the GPU: vertex and index buffers (the plugin's own or the engine's), draws,
+/// and the frame origin.
 pub struct Geometry {
     vertices: Buffer,
     indices: Buffer,
-    vertex_count: u32,
+    vertex: VertexLayout,
+    index: IndexLayout,
     draws: Vec<Draw>,
     triangle_count: u32,
     origin: DVec3,
@@ -45,11 +87,6 @@ impl Geometry {
         draws: &[Draw],
         origin: DVec3,
     ) -> Result<Self, PassError> {
-        if !origin.is_finite() {
-            return Err(PassError::InvalidGeometry(
-                "the frame origin is not finite".into(),
-            ));
-        }
         if positions.is_empty() || !positions.len().is_multiple_of(3) {
             return Err(PassError::InvalidGeometry(
                 "positions must be a non-empty list of xyz triples".into(),
@@ -61,42 +98,105 @@ impl Geometry {
                 i / 3
             )));
         }
-        let vertex_count = u32::try_from(positions.len() / 3)
+        let count = u32::try_from(positions.len() / 3)
             .map_err(|_| PassError::InvalidGeometry("too many vertices".into()))?;
-        if let Some(&i) = indices.iter().find(|&&i| i >= vertex_count) {
+        if let Some(&i) = indices.iter().find(|&&i| i >= count) {
             return Err(PassError::InvalidGeometry(format!(
-                "index {i} is out of range ({vertex_count} vertices)"
+                "index {i} is out of range ({count} vertices)"
             )));
+        }
+        let index_count = u32::try_from(indices.len())
+            .map_err(|_| PassError::InvalidGeometry("too many indices".into()))?;
+        if index_count == 0 {
+            return Err(PassError::InvalidGeometry("no indices".into()));
+        }
+        let usage = BufferUsage::STORAGE;
+        Self::from_buffers(
+            device.create_buffer_init("vertices", bytemuck::cast_slice(positions), usage)?,
+            VertexLayout {
+                offset: 0,
+                stride: 12,
+                count,
+            },
+            device.create_buffer_init("indices", bytemuck::cast_slice(indices), usage)?,
+            IndexLayout {
+                offset: 0,
+                format: IndexFormat::U32,
+                count: index_count,
+            },
+            draws,
+            origin,
+        )
+    }
+
+    /// Geometry in existing buffers (e.g. the engine's, wrapped with `Device::external_buffer`; they need
+    /// storage-buffer usage). Layouts and draws are validated against the buffer sizes; an index that is
+    /// out of range at run time makes its triangle degenerate (never rasterized, never hit).
+    pub fn from_buffers(
+        vertices: Buffer,
+        vertex: VertexLayout,
+        indices: Buffer,
+        index: IndexLayout,
+        draws: &[Draw],
+        origin: DVec3,
+    ) -> Result<Self, PassError> {
+        let bad = |m: String| Err(PassError::InvalidGeometry(m));
+        if !origin.is_finite() {
+            return bad("the frame origin is not finite".into());
+        }
+        if vertex.stride < 12
+            || !vertex.stride.is_multiple_of(4)
+            || !vertex.offset.is_multiple_of(4)
+            || vertex.count == 0
+        {
+            return bad(format!("vertex layout {vertex:?}: stride must be a multiple of 4 and >= 12, offset a multiple of 4, count > 0"));
+        }
+        let vertex_end =
+            vertex.offset + u64::from(vertex.count - 1) * u64::from(vertex.stride) + 12;
+        if vertex_end > vertices.size() {
+            return bad(format!(
+                "{} vertices need {vertex_end} bytes, the vertex buffer has {}",
+                vertex.count,
+                vertices.size()
+            ));
+        }
+        let word_aligned = index.offset.is_multiple_of(4);
+        if !word_aligned || index.count == 0 {
+            return bad(format!(
+                "index layout {index:?}: offset must be a multiple of 4, count > 0"
+            ));
+        }
+        let index_end = index.offset + u64::from(index.count) * index.format.bytes();
+        if index_end > indices.size() {
+            return bad(format!(
+                "{} indices need {index_end} bytes, the index buffer has {}",
+                index.count,
+                indices.size()
+            ));
         }
         let mut triangle_count = 0u32;
         for (n, d) in draws.iter().enumerate() {
             let end = u64::from(d.first_index) + u64::from(d.index_count);
-            if !d.index_count.is_multiple_of(3) || end > indices.len() as u64 {
-                return Err(PassError::InvalidGeometry(format!(
+            if !d.index_count.is_multiple_of(3) || end > u64::from(index.count) {
+                return bad(format!(
                     "draw {n} does not cover whole triangles of the index buffer"
-                )));
+                ));
             }
             if !d.model.is_finite() {
-                return Err(PassError::InvalidGeometry(format!(
-                    "draw {n} has a non-finite transform"
-                )));
+                return bad(format!("draw {n} has a non-finite transform"));
             }
             triangle_count = triangle_count
                 .checked_add(d.index_count / 3)
                 .ok_or_else(|| PassError::InvalidGeometry("too many triangles".into()))?;
         }
         if triangle_count == 0 {
-            return Err(PassError::InvalidGeometry("no triangles".into()));
+            return bad("no triangles".into());
         }
-        let usage = BufferUsage::STORAGE;
         Ok(Self {
-            vertices: device.create_buffer_init(
-                "vertices",
-                bytemuck::cast_slice(positions),
-                usage,
-            )?,
-            indices: device.create_buffer_init("indices", bytemuck::cast_slice(indices), usage)?,
-            vertex_count,
+            vertices,
+            indices,
+            vertex,
+            index,
             draws: draws.to_vec(),
             triangle_count,
             origin,
@@ -169,13 +269,15 @@ impl PrimBufferPass {
             let model = (DMat4::from_translation(-geometry.origin) * d.model.as_dmat4()).as_mat4();
             let push = PrimBufferPush {
                 model,
-                first_index: d.first_index,
+                first_index: (geometry.index.offset / geometry.index.format.bytes()) as u32
+                    + d.first_index,
                 triangle_count: count,
                 prim_offset: offset,
-                vertex_stride: 3,
-                vertex_offset: 0,
-                vertex_count: geometry.vertex_count,
-                pad: [0; 2],
+                vertex_stride: geometry.vertex.stride / 4,
+                vertex_offset: (geometry.vertex.offset / 4) as u32,
+                vertex_count: geometry.vertex.count,
+                index_16bit: u32::from(geometry.index.format == IndexFormat::U16),
+                pad: 0,
             };
             enc.dispatch(
                 &self.pipeline,

@@ -7,8 +7,8 @@ use crate::gpu_types::{MapStats, OccupancyPush, PrimMapPush};
 use crate::{shader, PassError};
 use rhi::{
     BindGroup, BindingKind, Buffer, BufferUsage, Capabilities, ComputePipeline,
-    ConservativeRasterTier, CullMode, Device, Encoder, Format, GraphicsPipeline,
-    GraphicsPipelineDesc, Image, ImageDesc, ImageUsage, MemoryLocation, Resource,
+    ConservativeRasterTier, Device, Encoder, Format, GraphicsPipeline, GraphicsPipelineDesc, Image,
+    ImageDesc, ImageUsage, MemoryLocation, Resource,
 };
 
 /// Which faces of the scene are stored.
@@ -32,6 +32,9 @@ pub enum RasterRequest {
     Hardware,
     /// Force the geometry-shader path.
     Software,
+    /// Hardware conservative raster made to behave like D3D12 Tier 1 (1/2 px uncertainty, post-snap
+    /// degenerate triangles culled) on a device with a better tier: for tier-fallback tests.
+    EmulateTier1,
 }
 
 /// The conservative-raster path in use.
@@ -41,6 +44,11 @@ pub enum RasterPath {
     Hardware(ConservativeRasterTier),
     /// Geometry-shader dilation + exact per-texel overlap test (GPU Gems 2, ch. 42).
     Software,
+    /// Hardware conservative raster on a device of tier `native`, emulating Tier 1.
+    EmulatedTier1 {
+        /// The device's own tier.
+        native: ConservativeRasterTier,
+    },
 }
 
 impl RasterPath {
@@ -49,6 +57,7 @@ impl RasterPath {
         match self {
             Self::Hardware(_) => "hardware",
             Self::Software => "software",
+            Self::EmulatedTier1 { .. } => "hardware (tier-1 emulation)",
         }
     }
     /// The tier used ("none" for software).
@@ -56,6 +65,7 @@ impl RasterPath {
         match self {
             Self::Hardware(t) => t,
             Self::Software => ConservativeRasterTier::NotSupported,
+            Self::EmulatedTier1 { .. } => ConservativeRasterTier::Tier1,
         }
     }
 }
@@ -76,6 +86,10 @@ pub fn choose_raster_path(
             Err(PassError::Unsupported("geometry shaders (software conservative rasterization)".into()))
         }
         RasterRequest::Software => Ok(RasterPath::Software),
+        RasterRequest::EmulateTier1 if hw == ConservativeRasterTier::NotSupported || !sw_ok => Err(PassError::Unsupported(
+            "tier-1 emulation needs hardware conservative rasterization and geometry shaders".into(),
+        )),
+        RasterRequest::EmulateTier1 => Ok(RasterPath::EmulatedTier1 { native: hw }),
         RasterRequest::Auto if hw != ConservativeRasterTier::NotSupported => Ok(RasterPath::Hardware(hw)),
         RasterRequest::Auto if sw_ok => Ok(RasterPath::Software),
         RasterRequest::Auto => Err(PassError::Unsupported(
@@ -215,10 +229,15 @@ impl PrimitiveMap {
                 None,
             ),
             RasterPath::Hardware(_) => (None, shader("prim_map_hw.frag")?, Some(0.0)),
-        };
-        let cull = match (path, config.faces) {
-            (RasterPath::Hardware(_), FaceMode::FrontOnly) => CullMode::Back,
-            _ => CullMode::None,
+            RasterPath::EmulatedTier1 { .. } => {
+                let extra = (0.5 - caps.primitive_overestimation_size)
+                    .clamp(0.0, caps.max_extra_primitive_overestimation_size);
+                (
+                    Some(shader("prim_map_snap.geom")?),
+                    shader("prim_map_hw.frag")?,
+                    Some(extra),
+                )
+            }
         };
         let raster = device.create_graphics_pipeline(&GraphicsPipelineDesc {
             name: "primitive map",
@@ -233,7 +252,6 @@ impl PrimitiveMap {
             push_constant_size: std::mem::size_of::<PrimMapPush>() as u32,
             color_formats: &[],
             depth: None,
-            cull,
             conservative_extra_overestimation: extra,
             depth_clamp: true,
         })?;
@@ -309,6 +327,7 @@ impl PrimitiveMap {
         let name = match self.path {
             RasterPath::Hardware(_) => "primitive map (HW CR)",
             RasterPath::Software => "primitive map (SW CR)",
+            RasterPath::EmulatedTier1 { .. } => "primitive map (HW CR, tier-1 emulation)",
         };
         enc.begin_pass(name);
         enc.begin_rendering((self.config.size, self.config.size), &[], None);
@@ -406,6 +425,29 @@ mod tests {
         assert_eq!(
             choose_raster_path(&t1, RasterRequest::Software).unwrap(),
             RasterPath::Software
+        );
+    }
+
+    #[test]
+    fn tier1_emulation_needs_hardware_and_geometry_shaders() {
+        let t3 = caps(ConservativeRasterTier::Tier3, true);
+        assert_eq!(
+            choose_raster_path(&t3, RasterRequest::EmulateTier1).unwrap(),
+            RasterPath::EmulatedTier1 {
+                native: ConservativeRasterTier::Tier3
+            }
+        );
+        let lavapipe = caps(ConservativeRasterTier::NotSupported, true);
+        assert!(matches!(
+            choose_raster_path(&lavapipe, RasterRequest::EmulateTier1),
+            Err(PassError::Unsupported(_))
+        ));
+        assert_eq!(
+            RasterPath::EmulatedTier1 {
+                native: ConservativeRasterTier::Tier3
+            }
+            .tier(),
+            ConservativeRasterTier::Tier1
         );
     }
 

@@ -1,16 +1,19 @@
 //! The demo host's frame: prim buffer → G-buffer → [`ShadowPipeline`], submitted and waited for, with
-//! read-back of every output.
+//! read-back of every output the plan produced.
 
+use crate::frame_plan::ResourceId;
 use crate::gbuffer::{GBufferPass, GBufferTargets};
 use crate::gpu_types::GBufferPush;
 use crate::prim_buffer::Geometry;
-use crate::primitive_map::PrimitiveMapConfig;
-use crate::shadow_pipeline::{FrameInputs, FrameReport, ShadowInputs, ShadowPipeline};
+use crate::shadow_pipeline::{
+    FrameInputs, FrameReport, ShadowConfig, ShadowInputs, ShadowPipeline,
+};
 use crate::PassError;
 use glam::DVec3;
 use rhi::{Barrier, BufferUsage, Device, Image, MemoryLocation, ResourceState as S};
 
-/// Everything the frame produced, read back to the host. Row-major, y = 0 at the top.
+/// Everything the frame produced, read back to the host. Row-major, y = 0 at the top. Outputs the plan
+/// did not produce are empty.
 pub struct FrameImages {
     /// World position (frame origin added back in f64), w = 1 on geometry.
     pub position: Vec<[f32; 4]>,
@@ -28,6 +31,18 @@ pub struct FrameImages {
     pub counts: Vec<u32>,
     /// Index map, layer-major: `indices[(slot * N + y) * N + x]`; empty unless requested.
     pub indices: Vec<u32>,
+    /// Classic single-tap shadow-map visibility.
+    pub shadow_map_visibility: Vec<f32>,
+    /// PCSS visibility.
+    pub pcss: Vec<f32>,
+    /// Ray-traced visibility after FXAA.
+    pub antialiased: Vec<f32>,
+    /// Hybrid lerp factor.
+    pub lerp_factor: Vec<f32>,
+    /// Hybrid visibility.
+    pub hybrid: Vec<f32>,
+    /// The pipeline's final output ([`ShadowPipeline::output`]).
+    pub output: Vec<f32>,
 }
 
 /// The demo frame: a G-buffer of its own plus the engine-facing [`ShadowPipeline`].
@@ -38,26 +53,32 @@ pub struct ShadowRenderer {
 }
 
 impl ShadowRenderer {
-    /// Creates every pass for a `width` x `height` frame over `geometry`.
+    /// Creates every pass for a `width` x `height` frame over `geometry`. The plan of `config` also keeps
+    /// the prim buffer, which this G-buffer rasterizes.
     pub fn new(
         device: &Device,
         geometry: Geometry,
         width: u32,
         height: u32,
-        map_config: PrimitiveMapConfig,
+        config: impl Into<ShadowConfig>,
     ) -> Result<Self, PassError> {
         if width == 0 || height == 0 {
             return Err(PassError::InvalidConfig(
                 "frame size must be non-zero".into(),
             ));
         }
+        let mut config = config.into();
+        config.extra_outputs = config.extra_outputs.with(ResourceId::PrimBuffer);
         let targets = GBufferTargets::new(device, width, height)?;
         let inputs = ShadowInputs {
             depth: &targets.depth,
             normal: &targets.normal,
         };
-        let pipeline = ShadowPipeline::new(device, geometry, &inputs, map_config)?;
-        let gbuffer = GBufferPass::new(device, pipeline.prims())?;
+        let pipeline = ShadowPipeline::new(device, geometry, &inputs, config)?;
+        let prims = pipeline.prims().ok_or_else(|| {
+            PassError::InvalidConfig("the demo G-buffer needs the prim buffer".into())
+        })?;
+        let gbuffer = GBufferPass::new(device, prims)?;
         Ok(Self {
             targets,
             gbuffer,
@@ -129,23 +150,36 @@ impl ShadowRenderer {
     /// Reads back the last frame's outputs (the index map only if `with_indices`).
     pub fn read_back(&self, device: &Device, with_indices: bool) -> Result<FrameImages, PassError> {
         let g = &self.targets;
-        let m = self.pipeline.primitive_map();
-        let r = self.pipeline.ray_trace();
-        let mut list: Vec<(&Image, S)> = vec![
-            (&g.position, S::RenderTarget),
-            (&g.normal, S::ShaderResource),
-            (&g.depth, S::ShaderResource),
-            (&r.visibility, S::UnorderedAccess),
-            (&r.blocker_distance, S::UnorderedAccess),
-            (&m.occupancy, S::UnorderedAccess),
-            (&m.count, S::UnorderedAccess),
+        let p = &self.pipeline;
+        let uav = |r: ResourceId| p.image(r).map(|image| (image, S::UnorderedAccess));
+        let mut wanted: Vec<(Option<(&Image, S)>, Slot)> = vec![
+            (Some((&g.position, S::RenderTarget)), Slot::Position),
+            (Some((&g.normal, S::ShaderResource)), Slot::Normal),
+            (Some((&g.depth, S::ShaderResource)), Slot::Depth),
+            (uav(ResourceId::RtVisibility), Slot::Visibility),
+            (uav(ResourceId::BlockerDistance), Slot::BlockerDistance),
+            (uav(ResourceId::Occupancy), Slot::Occupancy),
+            (uav(ResourceId::PrimCountMap), Slot::Counts),
+            (
+                uav(ResourceId::ShadowMapVisibility),
+                Slot::ShadowMapVisibility,
+            ),
+            (uav(ResourceId::Pcss), Slot::Pcss),
+            (uav(ResourceId::RtAntialiased), Slot::Antialiased),
+            (uav(ResourceId::LerpFactor), Slot::LerpFactor),
+            (uav(ResourceId::Hybrid), Slot::Hybrid),
+            (Some((p.output(), S::UnorderedAccess)), Slot::Output),
         ];
         if with_indices {
-            list.push((&m.indices, S::UnorderedAccess));
+            wanted.push((uav(ResourceId::PrimIndexMap), Slot::Indices));
         }
+        let list: Vec<(&Image, S, Slot)> = wanted
+            .into_iter()
+            .filter_map(|(found, slot)| found.map(|(image, state)| (image, state, slot)))
+            .collect();
         let buffers = list
             .iter()
-            .map(|(img, _)| {
+            .map(|(img, _, _)| {
                 device.create_buffer(
                     "read-back",
                     img.byte_size(),
@@ -154,8 +188,15 @@ impl ShadowRenderer {
                 )
             })
             .collect::<Result<Vec<_>, _>>()?;
+        // The final output is one of the images above: transition each image once.
+        let mut distinct: Vec<(&Image, S)> = Vec::new();
+        for &(image, state, _) in &list {
+            if !distinct.iter().any(|(i, _)| std::ptr::eq(*i, image)) {
+                distinct.push((image, state));
+            }
+        }
         device.submit_and_wait(|enc| {
-            let to_copy: Vec<Barrier<'_>> = list
+            let to_copy: Vec<Barrier<'_>> = distinct
                 .iter()
                 .map(|&(image, before)| Barrier::Image {
                     image,
@@ -164,10 +205,10 @@ impl ShadowRenderer {
                 })
                 .collect();
             enc.barriers(&to_copy);
-            for ((img, _), buf) in list.iter().zip(&buffers) {
+            for ((img, _, _), buf) in list.iter().zip(&buffers) {
                 enc.copy_image_to_buffer(img, buf)?;
             }
-            let back: Vec<Barrier<'_>> = list
+            let back: Vec<Barrier<'_>> = distinct
                 .iter()
                 .map(|&(image, after)| Barrier::Image {
                     image,
@@ -182,23 +223,66 @@ impl ShadowRenderer {
             }]);
             Ok(())
         })?;
-        let bytes = |i: usize| buffers[i].read();
-        let origin = self.pipeline.geometry().origin();
-        Ok(FrameImages {
-            position: to_world(bytemuck::pod_collect_to_vec(bytes(0)?), origin),
-            normal: bytemuck::pod_collect_to_vec(bytes(1)?),
-            depth: bytemuck::pod_collect_to_vec(bytes(2)?),
-            visibility: bytemuck::pod_collect_to_vec(bytes(3)?),
-            blocker_distance: bytemuck::pod_collect_to_vec(bytes(4)?),
-            occupancy: bytemuck::pod_collect_to_vec(bytes(5)?),
-            counts: bytemuck::pod_collect_to_vec(bytes(6)?),
-            indices: if with_indices {
-                bytemuck::pod_collect_to_vec(bytes(7)?)
-            } else {
-                Vec::new()
-            },
-        })
+        let mut images = FrameImages {
+            position: Vec::new(),
+            normal: Vec::new(),
+            depth: Vec::new(),
+            visibility: Vec::new(),
+            blocker_distance: Vec::new(),
+            occupancy: Vec::new(),
+            counts: Vec::new(),
+            indices: Vec::new(),
+            shadow_map_visibility: Vec::new(),
+            pcss: Vec::new(),
+            antialiased: Vec::new(),
+            lerp_factor: Vec::new(),
+            hybrid: Vec::new(),
+            output: Vec::new(),
+        };
+        let origin = p.geometry().origin();
+        for ((_, _, slot), buffer) in list.iter().zip(&buffers) {
+            let bytes = buffer.read()?;
+            let floats = || bytemuck::pod_collect_to_vec::<u8, f32>(bytes);
+            match slot {
+                Slot::Position => {
+                    images.position = to_world(bytemuck::pod_collect_to_vec(bytes), origin)
+                }
+                Slot::Normal => images.normal = bytemuck::pod_collect_to_vec(bytes),
+                Slot::Depth => images.depth = floats(),
+                Slot::Visibility => images.visibility = floats(),
+                Slot::BlockerDistance => images.blocker_distance = floats(),
+                Slot::Occupancy => images.occupancy = bytemuck::pod_collect_to_vec(bytes),
+                Slot::Counts => images.counts = bytemuck::pod_collect_to_vec(bytes),
+                Slot::Indices => images.indices = bytemuck::pod_collect_to_vec(bytes),
+                Slot::ShadowMapVisibility => images.shadow_map_visibility = floats(),
+                Slot::Pcss => images.pcss = floats(),
+                Slot::Antialiased => images.antialiased = floats(),
+                Slot::LerpFactor => images.lerp_factor = floats(),
+                Slot::Hybrid => images.hybrid = floats(),
+                Slot::Output => images.output = floats(),
+            }
+        }
+        Ok(images)
     }
+}
+
+/// Where a read-back image goes in [`FrameImages`].
+#[derive(Clone, Copy)]
+enum Slot {
+    Position,
+    Normal,
+    Depth,
+    Visibility,
+    BlockerDistance,
+    Occupancy,
+    Counts,
+    Indices,
+    ShadowMapVisibility,
+    Pcss,
+    Antialiased,
+    LerpFactor,
+    Hybrid,
+    Output,
 }
 
 fn into_rhi(e: PassError) -> rhi::RhiError {

@@ -1,13 +1,30 @@
-//! The engine-facing frame: prim buffer → primitive map → ray trace → occupancy, recorded into any
-//! command buffer. It reads the engine's depth and normal images and writes visibility (1 = lit) and
-//! blocker distance. The C ABI and the demo host both drive it.
+//! The engine-facing unit: the passes of one view of one light, chosen by the [`FramePlan`] from what the
+//! configuration asks for, recorded into any command buffer. It reads the engine's depth and normal images
+//! and writes one final visibility image (1 = lit): ray-traced, PCSS, hybrid or FXAA'd, whichever the
+//! plan's final output is. The C ABI and the demo host both drive it.
+//!
+//! Linear order of the passes (each runs only if the plan keeps it):
+//! prim buffer → shadow map → primitive map → occupancy → ray trace → classic shadow-map test → PCSS →
+//! FXAA (on the ray-traced visibility) → lerp factor → hybrid blend | fill lit.
 
-use crate::gpu_types::{MapStats, PrimMapPush, RayTraceConstants};
+use crate::frame_plan::{
+    FramePlan, HardEdge, PassId, PassStatus, PenumbraFilter, PlanRequest, ResourceId, ResourceSet,
+    ShadowMode, SkipReason,
+};
+use crate::fxaa::FxaaPass;
+use crate::gpu_types::{MapStats, PcssConstants, PrimMapPush, RayTraceConstants, ShadowMapPush};
+use crate::hybrid::{BlendPass, HybridConfig, LerpFactorPass};
+use crate::light::{rebased, Light, LightFrame};
+use crate::pcss::{PcssConfig, PcssInputs, PcssKind, PcssPass};
 use crate::prim_buffer::{Geometry, PrimBufferPass};
-use crate::primitive_map::{FaceMode, PrimitiveMap, PrimitiveMapConfig, RasterPath};
+use crate::primitive_map::{
+    choose_raster_path, FaceMode, PrimitiveMap, PrimitiveMapConfig, RasterPath,
+};
 use crate::ray_trace::{RayTraceInputs, RayTracePass, RAY_OFFSET_FLOAT_BOUND, RAY_OFFSET_PIXELS};
+use crate::screen_pass::visibility_image;
+use crate::shadow_map::{ShadowMapConfig, ShadowMapPass};
 use crate::PassError;
-use glam::{DMat4, DVec3, Mat4, UVec4, Vec3, Vec4};
+use glam::{Mat4, UVec4, Vec3, Vec4};
 use rhi::{
     Barrier, Buffer, BufferUsage, Device, Encoder, GpuTimer, Image, MemoryLocation, PassTiming,
     ResourceState as S,
@@ -22,21 +39,124 @@ pub struct FrameInputs {
     pub proj: Mat4,
     /// Camera position in world space.
     pub camera_position: Vec3,
-    /// Direction the light travels (unit).
-    pub light_direction: Vec3,
-    /// Orthographic light view-projection enclosing the scene (world coordinates).
-    pub light_view_proj: Mat4,
+    /// The light.
+    pub light: Light,
+}
+
+/// What the pipeline computes and how: the requested outputs (per light: none, hard, soft or hybrid;
+/// antialiasing), what may be cached across frames, and the settings of each technique.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadowConfig {
+    /// The light's shadow mode (default hybrid).
+    pub mode: ShadowMode,
+    /// FXAA over the ray-traced visibility (default on; no effect without a ray-traced shadow).
+    pub antialiasing: bool,
+    /// The vertex and index buffers do not change between frames: the prim buffer is built once
+    /// (default true). When false it is rebuilt every frame, and everything downstream with it.
+    pub static_geometry: bool,
+    /// The light does not move: with static geometry, the shadow map and the primitive map are kept from
+    /// the frame that built them for as long as the frame's light equals that frame's (default false).
+    pub static_light: bool,
+    /// The deep primitive map.
+    pub map: PrimitiveMapConfig,
+    /// The shadow map.
+    pub shadow_map: ShadowMapConfig,
+    /// PCSS.
+    pub pcss: PcssConfig,
+    /// The hybrid blend.
+    pub hybrid: HybridConfig,
+    /// Resources to produce besides the final output (comparison views, debug images, a host G-buffer
+    /// drawing the prim buffer). Empty by default.
+    pub extra_outputs: ResourceSet,
+}
+
+impl Default for ShadowConfig {
+    /// The talk's full technique: hybrid with FXAA, 1K×1K×32 primitive map, 3K shadow map, shrinking PCSS.
+    fn default() -> Self {
+        Self {
+            mode: ShadowMode::Hybrid,
+            antialiasing: true,
+            static_geometry: true,
+            static_light: false,
+            map: PrimitiveMapConfig::default(),
+            shadow_map: ShadowMapConfig::default(),
+            pcss: PcssConfig::default(),
+            hybrid: HybridConfig::default(),
+            extra_outputs: ResourceSet::EMPTY,
+        }
+    }
+}
+
+impl From<PrimitiveMapConfig> for ShadowConfig {
+    /// A primitive-map configuration alone asks for ray-traced hard shadows without antialiasing: the
+    /// output is the exact ray-traced visibility.
+    fn from(map: PrimitiveMapConfig) -> Self {
+        Self {
+            mode: ShadowMode::Hard,
+            antialiasing: false,
+            map,
+            ..Self::default()
+        }
+    }
+}
+
+impl ShadowConfig {
+    /// The frame-plan request of this configuration.
+    pub fn plan_request(&self) -> PlanRequest {
+        PlanRequest {
+            mode: self.mode,
+            antialiasing: self.antialiasing,
+            filter: self.pcss.filter,
+            extra_outputs: self.extra_outputs,
+        }
+    }
+}
+
+/// Bytes a resource of the plan takes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ResourceReport {
+    /// The resource.
+    pub resource: ResourceId,
+    /// Its size in bytes.
+    pub bytes: u64,
 }
 
 /// What a frame did.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameReport {
-    /// GPU time per pass (the prim buffer pass appears only on frames that rebuilt it).
+    /// GPU time per pass that ran this frame, in recording order.
     pub timings: Vec<PassTiming>,
-    /// The raster path used.
+    /// The conservative-raster path of the primitive map (the path the device would use when the plan
+    /// has no primitive map; software if it has none).
     pub raster_path: RasterPath,
-    /// Primitive-map statistics (overflow, occupancy).
+    /// Statistics of the primitive map as last built (zero without a primitive map).
     pub stats: MapStats,
+    /// Every pass of the linear order: ran this frame, or skipped and why.
+    pub passes: Vec<(PassId, PassStatus)>,
+    /// Every resource the pipeline allocated, with its size.
+    pub resources: Vec<ResourceReport>,
+    /// The resource [`ShadowPipeline::output`] holds.
+    pub output: ResourceId,
+}
+
+impl FrameReport {
+    /// Whether `pass` ran this frame.
+    pub fn ran(&self, pass: PassId) -> bool {
+        self.passes.contains(&(pass, PassStatus::Ran))
+    }
+
+    /// Why `pass` was skipped this frame (`None` if it ran).
+    pub fn status(&self, pass: PassId) -> Option<PassStatus> {
+        self.passes
+            .iter()
+            .find(|(p, _)| *p == pass)
+            .map(|&(_, s)| s)
+    }
+
+    /// Total bytes of the allocated resources.
+    pub fn total_bytes(&self) -> u64 {
+        self.resources.iter().map(|r| r.bytes).sum()
+    }
 }
 
 /// The engine's images the pipeline reads, bound at creation.
@@ -51,56 +171,170 @@ pub struct ShadowInputs<'a> {
 struct FrameConstants {
     view_proj_rel: Mat4,
     camera_frame: Vec3,
+    light: LightFrame,
     map: PrimMapPush,
     ray: RayTraceConstants,
+    pcss: PcssConstants,
 }
 
-/// `m * translation(origin)` in f64: `m` applied to coordinates relative to `origin`.
-fn rebased(m: Mat4, origin: DVec3) -> DMat4 {
-    m.as_dmat4() * DMat4::from_translation(origin)
-}
-
-/// The passes of one view of one light, and the resources they own.
+/// The passes of one view of one light, and the resources the plan allocates for them.
 pub struct ShadowPipeline {
+    config: ShadowConfig,
+    plan: FramePlan,
     geometry: Geometry,
-    prim_buffer: PrimBufferPass,
-    map: PrimitiveMap,
-    ray: RayTracePass,
+    prim_buffer: Option<PrimBufferPass>,
+    shadow_map: Option<ShadowMapPass>,
+    map: Option<PrimitiveMap>,
+    ray: Option<RayTracePass>,
+    shadow_map_test: Option<PcssPass>,
+    pcss: Option<PcssPass>,
+    fxaa: Option<FxaaPass>,
+    lerp: Option<LerpFactorPass>,
+    blend: Option<BlendPass>,
+    lit: Option<Image>,
     timer: GpuTimer,
     stats_readback: Buffer,
-    prims_built: bool,
+    raster_path: RasterPath,
+    /// Resources whose contents are valid from an earlier recording.
+    valid: ResourceSet,
+    /// The light of the last recording that rendered the light-space maps.
+    maps_light: Option<Light>,
+    /// Whether `begin_frame` rebuilt the prim buffer for the frame being recorded.
+    prims_rebuilt: bool,
+    statuses: Vec<(PassId, PassStatus)>,
     width: u32,
     height: u32,
 }
 
 impl ShadowPipeline {
-    /// Creates every pass over `geometry` for the size of `inputs.depth`.
+    /// Creates the passes the plan of `config` needs over `geometry`, for the size of `inputs.depth`.
+    /// `config` may be a [`ShadowConfig`] or, for ray-traced hard shadows alone, a
+    /// [`PrimitiveMapConfig`].
     pub fn new(
         device: &Device,
         geometry: Geometry,
         inputs: &ShadowInputs<'_>,
-        map_config: PrimitiveMapConfig,
+        config: impl Into<ShadowConfig>,
     ) -> Result<Self, PassError> {
+        let config = config.into();
         let (width, height) = (inputs.depth.width(), inputs.depth.height());
         if (inputs.normal.width(), inputs.normal.height()) != (width, height) {
             return Err(PassError::InvalidConfig(
                 "depth and normal images differ in size".into(),
             ));
         }
-        let prim_buffer = PrimBufferPass::new(device, &geometry)?;
-        let map = PrimitiveMap::new(device, prim_buffer.prims(), map_config)?;
-        let ray = RayTracePass::new(
-            device,
-            &RayTraceInputs {
+        let caps = device.capabilities();
+        config.map.validate(caps)?;
+        config.shadow_map.validate(caps)?;
+        config.pcss.validate()?;
+        config.hybrid.validate()?;
+        let plan = FramePlan::derive(config.plan_request());
+        let runs = |p| plan.runs(p);
+
+        let prim_buffer = if runs(PassId::PrimBuffer) {
+            Some(PrimBufferPass::new(device, &geometry)?)
+        } else {
+            None
+        };
+        let prims = prim_buffer.as_ref().map(PrimBufferPass::prims);
+        let need_prims = || {
+            prims.ok_or_else(|| PassError::InvalidConfig("the plan lacks the prim buffer".into()))
+        };
+        let shadow_map = if runs(PassId::ShadowMap) {
+            Some(ShadowMapPass::new(
+                device,
+                need_prims()?,
+                config.shadow_map.size,
+            )?)
+        } else {
+            None
+        };
+        let map = if runs(PassId::PrimitiveMap) {
+            Some(PrimitiveMap::new(device, need_prims()?, config.map)?)
+        } else {
+            None
+        };
+        let raster_path = match &map {
+            Some(m) => m.path(),
+            None => choose_raster_path(caps, config.map.raster).unwrap_or(RasterPath::Software),
+        };
+        let ray = match (&map, runs(PassId::RayTrace)) {
+            (Some(m), true) => Some(RayTracePass::new(
+                device,
+                &RayTraceInputs {
+                    depth: inputs.depth,
+                    normal: inputs.normal,
+                    count: &m.count,
+                    indices: &m.indices,
+                    prims: need_prims()?,
+                },
+                width,
+                height,
+            )?),
+            _ => None,
+        };
+        let pcss_pass = |kind| -> Result<Option<PcssPass>, PassError> {
+            let Some(sm) = &shadow_map else {
+                return Ok(None);
+            };
+            let pcss_inputs = PcssInputs {
                 depth: inputs.depth,
                 normal: inputs.normal,
-                count: &map.count,
-                indices: &map.indices,
-                prims: prim_buffer.prims(),
-            },
-            width,
-            height,
-        )?;
+                shadow_map: &sm.depth,
+                rt_visibility: ray.as_ref().map(|r| &r.visibility),
+            };
+            PcssPass::new(
+                device,
+                &pcss_inputs,
+                kind,
+                config.pcss.filter,
+                width,
+                height,
+            )
+            .map(Some)
+        };
+        let shadow_map_test = if runs(PassId::ShadowMapTest) {
+            pcss_pass(PcssKind::ClassicTest)?
+        } else {
+            None
+        };
+        let edge = match (config.pcss.filter, plan.hard_edge()) {
+            (PenumbraFilter::Shrinking, HardEdge::RayTrace) => HardEdge::RayTrace,
+            _ => HardEdge::ShadowMap,
+        };
+        let pcss = if runs(PassId::Pcss) {
+            pcss_pass(PcssKind::Pcss(edge))?
+        } else {
+            None
+        };
+        let fxaa = match (&ray, runs(PassId::Fxaa)) {
+            (Some(r), true) => Some(FxaaPass::new(device, &r.visibility)?),
+            _ => None,
+        };
+        let lerp = match (&ray, runs(PassId::LerpFactor)) {
+            (Some(r), true) => Some(LerpFactorPass::new(device, &r.blocker_distance)?),
+            _ => None,
+        };
+        let blend = if runs(PassId::Blend) {
+            let rts = if config.antialiasing {
+                fxaa.as_ref().map(|f| &f.output)
+            } else {
+                ray.as_ref().map(|r| &r.visibility)
+            };
+            match (rts, &pcss, &lerp) {
+                (Some(rts), Some(p), Some(l)) => {
+                    Some(BlendPass::new(device, rts, &p.output, &l.output)?)
+                }
+                _ => None,
+            }
+        } else {
+            None
+        };
+        let lit = if runs(PassId::FillLit) {
+            Some(visibility_image(device, "lit", width, height)?)
+        } else {
+            None
+        };
         let timer = device.create_timer(32)?;
         let stats_readback = device.create_buffer(
             "stats read-back",
@@ -108,22 +342,100 @@ impl ShadowPipeline {
             BufferUsage::COPY_DST,
             MemoryLocation::GpuToCpu,
         )?;
-        Ok(Self {
+        let pipeline = Self {
+            config,
+            plan,
             geometry,
             prim_buffer,
+            shadow_map,
             map,
             ray,
+            shadow_map_test,
+            pcss,
+            fxaa,
+            lerp,
+            blend,
+            lit,
             timer,
             stats_readback,
-            prims_built: false,
+            raster_path,
+            valid: ResourceSet::EMPTY,
+            maps_light: None,
+            prims_rebuilt: false,
+            statuses: Vec::new(),
             width,
             height,
-        })
+        };
+        // Every resource of the plan exists (a missing one would be a bug in the wiring above).
+        if let Some(r) = pipeline
+            .plan
+            .resources()
+            .iter()
+            .find(|&r| pipeline.resource_bytes(r).is_none())
+        {
+            return Err(PassError::InvalidConfig(format!(
+                "the plan needs {} but it was not created",
+                r.name()
+            )));
+        }
+        Ok(pipeline)
     }
 
-    /// The prim buffer (triangles in frame coordinates).
-    pub fn prims(&self) -> &Buffer {
-        self.prim_buffer.prims()
+    /// The configuration.
+    pub fn config(&self) -> &ShadowConfig {
+        &self.config
+    }
+
+    /// The frame plan.
+    pub fn plan(&self) -> &FramePlan {
+        &self.plan
+    }
+
+    /// The final visibility image of the plan (`R32_SFLOAT`, 1 = lit), in `UnorderedAccess` state after
+    /// [`ShadowPipeline::record`]. The engine may transition or copy it; the next `record` rewrites it.
+    pub fn output(&self) -> &Image {
+        match self.image(self.plan.final_output()) {
+            Some(image) => image,
+            // `new` returns an error rather than a pipeline whose plan's final output is not allocated.
+            None => unreachable!("the final output is allocated by ShadowPipeline::new"),
+        }
+    }
+
+    /// The image holding `resource`, if the plan allocated it (screen-space and light-space images).
+    pub fn image(&self, resource: ResourceId) -> Option<&Image> {
+        use ResourceId as R;
+        match resource {
+            R::ShadowMap => self.shadow_map.as_ref().map(|s| &s.depth),
+            R::PrimCountMap => self.map.as_ref().map(|m| &m.count),
+            R::PrimIndexMap => self.map.as_ref().map(|m| &m.indices),
+            R::Occupancy => self.map.as_ref().map(|m| &m.occupancy),
+            R::RtVisibility => self.ray.as_ref().map(|r| &r.visibility),
+            R::BlockerDistance => self.ray.as_ref().map(|r| &r.blocker_distance),
+            R::ShadowMapVisibility => self.shadow_map_test.as_ref().map(|p| &p.output),
+            R::Pcss => self.pcss.as_ref().map(|p| &p.output),
+            R::RtAntialiased => self.fxaa.as_ref().map(|f| &f.output),
+            R::LerpFactor => self.lerp.as_ref().map(|l| &l.output),
+            R::Hybrid => self.blend.as_ref().map(|b| &b.output),
+            R::Lit => self.lit.as_ref(),
+            R::SceneGeometry | R::Light | R::Depth | R::Normal | R::PrimBuffer => None,
+        }
+    }
+
+    /// Bytes of `resource` if the pipeline allocated it.
+    fn resource_bytes(&self, resource: ResourceId) -> Option<u64> {
+        match resource {
+            ResourceId::PrimBuffer => self.prim_buffer.as_ref().map(|p| p.prims().size()),
+            ResourceId::Occupancy => self
+                .map
+                .as_ref()
+                .map(|m| m.occupancy.byte_size() + m.stats.size()),
+            r => self.image(r).map(Image::byte_size),
+        }
+    }
+
+    /// The prim buffer (triangles in frame coordinates), if the plan has it.
+    pub fn prims(&self) -> Option<&Buffer> {
+        self.prim_buffer.as_ref().map(PrimBufferPass::prims)
     }
 
     /// The geometry.
@@ -131,24 +443,35 @@ impl ShadowPipeline {
         &self.geometry
     }
 
-    /// The primitive map.
-    pub fn primitive_map(&self) -> &PrimitiveMap {
-        &self.map
+    /// The primitive map, if the plan has it.
+    pub fn primitive_map(&self) -> Option<&PrimitiveMap> {
+        self.map.as_ref()
     }
 
-    /// The ray-trace outputs.
-    pub fn ray_trace(&self) -> &RayTracePass {
-        &self.ray
+    /// The ray-trace outputs, if the plan has them.
+    pub fn ray_trace(&self) -> Option<&RayTracePass> {
+        self.ray.as_ref()
     }
 
     /// Starts a frame: attaches the GPU timer (every pass recorded afterwards on `enc` is timed) and
-    /// builds the prim buffer when the geometry is new.
+    /// builds the prim buffer when the plan has it and it is not valid (first frame, or dynamic geometry).
     pub fn begin_frame(&mut self, enc: &mut Encoder<'_>) -> Result<(), PassError> {
         enc.attach_timer(&self.timer);
-        if !self.prims_built {
-            self.prim_buffer.record(enc, &self.geometry)?;
+        self.prims_rebuilt = false;
+        let changed = if self.config.static_geometry {
+            ResourceSet::EMPTY
+        } else {
+            ResourceSet::of(&[ResourceId::SceneGeometry])
+        };
+        let run = self
+            .plan
+            .schedule(changed, self.valid)
+            .contains(&(PassId::PrimBuffer, PassStatus::Ran));
+        if let (true, Some(p)) = (run, &self.prim_buffer) {
+            p.record(enc, &self.geometry)?;
             enc.barriers(&[Barrier::Uav]);
-            self.prims_built = true;
+            self.valid = self.valid.with(ResourceId::PrimBuffer);
+            self.prims_rebuilt = true;
         }
         Ok(())
     }
@@ -166,26 +489,32 @@ impl ShadowPipeline {
         let view_proj_rel = camera_rel.as_mat4();
         let inv_view_proj_rel = camera_rel.inverse().as_mat4();
         let origin = self.geometry.origin();
-        let light = rebased(inputs.light_view_proj, origin).as_mat4();
+        let light = LightFrame::new(&inputs.light, origin)?;
         let camera_frame = (cam - origin).as_vec3();
-        let dir = inputs.light_direction.normalize();
-        if !dir.is_finite()
-            || !view_proj_rel.is_finite()
-            || !inv_view_proj_rel.is_finite()
-            || !light.is_finite()
+        if !view_proj_rel.is_finite() || !inv_view_proj_rel.is_finite() || !camera_frame.is_finite()
         {
             return Err(PassError::InvalidConfig(
-                "camera or light matrices are not finite or invertible".into(),
+                "camera matrices are not finite or invertible".into(),
             ));
         }
-        let radians_per_pixel = 2.0 / (inputs.proj.y_axis.y * self.height as f32);
-        let cfg = *self.map.config();
+        let cfg = self.config.map;
+        if light.position.is_some() && cfg.faces == FaceMode::FrontOnly {
+            return Err(PassError::InvalidConfig(
+                "a front-only primitive map needs a directional light: store both faces for a spot light"
+                    .into(),
+            ));
+        }
+        let radians_per_pixel = (2.0 / (inputs.proj.y_axis.y * self.height as f32)).abs();
         let front_only = u32::from(cfg.faces == FaceMode::FrontOnly);
+        let dir = light.direction;
+        let sm = self.config.shadow_map;
+        let pc = self.config.pcss;
         Ok(FrameConstants {
             view_proj_rel,
             camera_frame,
+            light,
             map: PrimMapPush {
-                light_view_proj: light,
+                light_view_proj: light.view_proj,
                 to_light: (-dir).extend(0.0),
                 size: cfg.size,
                 depth: cfg.depth,
@@ -194,7 +523,7 @@ impl ShadowPipeline {
             },
             ray: RayTraceConstants {
                 inv_view_proj_rel,
-                light_view_proj: light,
+                light_view_proj: light.view_proj,
                 camera_pos: camera_frame.extend(1.0),
                 light_dir: dir.extend(0.0),
                 dims: UVec4::new(self.width, self.height, cfg.size, cfg.depth),
@@ -205,67 +534,248 @@ impl ShadowPipeline {
                     0.0,
                 ),
                 misc: UVec4::new(front_only, self.geometry.triangle_count(), 0, 0),
+                light_pos: light.position.map_or(Vec4::ZERO, |p| p.extend(1.0)),
+            },
+            pcss: PcssConstants {
+                inv_view_proj_rel,
+                camera_pos: camera_frame.extend(radians_per_pixel),
+                dims: UVec4::new(self.width, self.height, sm.size, 0),
+                taps: UVec4::new(pc.blocker_search_taps, pc.pcf_taps, 0, 0),
+                radii: Vec4::new(
+                    pc.max_search_radius,
+                    pc.min_filter_radius,
+                    pc.max_filter_radius,
+                    0.0,
+                ),
+                bias: Vec4::new(
+                    sm.constant_bias,
+                    sm.slope_bias,
+                    PLANE_TOLERANCE_TEXELS,
+                    CONSTANT_TOLERANCE_TEXELS,
+                ),
+                light: light.gpu(sm.size, pc.light_size(light.position.is_some())),
             },
         })
     }
 
-    /// Records the shadow passes. Depth and normal must be in `ShaderResource` state; afterwards the
-    /// visibility and blocker-distance images, count, index and occupancy maps are in `UnorderedAccess`.
+    /// Records the passes the plan runs this frame. Depth and normal must be in `ShaderResource` state;
+    /// afterwards every image the pipeline wrote this frame, [`ShadowPipeline::output`] included, is in
+    /// `UnorderedAccess` state (the shadow map in `ShaderResource`).
     pub fn record(&mut self, enc: &mut Encoder<'_>, inputs: &FrameInputs) -> Result<(), PassError> {
         let c = self.constants(inputs)?;
-        let (map, ray) = (&self.map, &mut self.ray);
-        let undefined_to = |image, after| Barrier::Image {
-            image,
-            before: S::Undefined,
-            after,
-        };
-        enc.barriers(&[
-            undefined_to(&map.count, S::CopyDest),
-            undefined_to(&map.indices, S::CopyDest),
-            undefined_to(&map.occupancy, S::UnorderedAccess),
-            undefined_to(&ray.visibility, S::UnorderedAccess),
-            undefined_to(&ray.blocker_distance, S::UnorderedAccess),
-        ]);
-        map.record_clear(enc);
-        enc.barriers(&[
-            Barrier::Image {
-                image: &map.count,
-                before: S::CopyDest,
-                after: S::UnorderedAccess,
-            },
-            Barrier::Image {
-                image: &map.indices,
-                before: S::CopyDest,
-                after: S::UnorderedAccess,
-            },
-            Barrier::Global {
-                before: S::CopyDest,
-                after: S::UnorderedAccess,
-            },
-        ]);
-        map.record_raster(enc, &c.map, self.geometry.triangle_count())?;
-        enc.barriers(&[Barrier::Uav]);
-        ray.record(enc, &c.ray)?;
-        map.record_occupancy(enc)?;
-        enc.barriers(&[Barrier::Global {
-            before: S::UnorderedAccess,
-            after: S::CopySource,
-        }]);
-        enc.copy_buffer(&map.stats, &self.stats_readback)?;
-        enc.barriers(&[Barrier::Global {
-            before: S::CopyDest,
-            after: S::HostRead,
-        }]);
+        if self.plan.runs(PassId::PrimBuffer) && !self.valid.contains(ResourceId::PrimBuffer) {
+            return Err(PassError::InvalidConfig(
+                "begin_frame must be recorded before record".into(),
+            ));
+        }
+        let mut changed = ResourceSet::of(&[ResourceId::Depth, ResourceId::Normal]);
+        if !self.config.static_light || self.maps_light != Some(inputs.light) {
+            changed = changed.with(ResourceId::Light);
+        }
+        if self.prims_rebuilt {
+            changed = changed.with(ResourceId::PrimBuffer);
+        }
+        let mut statuses = self.plan.schedule(changed, self.valid);
+        for s in &mut statuses {
+            if s.0 == PassId::PrimBuffer && self.plan.runs(PassId::PrimBuffer) {
+                s.1 = if self.prims_rebuilt {
+                    PassStatus::Ran
+                } else {
+                    PassStatus::Skipped(SkipReason::UpToDate)
+                };
+            }
+        }
+        self.prims_rebuilt = false;
+        let ran = |p| statuses.contains(&(p, PassStatus::Ran));
+        self.record_light_space(enc, &c, &ran)?;
+        self.record_screen_space(enc, &c, &ran)?;
+        for &(pass, status) in &statuses {
+            if status == PassStatus::Ran {
+                self.valid = self.valid.union(self.plan.writes(pass));
+            }
+        }
+        if ran(PassId::ShadowMap) || ran(PassId::PrimitiveMap) {
+            self.maps_light = Some(inputs.light);
+        }
+        self.statuses = statuses;
         Ok(())
     }
 
-    /// Timings and statistics of the last recorded frame; call after its submission has completed.
+    fn record_light_space(
+        &mut self,
+        enc: &mut Encoder<'_>,
+        c: &FrameConstants,
+        ran: &dyn Fn(PassId) -> bool,
+    ) -> Result<(), PassError> {
+        let tris = self.geometry.triangle_count();
+        if let (true, Some(sm)) = (ran(PassId::ShadowMap), &self.shadow_map) {
+            enc.barriers(&[Barrier::Image {
+                image: &sm.depth,
+                before: S::Undefined,
+                after: S::DepthWrite,
+            }]);
+            sm.record(
+                enc,
+                &ShadowMapPush {
+                    light_view_proj: c.light.view_proj,
+                },
+                tris,
+            )?;
+            enc.barriers(&[Barrier::Image {
+                image: &sm.depth,
+                before: S::DepthWrite,
+                after: S::ShaderResource,
+            }]);
+        }
+        let Some(map) = &self.map else {
+            return Ok(());
+        };
+        if ran(PassId::PrimitiveMap) {
+            let undefined_to = |image, after| Barrier::Image {
+                image,
+                before: S::Undefined,
+                after,
+            };
+            enc.barriers(&[
+                undefined_to(&map.count, S::CopyDest),
+                undefined_to(&map.indices, S::CopyDest),
+            ]);
+            map.record_clear(enc);
+            enc.barriers(&[
+                Barrier::Image {
+                    image: &map.count,
+                    before: S::CopyDest,
+                    after: S::UnorderedAccess,
+                },
+                Barrier::Image {
+                    image: &map.indices,
+                    before: S::CopyDest,
+                    after: S::UnorderedAccess,
+                },
+                Barrier::Global {
+                    before: S::CopyDest,
+                    after: S::UnorderedAccess,
+                },
+            ]);
+            map.record_raster(enc, &c.map, tris)?;
+            enc.barriers(&[Barrier::Uav]);
+        }
+        if ran(PassId::Occupancy) {
+            enc.barriers(&[Barrier::Image {
+                image: &map.occupancy,
+                before: S::Undefined,
+                after: S::UnorderedAccess,
+            }]);
+            map.record_occupancy(enc)?;
+            enc.barriers(&[Barrier::Global {
+                before: S::UnorderedAccess,
+                after: S::CopySource,
+            }]);
+            enc.copy_buffer(&map.stats, &self.stats_readback)?;
+            enc.barriers(&[Barrier::Global {
+                before: S::CopyDest,
+                after: S::HostRead,
+            }]);
+        }
+        Ok(())
+    }
+
+    fn record_screen_space(
+        &mut self,
+        enc: &mut Encoder<'_>,
+        c: &FrameConstants,
+        ran: &dyn Fn(PassId) -> bool,
+    ) -> Result<(), PassError> {
+        // Every screen-space image written this frame is rewritten whole: discard and make it a UAV.
+        let screen = [
+            (PassId::RayTrace, ResourceId::RtVisibility),
+            (PassId::RayTrace, ResourceId::BlockerDistance),
+            (PassId::ShadowMapTest, ResourceId::ShadowMapVisibility),
+            (PassId::Pcss, ResourceId::Pcss),
+            (PassId::Fxaa, ResourceId::RtAntialiased),
+            (PassId::LerpFactor, ResourceId::LerpFactor),
+            (PassId::Blend, ResourceId::Hybrid),
+        ];
+        let to_uav: Vec<Barrier<'_>> = screen
+            .iter()
+            .filter(|(p, _)| ran(*p))
+            .filter_map(|&(_, r)| self.image(r))
+            .map(|image| Barrier::Image {
+                image,
+                before: S::Undefined,
+                after: S::UnorderedAccess,
+            })
+            .collect();
+        enc.barriers(&to_uav);
+        if let (true, Some(ray)) = (ran(PassId::RayTrace), self.ray.as_mut()) {
+            ray.record(enc, &c.ray)?;
+            enc.barriers(&[Barrier::Uav]);
+        }
+        if let (true, Some(p)) = (ran(PassId::ShadowMapTest), self.shadow_map_test.as_mut()) {
+            p.record(enc, &c.pcss)?;
+        }
+        if let (true, Some(p)) = (ran(PassId::Pcss), self.pcss.as_mut()) {
+            p.record(enc, &c.pcss)?;
+        }
+        if let (true, Some(f)) = (ran(PassId::Fxaa), &self.fxaa) {
+            f.record(enc)?;
+        }
+        if let (true, Some(l)) = (ran(PassId::LerpFactor), &self.lerp) {
+            l.record(enc, &self.config.hybrid)?;
+        }
+        enc.barriers(&[Barrier::Uav]);
+        if let (true, Some(b)) = (ran(PassId::Blend), &self.blend) {
+            b.record(enc, &self.config.hybrid)?;
+            enc.barriers(&[Barrier::Uav]);
+        }
+        if let (true, Some(lit)) = (ran(PassId::FillLit), &self.lit) {
+            enc.begin_pass(PassId::FillLit.name());
+            enc.barriers(&[Barrier::Image {
+                image: lit,
+                before: S::Undefined,
+                after: S::CopyDest,
+            }]);
+            enc.clear_uint(lit, 1.0f32.to_bits());
+            enc.barriers(&[Barrier::Image {
+                image: lit,
+                before: S::CopyDest,
+                after: S::UnorderedAccess,
+            }]);
+            enc.end_pass();
+        }
+        Ok(())
+    }
+
+    /// Timings, pass statuses, resource sizes and map statistics of the last recorded frame; call after
+    /// its submission has completed.
     pub fn report(&self) -> Result<FrameReport, PassError> {
-        let stats: MapStats = bytemuck::pod_read_unaligned(self.stats_readback.read()?);
+        let stats: MapStats = if self.map.is_some() {
+            bytemuck::pod_read_unaligned(self.stats_readback.read()?)
+        } else {
+            MapStats::default()
+        };
+        let resources = self
+            .plan
+            .resources()
+            .iter()
+            .filter_map(|r| {
+                self.resource_bytes(r)
+                    .map(|bytes| ResourceReport { resource: r, bytes })
+            })
+            .collect();
         Ok(FrameReport {
             timings: self.timer.resolve()?,
-            raster_path: self.map.path(),
+            raster_path: self.raster_path,
             stats,
+            passes: self.statuses.clone(),
+            resources,
+            output: self.plan.final_output(),
         })
     }
 }
+
+/// PCSS receiver-plane tolerance, in texels of the receiver plane's depth slope: covers the rasterizer's
+/// sub-texel vertex snapping (1/256 texel) with margin.
+const PLANE_TOLERANCE_TEXELS: f32 = 1.0 / 16.0;
+/// PCSS constant tolerance, in texels of world size at the receiver.
+const CONSTANT_TOLERANCE_TEXELS: f32 = 1.0 / 32.0;

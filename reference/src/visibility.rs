@@ -1,6 +1,6 @@
 //! Exact per-pixel light visibility with ambiguity classification.
 
-use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
+use glam::{DMat4, DVec3, DVec4};
 use rayon::prelude::*;
 
 use crate::geometry::{intersect_watertight, line_segment_approach};
@@ -50,11 +50,16 @@ pub struct VisibilityParams {
     pub width: u32,
     /// Framebuffer height in pixels.
     pub height: u32,
-    /// Camera `projection * view`, exactly as uploaded to the GPU (reversed-Z,
-    /// infinite far plane: NDC z = 1 is the near plane).
-    pub view_proj: Mat4,
-    /// World-space camera position.
-    pub camera_position: Vec3,
+    /// Camera `projection * view` (reversed-Z, infinite far plane: NDC z = 1 is the
+    /// near plane), composed in `f64` from the `f32` matrices given to the GPU: a
+    /// product rounded to `f32` moves the rays by a sizeable fraction of a pixel once
+    /// the camera is 1e4 to 1e5 units from the origin.
+    pub view_proj: DMat4,
+    /// World-space origin of the camera rays: the eye of `view_proj` (for a view
+    /// matrix `v`, `v.inverse()` applied to the origin, in `f64`), which differs from
+    /// the `f32` position the view matrix was built from by the rounding of its
+    /// translation.
+    pub camera_position: DVec3,
     /// The light.
     pub light: Light,
     /// Tolerance in world units for shadow-ray events and camera z-fighting.
@@ -194,12 +199,12 @@ struct Camera {
 
 impl Camera {
     fn new(params: &VisibilityParams) -> Self {
-        let view_proj = params.view_proj.as_dmat4();
+        let view_proj = params.view_proj;
         let focal = view_proj.row(1).truncate().length() / view_proj.row(3).truncate().length();
         let pixel_angle = 2.0 / (focal * f64::from(params.height));
         Self {
             inv_view_proj: view_proj.inverse(),
-            origin: params.camera_position.as_dvec3(),
+            origin: params.camera_position,
             pixel_angle: if pixel_angle.is_finite() {
                 pixel_angle
             } else {

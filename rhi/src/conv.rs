@@ -73,6 +73,9 @@ pub enum ResourceState {
     VertexIndex,
     /// Host read-back after GPU writes.
     HostRead,
+    /// An engine-owned image in the `VkImageLayout` given by its raw value, used by any earlier or later
+    /// command of the engine (full scope on both sides of the transition).
+    Engine(i32),
 }
 
 /// Shader stages the RHI's pipelines use; shader-access states are scoped to these.
@@ -123,6 +126,11 @@ pub fn state_scope(
             A::VERTEX_ATTRIBUTE_READ | A::INDEX_READ,
         ),
         ResourceState::HostRead => (L::GENERAL, S::HOST, A::HOST_READ),
+        ResourceState::Engine(layout) => (
+            L::from_raw(layout),
+            S::ALL_COMMANDS,
+            A::MEMORY_READ | A::MEMORY_WRITE,
+        ),
     }
 }
 
@@ -134,6 +142,7 @@ pub fn state_writes(state: ResourceState) -> bool {
             | ResourceState::RenderTarget
             | ResourceState::DepthWrite
             | ResourceState::CopyDest
+            | ResourceState::Engine(_)
     )
 }
 
@@ -276,6 +285,16 @@ mod tests {
         assert!(access.contains(vk::AccessFlags2::SHADER_STORAGE_WRITE));
         assert!(state_writes(ResourceState::UnorderedAccess));
         assert!(!state_writes(ResourceState::ShaderResource));
+    }
+
+    #[test]
+    fn engine_state_keeps_the_raw_layout_with_full_scope() {
+        let (layout, stages, access) = state_scope(ResourceState::Engine(
+            vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL.as_raw(),
+        ));
+        assert_eq!(layout, vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL);
+        assert_eq!(stages, vk::PipelineStageFlags2::ALL_COMMANDS);
+        assert!(access.contains(vk::AccessFlags2::MEMORY_WRITE));
     }
 
     #[test]

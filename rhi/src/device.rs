@@ -136,24 +136,43 @@ pub struct Device {
     command_pool: vk::CommandPool,
 }
 
-/// The engine's Vulkan objects handed to [`Device::adopt`]. The RHI never destroys them.
+/// `vkGetInstanceProcAddr` as a plain C function pointer (`VkInstance` is a pointer-sized handle).
+pub type RawGetInstanceProcAddr = unsafe extern "C" fn(
+    instance: *mut c_void,
+    name: *const std::ffi::c_char,
+) -> Option<unsafe extern "C" fn()>;
+
+/// Core features an engine enabled on its device that the passes care about.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct EnabledFeatures {
+    /// `geometryShader` (software conservative raster, G-buffer primitive ids).
+    pub geometry_shader: bool,
+    /// `fragmentStoresAndAtomics` (required: the primitive map's UAV writes).
+    pub fragment_stores_and_atomics: bool,
+    /// `depthClamp`.
+    pub depth_clamp: bool,
+    /// `shaderFloat64`.
+    pub shader_float64: bool,
+}
+
+/// The engine's Vulkan objects handed to [`Device::adopt`], as raw handles. The RHI never destroys them.
 pub struct AdoptDesc {
     /// `vkGetInstanceProcAddr` of the engine's loader.
-    pub get_instance_proc_addr: vk::PFN_vkGetInstanceProcAddr,
-    /// The engine's instance (Vulkan 1.3).
-    pub instance: vk::Instance,
-    /// The physical device the engine's device was created from.
-    pub physical_device: vk::PhysicalDevice,
-    /// The engine's device; it must have Vulkan 1.3 `dynamicRendering` and `synchronization2` enabled.
-    pub device: vk::Device,
-    /// Family of the queue the plugin's command buffers are submitted to (graphics + compute).
+    pub get_instance_proc_addr: RawGetInstanceProcAddr,
+    /// The engine's `VkInstance` (Vulkan 1.3).
+    pub instance: u64,
+    /// The `VkPhysicalDevice` the engine's device was created from.
+    pub physical_device: u64,
+    /// The engine's `VkDevice`; it must have Vulkan 1.3 `dynamicRendering` and `synchronization2` enabled.
+    pub device: u64,
+    /// Family of the queue the engine submits the plugin's work on (graphics + compute).
     pub queue_family_index: u32,
     /// Index of that queue within its family.
     pub queue_index: u32,
     /// Device extensions the engine enabled.
     pub enabled_extensions: Vec<String>,
     /// Core features the engine enabled.
-    pub enabled_features: vk::PhysicalDeviceFeatures,
+    pub enabled_features: EnabledFeatures,
     /// Whether the engine's instance enabled `VK_EXT_debug_utils` (per-pass labels are emitted if so).
     pub debug_utils: bool,
 }
@@ -320,23 +339,41 @@ impl Device {
     /// been created with Vulkan 1.3 `dynamicRendering` and `synchronization2`, and the features and extensions
     /// listed in `desc` must be exactly those enabled. The engine must externally synchronise queue access.
     pub unsafe fn adopt(desc: AdoptDesc) -> Result<Self> {
+        use ash::vk::Handle;
+        // SAFETY: on every target where Vulkan's "system" calling convention is C (all 64-bit ones) this is
+        // the ABI of vkGetInstanceProcAddr: a dispatchable handle is a pointer, the result an optional fn.
+        let gipa: vk::PFN_vkGetInstanceProcAddr =
+            unsafe { std::mem::transmute(desc.get_instance_proc_addr) };
         let static_fn = ash::StaticFn {
-            get_instance_proc_addr: desc.get_instance_proc_addr,
+            get_instance_proc_addr: gipa,
         };
-        // SAFETY: the caller guarantees the function pointer and handles are valid.
+        let (instance, device) = (
+            vk::Instance::from_raw(desc.instance),
+            vk::Device::from_raw(desc.device),
+        );
+        // SAFETY: the caller guarantees the function pointer and handles are valid and belong together.
         let entry = unsafe { ash::Entry::from_static_fn(static_fn.clone()) };
-        let instance = unsafe { ash::Instance::load(&static_fn, desc.instance) };
-        let device = unsafe { ash::Device::load(instance.fp_v1_0(), desc.device) };
+        // SAFETY: as above.
+        let instance = unsafe { ash::Instance::load(&static_fn, instance) };
+        // SAFETY: as above.
+        let device = unsafe { ash::Device::load(instance.fp_v1_0(), device) };
+        // SAFETY: the caller guarantees the queue exists.
         let queue = unsafe { device.get_device_queue(desc.queue_family_index, desc.queue_index) };
+        let f = desc.enabled_features;
+        let features = vk::PhysicalDeviceFeatures::default()
+            .geometry_shader(f.geometry_shader)
+            .fragment_stores_and_atomics(f.fragment_stores_and_atomics)
+            .depth_clamp(f.depth_clamp)
+            .shader_float64(f.shader_float64);
         Self::from_parts(PartsDesc {
             entry,
             instance,
-            physical: desc.physical_device,
+            physical: vk::PhysicalDevice::from_raw(desc.physical_device),
             device,
             queue,
             queue_family: desc.queue_family_index,
             enabled_extensions: desc.enabled_extensions,
-            features: desc.enabled_features,
+            features,
             has_debug_utils: desc.debug_utils,
             messenger: None,
             validation: Arc::new(ValidationLog::default()),

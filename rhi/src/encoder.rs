@@ -104,33 +104,54 @@ impl Device {
 }
 
 impl GpuTimer {
-    /// Reads the timings of the last recording; call after its submission has completed.
+    /// Reads the timings of the last recording, waiting for them; call after its submission was made.
     pub fn resolve(&self) -> Result<Vec<PassTiming>> {
+        self.read(true).map(|t| t.unwrap_or_default())
+    }
+
+    /// Reads the timings of the last recording if the GPU has written all of them, else `None`.
+    pub fn try_resolve(&self) -> Result<Option<Vec<PassTiming>>> {
+        self.read(false)
+    }
+
+    fn read(&self, wait: bool) -> Result<Option<Vec<PassTiming>>> {
         let t = &self.inner;
         let names = t.names.lock().map(|n| n.clone()).unwrap_or_default();
         let n = names.len();
         if n == 0 {
-            return Ok(Vec::new());
+            return Ok(Some(Vec::new()));
         }
         let mut data = vec![0u64; n * 2];
-        // SAFETY: queries 0..2n were written by the completed recording; WAIT makes the call block until ready.
-        unsafe {
-            t.device.device.get_query_pool_results(
-                t.pool,
-                0,
-                &mut data,
-                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
-            )
+        let flags = if wait {
+            vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT
+        } else {
+            vk::QueryResultFlags::TYPE_64
+        };
+        // SAFETY: queries 0..2n were reset and written by the last recording.
+        match unsafe {
+            t.device
+                .device
+                .get_query_pool_results(t.pool, 0, &mut data, flags)
+        } {
+            Ok(()) => {}
+            Err(vk::Result::NOT_READY) if !wait => return Ok(None),
+            Err(result) => {
+                return Err(RhiError::Vulkan {
+                    call: "vkGetQueryPoolResults",
+                    result,
+                })
+            }
         }
-        .call("vkGetQueryPoolResults")?;
-        Ok(names
-            .iter()
-            .enumerate()
-            .map(|(i, name)| PassTiming {
-                name: name.clone(),
-                ms: data[2 * i + 1].saturating_sub(data[2 * i]) as f64 * t.period_ns * 1e-6,
-            })
-            .collect())
+        Ok(Some(
+            names
+                .iter()
+                .enumerate()
+                .map(|(i, name)| PassTiming {
+                    name: name.clone(),
+                    ms: data[2 * i + 1].saturating_sub(data[2 * i]) as f64 * t.period_ns * 1e-6,
+                })
+                .collect(),
+        ))
     }
 }
 
@@ -489,6 +510,42 @@ impl<'a> Encoder<'a> {
                 image.raw,
                 vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
                 buffer.raw,
+                &[region],
+            )
+        };
+        Ok(())
+    }
+
+    /// Copies all of `src` (in `CopySource` state) into `dst` (in `CopyDest` state): same size and format.
+    pub fn copy_image(&mut self, src: &Image, dst: &Image) -> Result<()> {
+        if (src.width(), src.height(), src.layers(), src.format())
+            != (dst.width(), dst.height(), dst.layers(), dst.format())
+        {
+            return Err(RhiError::InvalidArgument(
+                "image copy between different sizes or formats".into(),
+            ));
+        }
+        let layers = vk::ImageSubresourceLayers::default()
+            .aspect_mask(src.format().aspect())
+            .mip_level(0)
+            .base_array_layer(0)
+            .layer_count(src.layers());
+        let region = vk::ImageCopy::default()
+            .src_subresource(layers)
+            .dst_subresource(layers)
+            .extent(vk::Extent3D {
+                width: src.width(),
+                height: src.height(),
+                depth: 1,
+            });
+        // SAFETY: sizes and formats checked; the images are in the stated layouts by contract.
+        unsafe {
+            self.d().cmd_copy_image(
+                self.cmd,
+                src.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                dst.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
                 &[region],
             )
         };

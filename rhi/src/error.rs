@@ -48,6 +48,22 @@ pub enum RhiError {
     InvalidArgument(String),
 }
 
+impl RhiError {
+    /// Whether the error means GPU or host memory ran out.
+    pub fn is_out_of_memory(&self) -> bool {
+        match self {
+            Self::Allocation { .. } => true,
+            Self::Vulkan { result, .. } => {
+                matches!(
+                    *result,
+                    vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY
+                )
+            }
+            _ => false,
+        }
+    }
+}
+
 /// Result alias for the RHI.
 pub type Result<T> = std::result::Result<T, RhiError>;
 

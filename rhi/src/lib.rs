@@ -12,11 +12,15 @@ mod resources;
 
 pub use caps::Capabilities;
 pub use conv::{ConservativeRasterTier, Format, ResourceState};
-pub use device::{AdoptDesc, Device, DeviceDesc, ValidationLog};
+pub use device::{
+    AdoptDesc, Device, DeviceDesc, EnabledFeatures, RawGetInstanceProcAddr, ValidationLog,
+};
 pub use encoder::{Barrier, ColorTarget, DepthTarget, Encoder, GpuTimer, PassTiming};
 pub use error::{Result, RhiError};
 pub use pipeline::{
-    BindGroup, BindingKind, ComputePipeline, CullMode, DepthState, GraphicsPipeline,
-    GraphicsPipelineDesc, PipelineLayout, Resource,
+    BindGroup, BindingKind, ComputePipeline, DepthState, GraphicsPipeline, GraphicsPipelineDesc,
+    PipelineLayout, Resource,
 };
-pub use resources::{Buffer, BufferUsage, Image, ImageDesc, ImageUsage, MemoryLocation};
+pub use resources::{
+    live_gpu_allocation_bytes, Buffer, BufferUsage, Image, ImageDesc, ImageUsage, MemoryLocation,
+};

@@ -59,15 +59,6 @@ pub struct ComputePipeline {
     pub(crate) raw: vk::Pipeline,
 }
 
-/// Face culling.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum CullMode {
-    /// Both faces rasterized.
-    None,
-    /// Back faces culled.
-    Back,
-}
-
 /// Depth test state of a graphics pipeline.
 #[derive(Debug, Clone, Copy)]
 pub struct DepthState {
@@ -97,8 +88,6 @@ pub struct GraphicsPipelineDesc<'a> {
     pub color_formats: &'a [Format],
     /// Depth attachment and test.
     pub depth: Option<DepthState>,
-    /// Culling (front faces are clockwise in framebuffer space, i.e. counter-clockwise in a y-up view).
-    pub cull: CullMode,
     /// Hardware conservative rasterization with this extra overestimation in pixels (None = off).
     pub conservative_extra_overestimation: Option<f32>,
     /// Clamp depth instead of clipping against the near/far planes.
@@ -283,11 +272,7 @@ impl Device {
             );
         let mut raster = vk::PipelineRasterizationStateCreateInfo::default()
             .polygon_mode(vk::PolygonMode::FILL)
-            .cull_mode(match desc.cull {
-                CullMode::None => vk::CullModeFlags::NONE,
-                CullMode::Back => vk::CullModeFlags::BACK,
-            })
-            .front_face(vk::FrontFace::CLOCKWISE)
+            .cull_mode(vk::CullModeFlags::NONE)
             .depth_clamp_enable(desc.depth_clamp && caps.depth_clamp)
             .line_width(1.0);
         if desc.conservative_extra_overestimation.is_some() {
@@ -413,6 +398,13 @@ impl Device {
                             .buffer(b.raw)
                             .range(vk::WHOLE_SIZE),
                     ))
+                }
+                (Resource::Image(img), BindingKind::StorageImage | BindingKind::SampledImage)
+                    if img.view == vk::ImageView::null() =>
+                {
+                    return Err(RhiError::InvalidArgument(format!(
+                        "binding {i}: image was created without a sampled or storage usage"
+                    )));
                 }
                 (Resource::Image(img), BindingKind::StorageImage) => image_infos.push((
                     i,

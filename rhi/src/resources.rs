@@ -6,7 +6,24 @@ use crate::error::{Result, RhiError, VkResultExt};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 pub use gpu_allocator::MemoryLocation;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
+
+/// Bytes of GPU memory allocations alive in this process, over every device.
+static LIVE_GPU_BYTES: AtomicU64 = AtomicU64::new(0);
+
+/// Bytes of GPU memory allocated through the RHI and not yet freed, over every device of the process.
+pub fn live_gpu_allocation_bytes() -> u64 {
+    LIVE_GPU_BYTES.load(Ordering::SeqCst)
+}
+
+/// Returns an allocation to its device's allocator.
+fn free_allocation(shared: &Shared, allocation: Allocation) {
+    LIVE_GPU_BYTES.fetch_sub(allocation.size(), Ordering::SeqCst);
+    if let Ok(mut alloc) = shared.allocator.lock() {
+        let _ = alloc.free(allocation);
+    }
+}
 
 macro_rules! usage_flags {
     ($(#[$doc:meta])* $name:ident { $($(#[$fdoc:meta])* $flag:ident = $bit:expr),* $(,)? }) => {
@@ -105,15 +122,18 @@ pub fn image_usage_to_vk(u: ImageUsage) -> vk::ImageUsageFlags {
     f
 }
 
-/// A GPU buffer. Host-visible buffers (`CpuToGpu`, `GpuToCpu`) are persistently mapped.
+/// A GPU buffer. Host-visible buffers (`CpuToGpu`, `GpuToCpu`) are persistently mapped. A buffer made
+/// by [`Device::external_buffer`] belongs to the engine and is never destroyed here.
 pub struct Buffer {
     shared: Arc<Shared>,
     pub(crate) raw: vk::Buffer,
     allocation: Option<Allocation>,
     size: u64,
+    owned: bool,
 }
 
-/// A 2D image or 2D array image with one view over all layers.
+/// A 2D image or 2D array image with one view over all layers. An image made by
+/// [`Device::external_image`] belongs to the engine: only the view is ours.
 pub struct Image {
     shared: Arc<Shared>,
     pub(crate) raw: vk::Image,
@@ -123,6 +143,8 @@ pub struct Image {
     width: u32,
     height: u32,
     layers: u32,
+    usage: ImageUsage,
+    owned: bool,
 }
 
 /// Description of an image.
@@ -177,9 +199,16 @@ impl Device {
             .allocate(name, requirements, location, true)
             .and_then(|a| {
                 // SAFETY: the allocation satisfies `requirements` and is not bound elsewhere.
-                unsafe { d.bind_buffer_memory(raw, a.memory(), a.offset()) }
-                    .call("vkBindBufferMemory")
-                    .map(|_| a)
+                match unsafe { d.bind_buffer_memory(raw, a.memory(), a.offset()) } {
+                    Ok(()) => Ok(a),
+                    Err(result) => {
+                        free_allocation(&self.shared, a);
+                        Err(RhiError::Vulkan {
+                            call: "vkBindBufferMemory",
+                            result,
+                        })
+                    }
+                }
             });
         let allocation = match allocation {
             Ok(a) => a,
@@ -195,6 +224,7 @@ impl Device {
             raw,
             allocation: Some(allocation),
             size,
+            owned: true,
         })
     }
 
@@ -256,9 +286,16 @@ impl Device {
             .allocate(desc.name, requirements, MemoryLocation::GpuOnly, false)
             .and_then(|a| {
                 // SAFETY: the allocation satisfies `requirements`.
-                unsafe { d.bind_image_memory(raw, a.memory(), a.offset()) }
-                    .call("vkBindImageMemory")
-                    .map(|_| a)
+                match unsafe { d.bind_image_memory(raw, a.memory(), a.offset()) } {
+                    Ok(()) => Ok(a),
+                    Err(result) => {
+                        free_allocation(&self.shared, a);
+                        Err(RhiError::Vulkan {
+                            call: "vkBindImageMemory",
+                            result,
+                        })
+                    }
+                }
             });
         let allocation = match allocation {
             Ok(a) => a,
@@ -268,29 +305,14 @@ impl Device {
                 return Err(e);
             }
         };
-        let view_type = if desc.layers > 1 {
-            vk::ImageViewType::TYPE_2D_ARRAY
-        } else {
-            vk::ImageViewType::TYPE_2D
-        };
-        let view_info = vk::ImageViewCreateInfo::default()
-            .image(raw)
-            .view_type(view_type)
-            .format(desc.format.to_vk())
-            .subresource_range(subresource_range(desc.format, desc.layers));
         // SAFETY: `raw` is bound to memory; the view is destroyed before the image.
-        let view = match unsafe { d.create_image_view(&view_info, None) } {
+        let view = match unsafe { self.create_view(raw, desc) } {
             Ok(v) => v,
             Err(e) => {
                 // SAFETY: `raw` is unused; the allocation is returned to the allocator.
                 unsafe { d.destroy_image(raw, None) };
-                if let Ok(mut a) = self.shared.allocator.lock() {
-                    let _ = a.free(allocation);
-                }
-                return Err(RhiError::Vulkan {
-                    call: "vkCreateImageView",
-                    result: e,
-                });
+                free_allocation(&self.shared, allocation);
+                return Err(e);
             }
         };
         self.set_name(
@@ -307,7 +329,91 @@ impl Device {
             width: desc.width,
             height: desc.height,
             layers: desc.layers,
+            usage: desc.usage,
+            owned: true,
         })
+    }
+
+    /// Wraps an engine's `VkImage` (2D, one mip level, `desc.layers` layers, created with `desc.format` and
+    /// at least `desc.usage`). Only a view is created; the image and its memory stay the engine's.
+    ///
+    /// # Safety
+    /// `handle` must be a live `VkImage` of this device matching `desc`, outliving the returned `Image`.
+    pub unsafe fn external_image(&self, handle: u64, desc: &ImageDesc<'_>) -> Result<Image> {
+        if handle == 0 || desc.width == 0 || desc.height == 0 || desc.layers == 0 {
+            return Err(RhiError::InvalidArgument(format!(
+                "external image {} is null or empty",
+                desc.name
+            )));
+        }
+        let raw: vk::Image = ash::vk::Handle::from_raw(handle);
+        // SAFETY: the caller guarantees `raw` is a live image of this device matching `desc`.
+        let view = unsafe { self.create_view(raw, desc) }?;
+        Ok(Image {
+            shared: self.shared.clone(),
+            raw,
+            view,
+            allocation: None,
+            format: desc.format,
+            width: desc.width,
+            height: desc.height,
+            layers: desc.layers,
+            usage: desc.usage,
+            owned: false,
+        })
+    }
+
+    /// Wraps an engine's `VkBuffer` of `size` bytes (created with at least `STORAGE_BUFFER` usage).
+    ///
+    /// # Safety
+    /// `handle` must be a live `VkBuffer` of this device of at least `size` bytes, outliving the result.
+    pub unsafe fn external_buffer(&self, handle: u64, size: u64) -> Result<Buffer> {
+        if handle == 0 || size == 0 {
+            return Err(RhiError::InvalidArgument(
+                "external buffer is null or empty".into(),
+            ));
+        }
+        let limit = self.shared.caps.max_storage_buffer_range;
+        if size > limit {
+            return Err(RhiError::Limit {
+                what: "external storage buffer".into(),
+                value: size,
+                limit,
+            });
+        }
+        Ok(Buffer {
+            shared: self.shared.clone(),
+            raw: ash::vk::Handle::from_raw(handle),
+            allocation: None,
+            size,
+            owned: false,
+        })
+    }
+
+    /// A view over all layers when the usage allows one (sampled, storage or attachment), else null.
+    ///
+    /// # Safety
+    /// `raw` must be a live image of this device created as `desc` says.
+    unsafe fn create_view(&self, raw: vk::Image, desc: &ImageDesc<'_>) -> Result<vk::ImageView> {
+        let viewable = ImageUsage::SAMPLED
+            | ImageUsage::STORAGE
+            | ImageUsage::COLOR_TARGET
+            | ImageUsage::DEPTH_TARGET;
+        if desc.usage.0 & viewable.0 == 0 {
+            return Ok(vk::ImageView::null());
+        }
+        let view_type = if desc.layers > 1 {
+            vk::ImageViewType::TYPE_2D_ARRAY
+        } else {
+            vk::ImageViewType::TYPE_2D
+        };
+        let view_info = vk::ImageViewCreateInfo::default()
+            .image(raw)
+            .view_type(view_type)
+            .format(desc.format.to_vk())
+            .subresource_range(subresource_range(desc.format, desc.layers));
+        // SAFETY: guaranteed by the caller.
+        unsafe { self.shared.device.create_image_view(&view_info, None) }.call("vkCreateImageView")
     }
 
     fn allocate(
@@ -332,6 +438,9 @@ impl Device {
                 location,
                 linear,
                 allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
+            .inspect(|a| {
+                LIVE_GPU_BYTES.fetch_add(a.size(), Ordering::SeqCst);
             })
             .map_err(|e| RhiError::Allocation {
                 name: name.into(),
@@ -415,6 +524,10 @@ impl Image {
     pub fn layers(&self) -> u32 {
         self.layers
     }
+    /// Declared usage.
+    pub fn usage(&self) -> ImageUsage {
+        self.usage
+    }
     /// Bytes needed to read back all layers tightly packed.
     pub fn byte_size(&self) -> u64 {
         u64::from(self.width)
@@ -426,23 +539,29 @@ impl Image {
 
 impl Drop for Buffer {
     fn drop(&mut self) {
-        // SAFETY: callers wait for GPU work using this buffer before dropping it (submit_and_wait does).
-        unsafe { self.shared.device.destroy_buffer(self.raw, None) };
-        if let (Some(a), Ok(mut alloc)) = (self.allocation.take(), self.shared.allocator.lock()) {
-            let _ = alloc.free(a);
+        if self.owned {
+            // SAFETY: callers wait for GPU work using this buffer before dropping it (submit_and_wait does).
+            unsafe { self.shared.device.destroy_buffer(self.raw, None) };
+        }
+        if let Some(a) = self.allocation.take() {
+            free_allocation(&self.shared, a);
         }
     }
 }
 
 impl Drop for Image {
     fn drop(&mut self) {
-        // SAFETY: as for Buffer; the view is destroyed before its image.
+        // SAFETY: as for Buffer; the view is destroyed before its image, which is ours unless external.
         unsafe {
-            self.shared.device.destroy_image_view(self.view, None);
-            self.shared.device.destroy_image(self.raw, None);
+            if self.view != vk::ImageView::null() {
+                self.shared.device.destroy_image_view(self.view, None);
+            }
+            if self.owned {
+                self.shared.device.destroy_image(self.raw, None);
+            }
         }
-        if let (Some(a), Ok(mut alloc)) = (self.allocation.take(), self.shared.allocator.lock()) {
-            let _ = alloc.free(a);
+        if let Some(a) = self.allocation.take() {
+            free_allocation(&self.shared, a);
         }
     }
 }

@@ -26,9 +26,11 @@ impl Camera {
         Mat4::look_at_rh(self.position, self.target, self.up)
     }
 
-    /// View-to-clip matrix: `Mat4::perspective_infinite_reverse_rh(fov_y_radians, aspect, near)`.
+    /// View-to-clip matrix: `Mat4::perspective_infinite_reverse_rh(fov_y_radians, aspect, near)` with clip
+    /// y negated, so that view-space up is the top of a Vulkan framebuffer (whose y points down).
     pub fn proj(&self, aspect: f32) -> Mat4 {
-        Mat4::perspective_infinite_reverse_rh(self.fov_y_radians, aspect, self.near)
+        Mat4::from_scale(Vec3::new(1.0, -1.0, 1.0))
+            * Mat4::perspective_infinite_reverse_rh(self.fov_y_radians, aspect, self.near)
     }
 
     /// World-to-clip matrix: `proj(aspect) * view()`.

@@ -5,7 +5,8 @@
 //! - [`load_obj`]: Wavefront OBJ loading that rejects malformed, non-finite and out-of-range
 //!   content with a [`SceneError`] naming the file, and never panics;
 //! - [`procedural_default`]: the built-in demo scene of shadow-mapping trouble makers;
-//! - [`Camera`] and [`DirectionalLight`]: view and projection matrices that frame a scene.
+//! - [`Camera`] and [`DirectionalLight`]: view and projection matrices that frame a scene;
+//! - [`hard_cases`]: the deterministic hard numerical cases ([`HardCase`]) of the shadow renderer.
 //!
 //! Conventions: right-handed world in metres with +Y up; triangles wind counter-clockwise seen
 //! from their front side; a light direction is the unit vector along which the light travels;
@@ -16,6 +17,7 @@ pub use glam;
 mod aabb;
 mod camera;
 mod error;
+pub mod hard_cases;
 mod light;
 mod obj;
 mod procedural;
@@ -24,6 +26,7 @@ mod scene;
 pub use aabb::Aabb;
 pub use camera::Camera;
 pub use error::SceneError;
+pub use hard_cases::HardCase;
 pub use light::DirectionalLight;
 pub use obj::load_obj;
 pub use procedural::procedural_default;

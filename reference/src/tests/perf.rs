@@ -45,8 +45,9 @@ fn target_size_runs_fast() {
         width: 320,
         height: 240,
         view_proj: Mat4::perspective_infinite_reverse_rh(50f32.to_radians(), 320.0 / 240.0, 0.1)
-            * Mat4::look_at_rh(camera, Vec3::ZERO, Vec3::Y),
-        camera_position: camera,
+            .as_dmat4()
+            * Mat4::look_at_rh(camera, Vec3::ZERO, Vec3::Y).as_dmat4(),
+        camera_position: camera.as_dvec3(),
         light: Light::Directional {
             direction: DVec3::new(0.4, -1.0, -0.3).normalize(),
         },

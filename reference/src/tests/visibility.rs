@@ -32,8 +32,8 @@ fn params(camera: Vec3, light: Light) -> VisibilityParams {
     VisibilityParams {
         width: WIDTH,
         height: HEIGHT,
-        view_proj: proj * view,
-        camera_position: camera,
+        view_proj: proj.as_dmat4() * view.as_dmat4(),
+        camera_position: camera.as_dvec3(),
         light,
         tolerance: 1e-4,
         tolerance_per_distance: 0.0,
@@ -43,10 +43,10 @@ fn params(camera: Vec3, light: Light) -> VisibilityParams {
 
 /// Index of the pixel whose centre is nearest to the projection of `p`.
 fn pixel_of(params: &VisibilityParams, p: Vec3) -> usize {
-    let clip = params.view_proj * p.extend(1.0);
+    let clip = params.view_proj * p.as_dvec3().extend(1.0);
     let ndc = clip.xy() / clip.w;
-    let x = ((ndc.x + 1.0) * 0.5 * WIDTH as f32 - 0.5).round() as usize;
-    let y = ((ndc.y + 1.0) * 0.5 * HEIGHT as f32 - 0.5).round() as usize;
+    let x = ((ndc.x + 1.0) * 0.5 * f64::from(WIDTH) - 0.5).round() as usize;
+    let y = ((ndc.y + 1.0) * 0.5 * f64::from(HEIGHT) - 0.5).round() as usize;
     assert!(
         x < WIDTH as usize && y < HEIGHT as usize,
         "{p} is off screen"
@@ -281,15 +281,17 @@ fn camera_rays_through_edges_are_ambiguous_even_when_missing() {
             60f32.to_radians(),
             WIDTH as f32 / HEIGHT as f32,
             0.1,
-        ) * Mat4::look_at_rh(camera, Vec3::ZERO, Vec3::Y),
-        camera_position: camera,
+        )
+        .as_dmat4()
+            * Mat4::look_at_rh(camera, Vec3::ZERO, Vec3::Y).as_dmat4(),
+        camera_position: camera.as_dvec3(),
         light: Light::Directional {
             direction: -DVec3::Z,
         },
         ..params(camera, oblique_light())
     };
     // The camera ray through the centre of pixel (80, 60), as the reference builds it.
-    let inverse = params.view_proj.as_dmat4().inverse();
+    let inverse = params.view_proj.inverse();
     let ndc_x = (80.5 / f64::from(WIDTH)) * 2.0 - 1.0;
     let ndc_y = (60.5 / f64::from(HEIGHT)) * 2.0 - 1.0;
     let near = inverse.project_point3(DVec3::new(ndc_x, ndc_y, 1.0));

@@ -1,7 +1,8 @@
 //! Shared harness of the GPU integration tests: a validated device, rendering a view, and comparisons
 //! against the exact CPU reference with mismatches reported as counts.
 
-#![allow(dead_code)]
+// Each test binary uses only part of the harness.
+#![allow(dead_code, unused_imports)]
 
 pub use host_demo::accuracy::*;
 use host_demo::View;

@@ -1,0 +1,329 @@
+//! `host_demo compare`: the talk's side-by-sides on one view — shadow map 3K and 8K, ray traced
+//! 1K×1K×64 and ×32, PCSS, and the hybrid with the standard and the shrinking penumbra filter — as
+//! individual pictures, one labelled composite and a caption file that states every setting.
+
+use crate::images::{lerp_factor_preview, Canvas};
+use crate::output::{shade_preview, write_png};
+use crate::render::{default_world_space_scale, median_timings};
+use crate::{parse_vec3, View};
+use anyhow::{bail, Context, Result};
+use glam::Vec3;
+use passes::{
+    FrameImages, HybridConfig, PcssConfig, PenumbraFilter, PrimitiveMapConfig, RasterRequest,
+    ResourceId, ResourceSet, ShadowConfig, ShadowMapConfig, ShadowMode, ShadowRenderer,
+};
+use rhi::{Device, DeviceDesc};
+use scene::Camera;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// Options of `host_demo compare`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct CompareArgs {
+    /// Output folder (individual pictures, compare.png, caption.txt).
+    #[arg(long, default_value = "compare")]
+    pub out: PathBuf,
+    /// Width of each panel in pixels.
+    #[arg(long, default_value_t = 480)]
+    pub width: u32,
+    /// Height of each panel in pixels.
+    #[arg(long, default_value_t = 270)]
+    pub height: u32,
+    /// Camera position "x,y,z" (default: a close-up of the character, the fence and the sphere).
+    #[arg(long, value_parser = parse_vec3)]
+    pub camera_pos: Option<Vec3>,
+    /// Camera target "x,y,z".
+    #[arg(long, value_parser = parse_vec3)]
+    pub camera_target: Option<Vec3>,
+    /// Frames per panel (timings are medians over all but the first).
+    #[arg(long, default_value_t = 3)]
+    pub frames: u32,
+}
+
+/// One panel of the comparison.
+struct Panel {
+    file: &'static str,
+    label: &'static str,
+    config: ShadowConfig,
+    show: Show,
+    note: &'static str,
+}
+
+/// Which image of the frame a panel shows.
+#[derive(Clone, Copy)]
+enum Show {
+    ShadowMapTest,
+    RayTrace,
+    Pcss,
+    Output,
+    LerpFactor,
+}
+
+fn panels(wss: f32) -> Vec<Panel> {
+    let map = |depth| PrimitiveMapConfig {
+        size: 1024,
+        depth,
+        raster: RasterRequest::Auto,
+        ..PrimitiveMapConfig::default()
+    };
+    let sm = |size| ShadowMapConfig {
+        size,
+        ..ShadowMapConfig::default()
+    };
+    let pcss = |filter| PcssConfig {
+        filter,
+        ..PcssConfig::default()
+    };
+    let hybrid = HybridConfig {
+        world_space_scale: wss,
+        hard_shadow_percentage: 4.0,
+    };
+    let base = ShadowConfig {
+        static_geometry: true,
+        static_light: false,
+        hybrid,
+        ..ShadowConfig::default()
+    };
+    let classic = |size| ShadowConfig {
+        mode: ShadowMode::None,
+        shadow_map: sm(size),
+        extra_outputs: ResourceSet::of(&[ResourceId::ShadowMapVisibility]),
+        ..base
+    };
+    let traced = |depth| ShadowConfig {
+        mode: ShadowMode::Hard,
+        antialiasing: false,
+        map: map(depth),
+        ..base
+    };
+    let hybrid_with = |filter| ShadowConfig {
+        mode: ShadowMode::Hybrid,
+        antialiasing: true,
+        map: map(64),
+        shadow_map: sm(3072),
+        pcss: pcss(filter),
+        extra_outputs: ResourceSet::of(&[ResourceId::LerpFactor, ResourceId::RtVisibility]),
+        ..base
+    };
+    vec![
+        Panel {
+            file: "shadow_map_3k.png",
+            label: "SHADOW MAP 3K",
+            config: classic(3072),
+            show: Show::ShadowMapTest,
+            note: "classic single-tap shadow-map test, constant + slope-scaled bias of 1 texel each",
+        },
+        Panel {
+            file: "shadow_map_8k.png",
+            label: "SHADOW MAP 8K",
+            config: classic(8192),
+            show: Show::ShadowMapTest,
+            note: "same test and bias (in texels) at 8192x8192",
+        },
+        Panel {
+            file: "ray_traced_1k_64.png",
+            label: "RAY TRACED 1Kx1Kx64",
+            config: traced(64),
+            show: Show::RayTrace,
+            note: "deep primitive map 1024x1024x64, ray-traced visibility, no FXAA",
+        },
+        Panel {
+            file: "ray_traced_1k_32.png",
+            label: "RAY TRACED 1Kx1Kx32",
+            config: traced(32),
+            show: Show::RayTrace,
+            note: "deep primitive map 1024x1024x32 (overflowed texels are traced exhaustively)",
+        },
+        Panel {
+            file: "pcss_3k.png",
+            label: "PCSS 3K",
+            config: ShadowConfig {
+                mode: ShadowMode::Soft,
+                shadow_map: sm(3072),
+                pcss: pcss(PenumbraFilter::Standard),
+                ..base
+            },
+            show: Show::Pcss,
+            note: "PCSS, standard filter, 16 blocker-search + 32 PCF taps",
+        },
+        Panel {
+            file: "hybrid_standard.png",
+            label: "HYBRID, STANDARD FILTER",
+            config: hybrid_with(PenumbraFilter::Standard),
+            show: Show::Output,
+            note: "lerp(RT with FXAA, PCSS standard, L): the outer half of the penumbra is cut at the hard edge",
+        },
+        Panel {
+            file: "hybrid_shrinking.png",
+            label: "HYBRID, SHRINKING FILTER",
+            config: hybrid_with(PenumbraFilter::Shrinking),
+            show: Show::Output,
+            note: "lerp(RT with FXAA, PCSS shrinking, L): the penumbra grows inwards from the hard edge",
+        },
+        Panel {
+            file: "lerp_factor.png",
+            label: "LERP FACTOR L",
+            config: hybrid_with(PenumbraFilter::Shrinking),
+            show: Show::LerpFactor,
+            note: "L = saturate(BD / WSS * PHS): black = ray traced, white = PCSS, blue = no blocker",
+        },
+    ]
+}
+
+/// The default close-up: the character, the fence, the foliage and the sphere's long shadow.
+fn close_up(view: &View) -> Camera {
+    Camera {
+        position: Vec3::new(2.9, 1.5, 3.3),
+        target: Vec3::new(0.8, 0.35, 0.5),
+        near: 0.02,
+        ..view.camera
+    }
+}
+
+/// Runs the comparison on its own device.
+pub fn run_cli(device_filter: Option<String>, validation: bool, args: &CompareArgs) -> Result<()> {
+    if args.width == 0 || args.height == 0 {
+        bail!("--width and --height must be positive");
+    }
+    let mut desc = DeviceDesc::from_env();
+    desc.validation |= validation;
+    if device_filter.is_some() {
+        desc.device_filter = device_filter;
+    }
+    let device = Device::new_headless(&desc)?;
+    compare_to_folder(&device, args)?;
+    let errors = device.validation().errors();
+    if errors > 0 {
+        bail!(
+            "{errors} Vulkan validation errors (first: {:?})",
+            device.validation().messages().first()
+        );
+    }
+    Ok(())
+}
+
+/// Renders every panel of the procedural scene and writes the pictures, the composite and the caption.
+pub fn compare_to_folder(device: &Device, args: &CompareArgs) -> Result<()> {
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let mut view = View::framed(scene::procedural_default(), args.width, args.height);
+    let mut camera = close_up(&view);
+    if let Some(p) = args.camera_pos {
+        camera.position = p;
+    }
+    if let Some(t) = args.camera_target {
+        camera.target = t;
+    }
+    if (camera.position - camera.target).length() == 0.0 {
+        bail!("camera position and target coincide");
+    }
+    view.camera = camera;
+    let wss = default_world_space_scale(&view);
+    let (w, h) = (args.width, args.height);
+    let to_light = -view.light.direction;
+    let mut pictures = Vec::new();
+    let mut caption = String::new();
+    let _ = writeln!(
+        caption,
+        "host_demo compare: procedural scene ({} triangles), {w}x{h} per panel, directional light {:?}, \
+         camera {:?} -> {:?}. Previews are Lambert x visibility.\nDevice: {} ({}). GPU times are medians \
+         over {} frames after the first; on a CPU device they are relative only.\n",
+        view.scene.triangle_count(),
+        view.light.direction.to_array(),
+        view.camera.position.to_array(),
+        view.camera.target.to_array(),
+        device.capabilities().device_name,
+        device.capabilities().device_type,
+        args.frames.max(2) - 1,
+    );
+    for panel in panels(wss) {
+        let (images, timings) = render_panel(device, &view, &panel.config, args.frames)
+            .with_context(|| format!("rendering panel {}", panel.label))?;
+        let picture = match panel.show {
+            Show::LerpFactor => {
+                lerp_factor_preview(&images.normal, &images.lerp_factor, &images.visibility)
+            }
+            show => {
+                let vis = match show {
+                    Show::ShadowMapTest => &images.shadow_map_visibility,
+                    Show::RayTrace => &images.visibility,
+                    Show::Pcss => &images.pcss,
+                    _ => &images.output,
+                };
+                shade_preview(&images.normal, vis, to_light)
+            }
+        };
+        write_png(&args.out.join(panel.file), w, h, &picture)?;
+        let times: Vec<String> = timings
+            .iter()
+            .filter(|(name, _)| {
+                ["shadow map", "ray trace", "PCSS", "FXAA", "shadow map test"]
+                    .contains(&name.as_str())
+                    || name.starts_with("primitive map (")
+            })
+            .map(|(name, ms)| format!("{name} {ms:.2} ms"))
+            .collect();
+        let _ = writeln!(
+            caption,
+            "{} ({}): {}. GPU: {}.",
+            panel.label,
+            panel.file,
+            panel.note,
+            times.join(", ")
+        );
+        println!("{:<26} {}", panel.label, times.join(", "));
+        pictures.push((panel.label, picture));
+    }
+    let composite = compose(&pictures, w, h);
+    write_png(
+        &args.out.join("compare.png"),
+        composite.width,
+        composite.height,
+        &composite.pixels,
+    )?;
+    std::fs::write(args.out.join("caption.txt"), caption)
+        .with_context(|| format!("writing {}/caption.txt", args.out.display()))?;
+    println!(
+        "wrote {} (composite), the panels and caption.txt",
+        args.out.join("compare.png").display()
+    );
+    Ok(())
+}
+
+fn render_panel(
+    device: &Device,
+    view: &View,
+    config: &ShadowConfig,
+    frames: u32,
+) -> Result<(FrameImages, BTreeMap<String, f64>)> {
+    let geometry = view.upload(device).context("uploading the scene")?;
+    let mut renderer = ShadowRenderer::new(device, geometry, view.width, view.height, *config)?;
+    let inputs = view.frame_inputs();
+    let mut reports = Vec::new();
+    for _ in 0..frames.max(1) {
+        reports.push(renderer.render(device, &inputs)?);
+    }
+    Ok((renderer.read_back(device, false)?, median_timings(&reports)))
+}
+
+/// Panels in a grid of four columns, each under a label bar.
+fn compose(pictures: &[(&str, Vec<[u8; 4]>)], w: u32, h: u32) -> Canvas {
+    const COLUMNS: u32 = 4;
+    const BAR: u32 = 22;
+    const GAP: u32 = 4;
+    let rows = (pictures.len() as u32).div_ceil(COLUMNS);
+    let mut canvas = Canvas::new(
+        COLUMNS * (w + GAP) + GAP,
+        rows * (h + BAR + GAP) + GAP,
+        [24, 24, 24, 255],
+    );
+    for (i, (label, picture)) in pictures.iter().enumerate() {
+        let (col, row) = (i as u32 % COLUMNS, i as u32 / COLUMNS);
+        let x = i64::from(GAP + col * (w + GAP));
+        let y = i64::from(GAP + row * (h + BAR + GAP));
+        canvas.text(x + 4, y + 4, 2, label, [255, 255, 255, 255]);
+        canvas.blit(picture, w, h, x, y + i64::from(BAR));
+    }
+    canvas
+}

@@ -1,0 +1,992 @@
+//! `host_demo hardcases`: runs every [hard case](scene::hard_cases) on a device and measures it.
+//!
+//! Per case: the frame is rendered once (G-buffer, primitive map, ray trace) and read back; visibility is
+//! compared with the exact f64 reference (pixels whose exact shadow ray passes within a tolerance of an
+//! edge are counted as near-edge and not compared), the primitive map with exact conservative binning,
+//! and the case's analytic [`Check`]s are decided from the GPU's receiver positions:
+//!
+//! - **leaks**: lit receivers whose shadow ray passes through a blocker shrunk by [`MARGIN_PIXELS`] pixel
+//!   footprints;
+//! - **acne**: shadowed light-facing receivers where nothing lies between them and the light;
+//! - **contact gap**: the largest screen distance between a lit receiver in a contact shadow and the
+//!   footprint edge it should start at (peter-panning), which must stay below one pixel;
+//! - **differing pixels** from the untransformed scene, for translated and scaled copies;
+//! - the guard layer past slot d, which must hold [`GUARD_VALUE`] everywhere.
+//!
+//! The integration test `tests/tests/hard_cases.rs` calls [`run_cases`] too, so the table and the tests
+//! cannot drift apart.
+
+use crate::accuracy::{absolute_tolerance, compare_map_with, compare_visibility};
+use crate::output::write_png;
+use crate::View;
+use anyhow::{anyhow, bail, Context, Result};
+use glam::{DMat4, DVec2, DVec3, Mat4};
+use passes::{
+    FaceMode, FrameImages, FrameInputs, Light, PrimitiveMapConfig, RasterRequest, ShadowRenderer,
+    GUARD_VALUE,
+};
+use reference::{FaceSelection, RefScene};
+use rhi::{Device, DeviceDesc};
+use scene::hard_cases::{Check, Expectation, Family, HardCase, Overflow, Solid};
+use scene::{Aabb, DirectionalLight, Scene};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Margin of the analytic checks, in pixel footprints at the receiver's distance from the camera: a
+/// receiver counts as certainly shadowed (or certainly in a contact shadow) only if its shadow ray passes
+/// this far inside the blocker.
+pub const MARGIN_PIXELS: f64 = 2.0;
+
+/// Light-facing threshold of the acne check: receivers whose normal makes a cosine above this with the
+/// direction to the light (89.99°) must be lit where nothing blocks them.
+const FACING_COSINE: f64 = 1.7e-4;
+
+/// What one case measured.
+#[derive(Debug, Clone, Default)]
+pub struct Outcome {
+    /// Case name.
+    pub name: &'static str,
+    /// Rendered pixels.
+    pub pixels: usize,
+    /// Pixels near an edge within the reference's tolerance (counted, not compared).
+    pub near_edge: usize,
+    /// Visibility disagreements with the reference outside near-edge pixels.
+    pub mismatches: usize,
+    /// Blocker-distance disagreements with the reference.
+    pub blocker_mismatches: usize,
+    /// First disagreeing pixels `(x, y, exact class, GPU value)`.
+    pub examples: Vec<(u32, u32, &'static str, f32)>,
+    /// Whether blocker distances are comparable with the reference: not with front faces only, where the
+    /// distance is to the light-facing side of the blocker (where the ray leaves it), not its nearest side.
+    pub blocker_distance_compared: bool,
+    /// Receivers judged by the analytic checks: `[certainly shadowed, certainly lit, in a contact shadow]`.
+    pub judged: [usize; 3],
+    /// Analytic checks that judged no pixel at all (the case does not test what it claims).
+    pub vacuous_checks: Vec<String>,
+    /// Lit receivers that are certainly shadowed ([`Check::Shadowed`]).
+    pub leaks: usize,
+    /// Shadowed light-facing receivers that are certainly lit ([`Check::Lit`]).
+    pub acne: usize,
+    /// Largest screen distance in pixels between a lit receiver of a contact shadow and its footprint
+    /// edge ([`Check::Contact`]); 0 when every such receiver is shadowed.
+    pub contact_gap_pixels: Option<f64>,
+    /// Pixels whose visibility differs from the base case ([`Check::SameAs`]).
+    pub differing_pixels: Option<Differing>,
+    /// NaN or Inf in visibility or blocker distance.
+    pub non_finite: usize,
+    /// Texels whose count exceeded d.
+    pub overflowed_texels: u32,
+    /// Largest texel count.
+    pub max_count: u32,
+    /// What the case expects of overflow.
+    pub overflow: Option<Overflow>,
+    /// Required triangles missing from texel lists.
+    pub map_missing: usize,
+    /// Texel-list entries that are out of range, duplicated, or do not touch the texel.
+    pub map_garbage: usize,
+    /// Guard-layer texels written (with a guard layer).
+    pub guard_written: Option<usize>,
+    /// Vulkan validation errors raised while running the case.
+    pub validation_errors: u32,
+    /// The load error of a case that must be rejected.
+    pub rejected: Option<String>,
+    /// What stopped the case, if anything did.
+    pub error: Option<String>,
+    /// Raster path used.
+    pub raster_path: &'static str,
+    /// Wall-clock seconds (render, read-back and all comparisons).
+    pub seconds: f64,
+}
+
+/// Pixels whose visibility differs from a base case's.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Differing {
+    /// Pixels that differ.
+    pub total: usize,
+    /// Pixels that differ although neither reference puts them near an edge: the exact answer itself
+    /// changed with the f32 rounding of the transformed input (both images match their references there).
+    pub outside_near_edge: usize,
+    /// Largest `total` allowed.
+    pub bound: usize,
+}
+
+impl Outcome {
+    /// Every violated expectation, in words; empty when the case passes.
+    pub fn failures(&self) -> Vec<String> {
+        let mut f: Vec<String> = self.error.iter().cloned().collect();
+        let blocker_mismatches = if self.blocker_distance_compared {
+            self.blocker_mismatches
+        } else {
+            0
+        };
+        let differing = self.differing_pixels.unwrap_or_default();
+        for (n, what) in [
+            (self.mismatches, "mismatches"),
+            (blocker_mismatches, "blocker-distance mismatches"),
+            (self.leaks, "leaks"),
+            (self.acne, "acne pixels"),
+            (self.non_finite, "NaN/Inf pixels"),
+            (self.map_missing, "missing map entries"),
+            (self.map_garbage, "garbage map entries"),
+            (self.guard_written.unwrap_or(0), "guard texels written"),
+            (self.validation_errors as usize, "validation errors"),
+        ] {
+            if n > 0 {
+                f.push(format!("{n} {what}"));
+            }
+        }
+        if self.mismatches + blocker_mismatches > 0 {
+            let shown: Vec<String> = self
+                .examples
+                .iter()
+                .take(3)
+                .map(|(x, y, what, value)| format!("({x}, {y}) exact {what}, GPU {value}"))
+                .collect();
+            f.push(format!("e.g. {}", shown.join(", ")));
+        }
+        f.extend(
+            self.vacuous_checks
+                .iter()
+                .map(|c| format!("{c} judged no pixel")),
+        );
+        if let Some(gap) = self.contact_gap_pixels.filter(|&g| g >= 1.0) {
+            f.push(format!("contact gap {gap:.2} px >= 1 px"));
+        }
+        if differing.total > differing.bound {
+            f.push(format!(
+                "{} pixels differ from the base (bound {})",
+                differing.total, differing.bound
+            ));
+        }
+        match self.overflow {
+            Some(Overflow::Forbidden) if self.overflowed_texels > 0 => {
+                f.push("overflow (choose a larger d)".into())
+            }
+            Some(Overflow::Required) if self.overflowed_texels == 0 => f.push("no overflow".into()),
+            _ => {}
+        }
+        f
+    }
+
+    /// Whether every expectation holds.
+    pub fn passed(&self) -> bool {
+        self.failures().is_empty()
+    }
+
+    /// The result column: `pass`, `rejected: <message>` or `FAIL: <reasons>`.
+    pub fn result(&self) -> String {
+        let failures = self.failures();
+        if !failures.is_empty() {
+            format!("FAIL: {}", failures.join("; "))
+        } else if let Some(message) = &self.rejected {
+            format!("rejected: {message}")
+        } else {
+            "pass".into()
+        }
+    }
+
+    /// The family-specific measure column.
+    pub fn measure(&self) -> String {
+        let mut m = Vec::new();
+        let [shadowed, lit, contact] = self.judged;
+        for (n, what) in [
+            (shadowed, "certainly shadowed"),
+            (lit, "certainly lit"),
+            (contact, "in contact shadows"),
+        ] {
+            if n > 0 {
+                m.push(format!("{n} px {what}"));
+            }
+        }
+        if !self.blocker_distance_compared && self.blocker_mismatches > 0 {
+            m.push(format!(
+                "blocker distance to the far side on {} px (front faces only)",
+                self.blocker_mismatches
+            ));
+        }
+        if let Some(gap) = self.contact_gap_pixels {
+            m.push(format!("contact gap {gap:.2} px"));
+        }
+        if let Some(d) = self.differing_pixels {
+            m.push(format!(
+                "{} px differ from the base (bound {}; exact answer changed on {})",
+                d.total, d.bound, d.outside_near_edge
+            ));
+        }
+        if let Some(written) = self.guard_written {
+            m.push(if written == 0 {
+                "guard intact".into()
+            } else {
+                format!("guard: {written} written")
+            });
+        }
+        if self.rejected.is_none() && self.error.is_none() {
+            m.push(format!("max count {}", self.max_count));
+        }
+        m.join(", ")
+    }
+}
+
+/// Runs `cases` in order on `device`; a case whose [`Check::SameAs`] names an earlier case is compared
+/// with that case's image. With `previews`, writes a shaded PNG per case there (analytic failures red).
+pub fn run_cases(device: &Device, cases: &[HardCase], previews: Option<&Path>) -> Vec<Outcome> {
+    let mut bases = HashMap::new();
+    cases
+        .iter()
+        .map(|c| run_case(device, c, &mut bases, previews))
+        .collect()
+}
+
+/// Visibility images and near-edge masks of the cases run so far, by name.
+type Bases = HashMap<&'static str, (Vec<f32>, Vec<bool>)>;
+
+fn run_case(
+    device: &Device,
+    case: &HardCase,
+    bases: &mut Bases,
+    previews: Option<&Path>,
+) -> Outcome {
+    let start = Instant::now();
+    let errors_before = device.validation().errors();
+    let mut o = Outcome {
+        name: case.name,
+        ..Outcome::default()
+    };
+    match (&case.scene, &case.expectation) {
+        (Err(e), Expectation::RejectedAtLoad) => o.rejected = Some(e.to_string()),
+        (Ok(_), Expectation::RejectedAtLoad) => {
+            o.error = Some("non-finite input was accepted".into())
+        }
+        (Err(e), Expectation::Renders(_)) => o.error = Some(format!("loading failed: {e}")),
+        (Ok(scene), Expectation::Renders(checks)) => {
+            if let Err(e) = measure(device, case, scene, checks, bases, previews, &mut o) {
+                o.error = Some(format!("{e:#}"));
+            }
+        }
+    }
+    o.validation_errors = device.validation().errors().saturating_sub(errors_before);
+    o.seconds = start.elapsed().as_secs_f64();
+    o
+}
+
+fn measure(
+    device: &Device,
+    case: &HardCase,
+    scene: &Scene,
+    checks: &[Check],
+    bases: &mut Bases,
+    previews: Option<&Path>,
+    o: &mut Outcome,
+) -> Result<()> {
+    let frame = case.frame;
+    let mut view = View::framed(scene.clone(), frame.width, frame.height);
+    view.light = DirectionalLight::new(case.light_direction)
+        .ok_or_else(|| anyhow!("unusable light direction {}", case.light_direction))?;
+    if let Some(camera) = case.camera {
+        view.camera = camera;
+    }
+    let mut inputs = view.frame_inputs();
+    if let Some(m) = case.light_view_proj {
+        set_light_matrix(&mut inputs, m);
+    }
+    let config = PrimitiveMapConfig {
+        size: case.map.size,
+        depth: case.map.depth,
+        faces: if case.map.front_faces_only {
+            FaceMode::FrontOnly
+        } else {
+            FaceMode::Both
+        },
+        raster: RasterRequest::Auto,
+        guard_layer: case.map.guard_layer,
+    };
+    let geometry = view.upload(device).context("uploading")?;
+    let mut renderer = ShadowRenderer::new(device, geometry, frame.width, frame.height, config)
+        .context("creating the renderer")?;
+    let report = renderer.render(device, &inputs).context("rendering")?;
+    let images = renderer.read_back(device, true).context("reading back")?;
+    o.raster_path = report.raster_path.name();
+    o.overflowed_texels = report.stats.overflowed_texels;
+    o.max_count = report.stats.max_count;
+    o.overflow = Some(case.map.overflow);
+
+    let rs = RefScene::new(&view.scene);
+    let v = compare_visibility(&rs, &view, &images);
+    let near_edge_mask = v.near_edge_mask;
+    o.pixels = v.pixels;
+    o.near_edge = v.near_edge;
+    o.mismatches = v.mismatches;
+    o.blocker_mismatches = v.blocker_mismatches;
+    o.blocker_distance_compared = !case.map.front_faces_only;
+    o.examples = v.examples;
+    o.non_finite = v.non_finite;
+    let faces = match config.faces {
+        FaceMode::FrontOnly => FaceSelection::FrontOnly,
+        FaceMode::Both => FaceSelection::Both,
+    };
+    let m = compare_map_with(&rs, &inputs, &config, &images, faces);
+    o.map_missing = m.missing;
+    o.map_garbage = m.garbage;
+    if config.guard_layer {
+        let plane = (config.size * config.size) as usize;
+        let layer = config.depth as usize * plane;
+        let guard = images
+            .indices
+            .get(layer..layer + plane)
+            .ok_or_else(|| anyhow!("the index read-back has no guard layer"))?;
+        o.guard_written = Some(guard.iter().filter(|&&i| i != GUARD_VALUE).count());
+    }
+
+    let probe = Probe::new(&view, &inputs, &images);
+    let mut flagged = vec![false; images.visibility.len()];
+    for (k, check) in checks.iter().enumerate() {
+        let judged = match check {
+            Check::Shadowed(solid) => {
+                let (judged, leaks) = probe.leaks(solid, &mut flagged);
+                o.leaks += leaks;
+                o.judged[0] += judged;
+                Some(judged)
+            }
+            Check::Lit(region) => {
+                let (judged, acne) = probe.acne(region, &mut flagged);
+                o.acne += acne;
+                o.judged[1] += judged;
+                Some(judged)
+            }
+            Check::Contact(b) => {
+                let (judged, gap) = probe.contact_gap(b, &mut flagged);
+                o.contact_gap_pixels = Some(o.contact_gap_pixels.unwrap_or(0.0).max(gap));
+                o.judged[2] += judged;
+                Some(judged)
+            }
+            Check::SameAs {
+                base,
+                max_differing_pixels,
+            } => {
+                let (base_image, base_near_edge) = bases
+                    .get(base)
+                    .ok_or_else(|| anyhow!("base case \"{base}\" was not run before"))?;
+                if base_image.len() != images.visibility.len() {
+                    bail!("base case \"{base}\" has a different frame size");
+                }
+                let mut d = Differing {
+                    bound: *max_differing_pixels,
+                    ..Differing::default()
+                };
+                for (i, (a, b)) in base_image.iter().zip(&images.visibility).enumerate() {
+                    if a != b {
+                        d.total += 1;
+                        if !base_near_edge[i] && !near_edge_mask[i] {
+                            d.outside_near_edge += 1;
+                        }
+                    }
+                }
+                o.differing_pixels = Some(d);
+                None
+            }
+        };
+        if judged == Some(0) {
+            o.vacuous_checks
+                .push(format!("check {} ({})", k + 1, check_kind(check)));
+        }
+    }
+    if let Some(folder) = previews {
+        std::fs::create_dir_all(folder)
+            .with_context(|| format!("creating {}", folder.display()))?;
+        write_png(
+            &folder.join(format!("{}.png", slug(case.name))),
+            frame.width,
+            frame.height,
+            &preview(&images, probe.to_light, &flagged),
+        )?;
+    }
+    bases.insert(case.name, (images.visibility, near_edge_mask));
+    Ok(())
+}
+
+/// Replaces the light matrix of `inputs` (the direction stays).
+fn set_light_matrix(inputs: &mut FrameInputs, view_proj: Mat4) {
+    inputs.light = Light::Directional {
+        direction: inputs.light.direction(),
+        view_proj,
+    };
+}
+
+/// Short name of a check's kind.
+fn check_kind(check: &Check) -> &'static str {
+    match check {
+        Check::Shadowed(_) => "shadowed",
+        Check::Lit(_) => "lit",
+        Check::Contact(_) => "contact",
+        Check::SameAs { .. } => "same as",
+    }
+}
+
+/// Preview: lit receivers light (brighter facing the light), shadowed ones dark, background blue, pixels
+/// failing an analytic check red.
+fn preview(images: &FrameImages, to_light: DVec3, flagged: &[bool]) -> Vec<[u8; 4]> {
+    let pixel = |i: usize| {
+        let n = images.normal[i];
+        if flagged[i] {
+            return [255, 0, 0, 255];
+        }
+        if n[3] == 0.0 {
+            return [150, 180, 215, 255];
+        }
+        let facing = DVec3::new(n[0].into(), n[1].into(), n[2].into())
+            .dot(to_light)
+            .clamp(0.0, 1.0);
+        let g = if images.visibility[i] > 0.5 {
+            170.0 + 85.0 * facing
+        } else {
+            45.0 + 35.0 * facing
+        };
+        let g = g as u8;
+        [g, g, g, 255]
+    };
+    (0..images.normal.len()).map(pixel).collect()
+}
+
+/// `name` in lower case with every run of other characters than ASCII letters and digits as one `-`.
+fn slug(name: &str) -> String {
+    let mut s = String::new();
+    for c in name.chars() {
+        if c.is_ascii_alphanumeric() {
+            s.push(c.to_ascii_lowercase());
+        } else if !s.ends_with('-') {
+            s.push('-');
+        }
+    }
+    s.trim_matches('-').to_owned()
+}
+
+/// A receiver seen by one pixel.
+struct Receiver {
+    index: usize,
+    position: DVec3,
+    /// Camera-facing geometric normal.
+    normal: DVec3,
+    lit: bool,
+    /// Margin of the analytic checks at this receiver (world units).
+    margin: f64,
+}
+
+/// Per-pixel access to a frame's receivers for the analytic checks.
+struct Probe<'a> {
+    images: &'a FrameImages,
+    camera: DVec3,
+    view_proj: DMat4,
+    to_light: DVec3,
+    pixel_angle: f64,
+    absolute_margin: f64,
+    width: f64,
+    height: f64,
+}
+
+impl<'a> Probe<'a> {
+    fn new(view: &View, inputs: &FrameInputs, images: &'a FrameImages) -> Self {
+        Self {
+            images,
+            camera: inputs.camera_position.as_dvec3(),
+            view_proj: inputs.proj.as_dmat4() * inputs.view.as_dmat4(),
+            to_light: -view.light.direction.as_dvec3().normalize(),
+            pixel_angle: 2.0 * (f64::from(view.camera.fov_y_radians) / 2.0).tan()
+                / f64::from(view.height),
+            absolute_margin: absolute_tolerance(view),
+            width: f64::from(view.width),
+            height: f64::from(view.height),
+        }
+    }
+
+    fn receivers(&self) -> impl Iterator<Item = Receiver> + '_ {
+        let images = self.images;
+        (0..images.visibility.len()).filter_map(move |index| {
+            let n = images.normal[index];
+            let p = images.position[index];
+            if n[3] == 0.0 {
+                return None;
+            }
+            let position = DVec3::new(p[0].into(), p[1].into(), p[2].into());
+            let normal = DVec3::new(n[0].into(), n[1].into(), n[2].into());
+            if !position.is_finite() || !normal.is_finite() {
+                return None;
+            }
+            let margin = MARGIN_PIXELS * position.distance(self.camera) * self.pixel_angle
+                + self.absolute_margin;
+            Some(Receiver {
+                index,
+                position,
+                normal,
+                lit: images.visibility[index] > 0.5,
+                margin,
+            })
+        })
+    }
+
+    /// Receivers whose shadow ray passes through `solid` shrunk by the margin, and the lit ones among them.
+    fn leaks(&self, solid: &Solid, flagged: &mut [bool]) -> (usize, usize) {
+        let (mut judged, mut leaks) = (0, 0);
+        for r in self.receivers() {
+            if certainly_blocked(solid, r.position, self.to_light, r.margin) {
+                judged += 1;
+                if r.lit {
+                    flagged[r.index] = true;
+                    leaks += 1;
+                }
+            }
+        }
+        (judged, leaks)
+    }
+
+    /// Light-facing receivers inside `region`, and the shadowed ones among them.
+    fn acne(&self, region: &Aabb, flagged: &mut [bool]) -> (usize, usize) {
+        let (min, max) = (region.min.as_dvec3(), region.max.as_dvec3());
+        let (mut judged, mut acne) = (0, 0);
+        for r in self.receivers() {
+            let inside = r.position.cmpge(min).all() && r.position.cmple(max).all();
+            if inside && r.normal.dot(self.to_light) > FACING_COSINE {
+                judged += 1;
+                if !r.lit {
+                    flagged[r.index] = true;
+                    acne += 1;
+                }
+            }
+        }
+        (judged, acne)
+    }
+
+    /// Receivers in the contact shadow of box `b` (standing on a horizontal receiver at `b.min.y`), and the
+    /// largest screen distance (pixels) between a lit one and the footprint edge its shadow ray enters
+    /// through.
+    fn contact_gap(&self, b: &Aabb, flagged: &mut [bool]) -> (usize, f64) {
+        let (min, max) = (b.min.as_dvec3(), b.max.as_dvec3());
+        let l = self.to_light;
+        let horizontal = DVec2::new(l.x, l.z);
+        if l.y <= 0.0 || horizontal == DVec2::ZERO {
+            return (0, 0.0);
+        }
+        let (mut judged, mut gap) = (0, 0.0f64);
+        for r in self.receivers() {
+            let p = r.position;
+            let on_base = (p.y - min.y).abs() <= 1e-3 * r.margin + 1e-6 * (1.0 + min.y.abs());
+            if !on_base || r.normal.y < 0.999 {
+                continue;
+            }
+            let m = r.margin;
+            let start = DVec2::new(p.x, p.z);
+            let inner = slab_2d(
+                start,
+                horizontal,
+                DVec2::new(min.x + m, min.z + m),
+                DVec2::new(max.x - m, max.z - m),
+            );
+            let Some((enter, _)) = inner.filter(|&(enter, _)| enter >= 0.0) else {
+                continue;
+            };
+            if p.y + enter * l.y >= max.y - m {
+                continue;
+            }
+            judged += 1;
+            if !r.lit {
+                continue;
+            }
+            let outer = slab_2d(
+                start,
+                horizontal,
+                DVec2::new(min.x, min.z),
+                DVec2::new(max.x, max.z),
+            );
+            let edge = outer.map_or(enter, |(e, _)| e.max(0.0));
+            let contact = DVec3::new(p.x + edge * l.x, p.y, p.z + edge * l.z);
+            let distance = self.screen(p).distance(self.screen(contact));
+            flagged[r.index] = true;
+            gap = gap.max(distance);
+        }
+        (judged, gap)
+    }
+
+    /// Continuous pixel coordinates of a world point.
+    fn screen(&self, p: DVec3) -> DVec2 {
+        let clip = self.view_proj * p.extend(1.0);
+        let ndc = clip.truncate().truncate() / clip.w;
+        (ndc * 0.5 + 0.5) * DVec2::new(self.width, self.height)
+    }
+}
+
+/// Entry and exit parameters of the 2D ray `start + s * dir` through the box `[lo, hi]`, if it crosses it
+/// (at any `s`, also negative).
+fn slab_2d(start: DVec2, dir: DVec2, lo: DVec2, hi: DVec2) -> Option<(f64, f64)> {
+    let (mut enter, mut exit) = (f64::NEG_INFINITY, f64::INFINITY);
+    for axis in 0..2 {
+        if lo[axis] > hi[axis] {
+            return None;
+        }
+        if dir[axis] == 0.0 {
+            if start[axis] < lo[axis] || start[axis] > hi[axis] {
+                return None;
+            }
+        } else {
+            let a = (lo[axis] - start[axis]) / dir[axis];
+            let b = (hi[axis] - start[axis]) / dir[axis];
+            enter = enter.max(a.min(b));
+            exit = exit.min(a.max(b));
+        }
+    }
+    (enter < exit).then_some((enter, exit))
+}
+
+/// Whether the ray `p + s * l` (`s > 0`, `l` unit) certainly hits `solid`: it passes through the solid
+/// shrunk by `margin`, so that every parallel ray within `margin` of it hits the solid too.
+fn certainly_blocked(solid: &Solid, p: DVec3, l: DVec3, margin: f64) -> bool {
+    match solid {
+        Solid::Ball { center, radius } => {
+            let r = f64::from(*radius) - margin;
+            let oc = center.as_dvec3() - p;
+            let along = oc.dot(l);
+            let d2 = oc.length_squared() - along * along;
+            r > 0.0 && along > 0.0 && d2 < r * r && along - (r * r - d2).sqrt() > 0.0
+        }
+        Solid::Box(b) => {
+            let (lo, hi) = (b.min.as_dvec3() + margin, b.max.as_dvec3() - margin);
+            let (mut enter, mut exit) = (0.0f64, f64::INFINITY);
+            for axis in 0..3 {
+                if lo[axis] > hi[axis] {
+                    return false;
+                }
+                if l[axis] == 0.0 {
+                    if p[axis] < lo[axis] || p[axis] > hi[axis] {
+                        return false;
+                    }
+                } else {
+                    let a = (lo[axis] - p[axis]) / l[axis];
+                    let c = (hi[axis] - p[axis]) / l[axis];
+                    enter = enter.max(a.min(c));
+                    exit = exit.min(a.max(c));
+                }
+            }
+            enter > 0.0 && enter < exit
+        }
+        Solid::Polygon(vertices) => {
+            let v: Vec<DVec3> = vertices.iter().map(|p| p.as_dvec3()).collect();
+            if v.len() < 3 {
+                return false;
+            }
+            // Newell's normal.
+            let normal = v
+                .iter()
+                .zip(v.iter().cycle().skip(1))
+                .fold(DVec3::ZERO, |n, (a, b)| n + a.cross(*b))
+                .normalize_or_zero();
+            let cos = normal.dot(l);
+            if cos.abs() < 0.05 {
+                return false;
+            }
+            let s = normal.dot(v[0] - p) / cos;
+            if s <= margin {
+                return false;
+            }
+            let x = p + l * s;
+            // A parallel ray moved by less than `margin` crosses the plane less than this far from x.
+            let in_plane = margin * (1.0 + 1.0 / cos.abs());
+            v.iter().zip(v.iter().cycle().skip(1)).all(|(a, b)| {
+                let inward = normal.cross(*b - *a).normalize_or_zero();
+                inward != DVec3::ZERO && (x - *a).dot(inward) >= in_plane
+            })
+        }
+    }
+}
+
+/// Arguments of `host_demo hardcases`.
+#[derive(Debug, clap::Args)]
+pub struct HardcasesArgs {
+    /// Print the table as Markdown (for the README).
+    #[arg(long)]
+    pub markdown: bool,
+    /// Run only these families (repeatable): shared-edges, grazing, contact, scale, small-triangles,
+    /// texel-boundaries, frustum-border, coplanar, thin-geometry, models, non-finite, overflow.
+    #[arg(long, value_parser = parse_family)]
+    pub family: Vec<Family>,
+    /// Leave out the heavy cases, as the integration tests do.
+    #[arg(long)]
+    pub skip_heavy: bool,
+    /// The shared model folder.
+    #[arg(long, default_value = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/models"))]
+    pub models: PathBuf,
+    /// Write a shaded preview PNG of every case into this folder (pixels failing an analytic check in red).
+    #[arg(long)]
+    pub previews: Option<PathBuf>,
+}
+
+fn parse_family(s: &str) -> Result<Family, String> {
+    Family::from_name(s).ok_or_else(|| {
+        let names: Vec<&str> = Family::ALL.iter().map(|f| f.name()).collect();
+        format!(
+            "unknown family '{s}' (expected one of {})",
+            names.join(", ")
+        )
+    })
+}
+
+/// Runs the subcommand: creates the device (`device_filter`, `validation` as for `render`), runs the
+/// cases, prints the table, and fails if any case failed.
+pub fn run_cli(
+    device_filter: Option<String>,
+    validation: bool,
+    args: &HardcasesArgs,
+) -> Result<()> {
+    let mut desc = DeviceDesc::from_env();
+    desc.validation |= validation;
+    if device_filter.is_some() {
+        desc.device_filter = device_filter;
+    }
+    let device = Device::new_headless(&desc)?;
+    let families = if args.family.is_empty() {
+        Family::ALL.to_vec()
+    } else {
+        args.family.clone()
+    };
+    let cases: Vec<HardCase> = families
+        .iter()
+        .flat_map(|&f| scene::hard_cases::family(f, &args.models))
+        .filter(|c| !(args.skip_heavy && c.heavy))
+        .collect();
+    let start = Instant::now();
+    let outcomes = run_cases(&device, &cases, args.previews.as_deref());
+    let caps = device.capabilities();
+    let path = outcomes
+        .iter()
+        .map(|o| o.raster_path)
+        .find(|p| !p.is_empty())
+        .unwrap_or("none");
+    println!(
+        "Hard cases on {} ({}), {} conservative raster, validation {}: {:.1} s\n",
+        caps.device_name,
+        caps.driver,
+        path,
+        if desc.validation { "on" } else { "off" },
+        start.elapsed().as_secs_f64()
+    );
+    print!("{}", table(&outcomes, args.markdown));
+    let failed = outcomes.iter().filter(|o| !o.passed()).count();
+    if failed > 0 {
+        bail!("{failed} of {} hard cases failed", outcomes.len());
+    }
+    println!("\nall {} hard cases pass", outcomes.len());
+    Ok(())
+}
+
+/// The outcome table: plain text with aligned columns, or Markdown.
+pub fn table(outcomes: &[Outcome], markdown: bool) -> String {
+    const HEADER: [&str; 12] = [
+        "case",
+        "pixels",
+        "near-edge",
+        "mismatches",
+        "leaks",
+        "acne",
+        "NaN/Inf",
+        "overflowed texels",
+        "map errors",
+        "measure",
+        "time",
+        "result",
+    ];
+    let rows: Vec<[String; 12]> = outcomes
+        .iter()
+        .map(|o| {
+            let rendered = o.rejected.is_none() && o.error.is_none();
+            let n = |v: usize| {
+                if rendered {
+                    v.to_string()
+                } else {
+                    "-".into()
+                }
+            };
+            [
+                o.name.to_owned(),
+                n(o.pixels),
+                n(o.near_edge),
+                n(o.mismatches),
+                n(o.leaks),
+                n(o.acne),
+                n(o.non_finite),
+                n(o.overflowed_texels as usize),
+                n(o.map_missing + o.map_garbage),
+                o.measure(),
+                format!("{:.1} s", o.seconds),
+                o.result(),
+            ]
+        })
+        .collect();
+    let mut out = String::new();
+    if markdown {
+        let line = |cells: &[&str]| format!("| {} |\n", cells.join(" | "));
+        out += &line(&HEADER);
+        let align: Vec<&str> = HEADER
+            .iter()
+            .map(|h| match *h {
+                "case" | "measure" | "result" => "---",
+                _ => "---:",
+            })
+            .collect();
+        out += &line(&align);
+        for r in &rows {
+            let cells: Vec<String> = r.iter().map(|c| c.replace('|', "\\|")).collect();
+            out += &line(&cells.iter().map(String::as_str).collect::<Vec<_>>());
+        }
+    } else {
+        let mut widths = HEADER.map(|h| h.chars().count());
+        for r in &rows {
+            for (w, c) in widths.iter_mut().zip(r) {
+                *w = (*w).max(c.chars().count());
+            }
+        }
+        let line = |cells: &[&str]| {
+            let padded: Vec<String> = cells
+                .iter()
+                .zip(widths)
+                .enumerate()
+                .map(|(i, (c, w))| {
+                    if (1..9).contains(&i) || i == 10 {
+                        format!("{c:>w$}")
+                    } else {
+                        format!("{c:<w$}")
+                    }
+                })
+                .collect();
+            format!("{}\n", padded.join("  ").trim_end())
+        };
+        out += &line(&HEADER);
+        for r in &rows {
+            out += &line(&r.iter().map(String::as_str).collect::<Vec<_>>());
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn blocked_rays() {
+        let up = DVec3::Y;
+        let square = Solid::Polygon(vec![
+            Vec3::new(-1.0, 1.0, -1.0),
+            Vec3::new(1.0, 1.0, -1.0),
+            Vec3::new(1.0, 1.0, 1.0),
+            Vec3::new(-1.0, 1.0, 1.0),
+        ]);
+        assert!(certainly_blocked(&square, DVec3::ZERO, up, 0.1));
+        assert!(!certainly_blocked(
+            &square,
+            DVec3::new(0.95, 0.0, 0.0),
+            up,
+            0.1
+        ));
+        assert!(!certainly_blocked(
+            &square,
+            DVec3::new(0.0, 2.0, 0.0),
+            up,
+            0.1
+        ));
+        let ball = Solid::Ball {
+            center: Vec3::new(0.0, 2.0, 0.0),
+            radius: 1.0,
+        };
+        assert!(certainly_blocked(&ball, DVec3::new(0.5, 0.0, 0.0), up, 0.1));
+        assert!(!certainly_blocked(
+            &ball,
+            DVec3::new(0.95, 0.0, 0.0),
+            up,
+            0.1
+        ));
+        assert!(!certainly_blocked(
+            &ball,
+            DVec3::new(0.0, 4.0, 0.0),
+            up,
+            0.1
+        ));
+        let cube = Solid::Box(Aabb {
+            min: Vec3::new(-1.0, 1.0, -1.0),
+            max: Vec3::new(1.0, 2.0, 1.0),
+        });
+        assert!(certainly_blocked(
+            &cube,
+            DVec3::new(0.5, 0.0, -0.5),
+            up,
+            0.1
+        ));
+        assert!(!certainly_blocked(
+            &cube,
+            DVec3::new(0.95, 0.0, 0.0),
+            up,
+            0.1
+        ));
+        let slanted = DVec3::new(1.0, 1.0, 0.0).normalize();
+        assert!(certainly_blocked(
+            &cube,
+            DVec3::new(-1.5, 0.0, 0.0),
+            slanted,
+            0.1
+        ));
+        assert!(!certainly_blocked(
+            &cube,
+            DVec3::new(-0.5, 2.5, 0.0),
+            slanted,
+            0.1
+        ));
+    }
+
+    #[test]
+    fn slabs() {
+        let r = slab_2d(
+            DVec2::ZERO,
+            DVec2::X,
+            DVec2::new(1.0, -1.0),
+            DVec2::new(2.0, 1.0),
+        );
+        assert_eq!(r, Some((1.0, 2.0)));
+        assert_eq!(
+            slab_2d(
+                DVec2::ZERO,
+                DVec2::X,
+                DVec2::new(1.0, 0.5),
+                DVec2::new(2.0, 1.0)
+            ),
+            None
+        );
+    }
+
+    #[test]
+    fn table_layout() {
+        let pass = Outcome {
+            name: "a | b",
+            pixels: 10,
+            raster_path: "software",
+            ..Outcome::default()
+        };
+        let rejected = Outcome {
+            name: "nan",
+            rejected: Some("x.obj: vertex 1 has a non-finite coordinate (NaN)".into()),
+            ..Outcome::default()
+        };
+        let failed = Outcome {
+            name: "leaky",
+            leaks: 3,
+            ..Outcome::default()
+        };
+        assert!(pass.passed() && rejected.passed() && !failed.passed());
+        let md = table(&[pass.clone(), rejected, failed], true);
+        let lines: Vec<&str> = md.lines().collect();
+        assert_eq!(lines.len(), 5);
+        assert!(lines[2].starts_with("| a \\| b | 10 |"), "{}", lines[2]);
+        assert!(lines[3].contains("| rejected: x.obj"), "{}", lines[3]);
+        assert!(lines[4].ends_with("FAIL: 3 leaks |"), "{}", lines[4]);
+        let text = table(&[pass], false);
+        assert!(text.lines().all(|l| !l.ends_with(' ')));
+        assert_eq!(slug("fan disc (96 triangles)"), "fan-disc-96-triangles");
+    }
+}

@@ -1,0 +1,316 @@
+//! The light of a frame — directional (orthographic light frustum) or spot (perspective light frustum) —
+//! and the light-space constants every light-space pass derives from it, in frame coordinates.
+
+use crate::gpu_types::GpuLight;
+use crate::PassError;
+use glam::{DMat4, DVec3, DVec4, Mat4, Vec3, Vec4};
+
+/// The light whose shadows the pipeline computes. Matrices map world space to Vulkan clip space with
+/// standard depth (the light's near plane at depth 0, farther points deeper; not reversed Z).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Light {
+    /// Parallel light.
+    Directional {
+        /// Direction the light travels (normalised by the pipeline).
+        direction: Vec3,
+        /// Orthographic view-projection looking along `direction` and enclosing the shadow casters and
+        /// receivers (world coordinates). Used by the primitive map and the shadow map alike.
+        view_proj: Mat4,
+    },
+    /// Spot light: a point emitter with a perspective light frustum.
+    Spot {
+        /// Emitter position (world coordinates): shadow rays end there.
+        position: Vec3,
+        /// Axis of the cone (normalised by the pipeline): the direction the light points. It must agree
+        /// with the view axis of `view_proj`.
+        direction: Vec3,
+        /// Perspective view-projection with its eye at `position`, covering the cone (world
+        /// coordinates). Receivers outside it count as lit (no recorded occluder).
+        view_proj: Mat4,
+    },
+}
+
+impl Light {
+    /// The light view-projection (world coordinates).
+    pub fn view_proj(&self) -> Mat4 {
+        match *self {
+            Self::Directional { view_proj, .. } | Self::Spot { view_proj, .. } => view_proj,
+        }
+    }
+
+    /// The direction of travel (directional) or the cone axis (spot), as given.
+    pub fn direction(&self) -> Vec3 {
+        match *self {
+            Self::Directional { direction, .. } | Self::Spot { direction, .. } => direction,
+        }
+    }
+
+    /// The emitter position of a spot light.
+    pub fn position(&self) -> Option<Vec3> {
+        match *self {
+            Self::Directional { .. } => None,
+            Self::Spot { position, .. } => Some(position),
+        }
+    }
+
+    /// "directional" or "spot".
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Self::Directional { .. } => "directional",
+            Self::Spot { .. } => "spot",
+        }
+    }
+}
+
+/// Relative tolerance of the checks that a matrix matches the light it is given for.
+const MATCH_TOLERANCE: f64 = 1e-3;
+
+/// The light in frame coordinates, validated, with what light-space passes need.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LightFrame {
+    /// View-projection applied to frame coordinates.
+    pub view_proj: Mat4,
+    /// Its inverse.
+    pub inv_view_proj: Mat4,
+    /// Unit direction of travel (directional) or unit view axis (spot).
+    pub direction: Vec3,
+    /// Spot position in frame coordinates.
+    pub position: Option<Vec3>,
+    /// Linear depth (world units along the light axis) of NDC `c = (x, y, d, 1)` is
+    /// `dot(lin_num, c) / dot(lin_den, c)`.
+    pub lin_num: Vec4,
+    /// See `lin_num`.
+    pub lin_den: Vec4,
+}
+
+/// `m * translation(origin)` in f64: `m` applied to coordinates relative to `origin`.
+pub(crate) fn rebased(m: Mat4, origin: DVec3) -> DMat4 {
+    m.as_dmat4() * DMat4::from_translation(origin)
+}
+
+fn invalid(what: &str) -> PassError {
+    PassError::InvalidConfig(what.to_owned())
+}
+
+impl LightFrame {
+    /// Validates `light` and moves it into the frame whose origin is `origin`.
+    pub fn new(light: &Light, origin: DVec3) -> Result<Self, PassError> {
+        let m = rebased(light.view_proj(), origin);
+        let dir = light.direction().as_dvec3().normalize_or_zero();
+        if !m.is_finite() || dir == DVec3::ZERO || !dir.is_finite() {
+            return Err(invalid(
+                "the light's direction and view-projection must be finite and non-zero",
+            ));
+        }
+        let det = m.determinant();
+        if det == 0.0 || !det.is_finite() {
+            return Err(invalid("the light view-projection is not invertible"));
+        }
+        let inv = m.inverse();
+        let (axis, position, a) = match light {
+            Light::Directional { .. } => {
+                // Orthographic along the light: travelling along `dir` changes depth only.
+                let c = m * dir.extend(0.0);
+                let scale = c.z.abs();
+                if c.z <= 0.0
+                    || c.x.abs() > MATCH_TOLERANCE * scale
+                    || c.y.abs() > MATCH_TOLERANCE * scale
+                    || c.w.abs() > MATCH_TOLERANCE * scale
+                {
+                    return Err(invalid(
+                        "a directional light needs an orthographic view-projection looking along its \
+                         direction with depth increasing away from the light (not reversed Z)",
+                    ));
+                }
+                (dir, None, dir.extend(0.0))
+            }
+            Light::Spot { position, .. } => {
+                let p = position.as_dvec3() - origin;
+                if !p.is_finite() {
+                    return Err(invalid("the spot light position is not finite"));
+                }
+                // The eye of a perspective projection maps to clip (0, 0, z, 0).
+                let eye = m * p.extend(1.0);
+                let off_eye = [0, 1, 3].into_iter().any(|i| {
+                    let row = m.row(i);
+                    eye[i].abs() > MATCH_TOLERANCE * (row.truncate().length() * (1.0 + p.length()))
+                });
+                let w_axis = m.row(3).truncate();
+                let len = w_axis.length();
+                if len == 0.0 || off_eye {
+                    return Err(invalid(
+                        "a spot light needs a perspective view-projection whose eye is at its position",
+                    ));
+                }
+                let axis = w_axis / len;
+                if axis.dot(dir) < 0.99 {
+                    return Err(invalid(
+                        "the spot light direction does not match the view axis of its view-projection",
+                    ));
+                }
+                let depth_at = |t: f64| {
+                    let c = m * (p + axis * t).extend(1.0);
+                    c.z / c.w
+                };
+                if depth_at(2.0) <= depth_at(1.0) {
+                    return Err(invalid(
+                        "the spot light projection must use standard depth (near 0, far 1), not reversed Z",
+                    ));
+                }
+                (axis, Some(p), axis.extend(-axis.dot(p)))
+            }
+        };
+        // With X_h = inv * c and X = X_h.xyz / X_h.w: lin = dot(a, X_h) / X_h.w = dot(a.xyz, X) + a.w.
+        let mut num = DVec4::ZERO;
+        for i in 0..4 {
+            num += inv.row(i) * a[i];
+        }
+        let den = inv.row(3);
+        let frame = Self {
+            view_proj: m.as_mat4(),
+            inv_view_proj: inv.as_mat4(),
+            direction: axis.as_vec3(),
+            position: position.map(|p| p.as_vec3()),
+            lin_num: num.as_vec4(),
+            lin_den: den.as_vec4(),
+        };
+        if !frame.inv_view_proj.is_finite() || !frame.lin_num.is_finite() {
+            return Err(invalid("the light view-projection is too ill-conditioned"));
+        }
+        Ok(frame)
+    }
+
+    /// World size of one texel of a `size`² map: constant for a directional light, per unit of linear
+    /// depth for a spot light (measured on the map's central texel, in f64).
+    fn texel_world_size(&self, size: u32) -> f32 {
+        let inv = self.inv_view_proj.as_dmat4();
+        let at = |x: f64, y: f64| inv.project_point3(DVec3::new(x, y, 0.5));
+        let step = 2.0 / f64::from(size.max(1));
+        let c = at(0.0, 0.0);
+        let s = 0.5 * ((at(step, 0.0) - c).length() + (at(0.0, step) - c).length());
+        match self.position {
+            None => s as f32,
+            Some(p) => (s / (c - p.as_dvec3()).dot(self.direction.as_dvec3())) as f32,
+        }
+    }
+
+    /// Shader constants for a `size`² shadow map and an emitter of `light_size` (tangent of the angular
+    /// radius for a directional light, radius in world units for a spot light).
+    pub fn gpu(&self, size: u32, light_size: f32) -> GpuLight {
+        let (position, kind) = match self.position {
+            None => (Vec4::ZERO, 0.0),
+            Some(p) => (p.extend(1.0), 1.0),
+        };
+        GpuLight {
+            view_proj: self.view_proj,
+            inv_view_proj: self.inv_view_proj,
+            lin_num: self.lin_num,
+            lin_den: self.lin_den,
+            position,
+            direction: self.direction.extend(0.0),
+            params: Vec4::new(self.texel_world_size(size), light_size, size as f32, kind),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn directional() -> Light {
+        let direction = Vec3::new(0.3, -1.0, 0.2).normalize();
+        let view = Mat4::look_to_rh(-direction * 20.0, direction, Vec3::Y);
+        Light::Directional {
+            direction,
+            view_proj: Mat4::orthographic_rh(-5.0, 5.0, -5.0, 5.0, 1.0, 40.0) * view,
+        }
+    }
+
+    fn spot() -> Light {
+        let position = Vec3::new(1.0, 6.0, 2.0);
+        let direction = Vec3::new(0.0, -1.0, -0.3).normalize();
+        let view = Mat4::look_to_rh(position, direction, Vec3::Y);
+        Light::Spot {
+            position,
+            direction,
+            view_proj: Mat4::perspective_rh(1.0, 1.0, 0.5, 30.0) * view,
+        }
+    }
+
+    fn lin(f: &LightFrame, world: Vec3, origin: DVec3) -> f32 {
+        let c = f
+            .view_proj
+            .project_point3((world.as_dvec3() - origin).as_vec3());
+        let c = c.extend(1.0);
+        f.lin_num.dot(c) / f.lin_den.dot(c)
+    }
+
+    #[test]
+    fn linear_depth_is_distance_along_the_axis() {
+        let origin = DVec3::new(3.0, 0.0, -1.0);
+        let s = spot();
+        let f = LightFrame::new(&s, origin).unwrap();
+        let p = s.position().unwrap();
+        for t in [0.7, 3.0, 12.0] {
+            let x = p + s.direction() * t + Vec3::new(0.2, 0.0, 0.1).cross(s.direction());
+            assert!((lin(&f, x, origin) - t).abs() < 1e-3 * t, "{t}");
+        }
+        let d = directional();
+        let f = LightFrame::new(&d, origin).unwrap();
+        let a = Vec3::new(0.5, 1.0, 0.0);
+        let b = a + d.direction() * 2.5;
+        assert!((lin(&f, b, origin) - lin(&f, a, origin) - 2.5).abs() < 1e-4);
+    }
+
+    #[test]
+    fn texel_sizes() {
+        let f = LightFrame::new(&directional(), DVec3::ZERO).unwrap();
+        assert!((f.gpu(1000, 0.0).params.x - 0.01).abs() < 1e-6);
+        let f = LightFrame::new(&spot(), DVec3::ZERO).unwrap();
+        let expected = 2.0 * (0.5f32).tan() / 1000.0;
+        assert!((f.gpu(1000, 0.0).params.x - expected).abs() < 1e-6);
+    }
+
+    #[test]
+    fn mismatched_lights_are_rejected() {
+        let Light::Directional { view_proj, .. } = directional() else {
+            unreachable!()
+        };
+        let wrong = Light::Directional {
+            direction: Vec3::X,
+            view_proj,
+        };
+        assert!(LightFrame::new(&wrong, DVec3::ZERO).is_err());
+        let Light::Spot {
+            position,
+            direction,
+            view_proj,
+        } = spot()
+        else {
+            unreachable!()
+        };
+        let moved = Light::Spot {
+            position: position + Vec3::X,
+            direction,
+            view_proj,
+        };
+        assert!(LightFrame::new(&moved, DVec3::ZERO).is_err());
+        let reversed = Light::Spot {
+            position,
+            direction,
+            view_proj: Mat4::perspective_infinite_reverse_rh(1.0, 1.0, 0.5)
+                * Mat4::look_to_rh(position, direction, Vec3::Y),
+        };
+        assert!(LightFrame::new(&reversed, DVec3::ZERO).is_err());
+        let nan = Light::Directional {
+            direction: Vec3::NAN,
+            view_proj,
+        };
+        assert!(LightFrame::new(&nan, DVec3::ZERO).is_err());
+        let singular = Light::Directional {
+            direction: Vec3::NEG_Y,
+            view_proj: Mat4::ZERO,
+        };
+        assert!(LightFrame::new(&singular, DVec3::ZERO).is_err());
+    }
+}

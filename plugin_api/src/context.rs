@@ -1,0 +1,891 @@
+//! The plugin context behind the C ABI: state, validation of every input, and recording into the
+//! engine's command buffer.
+
+use crate::types::*;
+use glam::{DVec3, Mat4, Vec3};
+use passes::{
+    Draw, FaceMode, FrameInputs, Geometry, IndexFormat, IndexLayout, Light, PassError,
+    PrimitiveMapConfig, RasterPath, RasterRequest, ShadowConfig, ShadowInputs, ShadowMode,
+    ShadowPipeline, VertexLayout,
+};
+use rhi::{
+    Barrier, Device, Encoder, Format, Image, ImageDesc, ImageUsage, ResourceState as S, RhiError,
+};
+
+/// An error to return through the C ABI: a result code and a message.
+#[derive(Debug)]
+pub(crate) struct ApiError {
+    pub(crate) code: HrtsResult,
+    pub(crate) message: String,
+}
+
+impl ApiError {
+    pub(crate) fn new(code: HrtsResult, message: impl Into<String>) -> Self {
+        Self {
+            code,
+            message: message.into(),
+        }
+    }
+}
+
+impl From<PassError> for ApiError {
+    fn from(e: PassError) -> Self {
+        let code = match &e {
+            PassError::Rhi(r) => return r.into(),
+            PassError::InvalidConfig(_) | PassError::InvalidGeometry(_) => {
+                HrtsResult::ErrorInvalidArgument
+            }
+            PassError::Unsupported(_) => HrtsResult::ErrorUnsupported,
+        };
+        Self::new(code, e.to_string())
+    }
+}
+
+impl From<&RhiError> for ApiError {
+    fn from(e: &RhiError) -> Self {
+        let code = match e {
+            _ if e.is_out_of_memory() => HrtsResult::ErrorOutOfMemory,
+            RhiError::MissingFeature(_)
+            | RhiError::NoDevice(_)
+            | RhiError::Loader(_)
+            | RhiError::ValidationUnavailable => HrtsResult::ErrorUnsupported,
+            RhiError::InvalidArgument(_) | RhiError::Limit { .. } => {
+                HrtsResult::ErrorInvalidArgument
+            }
+            RhiError::Vulkan { .. } | RhiError::Allocation { .. } => HrtsResult::ErrorVulkan,
+        };
+        Self::new(code, e.to_string())
+    }
+}
+
+impl From<RhiError> for ApiError {
+    fn from(e: RhiError) -> Self {
+        (&e).into()
+    }
+}
+
+pub(crate) type ApiResult<T> = Result<T, ApiError>;
+
+fn invalid(message: impl Into<String>) -> ApiError {
+    ApiError::new(HrtsResult::ErrorInvalidArgument, message)
+}
+
+/// Checks a caller-provided `struct_size`.
+pub(crate) fn check_size<T>(size: u32, name: &str) -> ApiResult<()> {
+    let expected = std::mem::size_of::<T>();
+    if size as usize != expected {
+        return Err(ApiError::new(
+            HrtsResult::ErrorStructSize,
+            format!("{name}.struct_size is {size}, this library's {name} is {expected} bytes (header/library mismatch)"),
+        ));
+    }
+    Ok(())
+}
+
+fn finite(values: &[f32], what: &str) -> ApiResult<()> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(invalid(format!("{what} contains NaN or infinity")))
+    }
+}
+
+/// Geometry as the engine described it, kept to rebuild the passes after a configuration change.
+enum GeometrySource {
+    Cpu {
+        positions: Vec<f32>,
+        indices: Vec<u32>,
+        draws: Vec<Draw>,
+        origin: DVec3,
+    },
+    Vulkan {
+        vertices: (u64, u64),
+        vertex: VertexLayout,
+        indices: (u64, u64),
+        index: IndexLayout,
+        draws: Vec<Draw>,
+        origin: DVec3,
+    },
+}
+
+#[derive(Clone, Copy)]
+struct TargetSource {
+    width: u32,
+    height: u32,
+    depth: u64,
+    normal: u64,
+    output: u64,
+}
+
+/// The passes and the engine images they are bound to (the pipeline drops first).
+struct Built {
+    pipeline: ShadowPipeline,
+    depth: Image,
+    normal: Image,
+    output: Image,
+}
+
+/// State of one plugin context.
+pub(crate) struct Context {
+    built: Option<Built>,
+    device: Device,
+    config: ShadowConfig,
+    geometry: Option<GeometrySource>,
+    targets: Option<TargetSource>,
+    recorded: bool,
+    pub(crate) last_error: std::ffi::CString,
+}
+
+fn image_usage(vk_usage: u32) -> ImageUsage {
+    const TRANSFER_SRC: u32 = 0x1;
+    const TRANSFER_DST: u32 = 0x2;
+    const SAMPLED: u32 = 0x4;
+    const STORAGE: u32 = 0x8;
+    const COLOR: u32 = 0x10;
+    const DEPTH: u32 = 0x20;
+    let mut u = ImageUsage::default();
+    for (bit, ours) in [
+        (TRANSFER_SRC, ImageUsage::COPY_SRC),
+        (TRANSFER_DST, ImageUsage::COPY_DST),
+        (SAMPLED, ImageUsage::SAMPLED),
+        (STORAGE, ImageUsage::STORAGE),
+        (COLOR, ImageUsage::COLOR_TARGET),
+        (DEPTH, ImageUsage::DEPTH_TARGET),
+    ] {
+        if vk_usage & bit != 0 {
+            u = u | ours;
+        }
+    }
+    u
+}
+
+fn require_usage(
+    vk_usage: u32,
+    needed: ImageUsage,
+    what: &str,
+    needed_name: &str,
+) -> ApiResult<ImageUsage> {
+    let usage = image_usage(vk_usage);
+    if !usage.contains(needed) {
+        return Err(ApiError::new(
+            HrtsResult::ErrorImageUsage,
+            format!("{what} was not created with {needed_name} usage (usage flags 0x{vk_usage:x})"),
+        ));
+    }
+    Ok(usage)
+}
+
+fn mat4(m: &[f32; 16]) -> Mat4 {
+    Mat4::from_cols_array(m)
+}
+
+fn draws_from(ptr: *const HrtsDraw, count: u32) -> ApiResult<Vec<Draw>> {
+    if count == 0 {
+        return Err(invalid("draw_count is 0"));
+    }
+    if ptr.is_null() {
+        return Err(ApiError::new(HrtsResult::ErrorNullPointer, "draws is NULL"));
+    }
+    // SAFETY: the caller guarantees `ptr` points at `count` draws (documented contract).
+    let draws = unsafe { std::slice::from_raw_parts(ptr, count as usize) };
+    draws
+        .iter()
+        .enumerate()
+        .map(|(i, d)| {
+            finite(&d.transform, &format!("draws[{i}].transform"))?;
+            Ok(Draw {
+                first_index: d.first_index,
+                index_count: d.index_count,
+                model: mat4(&d.transform),
+            })
+        })
+        .collect()
+}
+
+impl Context {
+    /// Creates a context on an adopted or own device.
+    pub(crate) fn new(info: &HrtsContextCreateInfo) -> ApiResult<Self> {
+        if info.api_version >> 22 != HRTS_API_VERSION >> 22 {
+            return Err(ApiError::new(
+                HrtsResult::ErrorVersion,
+                format!(
+                    "caller built against API {}.x, this library is {}.x",
+                    info.api_version >> 22,
+                    HRTS_API_VERSION >> 22
+                ),
+            ));
+        }
+        let device = if info.vulkan.is_null() {
+            let filter = if info.device_name_filter.is_null() {
+                None
+            } else {
+                // SAFETY: a non-NULL filter is a NUL-terminated string (documented contract).
+                let s = unsafe { std::ffi::CStr::from_ptr(info.device_name_filter) };
+                Some(
+                    s.to_str()
+                        .map_err(|_| invalid("device_name_filter is not UTF-8"))?
+                        .to_owned(),
+                )
+            };
+            Device::new_headless(&rhi::DeviceDesc {
+                validation: info.enable_validation,
+                device_filter: filter,
+            })?
+        } else {
+            // SAFETY: non-NULL, checked above; the caller guarantees it points at a HrtsVulkanDevice.
+            let v = unsafe { &*info.vulkan };
+            check_size::<HrtsVulkanDevice>(v.struct_size, "HrtsVulkanDevice")?;
+            let gipa = v.get_instance_proc_addr.ok_or_else(|| {
+                ApiError::new(
+                    HrtsResult::ErrorNullPointer,
+                    "get_instance_proc_addr is NULL",
+                )
+            })?;
+            if v.instance == 0 || v.physical_device == 0 || v.device == 0 {
+                return Err(ApiError::new(
+                    HrtsResult::ErrorNullPointer,
+                    "instance, physical_device and device must be non-NULL",
+                ));
+            }
+            if !v.fragment_stores_and_atomics {
+                return Err(ApiError::new(
+                    HrtsResult::ErrorUnsupported,
+                    "the device must enable fragmentStoresAndAtomics (the primitive map's UAV writes)",
+                ));
+            }
+            let mut extensions = Vec::new();
+            if v.enabled_extension_count > 0 {
+                if v.enabled_extensions.is_null() {
+                    return Err(ApiError::new(
+                        HrtsResult::ErrorNullPointer,
+                        "enabled_extensions is NULL but its count is not 0",
+                    ));
+                }
+                // SAFETY: the caller guarantees `enabled_extension_count` valid C strings.
+                let names = unsafe {
+                    std::slice::from_raw_parts(
+                        v.enabled_extensions,
+                        v.enabled_extension_count as usize,
+                    )
+                };
+                for &n in names {
+                    if n.is_null() {
+                        return Err(ApiError::new(
+                            HrtsResult::ErrorNullPointer,
+                            "an enabled extension name is NULL",
+                        ));
+                    }
+                    // SAFETY: non-NULL NUL-terminated string.
+                    extensions.push(
+                        unsafe { std::ffi::CStr::from_ptr(n) }
+                            .to_string_lossy()
+                            .into_owned(),
+                    );
+                }
+            }
+            let desc = rhi::AdoptDesc {
+                get_instance_proc_addr: gipa,
+                instance: v.instance,
+                physical_device: v.physical_device,
+                device: v.device,
+                queue_family_index: v.queue_family_index,
+                queue_index: v.queue_index,
+                enabled_extensions: extensions,
+                enabled_features: rhi::EnabledFeatures {
+                    geometry_shader: v.geometry_shader,
+                    fragment_stores_and_atomics: v.fragment_stores_and_atomics,
+                    depth_clamp: v.depth_clamp,
+                    shader_float64: false,
+                },
+                debug_utils: v.debug_utils,
+            };
+            // SAFETY: the caller guarantees the handles are valid, belong together and outlive the context.
+            unsafe { Device::adopt(desc) }?
+        };
+        Ok(Self {
+            built: None,
+            device,
+            config: ShadowConfig::default(),
+            geometry: None,
+            targets: None,
+            recorded: false,
+            last_error: std::ffi::CString::default(),
+        })
+    }
+
+    pub(crate) fn capabilities(&self, out: &mut HrtsCapabilities) -> ApiResult<()> {
+        check_size::<HrtsCapabilities>(out.struct_size, "HrtsCapabilities")?;
+        let caps = self.device.capabilities();
+        let default_path = match passes::choose_raster_path(caps, RasterRequest::Auto) {
+            Ok(RasterPath::Hardware(_)) => HrtsRasterPath::Hardware as u32,
+            _ => HrtsRasterPath::Software as u32,
+        };
+        out.conservative_raster_tier = caps.conservative_raster_tier as u32;
+        out.default_raster_path = default_path;
+        out.geometry_shader = caps.geometry_shader;
+        out.timestamps = caps.timestamps;
+        out.ray_query = caps.ray_query;
+        out.ray_tracing_pipeline = caps.ray_tracing_pipeline;
+        out.fragment_shader_interlock = caps.fragment_shader_interlock;
+        out.max_map_size = caps.max_image_dimension_2d;
+        out.max_map_depth = caps.max_image_array_layers - 1;
+        out.max_storage_buffer_range = caps.max_storage_buffer_range;
+        out.device_name = [0; 128];
+        for (dst, src) in out
+            .device_name
+            .iter_mut()
+            .zip(caps.device_name.bytes().take(127))
+        {
+            *dst = src as std::ffi::c_char;
+        }
+        Ok(())
+    }
+
+    pub(crate) fn configure(&mut self, c: &HrtsConfig) -> ApiResult<()> {
+        let config = shadow_config(c)?;
+        let caps = self.device.capabilities();
+        config.map.validate(caps)?;
+        if config.map.raster != RasterRequest::Auto {
+            passes::choose_raster_path(caps, config.map.raster)?;
+        }
+        if config.shadow_map.size == 0 || config.shadow_map.size > caps.max_image_dimension_2d {
+            return Err(invalid(format!(
+                "shadow_map_size {} must be within 1..={}",
+                config.shadow_map.size, caps.max_image_dimension_2d
+            )));
+        }
+        self.config = config;
+        self.built = None;
+        Ok(())
+    }
+
+    pub(crate) fn set_geometry_cpu(&mut self, g: &HrtsCpuGeometry) -> ApiResult<()> {
+        check_size::<HrtsCpuGeometry>(g.struct_size, "HrtsCpuGeometry")?;
+        if g.positions.is_null() || g.indices.is_null() {
+            return Err(ApiError::new(
+                HrtsResult::ErrorNullPointer,
+                "positions and indices must be non-NULL",
+            ));
+        }
+        if g.vertex_count == 0 || g.index_count == 0 {
+            return Err(invalid("vertex_count and index_count must be positive"));
+        }
+        if g.vertex_stride < 12 || g.vertex_stride % 4 != 0 {
+            return Err(invalid(format!(
+                "vertex_stride {} must be a multiple of 4 and at least 12",
+                g.vertex_stride
+            )));
+        }
+        let floats = (g.vertex_count as usize - 1) * (g.vertex_stride as usize / 4) + 3;
+        // SAFETY: the caller guarantees the arrays hold `vertex_count` strided positions and `index_count`
+        // indices (documented contract); they are copied before returning.
+        let raw = unsafe { std::slice::from_raw_parts(g.positions, floats) };
+        let step = g.vertex_stride as usize / 4;
+        let positions: Vec<f32> = (0..g.vertex_count as usize)
+            .flat_map(|i| raw[i * step..i * step + 3].to_vec())
+            .collect();
+        finite(&positions, "positions")?;
+        // SAFETY: as above.
+        let indices =
+            unsafe { std::slice::from_raw_parts(g.indices, g.index_count as usize) }.to_vec();
+        let draws = draws_from(g.draws, g.draw_count)?;
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for d in &draws {
+            let model = d.model.as_dmat4();
+            for &i in indices
+                .iter()
+                .skip(d.first_index as usize)
+                .take(d.index_count as usize)
+            {
+                let Some(p) = positions.get(i as usize * 3..i as usize * 3 + 3) else {
+                    return Err(invalid(format!(
+                        "index {i} is out of range ({} vertices)",
+                        g.vertex_count
+                    )));
+                };
+                let w = model.transform_point3(Vec3::from_slice(p).as_dvec3());
+                lo = lo.min(w);
+                hi = hi.max(w);
+            }
+        }
+        if !lo.is_finite() || !hi.is_finite() {
+            return Err(invalid("the draws reference no vertices"));
+        }
+        for (n, d) in draws.iter().enumerate() {
+            if d.index_count % 3 != 0
+                || u64::from(d.first_index) + u64::from(d.index_count) > indices.len() as u64
+            {
+                return Err(invalid(format!(
+                    "draw {n} does not cover whole triangles of the index array"
+                )));
+            }
+        }
+        self.geometry = Some(GeometrySource::Cpu {
+            positions,
+            indices,
+            draws,
+            origin: (lo + hi) * 0.5,
+        });
+        self.built = None;
+        Ok(())
+    }
+
+    pub(crate) fn set_geometry_vulkan(&mut self, g: &HrtsVulkanGeometry) -> ApiResult<()> {
+        check_size::<HrtsVulkanGeometry>(g.struct_size, "HrtsVulkanGeometry")?;
+        if g.vertex_buffer == 0 || g.index_buffer == 0 {
+            return Err(ApiError::new(
+                HrtsResult::ErrorNullPointer,
+                "vertex_buffer and index_buffer must be non-NULL",
+            ));
+        }
+        let format = match g.index_type {
+            x if x == HrtsIndexType::Uint16 as u32 => IndexFormat::U16,
+            x if x == HrtsIndexType::Uint32 as u32 => IndexFormat::U32,
+            x => {
+                return Err(ApiError::new(
+                    HrtsResult::ErrorInvalidEnum,
+                    format!("index_type {x} is not a HrtsIndexType value"),
+                ))
+            }
+        };
+        finite(&g.bounds, "bounds")?;
+        let lo = Vec3::from_slice(&g.bounds[..3]).as_dvec3();
+        let hi = Vec3::from_slice(&g.bounds[3..]).as_dvec3();
+        if lo.cmpgt(hi).any() {
+            return Err(invalid("bounds min exceeds max"));
+        }
+        let draws = draws_from(g.draws, g.draw_count)?;
+        let vertex = VertexLayout {
+            offset: g.vertex_offset,
+            stride: g.vertex_stride,
+            count: g.vertex_count,
+        };
+        let index = IndexLayout {
+            offset: g.index_offset,
+            format,
+            count: g.index_count,
+        };
+        let source = GeometrySource::Vulkan {
+            vertices: (g.vertex_buffer, g.vertex_buffer_size),
+            vertex,
+            indices: (g.index_buffer, g.index_buffer_size),
+            index,
+            draws,
+            origin: (lo + hi) * 0.5,
+        };
+        geometry_from(&self.device, &source)?;
+        self.geometry = Some(source);
+        self.built = None;
+        Ok(())
+    }
+
+    pub(crate) fn set_targets(&mut self, t: &HrtsTargets) -> ApiResult<()> {
+        check_size::<HrtsTargets>(t.struct_size, "HrtsTargets")?;
+        if t.depth_image == 0 || t.normal_image == 0 || t.output_image == 0 {
+            return Err(ApiError::new(
+                HrtsResult::ErrorNullPointer,
+                "depth_image, normal_image and output_image must be non-NULL",
+            ));
+        }
+        let max = self.device.capabilities().max_image_dimension_2d;
+        if t.width == 0 || t.height == 0 || t.width > max || t.height > max {
+            return Err(invalid(format!(
+                "target size {}x{} must be within 1..={max}",
+                t.width, t.height
+            )));
+        }
+        require_usage(t.depth_usage, ImageUsage::SAMPLED, "depth_image", "SAMPLED")?;
+        require_usage(
+            t.normal_usage,
+            ImageUsage::SAMPLED,
+            "normal_image",
+            "SAMPLED",
+        )?;
+        require_usage(
+            t.output_usage,
+            ImageUsage::COPY_DST,
+            "output_image",
+            "TRANSFER_DST",
+        )?;
+        self.targets = Some(TargetSource {
+            width: t.width,
+            height: t.height,
+            depth: t.depth_image,
+            normal: t.normal_image,
+            output: t.output_image,
+        });
+        self.built = None;
+        Ok(())
+    }
+
+    pub(crate) fn record_frame(&mut self, f: &HrtsFrame) -> ApiResult<()> {
+        check_size::<HrtsFrame>(f.struct_size, "HrtsFrame")?;
+        if f.command_buffer == 0 {
+            return Err(ApiError::new(
+                HrtsResult::ErrorNullPointer,
+                "command_buffer is NULL",
+            ));
+        }
+        finite(&f.view, "view")?;
+        finite(&f.proj, "proj")?;
+        finite(&f.camera_position, "camera_position")?;
+        finite(&f.light_direction, "light_direction")?;
+        finite(&f.light_view_proj, "light_view_proj")?;
+        finite(&f.light_position, "light_position")?;
+        let dir = Vec3::from_array(f.light_direction);
+        if dir.length_squared() == 0.0 {
+            return Err(invalid("light_direction is zero"));
+        }
+        let view_proj = mat4(&f.light_view_proj);
+        let light = match f.light_type {
+            x if x == HrtsLightType::Directional as u32 => Light::Directional {
+                direction: dir.normalize(),
+                view_proj,
+            },
+            x if x == HrtsLightType::Spot as u32 => Light::Spot {
+                position: Vec3::from_array(f.light_position),
+                direction: dir.normalize(),
+                view_proj,
+            },
+            x => {
+                return Err(ApiError::new(
+                    HrtsResult::ErrorInvalidEnum,
+                    format!("light_type {x} is not a HrtsLightType value"),
+                ))
+            }
+        };
+        for (what, layout) in [
+            ("depth_layout", f.depth_layout),
+            ("normal_layout", f.normal_layout),
+            ("output_layout_after", f.output_layout_after),
+        ] {
+            if layout <= 0 {
+                return Err(invalid(format!(
+                    "{what} {layout} is not a usable VkImageLayout"
+                )));
+            }
+        }
+        let inputs = FrameInputs {
+            view: mat4(&f.view),
+            proj: mat4(&f.proj),
+            camera_position: Vec3::from_array(f.camera_position),
+            light,
+        };
+        if self.built.is_none() {
+            self.built = Some(build(
+                &self.device,
+                self.config,
+                self.geometry.as_ref(),
+                self.targets,
+            )?);
+        }
+        let (device, built) = match self.built.as_mut() {
+            Some(b) => (&self.device, b),
+            None => return Err(ApiError::new(HrtsResult::ErrorInternal, "passes not built")),
+        };
+        // SAFETY: the engine guarantees the command buffer is recording, outside a render pass, on this
+        // device and used by no other thread during the call (documented contract).
+        let mut enc = unsafe { Encoder::from_raw_handle(device, f.command_buffer) };
+        record(&mut enc, built, &inputs, f)?;
+        self.recorded = true;
+        Ok(())
+    }
+
+    pub(crate) fn report(&self, out: &mut HrtsFrameReport) -> ApiResult<()> {
+        check_size::<HrtsFrameReport>(out.struct_size, "HrtsFrameReport")?;
+        let (Some(built), true) = (&self.built, self.recorded) else {
+            return Err(ApiError::new(
+                HrtsResult::ErrorInvalidState,
+                "no frame has been recorded",
+            ));
+        };
+        let report = built.pipeline.report()?;
+        out.raster_path = match report.raster_path {
+            RasterPath::Hardware(_) | RasterPath::EmulatedTier1 { .. } => {
+                HrtsRasterPath::Hardware as u32
+            }
+            RasterPath::Software => HrtsRasterPath::Software as u32,
+        };
+        out.tier = report.raster_path.tier() as u32;
+        out.overflowed_texels = report.stats.overflowed_texels;
+        out.max_count = report.stats.max_count;
+        out.pass_count = report.timings.len().min(HRTS_MAX_REPORTED_PASSES) as u32;
+        for (slot, t) in out.passes.iter_mut().zip(&report.timings) {
+            slot.name = [0; 32];
+            for (dst, src) in slot.name.iter_mut().zip(t.name.bytes().take(31)) {
+                *dst = src as std::ffi::c_char;
+            }
+            slot.milliseconds = t.ms;
+        }
+        Ok(())
+    }
+}
+
+fn geometry_from(device: &Device, source: &GeometrySource) -> ApiResult<Geometry> {
+    Ok(match source {
+        GeometrySource::Cpu {
+            positions,
+            indices,
+            draws,
+            origin,
+        } => Geometry::upload(device, positions, indices, draws, *origin)?,
+        GeometrySource::Vulkan {
+            vertices,
+            vertex,
+            indices,
+            index,
+            draws,
+            origin,
+        } => {
+            // SAFETY: the engine guarantees its buffers are live and of the stated sizes (contract).
+            let (vb, ib) = unsafe {
+                (
+                    device.external_buffer(vertices.0, vertices.1)?,
+                    device.external_buffer(indices.0, indices.1)?,
+                )
+            };
+            Geometry::from_buffers(vb, *vertex, ib, *index, draws, *origin)?
+        }
+    })
+}
+
+/// Creates the passes over the engine's geometry and images.
+fn build(
+    device: &Device,
+    config: ShadowConfig,
+    source: Option<&GeometrySource>,
+    targets: Option<TargetSource>,
+) -> ApiResult<Built> {
+    let (Some(source), Some(t)) = (source, targets) else {
+        return Err(ApiError::new(
+            HrtsResult::ErrorInvalidState,
+            "set geometry and targets before recording",
+        ));
+    };
+    let geometry = geometry_from(device, source)?;
+    let wrap = |name, handle, format, usage| {
+        let desc = ImageDesc {
+            name,
+            format,
+            width: t.width,
+            height: t.height,
+            layers: 1,
+            usage,
+        };
+        // SAFETY: the engine guarantees its images are live and match the description (contract).
+        unsafe { device.external_image(handle, &desc) }
+    };
+    let depth = wrap(
+        "engine depth",
+        t.depth,
+        Format::D32Float,
+        ImageUsage::SAMPLED,
+    )?;
+    let normal = wrap(
+        "engine normal",
+        t.normal,
+        Format::Rgba32Float,
+        ImageUsage::SAMPLED,
+    )?;
+    let output = wrap(
+        "engine visibility",
+        t.output,
+        Format::R32Float,
+        ImageUsage::COPY_DST,
+    )?;
+    let pipeline = ShadowPipeline::new(
+        device,
+        geometry,
+        &ShadowInputs {
+            depth: &depth,
+            normal: &normal,
+        },
+        config,
+    )?;
+    Ok(Built {
+        pipeline,
+        depth,
+        normal,
+        output,
+    })
+}
+
+/// Records the passes and the engine-layout transitions around them.
+fn record(
+    enc: &mut Encoder<'_>,
+    b: &mut Built,
+    inputs: &FrameInputs,
+    f: &HrtsFrame,
+) -> ApiResult<()> {
+    enc.barriers(&[
+        Barrier::Image {
+            image: &b.depth,
+            before: S::Engine(f.depth_layout),
+            after: S::ShaderResource,
+        },
+        Barrier::Image {
+            image: &b.normal,
+            before: S::Engine(f.normal_layout),
+            after: S::ShaderResource,
+        },
+    ]);
+    b.pipeline.begin_frame(enc)?;
+    b.pipeline.record(enc, inputs)?;
+    let vis = b.pipeline.output();
+    enc.begin_pass("output copy");
+    enc.barriers(&[
+        Barrier::Image {
+            image: vis,
+            before: S::UnorderedAccess,
+            after: S::CopySource,
+        },
+        Barrier::Image {
+            image: &b.output,
+            before: S::Engine(f.output_layout_before),
+            after: S::CopyDest,
+        },
+    ]);
+    enc.copy_image(vis, &b.output)?;
+    enc.barriers(&[
+        Barrier::Image {
+            image: &b.output,
+            before: S::CopyDest,
+            after: S::Engine(f.output_layout_after),
+        },
+        Barrier::Image {
+            image: &b.depth,
+            before: S::ShaderResource,
+            after: S::Engine(f.depth_layout),
+        },
+        Barrier::Image {
+            image: &b.normal,
+            before: S::ShaderResource,
+            after: S::Engine(f.normal_layout),
+        },
+    ]);
+    enc.end_pass();
+    Ok(())
+}
+
+fn enum_value<T>(value: u32, variants: &[(u32, T)], field: &str, type_name: &str) -> ApiResult<T>
+where
+    T: Copy,
+{
+    variants
+        .iter()
+        .find(|(v, _)| *v == value)
+        .map(|(_, t)| *t)
+        .ok_or_else(|| {
+            ApiError::new(
+                HrtsResult::ErrorInvalidEnum,
+                format!("{field} {value} is not a {type_name} value"),
+            )
+        })
+}
+
+fn positive(value: f32, field: &str) -> ApiResult<f32> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(invalid(format!(
+            "{field} must be a positive finite number, got {value}"
+        )))
+    }
+}
+
+fn taps(value: u32, field: &str) -> ApiResult<u32> {
+    if (1..=256).contains(&value) {
+        Ok(value)
+    } else {
+        Err(invalid(format!(
+            "{field} must be within 1..=256, got {value}"
+        )))
+    }
+}
+
+/// The plugin's configuration from the C one (every field checked).
+fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
+    check_size::<HrtsConfig>(c.struct_size, "HrtsConfig")?;
+    let mode = enum_value(
+        c.mode,
+        &[
+            (HrtsShadowMode::None as u32, ShadowMode::None),
+            (HrtsShadowMode::Hard as u32, ShadowMode::Hard),
+            (HrtsShadowMode::Soft as u32, ShadowMode::Soft),
+            (HrtsShadowMode::Hybrid as u32, ShadowMode::Hybrid),
+        ],
+        "mode",
+        "HrtsShadowMode",
+    )?;
+    let faces = enum_value(
+        c.faces,
+        &[
+            (HrtsFaces::Both as u32, FaceMode::Both),
+            (HrtsFaces::FrontOnly as u32, FaceMode::FrontOnly),
+        ],
+        "faces",
+        "HrtsFaces",
+    )?;
+    let raster = enum_value(
+        c.raster_path,
+        &[
+            (HrtsRasterPath::Auto as u32, RasterRequest::Auto),
+            (HrtsRasterPath::Hardware as u32, RasterRequest::Hardware),
+            (HrtsRasterPath::Software as u32, RasterRequest::Software),
+        ],
+        "raster_path",
+        "HrtsRasterPath",
+    )?;
+    let mut config = ShadowConfig {
+        mode,
+        antialiasing: c.antialiasing,
+        static_light: c.static_light,
+        map: PrimitiveMapConfig {
+            size: c.map_size,
+            depth: c.map_depth,
+            faces,
+            raster,
+            guard_layer: false,
+        },
+        ..ShadowConfig::default()
+    };
+    config.shadow_map.size = c.shadow_map_size;
+    config.pcss.angular_radius = positive(c.pcss_angular_radius, "pcss_angular_radius")?;
+    config.pcss.spot_radius = positive(c.pcss_spot_radius, "pcss_spot_radius")?;
+    config.pcss.blocker_search_taps = taps(c.pcss_blocker_search_taps, "pcss_blocker_search_taps")?;
+    config.pcss.pcf_taps = taps(c.pcss_pcf_taps, "pcss_pcf_taps")?;
+    config.hybrid.world_space_scale =
+        positive(c.hybrid_world_space_scale, "hybrid_world_space_scale")?;
+    config.hybrid.hard_shadow_percentage = positive(
+        c.hybrid_hard_shadow_percentage,
+        "hybrid_hard_shadow_percentage",
+    )?;
+    Ok(config)
+}
+
+/// Fills `out` with the defaults of [`ShadowConfig::default`].
+pub(crate) fn config_defaults(out: &mut HrtsConfig) -> ApiResult<()> {
+    check_size::<HrtsConfig>(out.struct_size, "HrtsConfig")?;
+    let d = ShadowConfig::default();
+    out.mode = match d.mode {
+        ShadowMode::None => HrtsShadowMode::None,
+        ShadowMode::Hard => HrtsShadowMode::Hard,
+        ShadowMode::Soft => HrtsShadowMode::Soft,
+        ShadowMode::Hybrid => HrtsShadowMode::Hybrid,
+    } as u32;
+    out.antialiasing = d.antialiasing;
+    out.static_light = d.static_light;
+    out.map_size = d.map.size;
+    out.map_depth = d.map.depth;
+    out.faces = HrtsFaces::Both as u32;
+    out.raster_path = HrtsRasterPath::Auto as u32;
+    out.shadow_map_size = d.shadow_map.size;
+    out.pcss_angular_radius = d.pcss.angular_radius;
+    out.pcss_spot_radius = d.pcss.spot_radius;
+    out.pcss_blocker_search_taps = d.pcss.blocker_search_taps;
+    out.pcss_pcf_taps = d.pcss.pcf_taps;
+    out.hybrid_world_space_scale = d.hybrid.world_space_scale;
+    out.hybrid_hard_shadow_percentage = d.hybrid.hard_shadow_percentage;
+    Ok(())
+}

@@ -1,0 +1,388 @@
+//! The C-visible types. Input structs start with `struct_size` (the caller's `sizeof`), so a header of
+//! another version is rejected instead of misread. Enumerations passed *in* are `uint32_t` fields whose
+//! values are listed by the matching enum; unknown values are rejected with `HRTS_RESULT_ERROR_INVALID_ENUM`.
+
+use std::ffi::c_char;
+
+/// Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
+/// version differs.
+pub const HRTS_API_VERSION: u32 = (1 << 22) | (0 << 12);
+
+/// Result of every call. Append-only: values never change meaning.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HrtsResult {
+    /// Success.
+    Ok = 0,
+    /// A required pointer argument was NULL.
+    ErrorNullPointer = 1,
+    /// `struct_size` does not match this library's struct (header/library mismatch).
+    ErrorStructSize = 2,
+    /// The caller's `api_version` has another major version.
+    ErrorVersion = 3,
+    /// An enumeration field holds an unknown value.
+    ErrorInvalidEnum = 4,
+    /// A value is out of range (zero or absurd sizes, NaN, mismatched dimensions, ...).
+    ErrorInvalidArgument = 5,
+    /// The context is not live (never created, or destroyed).
+    ErrorInvalidContext = 6,
+    /// The call needs a state not reached yet (e.g. recording before geometry and targets are set).
+    ErrorInvalidState = 7,
+    /// The device lacks a feature the request needs.
+    ErrorUnsupported = 8,
+    /// A Vulkan call failed, or the device was lost.
+    ErrorVulkan = 9,
+    /// GPU or host memory ran out.
+    ErrorOutOfMemory = 10,
+    /// An image lacks a usage, format or size the plugin needs.
+    ErrorImageUsage = 11,
+    /// A bug inside the plugin was caught at the boundary; the context may be unusable.
+    ErrorInternal = 12,
+}
+
+/// Conservative-rasterization path (input field values and report values).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HrtsRasterPath {
+    /// Hardware where the device has a tier, else the geometry-shader path.
+    Auto = 0,
+    /// `VK_EXT_conservative_rasterization`.
+    Hardware = 1,
+    /// Geometry-shader dilation + exact per-texel test.
+    Software = 2,
+}
+
+/// Which faces are stored in the primitive map.
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HrtsFaces {
+    /// Both faces (open geometry).
+    Both = 0,
+    /// Faces towards the light only (closed meshes).
+    FrontOnly = 1,
+}
+
+/// What the plugin computes (the frame plan runs only the passes this needs).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HrtsShadowMode {
+    /// No shadow: the output is 1 everywhere and no pass runs.
+    None = 0,
+    /// Ray-traced hard shadows through the deep primitive map.
+    Hard = 1,
+    /// Soft shadows only: shadow map + PCSS.
+    Soft = 2,
+    /// The talk's hybrid: lerp(ray-traced, PCSS, saturate(BD / WSS * PHS)).
+    Hybrid = 3,
+}
+
+/// Light type of a frame.
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HrtsLightType {
+    /// Parallel light along `light_direction`, orthographic `light_view_proj`.
+    Directional = 0,
+    /// Spot light at `light_position` pointing along `light_direction`, perspective `light_view_proj`.
+    Spot = 1,
+}
+
+/// Index element type of engine geometry.
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HrtsIndexType {
+    /// `VK_INDEX_TYPE_UINT16`.
+    Uint16 = 0,
+    /// `VK_INDEX_TYPE_UINT32`.
+    Uint32 = 1,
+}
+
+/// `PFN_vkGetInstanceProcAddr` (cast the loader's `vkGetInstanceProcAddr` to this type); may be NULL.
+pub type HrtsGetInstanceProcAddr = Option<
+    unsafe extern "C" fn(
+        instance: *mut std::ffi::c_void,
+        name: *const c_char,
+    ) -> Option<unsafe extern "C" fn()>,
+>;
+
+/// Opaque plugin context.
+pub struct HrtsContext {
+    pub(crate) inner: crate::context::Context,
+}
+
+/// The engine's Vulkan objects, adopted (never destroyed) by the plugin.
+#[repr(C)]
+pub struct HrtsVulkanDevice {
+    /// `sizeof(HrtsVulkanDevice)`.
+    pub struct_size: u32,
+    /// The engine's `PFN_vkGetInstanceProcAddr`.
+    pub get_instance_proc_addr: HrtsGetInstanceProcAddr,
+    /// `VkInstance` (created for Vulkan 1.3 or later).
+    pub instance: u64,
+    /// `VkPhysicalDevice`.
+    pub physical_device: u64,
+    /// `VkDevice`, created with Vulkan 1.3 `dynamicRendering` and `synchronization2` enabled.
+    pub device: u64,
+    /// Queue family of the command buffers the plugin records into (graphics + compute).
+    pub queue_family_index: u32,
+    /// Queue index within that family.
+    pub queue_index: u32,
+    /// Device extensions the engine enabled (array of NUL-terminated names; may be NULL if count is 0).
+    pub enabled_extensions: *const *const c_char,
+    /// Number of entries in `enabled_extensions`.
+    pub enabled_extension_count: u32,
+    /// Whether `geometryShader` is enabled (needed by the software conservative-raster path).
+    pub geometry_shader: bool,
+    /// Whether `fragmentStoresAndAtomics` is enabled (required).
+    pub fragment_stores_and_atomics: bool,
+    /// Whether `depthClamp` is enabled.
+    pub depth_clamp: bool,
+    /// Whether the instance enabled `VK_EXT_debug_utils` (per-pass debug labels).
+    pub debug_utils: bool,
+}
+
+/// How to create a context.
+#[repr(C)]
+pub struct HrtsContextCreateInfo {
+    /// `sizeof(HrtsContextCreateInfo)`.
+    pub struct_size: u32,
+    /// `HRTS_API_VERSION` of the caller's header.
+    pub api_version: u32,
+    /// The engine's device to adopt, or NULL for a headless device of the plugin's own (simple hosts,
+    /// capability queries).
+    pub vulkan: *const HrtsVulkanDevice,
+    /// Own device only: pick the device whose name contains this (NULL: best GPU, else lavapipe).
+    pub device_name_filter: *const c_char,
+    /// Own device only: enable the Khronos validation layer.
+    pub enable_validation: bool,
+}
+
+/// What the device can do.
+#[repr(C)]
+pub struct HrtsCapabilities {
+    /// `sizeof(HrtsCapabilities)`, set by the caller.
+    pub struct_size: u32,
+    /// D3D12 conservative-raster tier: 0 none, 1..3.
+    pub conservative_raster_tier: u32,
+    /// Raster path `HRTS_RASTER_PATH_AUTO` resolves to (`HrtsRasterPath`).
+    pub default_raster_path: u32,
+    /// Geometry shaders available (software path possible).
+    pub geometry_shader: bool,
+    /// Timestamp queries available (per-pass GPU times in the report).
+    pub timestamps: bool,
+    /// `VK_KHR_ray_query` present.
+    pub ray_query: bool,
+    /// `VK_KHR_ray_tracing_pipeline` present.
+    pub ray_tracing_pipeline: bool,
+    /// `VK_EXT_fragment_shader_interlock` present.
+    pub fragment_shader_interlock: bool,
+    /// Largest primitive map size N.
+    pub max_map_size: u32,
+    /// Largest primitive map depth d.
+    pub max_map_depth: u32,
+    /// `maxStorageBufferRange` in bytes.
+    pub max_storage_buffer_range: u64,
+    /// Device name (NUL-terminated, truncated to fit).
+    pub device_name: [c_char; 128],
+}
+
+/// Plugin configuration. `hrts_config_defaults` fills the documented defaults; changing the configuration
+/// rebuilds the passes on the next recording.
+#[repr(C)]
+pub struct HrtsConfig {
+    /// `sizeof(HrtsConfig)`.
+    pub struct_size: u32,
+    /// `HrtsShadowMode` (default hybrid).
+    pub mode: u32,
+    /// FXAA over the ray-traced shadow (default true).
+    pub antialiasing: bool,
+    /// The light does not move between frames: the shadow and primitive maps are kept (default false).
+    pub static_light: bool,
+    /// Primitive map N (texels per side), 1..=max_map_size (default 1024).
+    pub map_size: u32,
+    /// Primitive map d (triangles per texel), 1..=max_map_depth (default 32).
+    pub map_depth: u32,
+    /// `HrtsFaces` (default both).
+    pub faces: u32,
+    /// `HrtsRasterPath` (default auto).
+    pub raster_path: u32,
+    /// Shadow map size (default 3072, as in the talk).
+    pub shadow_map_size: u32,
+    /// PCSS: angular radius of a directional emitter in radians (default 0.02).
+    pub pcss_angular_radius: f32,
+    /// PCSS: radius of a spot emitter in world units (default 0.05).
+    pub pcss_spot_radius: f32,
+    /// PCSS blocker-search taps (default 16).
+    pub pcss_blocker_search_taps: u32,
+    /// PCSS PCF taps (default 32).
+    pub pcss_pcf_taps: u32,
+    /// Hybrid blend: world-space scale WSS (default 1).
+    pub hybrid_world_space_scale: f32,
+    /// Hybrid blend: percentage of hard shadow PHS (default 4).
+    pub hybrid_hard_shadow_percentage: f32,
+}
+
+/// One draw of the geometry.
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub struct HrtsDraw {
+    /// First index of the draw.
+    pub first_index: u32,
+    /// Index count (a multiple of 3).
+    pub index_count: u32,
+    /// Object-to-world matrix, column-major.
+    pub transform: [f32; 16],
+}
+
+/// Geometry in CPU arrays (copied by the call).
+#[repr(C)]
+pub struct HrtsCpuGeometry {
+    /// `sizeof(HrtsCpuGeometry)`.
+    pub struct_size: u32,
+    /// Positions: `vertex_count` float3 at `vertex_stride` bytes apart.
+    pub positions: *const f32,
+    /// Number of vertices.
+    pub vertex_count: u32,
+    /// Bytes between consecutive positions (>= 12, multiple of 4).
+    pub vertex_stride: u32,
+    /// Triangle-list indices (32-bit).
+    pub indices: *const u32,
+    /// Number of indices.
+    pub index_count: u32,
+    /// Draws.
+    pub draws: *const HrtsDraw,
+    /// Number of draws.
+    pub draw_count: u32,
+}
+
+/// Geometry in the engine's Vulkan buffers (need `VK_BUFFER_USAGE_STORAGE_BUFFER_BIT`); read, never written.
+#[repr(C)]
+pub struct HrtsVulkanGeometry {
+    /// `sizeof(HrtsVulkanGeometry)`.
+    pub struct_size: u32,
+    /// `VkBuffer` holding positions (`R32G32B32_SFLOAT`).
+    pub vertex_buffer: u64,
+    /// Size of the vertex buffer in bytes.
+    pub vertex_buffer_size: u64,
+    /// Byte offset of vertex 0 (multiple of 4).
+    pub vertex_offset: u64,
+    /// Bytes between vertices (>= 12, multiple of 4).
+    pub vertex_stride: u32,
+    /// Number of vertices.
+    pub vertex_count: u32,
+    /// `VkBuffer` holding indices.
+    pub index_buffer: u64,
+    /// Size of the index buffer in bytes.
+    pub index_buffer_size: u64,
+    /// Byte offset of index 0 (multiple of 4).
+    pub index_offset: u64,
+    /// `HrtsIndexType`.
+    pub index_type: u32,
+    /// Number of indices.
+    pub index_count: u32,
+    /// Draws.
+    pub draws: *const HrtsDraw,
+    /// Number of draws.
+    pub draw_count: u32,
+    /// World-space bounds of all draws (min xyz, max xyz): the frame origin is their centre.
+    pub bounds: [f32; 6],
+}
+
+/// The engine's images the plugin reads and writes. All are 2D, one mip, one layer, same size.
+#[repr(C)]
+pub struct HrtsTargets {
+    /// `sizeof(HrtsTargets)`.
+    pub struct_size: u32,
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Reversed-Z depth `VkImage` (`VK_FORMAT_D32_SFLOAT`, usage includes SAMPLED): 1 at the near plane,
+    /// 0 at the far plane / background.
+    pub depth_image: u64,
+    /// Usage flags the depth image was created with (`VkImageUsageFlags`).
+    pub depth_usage: u32,
+    /// World-space normal `VkImage` (`VK_FORMAT_R32G32B32A32_SFLOAT`, usage includes SAMPLED): xyz the
+    /// geometric normal facing the camera, w = 1 on geometry and 0 on background.
+    pub normal_image: u64,
+    /// Usage flags of the normal image.
+    pub normal_usage: u32,
+    /// Visibility `VkImage` the plugin writes (`VK_FORMAT_R32_SFLOAT`, usage includes TRANSFER_DST): 1 = lit.
+    pub output_image: u64,
+    /// Usage flags of the output image.
+    pub output_usage: u32,
+}
+
+/// One frame to record into the engine's command buffer.
+#[repr(C)]
+pub struct HrtsFrame {
+    /// `sizeof(HrtsFrame)`.
+    pub struct_size: u32,
+    /// `VkCommandBuffer` in the recording state, outside a render pass, from `queue_family_index`.
+    pub command_buffer: u64,
+    /// World-to-view matrix, column-major.
+    pub view: [f32; 16],
+    /// View-to-clip matrix, column-major, reversed Z, Vulkan clip conventions.
+    pub proj: [f32; 16],
+    /// Camera position in world space.
+    pub camera_position: [f32; 3],
+    /// `HrtsLightType`.
+    pub light_type: u32,
+    /// Spot light: emitter position in world space (ignored for directional lights).
+    pub light_position: [f32; 3],
+    /// Direction the light travels, or the spot light's axis (need not be normalised; non-zero).
+    pub light_direction: [f32; 3],
+    /// The light's view-projection enclosing shadow casters and receivers (column-major): orthographic
+    /// for a directional light, perspective with its eye at `light_position` for a spot light.
+    pub light_view_proj: [f32; 16],
+    /// `VkImageLayout` of the depth image when the commands run; it is restored afterwards.
+    pub depth_layout: i32,
+    /// `VkImageLayout` of the normal image when the commands run; restored afterwards.
+    pub normal_layout: i32,
+    /// `VkImageLayout` of the output image before (its contents are discarded).
+    pub output_layout_before: i32,
+    /// `VkImageLayout` the output image is left in.
+    pub output_layout_after: i32,
+}
+
+/// Memory the plugin holds, process-wide (all contexts).
+#[repr(C)]
+pub struct HrtsMemoryStats {
+    /// `sizeof(HrtsMemoryStats)`, set by the caller.
+    pub struct_size: u32,
+    /// Host bytes allocated by the plugin and not freed.
+    pub host_bytes: u64,
+    /// GPU bytes allocated by the plugin and not freed (excludes what the Vulkan driver keeps internally).
+    pub gpu_bytes: u64,
+}
+
+/// GPU time of one pass.
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub struct HrtsPassTiming {
+    /// Pass name (NUL-terminated, truncated).
+    pub name: [c_char; 32],
+    /// Milliseconds.
+    pub milliseconds: f64,
+}
+
+/// Maximum passes in a report.
+pub const HRTS_MAX_REPORTED_PASSES: usize = 16;
+
+/// What the last completed frame did. Read it after the engine's submission has completed.
+#[repr(C)]
+pub struct HrtsFrameReport {
+    /// `sizeof(HrtsFrameReport)`, set by the caller.
+    pub struct_size: u32,
+    /// `HrtsRasterPath` used (hardware or software).
+    pub raster_path: u32,
+    /// Conservative-raster tier used (0 for software).
+    pub tier: u32,
+    /// Texels whose triangle count exceeded d (traced exhaustively).
+    pub overflowed_texels: u32,
+    /// Largest triangle count of any texel.
+    pub max_count: u32,
+    /// Number of valid entries in `passes`.
+    pub pass_count: u32,
+    /// Per-pass GPU times.
+    pub passes: [HrtsPassTiming; HRTS_MAX_REPORTED_PASSES],
+}
