@@ -26,6 +26,9 @@ pub struct MapComparison {
     pub garbage: usize,
     /// Texels whose count exceeded d (their lists are checked for garbage only).
     pub overflowed: usize,
+    /// Required triangles absent from a texel's list that the path is allowed to drop (see
+    /// [`compare_map_excusing`]); not counted in `missing`.
+    pub missing_excused: usize,
 }
 
 /// Compares every texel's list with the exact conservative set, for the light matrix fitted to the view.
@@ -47,6 +50,19 @@ pub fn compare_map_with(
     config: &PrimitiveMapConfig,
     images: &FrameImages,
     faces: FaceSelection,
+) -> MapComparison {
+    compare_map_excusing(rs, inputs, config, images, faces, &|_| false)
+}
+
+/// [`compare_map_with`], where a missing triangle for which `excused` is true is counted in
+/// `missing_excused` instead of `missing` (e.g. triangles D3D12 Tier 1 may cull after snapping).
+pub fn compare_map_excusing(
+    rs: &RefScene,
+    inputs: &FrameInputs,
+    config: &PrimitiveMapConfig,
+    images: &FrameImages,
+    faces: FaceSelection,
+    excused: &dyn Fn(u32) -> bool,
 ) -> MapComparison {
     let n = config.size;
     let d = config.depth as usize;
@@ -96,10 +112,13 @@ pub fn compare_map_with(
                 continue;
             }
             c.texels += 1;
-            c.missing += exact
-                .iter()
-                .filter(|i| sorted.binary_search(i).is_err())
-                .count();
+            for &i in exact.iter().filter(|i| sorted.binary_search(i).is_err()) {
+                if excused(i) {
+                    c.missing_excused += 1;
+                } else {
+                    c.missing += 1;
+                }
+            }
         }
     }
     c

@@ -2,7 +2,7 @@
 //! 1K×1K×64 and ×32, PCSS, and the hybrid with the standard and the shrinking penumbra filter — as
 //! individual pictures, one labelled composite and a caption file that states every setting.
 
-use crate::images::{lerp_factor_preview, Canvas};
+use crate::images::{lerp_factor_preview, write_png_compact, Canvas};
 use crate::output::{shade_preview, write_png};
 use crate::render::{default_world_space_scale, median_timings};
 use crate::{parse_vec3, View};
@@ -36,6 +36,12 @@ pub struct CompareArgs {
     /// Camera target "x,y,z".
     #[arg(long, value_parser = parse_vec3)]
     pub camera_target: Option<Vec3>,
+    /// Close-up camera position "x,y,z" (default: the sphere's contact and the end of its shadow).
+    #[arg(long, value_parser = parse_vec3)]
+    pub close_up_pos: Option<Vec3>,
+    /// Close-up camera target "x,y,z".
+    #[arg(long, value_parser = parse_vec3)]
+    pub close_up_target: Option<Vec3>,
     /// Frames per panel (timings are medians over all but the first).
     #[arg(long, default_value_t = 3)]
     pub frames: u32,
@@ -171,14 +177,23 @@ fn panels(wss: f32) -> Vec<Panel> {
     ]
 }
 
-/// The default close-up: the character, the fence, the foliage and the sphere's long shadow.
-fn close_up(view: &View) -> Camera {
-    Camera {
-        position: Vec3::new(2.9, 1.5, 3.3),
-        target: Vec3::new(0.8, 0.35, 0.5),
+/// A camera at `position` looking at `target`, overridden by the command line.
+fn camera(
+    view: &View,
+    position: Vec3,
+    target: Vec3,
+    given: (Option<Vec3>, Option<Vec3>),
+) -> Result<Camera> {
+    let c = Camera {
+        position: given.0.unwrap_or(position),
+        target: given.1.unwrap_or(target),
         near: 0.02,
         ..view.camera
+    };
+    if (c.position - c.target).length() == 0.0 {
+        bail!("camera position and target coincide");
     }
+    Ok(c)
 }
 
 /// Runs the comparison on its own device.
@@ -208,17 +223,21 @@ pub fn compare_to_folder(device: &Device, args: &CompareArgs) -> Result<()> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let mut view = View::framed(scene::procedural_default(), args.width, args.height);
-    let mut camera = close_up(&view);
-    if let Some(p) = args.camera_pos {
-        camera.position = p;
-    }
-    if let Some(t) = args.camera_target {
-        camera.target = t;
-    }
-    if (camera.position - camera.target).length() == 0.0 {
-        bail!("camera position and target coincide");
-    }
-    view.camera = camera;
+    // The overview: the character, the fence, the foliage and the sphere's long shadow.
+    view.camera = camera(
+        &view,
+        Vec3::new(2.9, 1.5, 3.3),
+        Vec3::new(0.8, 0.35, 0.5),
+        (args.camera_pos, args.camera_target),
+    )?;
+    // The close-up: the sphere's contact with the ground and the far end of its shadow.
+    let mut close = view.clone();
+    close.camera = camera(
+        &view,
+        Vec3::new(2.3, 0.9, 2.4),
+        Vec3::new(1.9, 0.1, 1.3),
+        (args.close_up_pos, args.close_up_target),
+    )?;
     let wss = default_world_space_scale(&view);
     let (w, h) = (args.width, args.height);
     let to_light = -view.light.direction;
@@ -226,35 +245,31 @@ pub fn compare_to_folder(device: &Device, args: &CompareArgs) -> Result<()> {
     let mut caption = String::new();
     let _ = writeln!(
         caption,
-        "host_demo compare: procedural scene ({} triangles), {w}x{h} per panel, directional light {:?}, \
-         camera {:?} -> {:?}. Previews are Lambert x visibility.\nDevice: {} ({}). GPU times are medians \
-         over {} frames after the first; on a CPU device they are relative only.\n",
+        "host_demo compare: procedural scene ({} triangles), {w}x{h} per picture, directional light {:?}; \
+         overview camera {:?} -> {:?} (top of each panel), close-up {:?} -> {:?} (below it). Previews are \
+         Lambert x visibility.\nDevice: {} ({}). GPU times (overview) are medians over {} frames after \
+         the first; on a CPU device they are relative only.\n",
         view.scene.triangle_count(),
         view.light.direction.to_array(),
         view.camera.position.to_array(),
         view.camera.target.to_array(),
+        close.camera.position.to_array(),
+        close.camera.target.to_array(),
         device.capabilities().device_name,
         device.capabilities().device_type,
         args.frames.max(2) - 1,
     );
     for panel in panels(wss) {
-        let (images, timings) = render_panel(device, &view, &panel.config, args.frames)
+        let (frames, timings) = render_panel(device, &[&view, &close], &panel.config, args.frames)
             .with_context(|| format!("rendering panel {}", panel.label))?;
-        let picture = match panel.show {
-            Show::LerpFactor => {
-                lerp_factor_preview(&images.normal, &images.lerp_factor, &images.visibility)
-            }
-            show => {
-                let vis = match show {
-                    Show::ShadowMapTest => &images.shadow_map_visibility,
-                    Show::RayTrace => &images.visibility,
-                    Show::Pcss => &images.pcss,
-                    _ => &images.output,
-                };
-                shade_preview(&images.normal, vis, to_light)
-            }
-        };
-        write_png(&args.out.join(panel.file), w, h, &picture)?;
+        let pictures_of_panel: Vec<Vec<[u8; 4]>> = frames
+            .iter()
+            .map(|images| picture(images, panel.show, to_light))
+            .collect();
+        for (picture, suffix) in pictures_of_panel.iter().zip(["", "_close"]) {
+            let file = panel.file.replace(".png", &format!("{suffix}.png"));
+            write_png(&args.out.join(file), w, h, picture)?;
+        }
         let times: Vec<String> = timings
             .iter()
             .filter(|(name, _)| {
@@ -266,17 +281,17 @@ pub fn compare_to_folder(device: &Device, args: &CompareArgs) -> Result<()> {
             .collect();
         let _ = writeln!(
             caption,
-            "{} ({}): {}. GPU: {}.",
+            "{} ({}, close-up in *_close.png): {}. GPU: {}.",
             panel.label,
             panel.file,
             panel.note,
             times.join(", ")
         );
         println!("{:<26} {}", panel.label, times.join(", "));
-        pictures.push((panel.label, picture));
+        pictures.push((panel.label, pictures_of_panel));
     }
     let composite = compose(&pictures, w, h);
-    write_png(
+    write_png_compact(
         &args.out.join("compare.png"),
         composite.width,
         composite.height,
@@ -291,39 +306,68 @@ pub fn compare_to_folder(device: &Device, args: &CompareArgs) -> Result<()> {
     Ok(())
 }
 
+/// Renders `frames` frames of the first view (for the timings), then one of every view, and reads each
+/// back.
 fn render_panel(
     device: &Device,
-    view: &View,
+    views: &[&View],
     config: &ShadowConfig,
     frames: u32,
-) -> Result<(FrameImages, BTreeMap<String, f64>)> {
-    let geometry = view.upload(device).context("uploading the scene")?;
-    let mut renderer = ShadowRenderer::new(device, geometry, view.width, view.height, *config)?;
-    let inputs = view.frame_inputs();
+) -> Result<(Vec<FrameImages>, BTreeMap<String, f64>)> {
+    let Some(first) = views.first() else {
+        bail!("no view to render");
+    };
+    let geometry = first.upload(device).context("uploading the scene")?;
+    let mut renderer = ShadowRenderer::new(device, geometry, first.width, first.height, *config)?;
+    let inputs = first.frame_inputs();
     let mut reports = Vec::new();
     for _ in 0..frames.max(1) {
         reports.push(renderer.render(device, &inputs)?);
     }
-    Ok((renderer.read_back(device, false)?, median_timings(&reports)))
+    let mut images = vec![renderer.read_back(device, false)?];
+    for view in &views[1..] {
+        renderer.render(device, &view.frame_inputs())?;
+        images.push(renderer.read_back(device, false)?);
+    }
+    Ok((images, median_timings(&reports)))
 }
 
-/// Panels in a grid of four columns, each under a label bar.
-fn compose(pictures: &[(&str, Vec<[u8; 4]>)], w: u32, h: u32) -> Canvas {
+/// The preview of what a panel shows.
+fn picture(images: &FrameImages, show: Show, to_light: Vec3) -> Vec<[u8; 4]> {
+    let vis = match show {
+        Show::LerpFactor => {
+            return lerp_factor_preview(&images.normal, &images.lerp_factor, &images.visibility)
+        }
+        Show::ShadowMapTest => &images.shadow_map_visibility,
+        Show::RayTrace => &images.visibility,
+        Show::Pcss => &images.pcss,
+        Show::Output => &images.output,
+    };
+    shade_preview(&images.normal, vis, to_light)
+}
+
+/// Panels in a grid of four columns, each under a label bar, its close-up below its overview.
+fn compose(panels: &[(&str, Vec<Vec<[u8; 4]>>)], w: u32, h: u32) -> Canvas {
     const COLUMNS: u32 = 4;
     const BAR: u32 = 22;
     const GAP: u32 = 4;
-    let rows = (pictures.len() as u32).div_ceil(COLUMNS);
+    let views = panels.iter().map(|(_, p)| p.len()).max().unwrap_or(1) as u32;
+    let rows = (panels.len() as u32).div_ceil(COLUMNS);
+    let cell_h = BAR + views * (h + GAP);
     let mut canvas = Canvas::new(
         COLUMNS * (w + GAP) + GAP,
-        rows * (h + BAR + GAP) + GAP,
+        rows * cell_h + GAP,
         [24, 24, 24, 255],
     );
-    for (i, (label, picture)) in pictures.iter().enumerate() {
+    for (i, (label, pictures)) in panels.iter().enumerate() {
         let (col, row) = (i as u32 % COLUMNS, i as u32 / COLUMNS);
         let x = i64::from(GAP + col * (w + GAP));
-        let y = i64::from(GAP + row * (h + BAR + GAP));
+        let y = i64::from(GAP + row * cell_h);
         canvas.text(x + 4, y + 4, 2, label, [255, 255, 255, 255]);
-        canvas.blit(picture, w, h, x, y + i64::from(BAR));
+        for (k, picture) in pictures.iter().enumerate() {
+            let top = y + i64::from(BAR) + k as i64 * i64::from(h + GAP);
+            canvas.blit(picture, w, h, x, top);
+        }
     }
     canvas
 }

@@ -1,5 +1,8 @@
-//! Picture helpers of the soft-shadow outputs: the lerp-factor view, and a canvas with a small bitmap font
-//! for labelled side-by-side composites.
+//! Picture helpers of the soft-shadow outputs: the lerp-factor view, a canvas with a small bitmap font
+//! for labelled side-by-side composites, and a compact PNG writer for them.
+
+use anyhow::{Context, Result};
+use std::path::Path;
 
 /// Lerp-factor view like the talk's: grey levels from black (L = 0, the ray-traced hard shadow) to white
 /// (L = 1, all PCSS) inside shadows; dark blue where the ray trace found no blocker (lit: L is 0 there and
@@ -103,6 +106,26 @@ impl Canvas {
     pub fn text_width(text: &str, scale: u32) -> u32 {
         (text.chars().count() as u32 * 6).saturating_sub(1) * scale.max(1)
     }
+}
+
+/// Writes an opaque picture as an RGB PNG with adaptive filtering and the best compression (for
+/// composites meant to be committed).
+pub fn write_png_compact(path: &Path, width: u32, height: u32, rgba: &[[u8; 4]]) -> Result<()> {
+    let rgb: Vec<u8> = rgba.iter().flat_map(|p| [p[0], p[1], p[2]]).collect();
+    let file =
+        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
+    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_compression(png::Compression::Best);
+    encoder.set_adaptive_filter(png::AdaptiveFilterType::Adaptive);
+    let mut writer = encoder
+        .write_header()
+        .with_context(|| format!("writing {}", path.display()))?;
+    writer
+        .write_image_data(&rgb)
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(())
 }
 
 /// Rows (top to bottom, bit 4 = leftmost column) of a 5x7 glyph.

@@ -2,11 +2,14 @@
 //! integration tests, so that what the tests check is what the demo shows.
 
 pub mod accuracy;
+pub mod bench;
 pub mod compare;
 pub mod hardcases;
 pub mod images;
 pub mod output;
 pub mod render;
+pub mod report;
+pub mod tiers;
 
 use glam::{Mat4, Vec3};
 use passes::{Draw, FrameInputs, Geometry, Light, PassError};

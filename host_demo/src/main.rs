@@ -36,6 +36,24 @@ enum Command {
     /// The talk's side-by-sides on one view (shadow map 3K/8K, ray traced x64/x32, PCSS, hybrid standard and
     /// shrinking): labelled composite PNG, the individual pictures and a caption file.
     Compare(host_demo::compare::CompareArgs),
+    /// The talk's timing tables (~10K/65K/240K triangles, 1920x1080, SM 3K, PM 1Kx1Kx32/64) next to its
+    /// GTX 980 column: GPU timestamps, medians over frames.
+    Bench {
+        #[command(flatten)]
+        args: host_demo::bench::BenchArgs,
+        /// Also write the Markdown tables to this file.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// What accuracy costs in time: shadow maps and primitive maps of growing size against the exact
+    /// reference, with GPU times and memory (Markdown).
+    Accuracy(host_demo::report::AccuracyArgs),
+    /// The conservative-raster tier matrix: every raster path of the device against exact binning (Markdown).
+    Tiers {
+        /// Folder with the test models.
+        #[arg(long, default_value = "../shared/models")]
+        models: PathBuf,
+    },
 }
 
 #[derive(clap::Args)]
@@ -151,6 +169,16 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// The device chosen by the global options.
+fn device(cli: &Cli) -> Result<Device> {
+    let mut desc = DeviceDesc::from_env();
+    desc.validation |= cli.validation;
+    if cli.device.is_some() {
+        desc.device_filter = cli.device.clone();
+    }
+    Ok(Device::new_headless(&desc)?)
+}
+
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
@@ -162,6 +190,27 @@ fn main() -> ExitCode {
         Command::Compare(args) => {
             host_demo::compare::run_cli(cli.device.clone(), cli.validation, args)
         }
+        Command::Bench { args, out } => {
+            device(&cli).and_then(|d| host_demo::bench::run_cli(&d, args, out.as_deref()))
+        }
+        Command::Accuracy(args) => device(&cli).and_then(|d| {
+            println!("{}", host_demo::report::run_report(&d, args)?);
+            Ok(())
+        }),
+        Command::Tiers { models } => device(&cli).and_then(|d| {
+            let rows = host_demo::tiers::tier_matrix(
+                &d,
+                &host_demo::tiers::standard_scenes(models)?,
+                256,
+                512,
+            )?;
+            println!("{}", host_demo::tiers::markdown(&d, &rows));
+            if rows.iter().all(|r| r.passed()) {
+                Ok(())
+            } else {
+                bail!("a raster path missed triangles of the exact conservative set")
+            }
+        }),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -5,9 +5,9 @@ use crate::output::{shade_preview, write_exr_rgba, write_exr_scalar, write_png};
 use crate::{focus_bounds, View};
 use anyhow::{Context, Result};
 use passes::{
-    FaceMode, FrameReport, HybridConfig, PassStatus, PcssConfig, PenumbraFilter,
+    FaceMode, FrameReport, HybridConfig, PassId, PassStatus, PcssConfig, PenumbraFilter,
     PrimitiveMapConfig, RasterRequest, ResourceId, ResourceSet, ShadowConfig, ShadowMapConfig,
-    ShadowMode, ShadowRenderer,
+    ShadowMode, ShadowRenderer, SkipReason,
 };
 use rhi::Device;
 use serde::Serialize;
@@ -383,19 +383,28 @@ pub fn render_to_folder(
         "device: {} ({}, {})",
         caps.device_name, caps.device_type, caps.driver
     );
-    println!(
-        "scene: {} triangles, {}x{} px; primitive map {}x{}x{} ({} path, tier {}), {} overflowed texels, max count {}",
-        view.scene.triangle_count(),
-        w,
-        h,
-        n,
-        n,
-        options.map.depth,
-        report.raster_path.name(),
-        report.raster_path.tier().name(),
-        stats.overflowed_texels,
-        stats.max_count
-    );
+    if report.status(PassId::PrimitiveMap) == Some(PassStatus::Skipped(SkipReason::NotRequested)) {
+        println!(
+            "scene: {} triangles, {}x{} px; no primitive map (the plan does not need one)",
+            view.scene.triangle_count(),
+            w,
+            h
+        );
+    } else {
+        println!(
+            "scene: {} triangles, {}x{} px; primitive map {}x{}x{} ({} path, tier {}), {} overflowed texels, max count {}",
+            view.scene.triangle_count(),
+            w,
+            h,
+            n,
+            n,
+            options.map.depth,
+            report.raster_path.name(),
+            report.raster_path.tier().name(),
+            stats.overflowed_texels,
+            stats.max_count
+        );
+    }
     println!(
         "shadows: {} (FXAA {}), shadow map {}x{}, PCSS {} filter {}+{} taps, WSS {:.3}, PHS {}",
         s.mode.name(),

@@ -18,7 +18,9 @@ pub enum FaceMode {
     #[default]
     Both,
     /// Only faces whose counter-clockwise normal points towards the light: half the entries, correct for
-    /// closed meshes only (a shadow ray leaving a closed blocker crosses a light-facing face).
+    /// closed meshes only (a shadow ray leaving a closed blocker crosses a light-facing face). Visibility
+    /// is unchanged; the blocker distance is measured to the blocker's far (light-facing) side, longer
+    /// than the true distance by the blocker's thickness along the ray.
     FrontOnly,
 }
 

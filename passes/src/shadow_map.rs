@@ -110,6 +110,9 @@ impl ShadowMapPass {
         triangle_count: u32,
     ) -> Result<(), PassError> {
         let size = self.depth.width();
+        let vertices = triangle_count
+            .checked_mul(3)
+            .ok_or_else(|| PassError::InvalidGeometry("too many triangles to draw".into()))?;
         enc.begin_pass("shadow map");
         enc.begin_rendering(
             (size, size),
@@ -123,7 +126,7 @@ impl ShadowMapPass {
             &self.pipeline,
             &self.group,
             bytemuck::bytes_of(push),
-            triangle_count * 3,
+            vertices,
         );
         enc.end_rendering();
         enc.end_pass();

@@ -561,6 +561,10 @@ impl ShadowPipeline {
     /// Records the passes the plan runs this frame. Depth and normal must be in `ShaderResource` state;
     /// afterwards every image the pipeline wrote this frame, [`ShadowPipeline::output`] included, is in
     /// `UnorderedAccess` state (the shadow map in `ShaderResource`).
+    ///
+    /// Contract: the previous recording has completed on the GPU (constants live in host-visible
+    /// buffers written here), and every recording is submitted — passes skipped as up to date reuse
+    /// what the last recording that ran them wrote.
     pub fn record(&mut self, enc: &mut Encoder<'_>, inputs: &FrameInputs) -> Result<(), PassError> {
         let c = self.constants(inputs)?;
         if self.plan.runs(PassId::PrimBuffer) && !self.valid.contains(ResourceId::PrimBuffer) {

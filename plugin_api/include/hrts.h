@@ -9,7 +9,7 @@
 
 // Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 // version differs.
-#define HRTS_API_VERSION ((1 << 22) | (0 << 12))
+#define HRTS_API_VERSION (1 << 22)
 
 // Maximum passes in a report.
 #define HRTS_MAX_REPORTED_PASSES 16

@@ -370,7 +370,7 @@ impl Context {
         if g.vertex_count == 0 || g.index_count == 0 {
             return Err(invalid("vertex_count and index_count must be positive"));
         }
-        if g.vertex_stride < 12 || g.vertex_stride % 4 != 0 {
+        if g.vertex_stride < 12 || !g.vertex_stride.is_multiple_of(4) {
             return Err(invalid(format!(
                 "vertex_stride {} must be a multiple of 4 and at least 12",
                 g.vertex_stride
@@ -413,7 +413,7 @@ impl Context {
             return Err(invalid("the draws reference no vertices"));
         }
         for (n, d) in draws.iter().enumerate() {
-            if d.index_count % 3 != 0
+            if !d.index_count.is_multiple_of(3)
                 || u64::from(d.first_index) + u64::from(d.index_count) > indices.len() as u64
             {
                 return Err(invalid(format!(

@@ -6,7 +6,7 @@ use std::ffi::c_char;
 
 /// Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 /// version differs.
-pub const HRTS_API_VERSION: u32 = (1 << 22) | (0 << 12);
+pub const HRTS_API_VERSION: u32 = 1 << 22;
 
 /// Result of every call. Append-only: values never change meaning.
 #[repr(C)]

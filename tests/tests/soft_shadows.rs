@@ -552,6 +552,8 @@ fn render_and_compare_write_the_soft_shadow_outputs() {
         height: 40,
         camera_pos: None,
         camera_target: None,
+        close_up_pos: None,
+        close_up_target: None,
         frames: 1,
     };
     host_demo::compare::compare_to_folder(&device, &compare).expect("compare");

@@ -1,0 +1,162 @@
+//! `host_demo accuracy`: what accuracy costs in time. For one view, the classic shadow map at growing
+//! sizes and the ray-traced deep primitive map at growing N and d, each with its GPU time, memory, and
+//! the pixels it gets wrong against the exact f64 reference (near-edge pixels counted apart).
+
+use crate::accuracy::compare_visibility;
+use crate::bench::median_of;
+use crate::render::median_timings;
+use crate::View;
+use anyhow::{Context, Result};
+use passes::{
+    FaceMode, PrimitiveMapConfig, RasterRequest, ResourceId, ResourceSet, ShadowConfig,
+    ShadowMapConfig, ShadowMode, ShadowRenderer,
+};
+use reference::RefScene;
+use rhi::Device;
+use std::path::PathBuf;
+
+/// Options of the report.
+#[derive(Debug, Clone, clap::Args)]
+pub struct AccuracyArgs {
+    /// OBJ model (a ground plane is added).
+    #[arg(long, default_value = "../shared/models/02_stanford_bunny_69k.obj")]
+    pub obj: PathBuf,
+    /// Frame width.
+    #[arg(long, default_value_t = 640)]
+    pub width: u32,
+    /// Frame height.
+    #[arg(long, default_value_t = 360)]
+    pub height: u32,
+    /// Frames per configuration (timings are medians over all but the first).
+    #[arg(long, default_value_t = 5)]
+    pub frames: u32,
+}
+
+struct Row {
+    method: String,
+    memory: u64,
+    ms: f64,
+    wrong: usize,
+    near_edge: usize,
+    overflowed: u32,
+}
+
+fn render(
+    device: &Device,
+    view: &View,
+    config: ShadowConfig,
+    frames: u32,
+) -> Result<(
+    passes::FrameImages,
+    std::collections::BTreeMap<String, f64>,
+    u32,
+)> {
+    let mut r = ShadowRenderer::new(
+        device,
+        view.upload(device)?,
+        view.width,
+        view.height,
+        config,
+    )?;
+    let inputs = view.frame_inputs();
+    let mut reports = Vec::new();
+    for _ in 0..frames.max(2) {
+        reports.push(r.render(device, &inputs)?);
+    }
+    let overflow = reports.last().map_or(0, |r| r.stats.overflowed_texels);
+    Ok((
+        r.read_back(device, false)?,
+        median_timings(&reports),
+        overflow,
+    ))
+}
+
+/// Builds the report as Markdown.
+pub fn run_report(device: &Device, args: &AccuracyArgs) -> Result<String> {
+    let scene = scene::load_obj(&args.obj)
+        .with_context(|| format!("loading {}", args.obj.display()))?
+        .with_ground_plane();
+    let view = View::framed(scene, args.width, args.height);
+    let rs = RefScene::new(&view.scene);
+    let sum = |t: &std::collections::BTreeMap<String, f64>, names: &[&str]| {
+        median_of(t, names).unwrap_or(f64::NAN)
+    };
+    let mut rows = Vec::new();
+    for size in [1024u32, 3072, 8192] {
+        let config = ShadowConfig {
+            mode: ShadowMode::Hard,
+            antialiasing: false,
+            map: PrimitiveMapConfig {
+                size: 256,
+                depth: 64,
+                faces: FaceMode::Both,
+                raster: RasterRequest::Auto,
+                guard_layer: false,
+            },
+            shadow_map: ShadowMapConfig {
+                size,
+                ..ShadowMapConfig::default()
+            },
+            extra_outputs: ResourceSet::of(&[ResourceId::ShadowMapVisibility]),
+            ..ShadowConfig::default()
+        };
+        let (mut images, t, _) = render(device, &view, config, args.frames)?;
+        images.visibility = std::mem::take(&mut images.shadow_map_visibility);
+        let c = compare_visibility(&rs, &view, &images);
+        rows.push(Row {
+            method: format!("shadow map {size}² (classic test, constant + slope bias)"),
+            memory: u64::from(size) * u64::from(size) * 4,
+            ms: sum(&t, &["shadow map"]),
+            wrong: c.mismatches,
+            near_edge: c.near_edge,
+            overflowed: 0,
+        });
+    }
+    for (size, depth) in [
+        (512u32, 32u32),
+        (1024, 16),
+        (1024, 32),
+        (1024, 64),
+        (2048, 32),
+    ] {
+        let map = PrimitiveMapConfig {
+            size,
+            depth,
+            faces: FaceMode::Both,
+            raster: RasterRequest::Auto,
+            guard_layer: false,
+        };
+        let (images, t, overflow) = render(device, &view, ShadowConfig::from(map), args.frames)?;
+        let c = compare_visibility(&rs, &view, &images);
+        rows.push(Row {
+            method: format!("ray traced, primitive map {size}²×{depth}"),
+            memory: map.memory_bytes(),
+            ms: sum(&t, &["primitive map", "ray trace"]),
+            wrong: c.mismatches,
+            near_edge: c.near_edge,
+            overflowed: overflow,
+        });
+    }
+    let caps = device.capabilities();
+    let mut s = format!(
+        "{} ({} triangles with the ground plane), {}×{} px on {}; wrong = pixels whose lit/shadowed value differs from the exact f64 reference outside near-edge pixels; GPU ms are medians over {} frames.\n\n| method | memory | GPU ms | wrong pixels | near-edge (not compared) | overflowed texels |\n|---|---:|---:|---:|---:|---:|\n",
+        args.obj.file_name().and_then(|n| n.to_str()).unwrap_or("model"),
+        view.scene.triangle_count(),
+        args.width,
+        args.height,
+        caps.device_name,
+        args.frames.max(2) - 1
+    );
+    for r in rows {
+        s.push_str(&format!(
+            "| {} | {:.1} MiB | {:.3} | {} | {} | {} |\n",
+            r.method,
+            r.memory as f64 / (1024.0 * 1024.0),
+            r.ms,
+            r.wrong,
+            r.near_edge,
+            r.overflowed
+        ));
+    }
+    Ok(s)
+}
