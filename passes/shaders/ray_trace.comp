@@ -51,6 +51,29 @@ void setup_ray(vec3 o, vec3 d) {
 }
 
 // Returns the hit distance along the ray, or -1.
+// Exact rounding error of the f32 product p = a * b (Dekker's TwoProduct with Veltkamp splitting, no
+// fma: some drivers, lavapipe among them, lower fma() to an unfused multiply-add).
+float product_error(float a, float b, float p) {
+    precise float ca = 4097.0 * a;
+    precise float ah = ca - (ca - a);
+    precise float al = a - ah;
+    precise float cb = 4097.0 * b;
+    precise float bh = cb - (cb - b);
+    precise float bl = b - bh;
+    precise float e = ((ah * bh - p) + ah * bl + al * bh) + al * bl;
+    return e;
+}
+
+// a * b - c * d with both products' rounding errors recovered: its sign is exact in all but
+// pathological double cancellations, and swapping the pairs negates the result exactly, so a shared edge
+// still gets opposite values in its two triangles.
+float edge_refined(float a, float b, float c, float d) {
+    precise float p = a * b;
+    precise float q = c * d;
+    precise float r = (p - q) + (product_error(a, b, p) - product_error(c, d, q));
+    return r;
+}
+
 float intersect(Triangle t) {
     precise vec3 a = t.v[0].xyz - origin;
     precise vec3 b = t.v[1].xyz - origin;
@@ -64,6 +87,14 @@ float intersect(Triangle t) {
     precise float u = cx * by - cy * bx;
     precise float v = ax * cy - ay * cx;
     precise float w = bx * ay - by * ax;
+    if (u == 0.0 || v == 0.0 || w == 0.0) {
+        // Woop et al. recompute in double when an edge function rounds to zero; the error-free products
+        // do the same without shaderFloat64. Without this, tiny distant triangles lying almost along
+        // the ray gave (0, 0, +) and a false hit.
+        u = edge_refined(cx, by, cy, bx);
+        v = edge_refined(ax, cy, ay, cx);
+        w = edge_refined(bx, ay, by, ax);
+    }
     if ((u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)) {
         return -1.0;
     }
