@@ -20,7 +20,7 @@ pub struct MapComparison {
     pub texels: usize,
     /// Required triangles absent from a texel's list.
     pub missing: usize,
-    /// Entries beyond the exact set but within `EXTRA_MARGIN_TEXELS` of the texel.
+    /// Entries beyond the exact set but within the path's margin of the texel.
     pub extra_within_margin: usize,
     /// Entries out of range, duplicated, or not touching the texel even with the margin.
     pub garbage: usize,
@@ -51,17 +51,28 @@ pub fn compare_map_with(
     images: &FrameImages,
     faces: FaceSelection,
 ) -> MapComparison {
-    compare_map_excusing(rs, inputs, config, images, faces, &|_| false)
+    compare_map_excusing(
+        rs,
+        inputs,
+        config,
+        images,
+        faces,
+        EXTRA_MARGIN_TEXELS,
+        &|_| false,
+    )
 }
 
-/// [`compare_map_with`], where a missing triangle for which `excused` is true is counted in
-/// `missing_excused` instead of `missing` (e.g. triangles D3D12 Tier 1 may cull after snapping).
+/// [`compare_map_with`] for a path whose coverage may exceed the exact set by `margin` texels (1/256 for
+/// the software path and Tier 2/3 hardware, 1/2 for Tier 1), where a missing triangle for which
+/// `excused` is true is counted in `missing_excused` instead of `missing` (e.g. triangles D3D12 Tier 1
+/// may cull after snapping).
 pub fn compare_map_excusing(
     rs: &RefScene,
     inputs: &FrameInputs,
     config: &PrimitiveMapConfig,
     images: &FrameImages,
     faces: FaceSelection,
+    margin: f64,
     excused: &dyn Fn(u32) -> bool,
 ) -> MapComparison {
     let n = config.size;
@@ -92,15 +103,8 @@ pub fn compare_map_excusing(
                 if i >= tri_count {
                     c.garbage += 1;
                 } else if exact.binary_search(&i).is_err() {
-                    if overlaps_texel_with_margin(
-                        rs,
-                        inputs.light.view_proj(),
-                        n,
-                        i,
-                        x,
-                        y,
-                        EXTRA_MARGIN_TEXELS,
-                    ) {
+                    if overlaps_texel_with_margin(rs, inputs.light.view_proj(), n, i, x, y, margin)
+                    {
                         c.extra_within_margin += 1;
                     } else {
                         c.garbage += 1;

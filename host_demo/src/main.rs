@@ -202,7 +202,7 @@ fn main() -> ExitCode {
                 &d,
                 &host_demo::tiers::standard_scenes(models)?,
                 256,
-                512,
+                1024,
             )?;
             println!("{}", host_demo::tiers::markdown(&d, &rows));
             if rows.iter().all(|r| r.passed()) {

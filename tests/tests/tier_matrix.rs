@@ -28,13 +28,17 @@ fn every_available_raster_path_stores_the_exact_conservative_set() {
         &device,
         &standard_scenes(&models).expect("scenes load"),
         256,
-        512,
+        1024,
     )
     .expect("matrix runs");
     println!("{}", markdown(&device, &rows));
     assert_eq!(rows.len(), 2 * requests.len());
     for r in &rows {
         assert!(r.passed(), "{} on {}: {:?}", r.path, r.scene, r.map);
+        if !r.path.contains("tier-1") {
+            // Exact paths are compared on every texel: d is chosen so that none overflows.
+            assert_eq!(r.map.overflowed, 0, "{} on {}", r.path, r.scene);
+        }
     }
     assert_no_validation_errors(&device);
 }
