@@ -12,7 +12,7 @@ use passes::{
     FrameImages, HybridConfig, PcssConfig, PenumbraFilter, PrimitiveMapConfig, RasterRequest,
     ResourceId, ResourceSet, ShadowConfig, ShadowMapConfig, ShadowMode, ShadowRenderer,
 };
-use rhi::{Device, DeviceDesc};
+use rhi::Device;
 use scene::Camera;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -201,21 +201,9 @@ pub fn run_cli(device_filter: Option<String>, validation: bool, args: &CompareAr
     if args.width == 0 || args.height == 0 {
         bail!("--width and --height must be positive");
     }
-    let mut desc = DeviceDesc::from_env();
-    desc.validation |= validation;
-    if device_filter.is_some() {
-        desc.device_filter = device_filter;
-    }
-    let device = Device::new_headless(&desc)?;
+    let device = crate::open_device(device_filter, validation)?;
     compare_to_folder(&device, args)?;
-    let errors = device.validation().errors();
-    if errors > 0 {
-        bail!(
-            "{errors} Vulkan validation errors (first: {:?})",
-            device.validation().messages().first()
-        );
-    }
-    Ok(())
+    crate::check_validation(&device)
 }
 
 /// Renders every panel of the procedural scene and writes the pictures, the composite and the caption.

@@ -26,7 +26,7 @@ use passes::{
     GUARD_VALUE,
 };
 use reference::{FaceSelection, RefScene};
-use rhi::{Device, DeviceDesc};
+use rhi::Device;
 use scene::hard_cases::{Check, Expectation, Family, HardCase, Overflow, Solid};
 use scene::{Aabb, DirectionalLight, Scene};
 use std::collections::HashMap;
@@ -735,12 +735,8 @@ pub fn run_cli(
     validation: bool,
     args: &HardcasesArgs,
 ) -> Result<()> {
-    let mut desc = DeviceDesc::from_env();
-    desc.validation |= validation;
-    if device_filter.is_some() {
-        desc.device_filter = device_filter;
-    }
-    let device = Device::new_headless(&desc)?;
+    let validation = validation || rhi::DeviceDesc::from_env().validation;
+    let device = crate::open_device(device_filter, validation)?;
     let families = if args.family.is_empty() {
         Family::ALL.to_vec()
     } else {
@@ -764,7 +760,7 @@ pub fn run_cli(
         caps.device_name,
         caps.driver,
         path,
-        if desc.validation { "on" } else { "off" },
+        if validation { "on" } else { "off" },
         start.elapsed().as_secs_f64()
     );
     print!("{}", table(&outcomes, args.markdown));

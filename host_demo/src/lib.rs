@@ -108,6 +108,29 @@ pub fn focus_bounds(scene: &Scene) -> Aabb {
 
 const GROUND: &str = "ground";
 
+/// Opens the device the command line asks for: a name filter (else `HRTS_DEVICE`), validation layers if
+/// `validation` (or `HRTS_VALIDATION=1`).
+pub fn open_device(filter: Option<String>, validation: bool) -> anyhow::Result<Device> {
+    let mut desc = rhi::DeviceDesc::from_env();
+    desc.validation |= validation;
+    if filter.is_some() {
+        desc.device_filter = filter;
+    }
+    Ok(Device::new_headless(&desc)?)
+}
+
+/// Fails if the validation layers reported errors on `device`.
+pub fn check_validation(device: &Device) -> anyhow::Result<()> {
+    let errors = device.validation().errors();
+    if errors > 0 {
+        anyhow::bail!(
+            "{errors} Vulkan validation errors (first: {:?})",
+            device.validation().messages().first()
+        );
+    }
+    Ok(())
+}
+
 /// Parses "x,y,z" into a vector.
 pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();

@@ -6,7 +6,7 @@ use glam::Vec3;
 use host_demo::render::{parse_faces, parse_raster, render_to_folder, RenderOptions};
 use host_demo::{parse_vec3, View};
 use passes::{FaceMode, PrimitiveMapConfig, RasterRequest};
-use rhi::{Device, DeviceDesc};
+use rhi::Device;
 use scene::{Camera, DirectionalLight};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -141,12 +141,7 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
             ..view.camera
         };
     }
-    let mut desc = DeviceDesc::from_env();
-    desc.validation |= cli.validation;
-    if cli.device.is_some() {
-        desc.device_filter = cli.device.clone();
-    }
-    let device = Device::new_headless(&desc)?;
+    let device = device(cli)?;
     let options = RenderOptions {
         map: PrimitiveMapConfig {
             size: args.map_size,
@@ -159,24 +154,12 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
         soft: args.soft.clone(),
     };
     render_to_folder(&device, &view, &options, &args.out)?;
-    let errors = device.validation().errors();
-    if errors > 0 {
-        bail!(
-            "{errors} Vulkan validation errors (first: {:?})",
-            device.validation().messages().first()
-        );
-    }
-    Ok(())
+    host_demo::check_validation(&device)
 }
 
 /// The device chosen by the global options.
 fn device(cli: &Cli) -> Result<Device> {
-    let mut desc = DeviceDesc::from_env();
-    desc.validation |= cli.validation;
-    if cli.device.is_some() {
-        desc.device_filter = cli.device.clone();
-    }
-    Ok(Device::new_headless(&desc)?)
+    host_demo::open_device(cli.device.clone(), cli.validation)
 }
 
 fn main() -> ExitCode {

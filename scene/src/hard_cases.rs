@@ -36,9 +36,7 @@ use glam::{DMat4, DQuat, DVec3, Mat4, Vec3};
 use crate::obj::parse_obj;
 use crate::procedural::Rng;
 use crate::scene::ground_square;
-use crate::{
-    load_obj, procedural_default, Aabb, Camera, DirectionalLight, Object, Scene, SceneError,
-};
+use crate::{load_obj, procedural_default, Aabb, Camera, DirectionalLight, Scene, SceneError};
 
 /// A group of related cases (one integration test each).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -525,16 +523,7 @@ impl Mesh {
     }
 
     fn object(self, name: &str) -> Scene {
-        let triangle_count = (self.indices.len() / 3) as u32;
-        Scene {
-            positions: self.positions,
-            indices: self.indices,
-            objects: vec![Object {
-                name: name.to_owned(),
-                first_triangle: 0,
-                triangle_count,
-            }],
-        }
+        Scene::single_object(self.positions, self.indices, name)
     }
 }
 

@@ -5,7 +5,7 @@ use std::f32::consts::{FRAC_PI_2, PI, TAU};
 use glam::{Affine3A, EulerRot, Quat, Vec2, Vec3};
 
 use crate::scene::ground_square;
-use crate::{Object, Scene};
+use crate::Scene;
 
 /// The demo's built-in scene: a collection of shadow-mapping trouble makers on a ground plane.
 ///
@@ -191,16 +191,7 @@ impl MeshBuilder {
     }
 
     fn into_object(self, name: &str) -> Scene {
-        let triangle_count = (self.indices.len() / 3) as u32;
-        Scene {
-            positions: self.positions,
-            indices: self.indices,
-            objects: vec![Object {
-                name: name.to_owned(),
-                first_triangle: 0,
-                triangle_count,
-            }],
-        }
+        Scene::single_object(self.positions, self.indices, name)
     }
 
     /// Adds a vertex given in the builder's local space.
@@ -339,7 +330,7 @@ mod tests {
     use std::collections::HashMap;
 
     use super::*;
-    use crate::Aabb;
+    use crate::{Aabb, Object};
 
     fn object<'a>(scene: &'a Scene, name: &str) -> &'a Object {
         scene

@@ -35,6 +35,20 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// A scene of one object named `name` holding every triangle of `indices`.
+    pub fn single_object(positions: Vec<Vec3>, indices: Vec<u32>, name: &str) -> Scene {
+        let triangle_count = (indices.len() / 3) as u32;
+        Scene {
+            positions,
+            indices,
+            objects: vec![Object {
+                name: name.to_owned(),
+                first_triangle: 0,
+                triangle_count,
+            }],
+        }
+    }
+
     /// Number of complete triangles (`indices.len() / 3`).
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
