@@ -10,7 +10,8 @@ fn workspace() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// The folder holding `libhrts.so` for this build profile (target/<profile>).
+/// The folder holding `libhrts.so` for this build profile (target/<profile>), building the plugin's
+/// shared library there first: `cargo test` builds only the rlib of a dependency.
 fn library_dir() -> PathBuf {
     let exe = std::env::current_exe().expect("test executable path");
     let dir = exe
@@ -18,9 +19,27 @@ fn library_dir() -> PathBuf {
         .and_then(Path::parent)
         .expect("target/<profile>/deps/<test>")
         .to_path_buf();
+    let target = dir.parent().expect("target/<profile>").to_path_buf();
+    let profile = match dir.file_name().and_then(|n| n.to_str()) {
+        Some("debug") => "dev".to_owned(),
+        Some(other) => other.to_owned(),
+        None => panic!("unexpected target folder {}", dir.display()),
+    };
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    run(Command::new(cargo)
+        .args([
+            "build",
+            "-p",
+            "plugin_api",
+            "--profile",
+            &profile,
+            "--target-dir",
+        ])
+        .arg(&target)
+        .current_dir(workspace()));
     assert!(
         dir.join("libhrts.so").exists(),
-        "libhrts.so not found in {}: build plugin_api first",
+        "libhrts.so not found in {} after building plugin_api",
         dir.display()
     );
     dir
