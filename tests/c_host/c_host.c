@@ -515,6 +515,26 @@ static HrtsResult run_frame(HrtsContext *ctx, float *vis) {
     return r;
 }
 
+/* Pixels whose plugin visibility differs from the exact shadow (near-edge pixels counted apart). */
+static int count_mismatches(const float *vis, double tol, int *near_edge, int *shadowed, int *lit) {
+    int mismatches = 0;
+    *near_edge = *shadowed = *lit = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            int e = exact(x, y, tol);
+            float v = vis[y * W + x];
+            if (e == -1) { (*near_edge)++; continue; }
+            float want = e == 0 ? 0.0f : 1.0f;
+            if (e == 0) (*shadowed)++;
+            if (e == 1) (*lit)++;
+            if (v != want) {
+                if (mismatches < 8) fprintf(stderr, "pixel (%d,%d): exact %d, plugin %g\n", x, y, e, v);
+                mismatches++;
+            }
+        }
+    return mismatches;
+}
+
 static long rss_kib(void) {
     FILE *f = fopen("/proc/self/statm", "r");
     long pages = 0, resident = 0;
@@ -748,20 +768,8 @@ int main(void) {
 
     /* compare with the exact shadow; tolerance 1/16 of the pixel footprint at the farthest point */
     double tol = 12.0 * (2 * tan(FOV_Y / 2) / H) / 16.0;
-    int mismatches = 0, near_edge = 0, shadowed = 0, lit = 0;
-    for (int y = 0; y < H; y++)
-        for (int x = 0; x < W; x++) {
-            int e = exact(x, y, tol);
-            float v = vis[y * W + x];
-            if (e == -1) { near_edge++; continue; }
-            float want = e == 0 ? 0.0f : 1.0f;
-            if (e == 0) shadowed++;
-            if (e == 1) lit++;
-            if (v != want) {
-                if (mismatches < 8) fprintf(stderr, "pixel (%d,%d): exact %d, plugin %g\n", x, y, e, v);
-                mismatches++;
-            }
-        }
+    int near_edge, shadowed, lit;
+    int mismatches = count_mismatches(vis, tol, &near_edge, &shadowed, &lit);
     printf("visibility: %d px, %d lit, %d shadowed, %d near-edge, %d mismatches\n", W * H, lit, shadowed, near_edge, mismatches);
     CHECK(mismatches == 0, "%d pixels differ from the exact shadow", mismatches);
     CHECK(shadowed > 300 && lit > 1000, "the view should show both lit and shadowed pixels");
@@ -784,6 +792,48 @@ int main(void) {
     CHECK(halo == 0 && out_of_range == 0, "hybrid: %d halo, %d out of range", halo, out_of_range);
     CHECK(soft > 0, "hybrid shows no penumbra");
     CHECK(hrts_configure(ctx, &cfg) == HRTS_RESULT_OK, "configure back: %s", hrts_last_error(ctx));
+
+    /* the same scene from the engine's own Vulkan buffers: float4 positions (stride 16) at byte offset 64,
+     * 16-bit indices at byte offset 8 */
+    Buf vb = make_host_buffer(64 + 12 * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    Buf ib = make_host_buffer(8 + 44 * 2, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    float *vp = (float *)((char *)vb.map + 64);
+    uint16_t *ip = (uint16_t *)((char *)ib.map + 8);
+    for (int v = 0; v < 12; v++) {
+        vp[4 * v + 0] = positions[3 * v + 0];
+        vp[4 * v + 1] = positions[3 * v + 1];
+        vp[4 * v + 2] = positions[3 * v + 2];
+        vp[4 * v + 3] = 1.0f;
+    }
+    for (int k = 0; k < 42; k++) ip[k] = (uint16_t)indices[k];
+    HrtsVulkanGeometry vg;
+    memset(&vg, 0, sizeof vg);
+    vg.struct_size = sizeof vg;
+    vg.vertex_buffer = (uint64_t)(uintptr_t)vb.buffer;
+    vg.vertex_buffer_size = 64 + 12 * 16;
+    vg.vertex_offset = 64;
+    vg.vertex_stride = 16;
+    vg.vertex_count = 12;
+    vg.index_buffer = (uint64_t)(uintptr_t)ib.buffer;
+    vg.index_buffer_size = 8 + 44 * 2;
+    vg.index_offset = 8;
+    vg.index_type = HRTS_INDEX_TYPE_UINT16;
+    vg.index_count = 42;
+    vg.draws = draws;
+    vg.draw_count = 2;
+    const float bounds[6] = {-4.0f, 0.0f, -4.0f, 4.0f, 1.6f, 4.0f};
+    memcpy(vg.bounds, bounds, sizeof bounds);
+    CHECK(hrts_set_geometry_vulkan(ctx, &vg) == HRTS_RESULT_OK, "vulkan geometry: %s", hrts_last_error(ctx));
+    static float vis_engine[W * H];
+    CHECK(run_frame(ctx, vis_engine) == HRTS_RESULT_OK, "record with engine buffers: %s", hrts_last_error(ctx));
+    int ne2, sh2, lit2;
+    int mismatches_engine = count_mismatches(vis_engine, tol, &ne2, &sh2, &lit2);
+    printf("engine buffers (u16 indices, stride 16, offsets): %d mismatches\n", mismatches_engine);
+    CHECK(mismatches_engine == 0, "%d pixels differ with engine geometry", mismatches_engine);
+    CHECK(hrts_set_geometry_cpu(ctx, &g) == HRTS_RESULT_OK, "back to CPU geometry: %s", hrts_last_error(ctx));
+    VK(vkDeviceWaitIdle(device));
+    free_buffer(vb);
+    free_buffer(ib);
 
     misuse(ctx, &vk);
     CHECK(run_frame(ctx, NULL) == HRTS_RESULT_OK, "context still records after misuse: %s", hrts_last_error(ctx));
