@@ -404,6 +404,15 @@ pub fn render_to_folder(
             stats.overflowed_texels,
             stats.max_count
         );
+        if stats.overflowed_texels > 0 {
+            println!(
+                "note: {} texels hold more than d = {} triangles; they stay exact but are traced against every \
+                 triangle (slow): --map-depth {} avoids it",
+                stats.overflowed_texels,
+                options.map.depth,
+                stats.max_count.next_power_of_two()
+            );
+        }
     }
     println!(
         "shadows: {} (FXAA {}), shadow map {}x{}, PCSS {} filter {}+{} taps, WSS {:.3}, PHS {}",

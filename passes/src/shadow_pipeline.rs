@@ -750,9 +750,22 @@ impl ShadowPipeline {
         Ok(())
     }
 
-    /// Timings, pass statuses, resource sizes and map statistics of the last recorded frame; call after
-    /// its submission has completed.
+    /// Timings and statistics of the last recorded frame, waiting for its GPU timestamps; call after its
+    /// submission was made.
     pub fn report(&self) -> Result<FrameReport, PassError> {
+        let timings = self.timer.resolve()?;
+        self.report_with(timings)
+    }
+
+    /// [`ShadowPipeline::report`] without waiting: `None` while the GPU has not finished the frame.
+    pub fn try_report(&self) -> Result<Option<FrameReport>, PassError> {
+        match self.timer.try_resolve()? {
+            Some(timings) => self.report_with(timings).map(Some),
+            None => Ok(None),
+        }
+    }
+
+    fn report_with(&self, timings: Vec<PassTiming>) -> Result<FrameReport, PassError> {
         let stats: MapStats = if self.map.is_some() {
             bytemuck::pod_read_unaligned(self.stats_readback.read()?)
         } else {
@@ -768,7 +781,7 @@ impl ShadowPipeline {
             })
             .collect();
         Ok(FrameReport {
-            timings: self.timer.resolve()?,
+            timings,
             raster_path: self.raster_path,
             stats,
             passes: self.statuses.clone(),

@@ -600,7 +600,12 @@ impl Context {
                 "no frame has been recorded",
             ));
         };
-        let report = built.pipeline.report()?;
+        let report = built.pipeline.try_report()?.ok_or_else(|| {
+            ApiError::new(
+                HrtsResult::ErrorInvalidState,
+                "the last recorded frame has not completed on the GPU: read the report after its fence signalled",
+            )
+        })?;
         out.raster_path = match report.raster_path {
             RasterPath::Hardware(_) | RasterPath::EmulatedTier1 { .. } => {
                 HrtsRasterPath::Hardware as u32
