@@ -148,6 +148,19 @@ typedef uint32_t HrtsLightType;
 // Opaque plugin context.
 typedef struct HrtsContext HrtsContext;
 
+// The engine's host allocator. The plugin's host memory (not Vulkan's) goes through it for the whole
+// process once installed with `hrts_set_allocation_callbacks`.
+typedef struct HrtsAllocationCallbacks {
+  // `sizeof(HrtsAllocationCallbacks)`.
+  uint32_t struct_size;
+  // Passed back to both functions.
+  void *user_data;
+  // Returns `size` bytes aligned to `alignment` (a power of two), or NULL.
+  void *(*allocate)(void *user_data, size_t size, size_t alignment);
+  // Frees memory returned by `allocate`, with the size and alignment it was allocated with.
+  void (*free)(void *user_data, void *memory, size_t size, size_t alignment);
+} HrtsAllocationCallbacks;
+
 // Memory the plugin holds, process-wide (all contexts).
 typedef struct HrtsMemoryStats {
   // `sizeof(HrtsMemoryStats)`, set by the caller.
@@ -418,6 +431,14 @@ extern "C" {
 
 // The library's `HRTS_API_VERSION`.
 uint32_t hrts_get_api_version(void);
+
+// Routes the plugin's host memory through the engine's allocator, for the whole process. It must be the
+// first call into the plugin: once the plugin has allocated anything (or callbacks are installed) it
+// returns `HRTS_RESULT_ERROR_INVALID_STATE`. Vulkan objects keep the driver's allocator.
+//
+// # Safety
+// `callbacks` is NULL or valid; its functions are thread-safe and outlive every use of the plugin.
+enum HrtsResult hrts_set_allocation_callbacks(const struct HrtsAllocationCallbacks *callbacks);
 
 // Fills `out` (with `out->struct_size` set) with the memory the plugin holds now, over all contexts.
 //

@@ -112,6 +112,41 @@ pub extern "C" fn hrts_get_api_version() -> u32 {
     HRTS_API_VERSION
 }
 
+/// Routes the plugin's host memory through the engine's allocator, for the whole process. It must be the
+/// first call into the plugin: once the plugin has allocated anything (or callbacks are installed) it
+/// returns `HRTS_RESULT_ERROR_INVALID_STATE`. Vulkan objects keep the driver's allocator.
+///
+/// # Safety
+/// `callbacks` is NULL or valid; its functions are thread-safe and outlive every use of the plugin.
+#[no_mangle]
+pub unsafe extern "C" fn hrts_set_allocation_callbacks(
+    callbacks: *const HrtsAllocationCallbacks,
+) -> HrtsResult {
+    boundary(None, || {
+        let c = deref(callbacks, "callbacks")?;
+        context::check_size::<HrtsAllocationCallbacks>(c.struct_size, "HrtsAllocationCallbacks")?;
+        let (Some(allocate), Some(free)) = (c.allocate, c.free) else {
+            return Err(ApiError::new(
+                HrtsResult::ErrorNullPointer,
+                "allocate and free must be non-NULL",
+            ));
+        };
+        let installed = memory::install(memory::Callbacks {
+            user_data: c.user_data as usize,
+            allocate,
+            free,
+        });
+        if installed {
+            Ok(())
+        } else {
+            Err(ApiError::new(
+                HrtsResult::ErrorInvalidState,
+                "allocation callbacks must be installed before the plugin allocates anything (first call), once",
+            ))
+        }
+    })
+}
+
 /// Fills `out` (with `out->struct_size` set) with the memory the plugin holds now, over all contexts.
 ///
 /// # Safety

@@ -344,6 +344,33 @@ pub struct HrtsFrame {
     pub output_layout_after: i32,
 }
 
+/// The engine's host allocator. The plugin's host memory (not Vulkan's) goes through it for the whole
+/// process once installed with `hrts_set_allocation_callbacks`.
+#[repr(C)]
+pub struct HrtsAllocationCallbacks {
+    /// `sizeof(HrtsAllocationCallbacks)`.
+    pub struct_size: u32,
+    /// Passed back to both functions.
+    pub user_data: *mut std::ffi::c_void,
+    /// Returns `size` bytes aligned to `alignment` (a power of two), or NULL.
+    pub allocate: Option<
+        unsafe extern "C" fn(
+            user_data: *mut std::ffi::c_void,
+            size: usize,
+            alignment: usize,
+        ) -> *mut std::ffi::c_void,
+    >,
+    /// Frees memory returned by `allocate`, with the size and alignment it was allocated with.
+    pub free: Option<
+        unsafe extern "C" fn(
+            user_data: *mut std::ffi::c_void,
+            memory: *mut std::ffi::c_void,
+            size: usize,
+            alignment: usize,
+        ),
+    >,
+}
+
 /// Memory the plugin holds, process-wide (all contexts).
 #[repr(C)]
 pub struct HrtsMemoryStats {

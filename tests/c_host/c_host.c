@@ -3,6 +3,7 @@
  * plane itself (analytic ray casting on the CPU), records the plugin into its own command buffer, reads
  * back the visibility image and compares it with the exact shadow of that scene. It then checks misuse
  * cases and 100 create/destroy cycles. Prints "N passed, M failed" and exits non-zero on any failure. */
+#define _POSIX_C_SOURCE 200112L
 #include "hrts.h"
 
 #include <math.h>
@@ -535,6 +536,26 @@ static int count_mismatches(const float *vis, double tol, int *near_edge, int *s
     return mismatches;
 }
 
+/* The engine's host allocator, handed to the plugin before anything else: it counts live bytes. */
+static size_t engine_live_bytes, engine_allocations;
+
+static void *engine_allocate(void *user, size_t size, size_t alignment) {
+    (void)user;
+    void *p = NULL;
+    if (alignment < sizeof(void *)) alignment = sizeof(void *);
+    if (posix_memalign(&p, alignment, size ? size : 1) != 0) return NULL;
+    __atomic_fetch_add(&engine_live_bytes, size, __ATOMIC_RELAXED);
+    __atomic_fetch_add(&engine_allocations, 1, __ATOMIC_RELAXED);
+    return p;
+}
+
+static void engine_free(void *user, void *memory, size_t size, size_t alignment) {
+    (void)user;
+    (void)alignment;
+    __atomic_fetch_sub(&engine_live_bytes, size, __ATOMIC_RELAXED);
+    free(memory);
+}
+
 static long rss_kib(void) {
     FILE *f = fopen("/proc/self/statm", "r");
     long pages = 0, resident = 0;
@@ -730,6 +751,13 @@ static void misuse(HrtsContext *ctx, const HrtsVulkanDevice *vk) {
 }
 
 int main(void) {
+    HrtsAllocationCallbacks callbacks;
+    memset(&callbacks, 0, sizeof callbacks);
+    callbacks.struct_size = sizeof callbacks;
+    callbacks.allocate = engine_allocate;
+    callbacks.free = engine_free;
+    CHECK(hrts_set_allocation_callbacks(&callbacks) == HRTS_RESULT_OK, "allocation callbacks: %s", hrts_last_error(NULL));
+    CHECK(hrts_set_allocation_callbacks(&callbacks) == HRTS_RESULT_ERROR_INVALID_STATE, "second install accepted");
     setup_camera();
     create_device();
     HrtsVulkanDevice vk = adopt_info();
@@ -873,6 +901,15 @@ int main(void) {
           (unsigned long long)after.gpu_bytes);
     memset(&before, 0, sizeof before);
     CHECK(hrts_get_memory_stats(&before) == HRTS_RESULT_ERROR_STRUCT_SIZE, "memory stats with size 0");
+    HrtsMemoryStats now;
+    memset(&now, 0, sizeof now);
+    now.struct_size = sizeof now;
+    CHECK(hrts_get_memory_stats(&now) == HRTS_RESULT_OK, "memory stats: %s", hrts_last_error(NULL));
+    printf("engine allocator: %zu allocations by the plugin, %zu bytes live (plugin reports %llu)\n",
+           engine_allocations, engine_live_bytes, (unsigned long long)now.host_bytes);
+    CHECK(engine_allocations > 1000, "the plugin did not use the engine's allocator");
+    CHECK(engine_live_bytes == now.host_bytes, "engine allocator sees %zu live bytes, plugin reports %llu",
+          engine_live_bytes, (unsigned long long)now.host_bytes);
 
     vkDestroyImage(device, depth_img.image, NULL);
     vkFreeMemory(device, depth_img.memory, NULL);
