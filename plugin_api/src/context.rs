@@ -439,16 +439,15 @@ impl Context {
                 "vertex_buffer and index_buffer must be non-NULL",
             ));
         }
-        let format = match g.index_type {
-            x if x == HrtsIndexType::Uint16 as u32 => IndexFormat::U16,
-            x if x == HrtsIndexType::Uint32 as u32 => IndexFormat::U32,
-            x => {
-                return Err(ApiError::new(
-                    HrtsResult::ErrorInvalidEnum,
-                    format!("index_type {x} is not a HrtsIndexType value"),
-                ))
-            }
-        };
+        let format = enum_value(
+            g.index_type,
+            &[
+                (HrtsIndexType::Uint16 as u32, IndexFormat::U16),
+                (HrtsIndexType::Uint32 as u32, IndexFormat::U32),
+            ],
+            "index_type",
+            "HrtsIndexType",
+        )?;
         finite(&g.bounds, "bounds")?;
         let lo = Vec3::from_slice(&g.bounds[..3]).as_dvec3();
         let hi = Vec3::from_slice(&g.bounds[3..]).as_dvec3();
@@ -538,21 +537,26 @@ impl Context {
             return Err(invalid("light_direction is zero"));
         }
         let view_proj = mat4(&f.light_view_proj);
-        let light = match f.light_type {
-            x if x == HrtsLightType::Directional as u32 => Light::Directional {
-                direction: dir.normalize(),
-                view_proj,
-            },
-            x if x == HrtsLightType::Spot as u32 => Light::Spot {
+        let spot = enum_value(
+            f.light_type,
+            &[
+                (HrtsLightType::Directional as u32, false),
+                (HrtsLightType::Spot as u32, true),
+            ],
+            "light_type",
+            "HrtsLightType",
+        )?;
+        let direction = dir.normalize();
+        let light = if spot {
+            Light::Spot {
                 position: Vec3::from_array(f.light_position),
-                direction: dir.normalize(),
+                direction,
                 view_proj,
-            },
-            x => {
-                return Err(ApiError::new(
-                    HrtsResult::ErrorInvalidEnum,
-                    format!("light_type {x} is not a HrtsLightType value"),
-                ))
+            }
+        } else {
+            Light::Directional {
+                direction,
+                view_proj,
             }
         };
         for (what, layout) in [
