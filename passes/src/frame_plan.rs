@@ -181,6 +181,12 @@ impl ResourceSet {
         Self(self.0 | other.0)
     }
 
+    /// This set without the members of `other`.
+    #[must_use]
+    pub fn difference(self, other: Self) -> Self {
+        Self(self.0 & !other.0)
+    }
+
     /// The members, in [`ResourceId`] order.
     pub fn iter(self) -> impl Iterator<Item = ResourceId> {
         ResourceId::ALL

@@ -1,7 +1,7 @@
 //! The demo host's frame: prim buffer → G-buffer → [`ShadowPipeline`], submitted and waited for, with
 //! read-back of every output the plan produced.
 
-use crate::frame_plan::ResourceId;
+use crate::frame_plan::{PassId, ResourceId};
 use crate::gbuffer::{GBufferPass, GBufferTargets};
 use crate::gpu_types::GBufferPush;
 use crate::prim_buffer::Geometry;
@@ -108,8 +108,10 @@ impl ShadowRenderer {
             gbuffer,
             pipeline,
         } = self;
+        pipeline.begin_frame(inputs)?;
         device.submit_and_wait(|enc| {
-            pipeline.begin_frame(enc).map_err(into_rhi)?;
+            let (prim_buffer, rest) = PassId::ALL.split_at(1);
+            pipeline.record_passes(enc, prim_buffer).map_err(into_rhi)?;
             enc.barriers(&[
                 Barrier::Image {
                     image: &targets.position,
@@ -142,7 +144,7 @@ impl ShadowRenderer {
                     after: S::ShaderResource,
                 },
             ]);
-            pipeline.record(enc, inputs).map_err(into_rhi)
+            pipeline.record_passes(enc, rest).map_err(into_rhi)
         })?;
         self.pipeline.report()
     }

@@ -9,7 +9,7 @@
 
 use crate::frame_plan::{
     FramePlan, HardEdge, PassId, PassStatus, PenumbraFilter, PlanRequest, ResourceId, ResourceSet,
-    ShadowMode, SkipReason,
+    ShadowMode,
 };
 use crate::fxaa::FxaaPass;
 use crate::gpu_types::{MapStats, PcssConstants, PrimMapPush, RayTraceConstants, ShadowMapPush};
@@ -177,6 +177,16 @@ struct FrameConstants {
     pcss: PcssConstants,
 }
 
+/// A frame begun and being recorded.
+struct FrameState {
+    constants: FrameConstants,
+    light: Light,
+    /// Index in the linear order of the first pass neither recorded nor passed over yet.
+    next: usize,
+    /// Whether a recording of this frame has reset and attached the GPU timer.
+    timer_started: bool,
+}
+
 /// The passes of one view of one light, and the resources the plan allocates for them.
 pub struct ShadowPipeline {
     config: ShadowConfig,
@@ -199,8 +209,11 @@ pub struct ShadowPipeline {
     valid: ResourceSet,
     /// The light of the last recording that rendered the light-space maps.
     maps_light: Option<Light>,
-    /// Whether `begin_frame` rebuilt the prim buffer for the frame being recorded.
-    prims_rebuilt: bool,
+    /// The frame of the last `begin_frame`.
+    frame: Option<FrameState>,
+    /// Storage writes recorded and not yet followed by a UAV barrier.
+    pending_uav: bool,
+    /// The schedule of the last frame begun, in linear order.
     statuses: Vec<(PassId, PassStatus)>,
     width: u32,
     height: u32,
@@ -361,7 +374,8 @@ impl ShadowPipeline {
             raster_path,
             valid: ResourceSet::EMPTY,
             maps_light: None,
-            prims_rebuilt: false,
+            frame: None,
+            pending_uav: false,
             statuses: Vec::new(),
             width,
             height,
@@ -453,29 +467,6 @@ impl ShadowPipeline {
         self.ray.as_ref()
     }
 
-    /// Starts a frame: attaches the GPU timer (every pass recorded afterwards on `enc` is timed) and
-    /// builds the prim buffer when the plan has it and it is not valid (first frame, or dynamic geometry).
-    pub fn begin_frame(&mut self, enc: &mut Encoder<'_>) -> Result<(), PassError> {
-        enc.attach_timer(&self.timer);
-        self.prims_rebuilt = false;
-        let changed = if self.config.static_geometry {
-            ResourceSet::EMPTY
-        } else {
-            ResourceSet::of(&[ResourceId::SceneGeometry])
-        };
-        let run = self
-            .plan
-            .schedule(changed, self.valid)
-            .contains(&(PassId::PrimBuffer, PassStatus::Ran));
-        if let (true, Some(p)) = (run, &self.prim_buffer) {
-            p.record(enc, &self.geometry)?;
-            enc.barriers(&[Barrier::Uav]);
-            self.valid = self.valid.with(ResourceId::PrimBuffer);
-            self.prims_rebuilt = true;
-        }
-        Ok(())
-    }
-
     /// Camera-relative view-projection and the camera in frame coordinates (for a host G-buffer that
     /// rasterizes the prim buffer).
     pub fn camera_in_frame(&self, inputs: &FrameInputs) -> Result<(Mat4, Vec3), PassError> {
@@ -558,152 +549,143 @@ impl ShadowPipeline {
         })
     }
 
-    /// Records the passes the plan runs this frame. Depth and normal must be in `ShaderResource` state;
-    /// afterwards every image the pipeline wrote this frame, [`ShadowPipeline::output`] included, is in
-    /// `UnorderedAccess` state (the shadow map in `ShaderResource`).
-    ///
-    /// Contract: the previous recording has completed on the GPU (constants live in host-visible
-    /// buffers written here), and every recording is submitted — passes skipped as up to date reuse
-    /// what the last recording that ran them wrote.
-    pub fn record(&mut self, enc: &mut Encoder<'_>, inputs: &FrameInputs) -> Result<(), PassError> {
-        let c = self.constants(inputs)?;
-        if self.plan.runs(PassId::PrimBuffer) && !self.valid.contains(ResourceId::PrimBuffer) {
-            return Err(PassError::InvalidConfig(
-                "begin_frame must be recorded before record".into(),
-            ));
+    /// Plans a frame (no commands): computes its constants and decides which passes run and which are
+    /// skipped as up to date. Then [`ShadowPipeline::record_passes`] records them, in one call or several,
+    /// in linear order. A frame begun before this one and not recorded to its end is abandoned: the outputs
+    /// of its unrecorded passes count as stale.
+    pub fn begin_frame(&mut self, inputs: &FrameInputs) -> Result<(), PassError> {
+        let constants = self.constants(inputs)?;
+        if let Some(open) = self.frame.take() {
+            for &(pass, status) in &self.statuses[open.next..] {
+                if status == PassStatus::Ran {
+                    self.valid = self.valid.difference(self.plan.writes(pass));
+                }
+            }
         }
         let mut changed = ResourceSet::of(&[ResourceId::Depth, ResourceId::Normal]);
+        if !self.config.static_geometry {
+            changed = changed.with(ResourceId::SceneGeometry);
+        }
         if !self.config.static_light || self.maps_light != Some(inputs.light) {
             changed = changed.with(ResourceId::Light);
         }
-        if self.prims_rebuilt {
-            changed = changed.with(ResourceId::PrimBuffer);
-        }
-        let mut statuses = self.plan.schedule(changed, self.valid);
-        for s in &mut statuses {
-            if s.0 == PassId::PrimBuffer && self.plan.runs(PassId::PrimBuffer) {
-                s.1 = if self.prims_rebuilt {
-                    PassStatus::Ran
-                } else {
-                    PassStatus::Skipped(SkipReason::UpToDate)
-                };
-            }
-        }
-        self.prims_rebuilt = false;
-        let ran = |p| statuses.contains(&(p, PassStatus::Ran));
-        self.record_light_space(enc, &c, &ran)?;
-        self.record_screen_space(enc, &c, &ran)?;
-        for &(pass, status) in &statuses {
-            if status == PassStatus::Ran {
-                self.valid = self.valid.union(self.plan.writes(pass));
-            }
-        }
-        if ran(PassId::ShadowMap) || ran(PassId::PrimitiveMap) {
-            self.maps_light = Some(inputs.light);
-        }
-        self.statuses = statuses;
+        self.statuses = self.plan.schedule(changed, self.valid);
+        self.frame = Some(FrameState {
+            constants,
+            light: inputs.light,
+            next: 0,
+            timer_started: false,
+        });
         Ok(())
     }
 
-    fn record_light_space(
+    /// The passes the current frame runs and has not recorded yet.
+    pub fn passes_to_record(&self) -> Vec<PassId> {
+        self.frame.as_ref().map_or_else(Vec::new, |f| {
+            self.statuses[f.next..]
+                .iter()
+                .filter(|(_, s)| *s == PassStatus::Ran)
+                .map(|&(p, _)| p)
+                .collect()
+        })
+    }
+
+    /// Records `passes` of the frame begun by [`ShadowPipeline::begin_frame`] (those the frame skips
+    /// record nothing). Calls go forward through the linear order: every pass requested must come after
+    /// those of earlier calls of the frame, and every pass the frame runs up to the last one requested
+    /// must be requested. Calls may use different command buffers submitted in recording order; the
+    /// first one resets the GPU timer, later ones (even with no pass) go on timing into it.
+    ///
+    /// States: depth and normal must be in `ShaderResource` state for the screen-space passes (ray trace,
+    /// shadow-map test, PCSS); every image a pass writes is left in `UnorderedAccess` state (the shadow
+    /// map in `ShaderResource`), [`ShadowPipeline::output`] included.
+    ///
+    /// Contract: the previous frame's recordings have completed on the GPU (constants live in
+    /// host-visible buffers written here), and every recording is submitted: passes skipped as up to
+    /// date reuse what the recording that last ran them wrote.
+    pub fn record_passes(
         &mut self,
         enc: &mut Encoder<'_>,
-        c: &FrameConstants,
-        ran: &dyn Fn(PassId) -> bool,
+        passes: &[PassId],
     ) -> Result<(), PassError> {
-        let tris = self.geometry.triangle_count();
-        if let (true, Some(sm)) = (ran(PassId::ShadowMap), &self.shadow_map) {
-            enc.barriers(&[Barrier::Image {
-                image: &sm.depth,
-                before: S::Undefined,
-                after: S::DepthWrite,
-            }]);
-            sm.record(
-                enc,
-                &ShadowMapPush {
-                    light_view_proj: c.light.view_proj,
-                },
-                tris,
-            )?;
-            enc.barriers(&[Barrier::Image {
-                image: &sm.depth,
-                before: S::DepthWrite,
-                after: S::ShaderResource,
-            }]);
+        let Some(mut frame) = self.frame.take() else {
+            return Err(PassError::InvalidConfig(
+                "no frame: call begin_frame first".into(),
+            ));
+        };
+        let outcome = self.record_forward(enc, &mut frame, passes);
+        self.frame = Some(frame);
+        outcome
+    }
+
+    /// Records every pass of a frame: [`ShadowPipeline::begin_frame`], then
+    /// [`ShadowPipeline::record_passes`] of the whole linear order.
+    pub fn record(&mut self, enc: &mut Encoder<'_>, inputs: &FrameInputs) -> Result<(), PassError> {
+        self.begin_frame(inputs)?;
+        self.record_passes(enc, PassId::ALL)
+    }
+
+    fn record_forward(
+        &mut self,
+        enc: &mut Encoder<'_>,
+        frame: &mut FrameState,
+        passes: &[PassId],
+    ) -> Result<(), PassError> {
+        if frame.timer_started {
+            enc.continue_timer(&self.timer);
+        } else {
+            enc.attach_timer(&self.timer);
+            frame.timer_started = true;
         }
-        let Some(map) = &self.map else {
+        let Some(&last) = passes.iter().max() else {
             return Ok(());
         };
-        if ran(PassId::PrimitiveMap) {
-            let undefined_to = |image, after| Barrier::Image {
-                image,
-                before: S::Undefined,
-                after,
-            };
-            enc.barriers(&[
-                undefined_to(&map.count, S::CopyDest),
-                undefined_to(&map.indices, S::CopyDest),
-            ]);
-            map.record_clear(enc);
-            enc.barriers(&[
-                Barrier::Image {
-                    image: &map.count,
-                    before: S::CopyDest,
-                    after: S::UnorderedAccess,
-                },
-                Barrier::Image {
-                    image: &map.indices,
-                    before: S::CopyDest,
-                    after: S::UnorderedAccess,
-                },
-                Barrier::Global {
-                    before: S::CopyDest,
-                    after: S::UnorderedAccess,
-                },
-            ]);
-            map.record_raster(enc, &c.map, tris)?;
-            enc.barriers(&[Barrier::Uav]);
+        if let Some(&first) = passes.iter().min().filter(|&&p| (p as usize) < frame.next) {
+            return Err(PassError::InvalidConfig(format!(
+                "pass '{}' comes before a pass already recorded this frame: record passes in linear order",
+                first.name()
+            )));
         }
-        if ran(PassId::Occupancy) {
-            enc.barriers(&[Barrier::Image {
-                image: &map.occupancy,
-                before: S::Undefined,
-                after: S::UnorderedAccess,
-            }]);
-            map.record_occupancy(enc)?;
-            enc.barriers(&[Barrier::Global {
-                before: S::UnorderedAccess,
-                after: S::CopySource,
-            }]);
-            enc.copy_buffer(&map.stats, &self.stats_readback)?;
-            enc.barriers(&[Barrier::Global {
-                before: S::CopyDest,
-                after: S::HostRead,
-            }]);
+        let statuses = self.statuses.clone();
+        let runs = |p: PassId| statuses[p as usize].1 == PassStatus::Ran;
+        if let Some(&missing) = PassId::ALL[frame.next..=last as usize]
+            .iter()
+            .find(|&&p| runs(p) && !passes.contains(&p))
+        {
+            return Err(PassError::InvalidConfig(format!(
+                "pass '{}' runs this frame: record it (it comes before '{}')",
+                missing.name(),
+                last.name()
+            )));
         }
+        for &pass in &PassId::ALL[frame.next..=last as usize] {
+            if runs(pass) {
+                self.record_pass(enc, pass, &frame.constants)?;
+                self.valid = self.valid.union(self.plan.writes(pass));
+                if matches!(pass, PassId::ShadowMap | PassId::PrimitiveMap) {
+                    self.maps_light = Some(frame.light);
+                }
+            }
+            frame.next = pass as usize + 1;
+        }
+        self.flush_uav(enc);
         Ok(())
     }
 
-    fn record_screen_space(
-        &mut self,
-        enc: &mut Encoder<'_>,
-        c: &FrameConstants,
-        ran: &dyn Fn(PassId) -> bool,
-    ) -> Result<(), PassError> {
-        // Every screen-space image written this frame is rewritten whole: discard and make it a UAV.
-        let screen = [
-            (PassId::RayTrace, ResourceId::RtVisibility),
-            (PassId::RayTrace, ResourceId::BlockerDistance),
-            (PassId::ShadowMapTest, ResourceId::ShadowMapVisibility),
-            (PassId::Pcss, ResourceId::Pcss),
-            (PassId::Fxaa, ResourceId::RtAntialiased),
-            (PassId::LerpFactor, ResourceId::LerpFactor),
-            (PassId::Blend, ResourceId::Hybrid),
-        ];
-        let to_uav: Vec<Barrier<'_>> = screen
+    /// Makes the storage writes of the passes recorded since the last UAV barrier visible.
+    fn flush_uav(&mut self, enc: &mut Encoder<'_>) {
+        if std::mem::take(&mut self.pending_uav) {
+            enc.barriers(&[Barrier::Uav]);
+        }
+    }
+
+    /// Discards the screen-space outputs of `pass` and makes them UAVs.
+    fn outputs_to_uav(&self, enc: &mut Encoder<'_>, pass: PassId) {
+        let to_uav: Vec<Barrier<'_>> = self
+            .plan
+            .writes(pass)
             .iter()
-            .filter(|(p, _)| ran(*p))
-            .filter_map(|&(_, r)| self.image(r))
+            .filter_map(|r| self.image(r))
             .map(|image| Barrier::Image {
                 image,
                 before: S::Undefined,
@@ -711,42 +693,145 @@ impl ShadowPipeline {
             })
             .collect();
         enc.barriers(&to_uav);
-        if let (true, Some(ray)) = (ran(PassId::RayTrace), self.ray.as_mut()) {
-            ray.record(enc, &c.ray)?;
-            enc.barriers(&[Barrier::Uav]);
+    }
+
+    /// Records one pass with the barriers around it. The screen-space passes that do not read each
+    /// other's outputs (shadow-map test, PCSS, FXAA, lerp factor) share one UAV barrier after them.
+    fn record_pass(
+        &mut self,
+        enc: &mut Encoder<'_>,
+        pass: PassId,
+        c: &FrameConstants,
+    ) -> Result<(), PassError> {
+        let independent = matches!(
+            pass,
+            PassId::ShadowMapTest | PassId::Pcss | PassId::Fxaa | PassId::LerpFactor
+        );
+        if !independent {
+            self.flush_uav(enc);
         }
-        if let (true, Some(p)) = (ran(PassId::ShadowMapTest), self.shadow_map_test.as_mut()) {
-            p.record(enc, &c.pcss)?;
+        let tris = self.geometry.triangle_count();
+        match pass {
+            PassId::PrimBuffer => {
+                if let Some(p) = &self.prim_buffer {
+                    p.record(enc, &self.geometry)?;
+                }
+            }
+            PassId::ShadowMap => {
+                if let Some(sm) = &self.shadow_map {
+                    enc.barriers(&[Barrier::Image {
+                        image: &sm.depth,
+                        before: S::Undefined,
+                        after: S::DepthWrite,
+                    }]);
+                    let push = ShadowMapPush {
+                        light_view_proj: c.light.view_proj,
+                    };
+                    sm.record(enc, &push, tris)?;
+                    enc.barriers(&[Barrier::Image {
+                        image: &sm.depth,
+                        before: S::DepthWrite,
+                        after: S::ShaderResource,
+                    }]);
+                }
+            }
+            PassId::PrimitiveMap => {
+                if let Some(map) = &self.map {
+                    let transition = |image, before, after| Barrier::Image {
+                        image,
+                        before,
+                        after,
+                    };
+                    enc.barriers(&[
+                        transition(&map.count, S::Undefined, S::CopyDest),
+                        transition(&map.indices, S::Undefined, S::CopyDest),
+                    ]);
+                    map.record_clear(enc);
+                    enc.barriers(&[
+                        transition(&map.count, S::CopyDest, S::UnorderedAccess),
+                        transition(&map.indices, S::CopyDest, S::UnorderedAccess),
+                        Barrier::Global {
+                            before: S::CopyDest,
+                            after: S::UnorderedAccess,
+                        },
+                    ]);
+                    map.record_raster(enc, &c.map, tris)?;
+                }
+            }
+            PassId::Occupancy => {
+                if let Some(map) = &self.map {
+                    enc.barriers(&[Barrier::Image {
+                        image: &map.occupancy,
+                        before: S::Undefined,
+                        after: S::UnorderedAccess,
+                    }]);
+                    map.record_occupancy(enc)?;
+                    enc.barriers(&[Barrier::Global {
+                        before: S::UnorderedAccess,
+                        after: S::CopySource,
+                    }]);
+                    enc.copy_buffer(&map.stats, &self.stats_readback)?;
+                    enc.barriers(&[Barrier::Global {
+                        before: S::CopyDest,
+                        after: S::HostRead,
+                    }]);
+                }
+            }
+            PassId::RayTrace => {
+                self.outputs_to_uav(enc, pass);
+                if let Some(ray) = self.ray.as_mut() {
+                    ray.record(enc, &c.ray)?;
+                }
+            }
+            PassId::ShadowMapTest => {
+                self.outputs_to_uav(enc, pass);
+                if let Some(p) = self.shadow_map_test.as_mut() {
+                    p.record(enc, &c.pcss)?;
+                }
+            }
+            PassId::Pcss => {
+                self.outputs_to_uav(enc, pass);
+                if let Some(p) = self.pcss.as_mut() {
+                    p.record(enc, &c.pcss)?;
+                }
+            }
+            PassId::Fxaa => {
+                self.outputs_to_uav(enc, pass);
+                if let Some(f) = &self.fxaa {
+                    f.record(enc)?;
+                }
+            }
+            PassId::LerpFactor => {
+                self.outputs_to_uav(enc, pass);
+                if let Some(l) = &self.lerp {
+                    l.record(enc, &self.config.hybrid)?;
+                }
+            }
+            PassId::Blend => {
+                self.outputs_to_uav(enc, pass);
+                if let Some(b) = &self.blend {
+                    b.record(enc, &self.config.hybrid)?;
+                }
+            }
+            PassId::FillLit => {
+                if let Some(lit) = &self.lit {
+                    enc.begin_pass(PassId::FillLit.name());
+                    enc.barriers(&[Barrier::Image {
+                        image: lit,
+                        before: S::Undefined,
+                        after: S::CopyDest,
+                    }]);
+                    enc.clear_uint(lit, 1.0f32.to_bits());
+                    enc.barriers(&[Barrier::Image {
+                        image: lit,
+                        before: S::CopyDest,
+                        after: S::UnorderedAccess,
+                    }]);
+                    enc.end_pass();
+                }
+            }
         }
-        if let (true, Some(p)) = (ran(PassId::Pcss), self.pcss.as_mut()) {
-            p.record(enc, &c.pcss)?;
-        }
-        if let (true, Some(f)) = (ran(PassId::Fxaa), &self.fxaa) {
-            f.record(enc)?;
-        }
-        if let (true, Some(l)) = (ran(PassId::LerpFactor), &self.lerp) {
-            l.record(enc, &self.config.hybrid)?;
-        }
-        enc.barriers(&[Barrier::Uav]);
-        if let (true, Some(b)) = (ran(PassId::Blend), &self.blend) {
-            b.record(enc, &self.config.hybrid)?;
-            enc.barriers(&[Barrier::Uav]);
-        }
-        if let (true, Some(lit)) = (ran(PassId::FillLit), &self.lit) {
-            enc.begin_pass(PassId::FillLit.name());
-            enc.barriers(&[Barrier::Image {
-                image: lit,
-                before: S::Undefined,
-                after: S::CopyDest,
-            }]);
-            enc.clear_uint(lit, 1.0f32.to_bits());
-            enc.barriers(&[Barrier::Image {
-                image: lit,
-                before: S::CopyDest,
-                after: S::UnorderedAccess,
-            }]);
-            enc.end_pass();
-        }
+        self.pending_uav = true;
         Ok(())
     }
 

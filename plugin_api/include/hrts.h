@@ -9,7 +9,22 @@
 
 // Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 // version differs.
-#define HRTS_API_VERSION (1 << 22)
+#define HRTS_API_VERSION ((1 << 22) | (1 << 12))
+
+// Number of `HrtsPass` values.
+#define HRTS_PASS_COUNT 12
+
+// The light-space passes (they read neither depth nor normal: record them before the engine's depth).
+#define HRTS_PASS_MASK_LIGHT_SPACE 15
+
+// The screen-space passes and the output copy (after the engine's depth and normal).
+#define HRTS_PASS_MASK_SCREEN_SPACE 4080
+
+// Every pass.
+#define HRTS_PASS_MASK_ALL 4095
+
+// Number of `HrtsResource` values.
+#define HRTS_RESOURCE_COUNT 12
 
 // Maximum passes in a report.
 #define HRTS_MAX_REPORTED_PASSES 16
@@ -56,6 +71,9 @@ enum HrtsRasterPath
   HRTS_RASTER_PATH_HARDWARE = 1,
   // Geometry-shader dilation + exact per-texel test.
   HRTS_RASTER_PATH_SOFTWARE = 2,
+  // Hardware conservative raster made to behave like D3D12 Tier 1 (1/2 px uncertainty, post-snap
+  // degenerate triangles culled) on a device with a better tier: for tier-fallback tests.
+  HRTS_RASTER_PATH_EMULATED_TIER1 = 3,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -142,6 +160,126 @@ enum HrtsLightType
 typedef enum HrtsLightType HrtsLightType;
 #else
 typedef uint32_t HrtsLightType;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+// How PCSS shapes the penumbra.
+enum HrtsPenumbraFilter
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  // The talk's shrinking penumbra: it grows only inwards from the hard shadow edge (no halo in the
+  // hybrid blend).
+  HRTS_PENUMBRA_FILTER_SHRINKING = 0,
+  // Classic PCSS: the penumbra straddles the hard edge.
+  HRTS_PENUMBRA_FILTER_STANDARD = 1,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum HrtsPenumbraFilter HrtsPenumbraFilter;
+#else
+typedef uint32_t HrtsPenumbraFilter;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+// A pass of the frame, in linear (recording) order. Bit `1 << pass` in a pass mask.
+enum HrtsPass
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  // Triangles in frame coordinates from the geometry (first frame, or every frame if dynamic).
+  HRTS_PASS_PRIM_BUFFER = 0,
+  // Depth from the light, for PCSS.
+  HRTS_PASS_SHADOW_MAP = 1,
+  // Clear and conservative raster of the deep primitive map.
+  HRTS_PASS_PRIMITIVE_MAP = 2,
+  // Occupancy view and statistics of the primitive map (overflow count of the report).
+  HRTS_PASS_OCCUPANCY = 3,
+  // Shadow rays through the primitive map: hard visibility and blocker distance (reads depth, normal).
+  HRTS_PASS_RAY_TRACE = 4,
+  // Classic single-tap shadow-map test (comparison output; reads depth, normal).
+  HRTS_PASS_SHADOW_MAP_TEST = 5,
+  // Blocker search, penumbra estimate and PCF (reads depth, normal).
+  HRTS_PASS_PCSS = 6,
+  // FXAA over the ray-traced visibility.
+  HRTS_PASS_FXAA = 7,
+  // Hybrid lerp factor from the blocker distance.
+  HRTS_PASS_LERP_FACTOR = 8,
+  // Hybrid blend.
+  HRTS_PASS_BLEND = 9,
+  // Fills the output with 1 (mode none).
+  HRTS_PASS_FILL_LIT = 10,
+  // Copies the final visibility into the engine's output image.
+  HRTS_PASS_OUTPUT_COPY = 11,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum HrtsPass HrtsPass;
+#else
+typedef uint32_t HrtsPass;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+// What a frame did with a pass (report values).
+enum HrtsPassStatus
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  // The configuration does not need the pass: it never runs.
+  HRTS_PASS_STATUS_NOT_IN_PLAN = 0,
+  // Recorded this frame.
+  HRTS_PASS_STATUS_RAN = 1,
+  // Skipped: its inputs did not change since it last ran (static geometry, static light).
+  HRTS_PASS_STATUS_UP_TO_DATE = 2,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum HrtsPassStatus HrtsPassStatus;
+#else
+typedef uint32_t HrtsPassStatus;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+// A resource the plugin allocates (for the report, `hrts_get_resource_info` and
+// `hrts_record_resource_readback`). Bit `1 << resource` in `HrtsConfig::extra_outputs`.
+enum HrtsResource
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  // Light-space depth, `D32_SFLOAT`, shadow_map_size².
+  HRTS_RESOURCE_SHADOW_MAP = 0,
+  // Triangle count per texel, `R32_UINT`, N².
+  HRTS_RESOURCE_PRIM_COUNT_MAP = 1,
+  // Triangle indices, `R32_UINT`, N² × d layers (layer-major).
+  HRTS_RESOURCE_PRIM_INDEX_MAP = 2,
+  // Occupancy view, `R8G8B8A8_UNORM`, N² (red: overflowed texel).
+  HRTS_RESOURCE_OCCUPANCY = 3,
+  // Ray-traced visibility, `R32_SFLOAT`, 1 = lit.
+  HRTS_RESOURCE_RT_VISIBILITY = 4,
+  // Ray-traced blocker distance, `R32_SFLOAT`.
+  HRTS_RESOURCE_BLOCKER_DISTANCE = 5,
+  // Classic shadow-map visibility, `R32_SFLOAT`.
+  HRTS_RESOURCE_SHADOW_MAP_VISIBILITY = 6,
+  // PCSS visibility, `R32_SFLOAT`.
+  HRTS_RESOURCE_PCSS = 7,
+  // FXAA'd ray-traced visibility, `R32_SFLOAT`.
+  HRTS_RESOURCE_RT_ANTIALIASED = 8,
+  // Hybrid lerp factor, `R32_SFLOAT`.
+  HRTS_RESOURCE_LERP_FACTOR = 9,
+  // Hybrid visibility, `R32_SFLOAT`.
+  HRTS_RESOURCE_HYBRID = 10,
+  // Constant 1, `R32_SFLOAT` (mode none).
+  HRTS_RESOURCE_LIT = 11,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum HrtsResource HrtsResource;
+#else
+typedef uint32_t HrtsResource;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
@@ -280,6 +418,24 @@ typedef struct HrtsConfig {
   float hybrid_world_space_scale;
   // Hybrid blend: percentage of hard shadow PHS (default 4).
   float hybrid_hard_shadow_percentage;
+  // `HrtsPenumbraFilter` (default shrinking).
+  uint32_t pcss_filter;
+  // PCSS: largest blocker-search radius in shadow-map texels (default 48).
+  float pcss_max_search_radius;
+  // PCSS: smallest PCF radius in texels (default 1).
+  float pcss_min_filter_radius;
+  // PCSS: largest PCF radius in texels (default 32).
+  float pcss_max_filter_radius;
+  // Classic shadow-map test: constant depth bias in texels of world size (default 1).
+  float shadow_map_constant_bias;
+  // Classic shadow-map test: slope-scaled depth bias (default 1).
+  float shadow_map_slope_bias;
+  // The geometry changes every frame: the prim buffer is rebuilt each frame (default false: built once
+  // per `hrts_set_geometry_*`).
+  bool dynamic_geometry;
+  // Resources to produce besides those the mode needs, for `hrts_record_resource_readback` (bit
+  // `1 << HrtsResource`; default 0). E.g. the shadow-map visibility for comparisons.
+  uint32_t extra_outputs;
 } HrtsConfig;
 
 // One draw of the geometry.
@@ -399,6 +555,40 @@ typedef struct HrtsFrame {
   int32_t output_layout_after;
 } HrtsFrame;
 
+// Shape of a plugin resource, for reading it back.
+typedef struct HrtsResourceInfo {
+  // `sizeof(HrtsResourceInfo)`, set by the caller.
+  uint32_t struct_size;
+  // Whether the current configuration allocates it.
+  bool allocated;
+  // Width in texels.
+  uint32_t width;
+  // Height in texels.
+  uint32_t height;
+  // Array layers.
+  uint32_t layers;
+  // `VkFormat`.
+  int32_t format;
+  // Bytes of a tightly packed read-back of all layers (layer-major, rows top to bottom).
+  uint64_t bytes;
+} HrtsResourceInfo;
+
+// A copy of a plugin resource into an engine buffer, recorded after a complete frame.
+typedef struct HrtsResourceReadback {
+  // `sizeof(HrtsResourceReadback)`.
+  uint32_t struct_size;
+  // `VkCommandBuffer` in the recording state, outside a render pass, submitted after the frame's.
+  uint64_t command_buffer;
+  // `HrtsResource` to copy (allocated by the configuration: see `HrtsConfig::extra_outputs`).
+  uint32_t resource;
+  // Destination `VkBuffer` (usage includes TRANSFER_DST).
+  uint64_t buffer;
+  // Size of the destination buffer in bytes.
+  uint64_t buffer_size;
+  // Byte offset of the copy in the buffer (a multiple of 4); `HrtsResourceInfo::bytes` are written.
+  uint64_t offset;
+} HrtsResourceReadback;
+
 // GPU time of one pass.
 typedef struct HrtsPassTiming {
   // Pass name (NUL-terminated, truncated).
@@ -423,6 +613,16 @@ typedef struct HrtsFrameReport {
   uint32_t pass_count;
   // Per-pass GPU times.
   struct HrtsPassTiming passes[HRTS_MAX_REPORTED_PASSES];
+  // Texels holding at least one triangle.
+  uint32_t occupied_texels;
+  // Triangle indices stored in the map (sum over texels of min(count, d)).
+  uint32_t stored_entries;
+  // `HrtsPassStatus` of each `HrtsPass` this frame.
+  uint32_t pass_status[HRTS_PASS_COUNT];
+  // Bytes of each `HrtsResource` the plugin allocated (0: not allocated).
+  uint64_t resource_bytes[HRTS_RESOURCE_COUNT];
+  // The `HrtsResource` copied into the output image.
+  uint32_t output_resource;
 } HrtsFrameReport;
 
 #ifdef __cplusplus
@@ -510,15 +710,53 @@ enum HrtsResult hrts_set_geometry_vulkan(struct HrtsContext *context,
 // As for `hrts_get_capabilities`; the images are live `VkImage`s of the adopted device.
 enum HrtsResult hrts_set_targets(struct HrtsContext *context, const struct HrtsTargets *targets);
 
-// Records every pass of one frame into `frame->command_buffer`: layout transitions of the engine images
-// (restored afterwards), prim buffer (first frame), primitive map, ray trace, occupancy, and the copy
-// into the output image. Binds its own pipelines and descriptor sets and sets viewport and scissor:
-// re-bind yours afterwards.
+// Records every pass of one frame into `frame->command_buffer`: `hrts_record_passes` with
+// `HRTS_PASS_MASK_ALL`.
+//
+// # Safety
+// As for `hrts_record_passes`.
+enum HrtsResult hrts_record_frame(struct HrtsContext *context, const struct HrtsFrame *frame);
+
+// Records the passes of `pass_mask` (bits `1 << HrtsPass`) into `frame->command_buffer`, so that an
+// engine can place them in its frame: typically `HRTS_PASS_MASK_LIGHT_SPACE` before its depth pass and
+// `HRTS_PASS_MASK_SCREEN_SPACE` after its G-buffer, in the same or a later command buffer of the same
+// queue, submitted in recording order.
+//
+// A call whose lowest pass comes after the last pass recorded in the current frame continues that frame
+// (its camera and light must be the same); any other call begins a new frame. Passes the frame does not
+// run (not needed by the configuration, or up to date) record nothing. Within a frame, every pass that
+// runs must be recorded, in order: a call that leaves out such a pass before its last requested one fails
+// with `HRTS_RESULT_ERROR_INVALID_STATE`. `HRTS_PASS_OUTPUT_COPY` ends the frame.
+//
+// Layouts: a call with a ray-trace, shadow-map-test or PCSS pass transitions depth and normal from
+// `depth_layout` and `normal_layout` and back; the output copy takes the output image from
+// `output_layout_before` to `output_layout_after`. Other calls leave the engine's images alone. The
+// plugin binds its own pipelines and descriptor sets and sets viewport and scissor: re-bind yours after.
 //
 // # Safety
 // As for `hrts_get_capabilities`; the command buffer is recording, outside a render pass.
-enum HrtsResult hrts_record_frame(struct HrtsContext *context,
-                                  const struct HrtsFrame *frame);
+enum HrtsResult hrts_record_passes(struct HrtsContext *context,
+                                   const struct HrtsFrame *frame,
+                                   uint32_t pass_mask);
+
+// Fills `out` (with `out->struct_size` set) with the shape of `resource` (`HrtsResource`) under the
+// current configuration, geometry and targets (building the passes if needed).
+//
+// # Safety
+// As for `hrts_get_capabilities`.
+enum HrtsResult hrts_get_resource_info(struct HrtsContext *context,
+                                       uint32_t resource,
+                                       struct HrtsResourceInfo *out);
+
+// Records a copy of a plugin resource (as the last complete frame left it) into an engine buffer: for
+// debug views and comparisons. The buffer's contents are available to later commands and, after the
+// submission completed, to the host.
+//
+// # Safety
+// As for `hrts_get_capabilities`; the command buffer is recording, outside a render pass; the buffer is
+// a live `VkBuffer` of the adopted device of the stated size.
+enum HrtsResult hrts_record_resource_readback(struct HrtsContext *context,
+                                              const struct HrtsResourceReadback *readback);
 
 // Fills `out` (with `out->struct_size` set) with the last frame's report. Call only after the engine's
 // submission of that frame has completed (its fence signalled).

@@ -4,9 +4,9 @@
 use crate::types::*;
 use glam::{DVec3, Mat4, Vec3};
 use passes::{
-    Draw, FaceMode, FrameInputs, Geometry, IndexFormat, IndexLayout, Light, PassError,
-    PrimitiveMapConfig, RasterPath, RasterRequest, ShadowConfig, ShadowInputs, ShadowMode,
-    ShadowPipeline, VertexLayout,
+    Draw, FaceMode, FrameInputs, Geometry, IndexFormat, IndexLayout, Light, PassError, PassId,
+    PassStatus, PenumbraFilter, PrimitiveMapConfig, RasterPath, RasterRequest, ResourceId,
+    ResourceSet, ShadowConfig, ShadowInputs, ShadowMode, ShadowPipeline, SkipReason, VertexLayout,
 };
 use rhi::{
     Barrier, Device, Encoder, Format, Image, ImageDesc, ImageUsage, ResourceState as S, RhiError,
@@ -125,6 +125,41 @@ struct Built {
     output: Image,
 }
 
+/// Where the recording of frames stands.
+#[derive(Default)]
+struct FrameProgress {
+    /// The frame being recorded: its camera and light, and the last `HrtsPass` recorded.
+    open: Option<(FrameInputs, u32)>,
+    /// Whether a frame was recorded to its end since the passes were built.
+    completed: bool,
+}
+
+/// Pass-mask bits of the passes that read the engine's depth and normal images.
+const DEPTH_NORMAL_READERS: u32 = 1 << HrtsPass::RayTrace as u32
+    | 1 << HrtsPass::ShadowMapTest as u32
+    | 1 << HrtsPass::Pcss as u32;
+
+/// The plugin's resources by their C value (`HrtsResource`), in that order.
+const RESOURCES: [ResourceId; HRTS_RESOURCE_COUNT] = [
+    ResourceId::ShadowMap,
+    ResourceId::PrimCountMap,
+    ResourceId::PrimIndexMap,
+    ResourceId::Occupancy,
+    ResourceId::RtVisibility,
+    ResourceId::BlockerDistance,
+    ResourceId::ShadowMapVisibility,
+    ResourceId::Pcss,
+    ResourceId::RtAntialiased,
+    ResourceId::LerpFactor,
+    ResourceId::Hybrid,
+    ResourceId::Lit,
+];
+
+/// The pipeline's passes by their C value (`HrtsPass`); `HRTS_PASS_OUTPUT_COPY` is the context's own.
+fn pass_from_index(index: u32) -> Option<PassId> {
+    PassId::ALL.get(index as usize).copied()
+}
+
 /// State of one plugin context.
 pub(crate) struct Context {
     built: Option<Built>,
@@ -132,7 +167,7 @@ pub(crate) struct Context {
     config: ShadowConfig,
     geometry: Option<GeometrySource>,
     targets: Option<TargetSource>,
-    recorded: bool,
+    progress: FrameProgress,
     pub(crate) last_error: std::ffi::CString,
 }
 
@@ -308,7 +343,7 @@ impl Context {
             config: ShadowConfig::default(),
             geometry: None,
             targets: None,
-            recorded: false,
+            progress: FrameProgress::default(),
             last_error: std::ffi::CString::default(),
         })
     }
@@ -355,7 +390,7 @@ impl Context {
             )));
         }
         self.config = config;
-        self.built = None;
+        self.invalidate();
         Ok(())
     }
 
@@ -427,7 +462,7 @@ impl Context {
             draws,
             origin: (lo + hi) * 0.5,
         });
-        self.built = None;
+        self.invalidate();
         Ok(())
     }
 
@@ -475,7 +510,7 @@ impl Context {
         };
         geometry_from(&self.device, &source)?;
         self.geometry = Some(source);
-        self.built = None;
+        self.invalidate();
         Ok(())
     }
 
@@ -514,69 +549,20 @@ impl Context {
             normal: t.normal_image,
             output: t.output_image,
         });
-        self.built = None;
+        self.invalidate();
         Ok(())
     }
 
-    pub(crate) fn record_frame(&mut self, f: &HrtsFrame) -> ApiResult<()> {
-        check_size::<HrtsFrame>(f.struct_size, "HrtsFrame")?;
-        if f.command_buffer == 0 {
-            return Err(ApiError::new(
-                HrtsResult::ErrorNullPointer,
-                "command_buffer is NULL",
-            ));
-        }
-        finite(&f.view, "view")?;
-        finite(&f.proj, "proj")?;
-        finite(&f.camera_position, "camera_position")?;
-        finite(&f.light_direction, "light_direction")?;
-        finite(&f.light_view_proj, "light_view_proj")?;
-        finite(&f.light_position, "light_position")?;
-        let dir = Vec3::from_array(f.light_direction);
-        if dir.length_squared() == 0.0 {
-            return Err(invalid("light_direction is zero"));
-        }
-        let view_proj = mat4(&f.light_view_proj);
-        let spot = enum_value(
-            f.light_type,
-            &[
-                (HrtsLightType::Directional as u32, false),
-                (HrtsLightType::Spot as u32, true),
-            ],
-            "light_type",
-            "HrtsLightType",
-        )?;
-        let direction = dir.normalize();
-        let light = if spot {
-            Light::Spot {
-                position: Vec3::from_array(f.light_position),
-                direction,
-                view_proj,
-            }
-        } else {
-            Light::Directional {
-                direction,
-                view_proj,
-            }
-        };
-        for (what, layout) in [
-            ("depth_layout", f.depth_layout),
-            ("normal_layout", f.normal_layout),
-            ("output_layout_after", f.output_layout_after),
-        ] {
-            if layout <= 0 {
-                return Err(invalid(format!(
-                    "{what} {layout} is not a usable VkImageLayout"
-                )));
-            }
-        }
-        let inputs = FrameInputs {
-            view: mat4(&f.view),
-            proj: mat4(&f.proj),
-            camera_position: Vec3::from_array(f.camera_position),
-            light,
-        };
+    /// Forgets the passes (rebuilt on the next recording) and the frame in progress.
+    fn invalidate(&mut self) {
+        self.built = None;
+        self.progress = FrameProgress::default();
+    }
+
+    /// Builds the passes if a configuration, geometry or targets call dropped them.
+    fn ensure_built(&mut self) -> ApiResult<&mut Built> {
         if self.built.is_none() {
+            self.progress = FrameProgress::default();
             self.built = Some(build(
                 &self.device,
                 self.config,
@@ -584,26 +570,136 @@ impl Context {
                 self.targets,
             )?);
         }
+        self.built
+            .as_mut()
+            .ok_or_else(|| ApiError::new(HrtsResult::ErrorInternal, "passes not built"))
+    }
+
+    pub(crate) fn record_passes(&mut self, f: &HrtsFrame, mask: u32) -> ApiResult<()> {
+        check_size::<HrtsFrame>(f.struct_size, "HrtsFrame")?;
+        if f.command_buffer == 0 {
+            return Err(ApiError::new(
+                HrtsResult::ErrorNullPointer,
+                "command_buffer is NULL",
+            ));
+        }
+        if mask == 0 || mask & !HRTS_PASS_MASK_ALL != 0 {
+            return Err(invalid(format!(
+                "pass mask 0x{mask:x} must be a non-empty set of HRTS_PASS_MASK_ALL (0x{HRTS_PASS_MASK_ALL:x}) bits"
+            )));
+        }
+        let inputs = frame_inputs(f)?;
+        let mut used_layouts = Vec::new();
+        if mask & DEPTH_NORMAL_READERS != 0 {
+            used_layouts.extend([
+                ("depth_layout", f.depth_layout),
+                ("normal_layout", f.normal_layout),
+            ]);
+        }
+        let copy_output = mask & 1 << HrtsPass::OutputCopy as u32 != 0;
+        if copy_output {
+            used_layouts.push(("output_layout_after", f.output_layout_after));
+        }
+        for (what, layout) in used_layouts {
+            if layout <= 0 {
+                return Err(invalid(format!(
+                    "{what} {layout} is not a usable VkImageLayout"
+                )));
+            }
+        }
+        self.ensure_built()?;
+        let lowest = mask.trailing_zeros();
+        let highest = 31 - mask.leading_zeros();
+        let continues = match self.progress.open {
+            Some((open_inputs, last)) if lowest > last => {
+                if open_inputs != inputs {
+                    return Err(invalid(
+                        "the camera and light must stay the same across the calls of one frame",
+                    ));
+                }
+                true
+            }
+            _ => false,
+        };
         let (device, built) = match self.built.as_mut() {
             Some(b) => (&self.device, b),
             None => return Err(ApiError::new(HrtsResult::ErrorInternal, "passes not built")),
         };
+        if !continues {
+            self.progress.open = None;
+            built.pipeline.begin_frame(&inputs)?;
+        }
+        let passes: Vec<PassId> = (0..HRTS_PASS_COUNT as u32)
+            .filter(|i| mask & 1 << i != 0)
+            .filter_map(pass_from_index)
+            .collect();
+        if copy_output {
+            if let Some(missing) = built
+                .pipeline
+                .passes_to_record()
+                .into_iter()
+                .find(|p| !passes.contains(p))
+            {
+                return Err(ApiError::new(
+                    HrtsResult::ErrorInvalidState,
+                    format!(
+                        "pass '{}' runs this frame and has not been recorded: record it before (or with) the output copy",
+                        missing.name()
+                    ),
+                ));
+            }
+        }
         // SAFETY: the engine guarantees the command buffer is recording, outside a render pass, on this
         // device and used by no other thread during the call (documented contract).
         let mut enc = unsafe { Encoder::from_raw_handle(device, f.command_buffer) };
-        record(&mut enc, built, &inputs, f)?;
-        self.recorded = true;
+        let reads_depth = mask & DEPTH_NORMAL_READERS != 0;
+        if reads_depth {
+            engine_inputs(&mut enc, built, f, true);
+        }
+        let recorded = built.pipeline.record_passes(&mut enc, &passes);
+        if reads_depth {
+            engine_inputs(&mut enc, built, f, false);
+        }
+        recorded.map_err(|e| match e {
+            PassError::InvalidConfig(m) => ApiError::new(HrtsResult::ErrorInvalidState, m),
+            other => other.into(),
+        })?;
+        if copy_output {
+            record_output_copy(&mut enc, built, f)?;
+            self.progress = FrameProgress {
+                open: None,
+                completed: true,
+            };
+        } else {
+            self.progress.open = Some((inputs, highest));
+        }
         Ok(())
+    }
+
+    /// The passes, once a frame was recorded to its end and no other is being recorded.
+    fn finished_frame(&self) -> ApiResult<&Built> {
+        match (&self.built, &self.progress) {
+            (
+                Some(built),
+                FrameProgress {
+                    open: None,
+                    completed: true,
+                },
+            ) => Ok(built),
+            (_, FrameProgress { open: Some(_), .. }) => Err(ApiError::new(
+                HrtsResult::ErrorInvalidState,
+                "a frame is being recorded: record its remaining passes through HRTS_PASS_OUTPUT_COPY first",
+            )),
+            _ => Err(ApiError::new(
+                HrtsResult::ErrorInvalidState,
+                "no frame has been recorded to its end since the last configuration, geometry or targets call",
+            )),
+        }
     }
 
     pub(crate) fn report(&self, out: &mut HrtsFrameReport) -> ApiResult<()> {
         check_size::<HrtsFrameReport>(out.struct_size, "HrtsFrameReport")?;
-        let (Some(built), true) = (&self.built, self.recorded) else {
-            return Err(ApiError::new(
-                HrtsResult::ErrorInvalidState,
-                "no frame has been recorded",
-            ));
-        };
+        let built = self.finished_frame()?;
         let report = built.pipeline.try_report()?.ok_or_else(|| {
             ApiError::new(
                 HrtsResult::ErrorInvalidState,
@@ -611,14 +707,15 @@ impl Context {
             )
         })?;
         out.raster_path = match report.raster_path {
-            RasterPath::Hardware(_) | RasterPath::EmulatedTier1 { .. } => {
-                HrtsRasterPath::Hardware as u32
-            }
-            RasterPath::Software => HrtsRasterPath::Software as u32,
-        };
+            RasterPath::Hardware(_) => HrtsRasterPath::Hardware,
+            RasterPath::EmulatedTier1 { .. } => HrtsRasterPath::EmulatedTier1,
+            RasterPath::Software => HrtsRasterPath::Software,
+        } as u32;
         out.tier = report.raster_path.tier() as u32;
         out.overflowed_texels = report.stats.overflowed_texels;
         out.max_count = report.stats.max_count;
+        out.occupied_texels = report.stats.occupied_texels;
+        out.stored_entries = report.stats.stored_entries;
         out.pass_count = report.timings.len().min(HRTS_MAX_REPORTED_PASSES) as u32;
         for (slot, t) in out.passes.iter_mut().zip(&report.timings) {
             slot.name = [0; 32];
@@ -627,8 +724,136 @@ impl Context {
             }
             slot.milliseconds = t.ms;
         }
+        out.pass_status = [HrtsPassStatus::NotInPlan as u32; HRTS_PASS_COUNT];
+        for (i, &(_, status)) in report.passes.iter().enumerate() {
+            out.pass_status[i] = match status {
+                PassStatus::Ran => HrtsPassStatus::Ran,
+                PassStatus::Skipped(SkipReason::UpToDate) => HrtsPassStatus::UpToDate,
+                PassStatus::Skipped(SkipReason::NotRequested) => HrtsPassStatus::NotInPlan,
+            } as u32;
+        }
+        out.pass_status[HrtsPass::OutputCopy as usize] = HrtsPassStatus::Ran as u32;
+        out.resource_bytes = [0; HRTS_RESOURCE_COUNT];
+        for r in &report.resources {
+            if let Some(i) = RESOURCES.iter().position(|&id| id == r.resource) {
+                out.resource_bytes[i] = r.bytes;
+            }
+        }
+        out.output_resource = resource_index(report.output)?;
         Ok(())
     }
+
+    pub(crate) fn resource_info(
+        &mut self,
+        resource: u32,
+        out: &mut HrtsResourceInfo,
+    ) -> ApiResult<()> {
+        check_size::<HrtsResourceInfo>(out.struct_size, "HrtsResourceInfo")?;
+        let id = resource_id(resource)?;
+        let built = self.ensure_built()?;
+        match built.pipeline.image(id) {
+            Some(image) => {
+                out.allocated = true;
+                out.width = image.width();
+                out.height = image.height();
+                out.layers = image.layers();
+                out.format = image.format().raw_vk();
+                out.bytes = image.byte_size();
+            }
+            None => {
+                out.allocated = false;
+                (out.width, out.height, out.layers, out.format, out.bytes) = (0, 0, 0, 0, 0);
+            }
+        }
+        Ok(())
+    }
+
+    pub(crate) fn record_readback(&self, r: &HrtsResourceReadback) -> ApiResult<()> {
+        check_size::<HrtsResourceReadback>(r.struct_size, "HrtsResourceReadback")?;
+        if r.command_buffer == 0 || r.buffer == 0 {
+            return Err(ApiError::new(
+                HrtsResult::ErrorNullPointer,
+                "command_buffer and buffer must be non-NULL",
+            ));
+        }
+        let id = resource_id(r.resource)?;
+        let built = self.finished_frame()?;
+        let image = built.pipeline.image(id).ok_or_else(|| {
+            ApiError::new(
+                HrtsResult::ErrorInvalidState,
+                format!(
+                    "{} is not allocated by this configuration: add it to extra_outputs",
+                    id.name()
+                ),
+            )
+        })?;
+        let fits = r
+            .offset
+            .checked_add(image.byte_size())
+            .is_some_and(|end| end <= r.buffer_size);
+        if !fits || !r.offset.is_multiple_of(4) {
+            return Err(invalid(format!(
+                "{} needs {} bytes at a multiple-of-4 offset: offset {} in a buffer of {} bytes does not do",
+                id.name(),
+                image.byte_size(),
+                r.offset,
+                r.buffer_size
+            )));
+        }
+        // SAFETY: the engine guarantees a live buffer of `buffer_size` bytes with TRANSFER_DST usage.
+        let buffer = unsafe { self.device.external_buffer(r.buffer, r.buffer_size)? };
+        let state = if id == ResourceId::ShadowMap {
+            S::ShaderResource
+        } else {
+            S::UnorderedAccess
+        };
+        // SAFETY: as for `record_passes`.
+        let mut enc = unsafe { Encoder::from_raw_handle(&self.device, r.command_buffer) };
+        enc.barriers(&[Barrier::Image {
+            image,
+            before: state,
+            after: S::CopySource,
+        }]);
+        enc.copy_image_to_buffer_at(image, &buffer, r.offset)?;
+        enc.barriers(&[
+            Barrier::Image {
+                image,
+                before: S::CopySource,
+                after: state,
+            },
+            Barrier::Global {
+                before: S::CopyDest,
+                after: S::Engine(0),
+            },
+            Barrier::Global {
+                before: S::CopyDest,
+                after: S::HostRead,
+            },
+        ]);
+        Ok(())
+    }
+}
+
+fn resource_id(value: u32) -> ApiResult<ResourceId> {
+    RESOURCES.get(value as usize).copied().ok_or_else(|| {
+        ApiError::new(
+            HrtsResult::ErrorInvalidEnum,
+            format!("resource {value} is not a HrtsResource value"),
+        )
+    })
+}
+
+fn resource_index(id: ResourceId) -> ApiResult<u32> {
+    RESOURCES
+        .iter()
+        .position(|&r| r == id)
+        .map(|i| i as u32)
+        .ok_or_else(|| {
+            ApiError::new(
+                HrtsResult::ErrorInternal,
+                format!("{} has no HrtsResource value", id.name()),
+            )
+        })
 }
 
 fn geometry_from(device: &Device, source: &GeometrySource) -> ApiResult<Geometry> {
@@ -720,27 +945,29 @@ fn build(
     })
 }
 
-/// Records the passes and the engine-layout transitions around them.
-fn record(
-    enc: &mut Encoder<'_>,
-    b: &mut Built,
-    inputs: &FrameInputs,
-    f: &HrtsFrame,
-) -> ApiResult<()> {
+/// Transitions the engine's depth and normal images from their layouts to `ShaderResource` (`to_shader`)
+/// or back.
+fn engine_inputs(enc: &mut Encoder<'_>, b: &Built, f: &HrtsFrame, to_shader: bool) {
+    let transition = |image, layout| {
+        let (before, after) = if to_shader {
+            (S::Engine(layout), S::ShaderResource)
+        } else {
+            (S::ShaderResource, S::Engine(layout))
+        };
+        Barrier::Image {
+            image,
+            before,
+            after,
+        }
+    };
     enc.barriers(&[
-        Barrier::Image {
-            image: &b.depth,
-            before: S::Engine(f.depth_layout),
-            after: S::ShaderResource,
-        },
-        Barrier::Image {
-            image: &b.normal,
-            before: S::Engine(f.normal_layout),
-            after: S::ShaderResource,
-        },
+        transition(&b.depth, f.depth_layout),
+        transition(&b.normal, f.normal_layout),
     ]);
-    b.pipeline.begin_frame(enc)?;
-    b.pipeline.record(enc, inputs)?;
+}
+
+/// Copies the pipeline's final visibility into the engine's output image.
+fn record_output_copy(enc: &mut Encoder<'_>, b: &Built, f: &HrtsFrame) -> ApiResult<()> {
     let vis = b.pipeline.output();
     enc.begin_pass("output copy");
     enc.barriers(&[
@@ -763,18 +990,56 @@ fn record(
             after: S::Engine(f.output_layout_after),
         },
         Barrier::Image {
-            image: &b.depth,
-            before: S::ShaderResource,
-            after: S::Engine(f.depth_layout),
-        },
-        Barrier::Image {
-            image: &b.normal,
-            before: S::ShaderResource,
-            after: S::Engine(f.normal_layout),
+            image: vis,
+            before: S::CopySource,
+            after: S::UnorderedAccess,
         },
     ]);
     enc.end_pass();
     Ok(())
+}
+
+/// The camera and light of a frame (every field checked).
+fn frame_inputs(f: &HrtsFrame) -> ApiResult<FrameInputs> {
+    finite(&f.view, "view")?;
+    finite(&f.proj, "proj")?;
+    finite(&f.camera_position, "camera_position")?;
+    finite(&f.light_direction, "light_direction")?;
+    finite(&f.light_view_proj, "light_view_proj")?;
+    finite(&f.light_position, "light_position")?;
+    let dir = Vec3::from_array(f.light_direction);
+    if dir.length_squared() == 0.0 {
+        return Err(invalid("light_direction is zero"));
+    }
+    let view_proj = mat4(&f.light_view_proj);
+    let spot = enum_value(
+        f.light_type,
+        &[
+            (HrtsLightType::Directional as u32, false),
+            (HrtsLightType::Spot as u32, true),
+        ],
+        "light_type",
+        "HrtsLightType",
+    )?;
+    let direction = dir.normalize();
+    let light = if spot {
+        Light::Spot {
+            position: Vec3::from_array(f.light_position),
+            direction,
+            view_proj,
+        }
+    } else {
+        Light::Directional {
+            direction,
+            view_proj,
+        }
+    };
+    Ok(FrameInputs {
+        view: mat4(&f.view),
+        proj: mat4(&f.proj),
+        camera_position: Vec3::from_array(f.camera_position),
+        light,
+    })
 }
 
 fn enum_value<T>(value: u32, variants: &[(u32, T)], field: &str, type_name: &str) -> ApiResult<T>
@@ -799,6 +1064,16 @@ fn positive(value: f32, field: &str) -> ApiResult<f32> {
     } else {
         Err(invalid(format!(
             "{field} must be a positive finite number, got {value}"
+        )))
+    }
+}
+
+fn non_negative(value: f32, field: &str) -> ApiResult<f32> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(invalid(format!(
+            "{field} must be a non-negative finite number, got {value}"
         )))
     }
 }
@@ -842,14 +1117,49 @@ fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
             (HrtsRasterPath::Auto as u32, RasterRequest::Auto),
             (HrtsRasterPath::Hardware as u32, RasterRequest::Hardware),
             (HrtsRasterPath::Software as u32, RasterRequest::Software),
+            (
+                HrtsRasterPath::EmulatedTier1 as u32,
+                RasterRequest::EmulateTier1,
+            ),
         ],
         "raster_path",
         "HrtsRasterPath",
     )?;
+    let filter = enum_value(
+        c.pcss_filter,
+        &[
+            (
+                HrtsPenumbraFilter::Shrinking as u32,
+                PenumbraFilter::Shrinking,
+            ),
+            (
+                HrtsPenumbraFilter::Standard as u32,
+                PenumbraFilter::Standard,
+            ),
+        ],
+        "pcss_filter",
+        "HrtsPenumbraFilter",
+    )?;
+    if c.extra_outputs >> HRTS_RESOURCE_COUNT != 0 {
+        return Err(ApiError::new(
+            HrtsResult::ErrorInvalidEnum,
+            format!(
+                "extra_outputs 0x{:x} has bits of no HrtsResource",
+                c.extra_outputs
+            ),
+        ));
+    }
+    let extra_outputs = RESOURCES
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| c.extra_outputs & 1 << i != 0)
+        .fold(ResourceSet::EMPTY, |set, (_, &r)| set.with(r));
     let mut config = ShadowConfig {
         mode,
         antialiasing: c.antialiasing,
         static_light: c.static_light,
+        static_geometry: !c.dynamic_geometry,
+        extra_outputs,
         map: PrimitiveMapConfig {
             size: c.map_size,
             depth: c.map_depth,
@@ -860,6 +1170,14 @@ fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
         ..ShadowConfig::default()
     };
     config.shadow_map.size = c.shadow_map_size;
+    config.shadow_map.constant_bias =
+        non_negative(c.shadow_map_constant_bias, "shadow_map_constant_bias")?;
+    config.shadow_map.slope_bias = non_negative(c.shadow_map_slope_bias, "shadow_map_slope_bias")?;
+    config.pcss.filter = filter;
+    config.pcss.max_search_radius = positive(c.pcss_max_search_radius, "pcss_max_search_radius")?;
+    config.pcss.min_filter_radius =
+        non_negative(c.pcss_min_filter_radius, "pcss_min_filter_radius")?;
+    config.pcss.max_filter_radius = positive(c.pcss_max_filter_radius, "pcss_max_filter_radius")?;
     config.pcss.angular_radius = positive(c.pcss_angular_radius, "pcss_angular_radius")?;
     config.pcss.spot_radius = positive(c.pcss_spot_radius, "pcss_spot_radius")?;
     config.pcss.blocker_search_taps = taps(c.pcss_blocker_search_taps, "pcss_blocker_search_taps")?;
@@ -870,6 +1188,7 @@ fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
         c.hybrid_hard_shadow_percentage,
         "hybrid_hard_shadow_percentage",
     )?;
+    config.pcss.validate()?;
     Ok(config)
 }
 
@@ -896,5 +1215,16 @@ pub(crate) fn config_defaults(out: &mut HrtsConfig) -> ApiResult<()> {
     out.pcss_pcf_taps = d.pcss.pcf_taps;
     out.hybrid_world_space_scale = d.hybrid.world_space_scale;
     out.hybrid_hard_shadow_percentage = d.hybrid.hard_shadow_percentage;
+    out.pcss_filter = match d.pcss.filter {
+        PenumbraFilter::Shrinking => HrtsPenumbraFilter::Shrinking,
+        PenumbraFilter::Standard => HrtsPenumbraFilter::Standard,
+    } as u32;
+    out.pcss_max_search_radius = d.pcss.max_search_radius;
+    out.pcss_min_filter_radius = d.pcss.min_filter_radius;
+    out.pcss_max_filter_radius = d.pcss.max_filter_radius;
+    out.shadow_map_constant_bias = d.shadow_map.constant_bias;
+    out.shadow_map_slope_bias = d.shadow_map.slope_bias;
+    out.dynamic_geometry = !d.static_geometry;
+    out.extra_outputs = 0;
     Ok(())
 }

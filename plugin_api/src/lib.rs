@@ -330,19 +330,79 @@ pub unsafe extern "C" fn hrts_set_targets(
     with_context(context, |c| c.set_targets(deref(targets, "targets")?))
 }
 
-/// Records every pass of one frame into `frame->command_buffer`: layout transitions of the engine images
-/// (restored afterwards), prim buffer (first frame), primitive map, ray trace, occupancy, and the copy
-/// into the output image. Binds its own pipelines and descriptor sets and sets viewport and scissor:
-/// re-bind yours afterwards.
+/// Records every pass of one frame into `frame->command_buffer`: `hrts_record_passes` with
+/// `HRTS_PASS_MASK_ALL`.
 ///
 /// # Safety
-/// As for `hrts_get_capabilities`; the command buffer is recording, outside a render pass.
+/// As for `hrts_record_passes`.
 #[no_mangle]
 pub unsafe extern "C" fn hrts_record_frame(
     context: *mut HrtsContext,
     frame: *const HrtsFrame,
 ) -> HrtsResult {
-    with_context(context, |c| c.record_frame(deref(frame, "frame")?))
+    with_context(context, |c| {
+        c.record_passes(deref(frame, "frame")?, HRTS_PASS_MASK_ALL)
+    })
+}
+
+/// Records the passes of `pass_mask` (bits `1 << HrtsPass`) into `frame->command_buffer`, so that an
+/// engine can place them in its frame: typically `HRTS_PASS_MASK_LIGHT_SPACE` before its depth pass and
+/// `HRTS_PASS_MASK_SCREEN_SPACE` after its G-buffer, in the same or a later command buffer of the same
+/// queue, submitted in recording order.
+///
+/// A call whose lowest pass comes after the last pass recorded in the current frame continues that frame
+/// (its camera and light must be the same); any other call begins a new frame. Passes the frame does not
+/// run (not needed by the configuration, or up to date) record nothing. Within a frame, every pass that
+/// runs must be recorded, in order: a call that leaves out such a pass before its last requested one fails
+/// with `HRTS_RESULT_ERROR_INVALID_STATE`. `HRTS_PASS_OUTPUT_COPY` ends the frame.
+///
+/// Layouts: a call with a ray-trace, shadow-map-test or PCSS pass transitions depth and normal from
+/// `depth_layout` and `normal_layout` and back; the output copy takes the output image from
+/// `output_layout_before` to `output_layout_after`. Other calls leave the engine's images alone. The
+/// plugin binds its own pipelines and descriptor sets and sets viewport and scissor: re-bind yours after.
+///
+/// # Safety
+/// As for `hrts_get_capabilities`; the command buffer is recording, outside a render pass.
+#[no_mangle]
+pub unsafe extern "C" fn hrts_record_passes(
+    context: *mut HrtsContext,
+    frame: *const HrtsFrame,
+    pass_mask: u32,
+) -> HrtsResult {
+    with_context(context, |c| {
+        c.record_passes(deref(frame, "frame")?, pass_mask)
+    })
+}
+
+/// Fills `out` (with `out->struct_size` set) with the shape of `resource` (`HrtsResource`) under the
+/// current configuration, geometry and targets (building the passes if needed).
+///
+/// # Safety
+/// As for `hrts_get_capabilities`.
+#[no_mangle]
+pub unsafe extern "C" fn hrts_get_resource_info(
+    context: *mut HrtsContext,
+    resource: u32,
+    out: *mut HrtsResourceInfo,
+) -> HrtsResult {
+    with_context(context, |c| {
+        c.resource_info(resource, deref_mut(out, "out")?)
+    })
+}
+
+/// Records a copy of a plugin resource (as the last complete frame left it) into an engine buffer: for
+/// debug views and comparisons. The buffer's contents are available to later commands and, after the
+/// submission completed, to the host.
+///
+/// # Safety
+/// As for `hrts_get_capabilities`; the command buffer is recording, outside a render pass; the buffer is
+/// a live `VkBuffer` of the adopted device of the stated size.
+#[no_mangle]
+pub unsafe extern "C" fn hrts_record_resource_readback(
+    context: *mut HrtsContext,
+    readback: *const HrtsResourceReadback,
+) -> HrtsResult {
+    with_context(context, |c| c.record_readback(deref(readback, "readback")?))
 }
 
 /// Fills `out` (with `out->struct_size` set) with the last frame's report. Call only after the engine's

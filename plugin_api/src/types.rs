@@ -6,7 +6,7 @@ use std::ffi::c_char;
 
 /// Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 /// version differs.
-pub const HRTS_API_VERSION: u32 = 1 << 22;
+pub const HRTS_API_VERSION: u32 = 1 << 22 | 1 << 12;
 
 /// Result of every call. Append-only: values never change meaning.
 #[repr(C)]
@@ -50,7 +50,106 @@ pub enum HrtsRasterPath {
     Hardware = 1,
     /// Geometry-shader dilation + exact per-texel test.
     Software = 2,
+    /// Hardware conservative raster made to behave like D3D12 Tier 1 (1/2 px uncertainty, post-snap
+    /// degenerate triangles culled) on a device with a better tier: for tier-fallback tests.
+    EmulatedTier1 = 3,
 }
+
+/// How PCSS shapes the penumbra.
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HrtsPenumbraFilter {
+    /// The talk's shrinking penumbra: it grows only inwards from the hard shadow edge (no halo in the
+    /// hybrid blend).
+    Shrinking = 0,
+    /// Classic PCSS: the penumbra straddles the hard edge.
+    Standard = 1,
+}
+
+/// A pass of the frame, in linear (recording) order. Bit `1 << pass` in a pass mask.
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HrtsPass {
+    /// Triangles in frame coordinates from the geometry (first frame, or every frame if dynamic).
+    PrimBuffer = 0,
+    /// Depth from the light, for PCSS.
+    ShadowMap = 1,
+    /// Clear and conservative raster of the deep primitive map.
+    PrimitiveMap = 2,
+    /// Occupancy view and statistics of the primitive map (overflow count of the report).
+    Occupancy = 3,
+    /// Shadow rays through the primitive map: hard visibility and blocker distance (reads depth, normal).
+    RayTrace = 4,
+    /// Classic single-tap shadow-map test (comparison output; reads depth, normal).
+    ShadowMapTest = 5,
+    /// Blocker search, penumbra estimate and PCF (reads depth, normal).
+    Pcss = 6,
+    /// FXAA over the ray-traced visibility.
+    Fxaa = 7,
+    /// Hybrid lerp factor from the blocker distance.
+    LerpFactor = 8,
+    /// Hybrid blend.
+    Blend = 9,
+    /// Fills the output with 1 (mode none).
+    FillLit = 10,
+    /// Copies the final visibility into the engine's output image.
+    OutputCopy = 11,
+}
+
+/// Number of `HrtsPass` values.
+pub const HRTS_PASS_COUNT: usize = 12;
+/// The light-space passes (they read neither depth nor normal: record them before the engine's depth).
+pub const HRTS_PASS_MASK_LIGHT_SPACE: u32 = 0xF;
+/// The screen-space passes and the output copy (after the engine's depth and normal).
+pub const HRTS_PASS_MASK_SCREEN_SPACE: u32 = 0xFF0;
+/// Every pass.
+pub const HRTS_PASS_MASK_ALL: u32 = 0xFFF;
+
+/// What a frame did with a pass (report values).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HrtsPassStatus {
+    /// The configuration does not need the pass: it never runs.
+    NotInPlan = 0,
+    /// Recorded this frame.
+    Ran = 1,
+    /// Skipped: its inputs did not change since it last ran (static geometry, static light).
+    UpToDate = 2,
+}
+
+/// A resource the plugin allocates (for the report, `hrts_get_resource_info` and
+/// `hrts_record_resource_readback`). Bit `1 << resource` in `HrtsConfig::extra_outputs`.
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HrtsResource {
+    /// Light-space depth, `D32_SFLOAT`, shadow_map_size².
+    ShadowMap = 0,
+    /// Triangle count per texel, `R32_UINT`, N².
+    PrimCountMap = 1,
+    /// Triangle indices, `R32_UINT`, N² × d layers (layer-major).
+    PrimIndexMap = 2,
+    /// Occupancy view, `R8G8B8A8_UNORM`, N² (red: overflowed texel).
+    Occupancy = 3,
+    /// Ray-traced visibility, `R32_SFLOAT`, 1 = lit.
+    RtVisibility = 4,
+    /// Ray-traced blocker distance, `R32_SFLOAT`.
+    BlockerDistance = 5,
+    /// Classic shadow-map visibility, `R32_SFLOAT`.
+    ShadowMapVisibility = 6,
+    /// PCSS visibility, `R32_SFLOAT`.
+    Pcss = 7,
+    /// FXAA'd ray-traced visibility, `R32_SFLOAT`.
+    RtAntialiased = 8,
+    /// Hybrid lerp factor, `R32_SFLOAT`.
+    LerpFactor = 9,
+    /// Hybrid visibility, `R32_SFLOAT`.
+    Hybrid = 10,
+    /// Constant 1, `R32_SFLOAT` (mode none).
+    Lit = 11,
+}
+
+/// Number of `HrtsResource` values.
+pub const HRTS_RESOURCE_COUNT: usize = 12;
 
 /// Which faces are stored in the primitive map.
 #[repr(u32)]
@@ -219,6 +318,24 @@ pub struct HrtsConfig {
     pub hybrid_world_space_scale: f32,
     /// Hybrid blend: percentage of hard shadow PHS (default 4).
     pub hybrid_hard_shadow_percentage: f32,
+    /// `HrtsPenumbraFilter` (default shrinking).
+    pub pcss_filter: u32,
+    /// PCSS: largest blocker-search radius in shadow-map texels (default 48).
+    pub pcss_max_search_radius: f32,
+    /// PCSS: smallest PCF radius in texels (default 1).
+    pub pcss_min_filter_radius: f32,
+    /// PCSS: largest PCF radius in texels (default 32).
+    pub pcss_max_filter_radius: f32,
+    /// Classic shadow-map test: constant depth bias in texels of world size (default 1).
+    pub shadow_map_constant_bias: f32,
+    /// Classic shadow-map test: slope-scaled depth bias (default 1).
+    pub shadow_map_slope_bias: f32,
+    /// The geometry changes every frame: the prim buffer is rebuilt each frame (default false: built once
+    /// per `hrts_set_geometry_*`).
+    pub dynamic_geometry: bool,
+    /// Resources to produce besides those the mode needs, for `hrts_record_resource_readback` (bit
+    /// `1 << HrtsResource`; default 0). E.g. the shadow-map visibility for comparisons.
+    pub extra_outputs: u32,
 }
 
 /// One draw of the geometry.
@@ -412,4 +529,50 @@ pub struct HrtsFrameReport {
     pub pass_count: u32,
     /// Per-pass GPU times.
     pub passes: [HrtsPassTiming; HRTS_MAX_REPORTED_PASSES],
+    /// Texels holding at least one triangle.
+    pub occupied_texels: u32,
+    /// Triangle indices stored in the map (sum over texels of min(count, d)).
+    pub stored_entries: u32,
+    /// `HrtsPassStatus` of each `HrtsPass` this frame.
+    pub pass_status: [u32; HRTS_PASS_COUNT],
+    /// Bytes of each `HrtsResource` the plugin allocated (0: not allocated).
+    pub resource_bytes: [u64; HRTS_RESOURCE_COUNT],
+    /// The `HrtsResource` copied into the output image.
+    pub output_resource: u32,
+}
+
+/// A copy of a plugin resource into an engine buffer, recorded after a complete frame.
+#[repr(C)]
+pub struct HrtsResourceReadback {
+    /// `sizeof(HrtsResourceReadback)`.
+    pub struct_size: u32,
+    /// `VkCommandBuffer` in the recording state, outside a render pass, submitted after the frame's.
+    pub command_buffer: u64,
+    /// `HrtsResource` to copy (allocated by the configuration: see `HrtsConfig::extra_outputs`).
+    pub resource: u32,
+    /// Destination `VkBuffer` (usage includes TRANSFER_DST).
+    pub buffer: u64,
+    /// Size of the destination buffer in bytes.
+    pub buffer_size: u64,
+    /// Byte offset of the copy in the buffer (a multiple of 4); `HrtsResourceInfo::bytes` are written.
+    pub offset: u64,
+}
+
+/// Shape of a plugin resource, for reading it back.
+#[repr(C)]
+pub struct HrtsResourceInfo {
+    /// `sizeof(HrtsResourceInfo)`, set by the caller.
+    pub struct_size: u32,
+    /// Whether the current configuration allocates it.
+    pub allocated: bool,
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// Array layers.
+    pub layers: u32,
+    /// `VkFormat`.
+    pub format: i32,
+    /// Bytes of a tightly packed read-back of all layers (layer-major, rows top to bottom).
+    pub bytes: u64,
 }

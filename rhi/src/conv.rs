@@ -78,6 +78,13 @@ pub enum ResourceState {
     Engine(i32),
 }
 
+impl ResourceState {
+    /// The raw `VkImageLayout` an image is in while in this state (what a C ABI exchanges).
+    pub fn raw_layout(self) -> i32 {
+        state_scope(self).0.as_raw()
+    }
+}
+
 /// Shader stages the RHI's pipelines use; shader-access states are scoped to these.
 pub const SHADER_STAGES: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::from_raw(
     vk::PipelineStageFlags2::VERTEX_SHADER.as_raw()
@@ -183,6 +190,10 @@ impl Format {
             Self::Rgba8Unorm => vk::Format::R8G8B8A8_UNORM,
             Self::D32Float => vk::Format::D32_SFLOAT,
         }
+    }
+    /// The raw `VkFormat` value (what a C ABI exchanges).
+    pub fn raw_vk(self) -> i32 {
+        self.to_vk().as_raw()
     }
     /// Bytes per texel.
     pub fn texel_size(self) -> u32 {

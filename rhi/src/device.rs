@@ -99,8 +99,13 @@ unsafe extern "system" fn debug_callback(
 
 /// State shared by the device and every resource created from it.
 pub(crate) struct Shared {
-    pub(crate) _entry: ash::Entry,
+    entry: ash::Entry,
     pub(crate) instance: ash::Instance,
+    physical: vk::PhysicalDevice,
+    queue_family: u32,
+    queue_index: u32,
+    enabled_extensions: Vec<String>,
+    enabled_features: EnabledFeatures,
     pub(crate) device: ash::Device,
     pub(crate) queue: vk::Queue,
     pub(crate) caps: Capabilities,
@@ -156,6 +161,7 @@ pub struct EnabledFeatures {
 }
 
 /// The engine's Vulkan objects handed to [`Device::adopt`], as raw handles. The RHI never destroys them.
+#[derive(Debug, Clone)]
 pub struct AdoptDesc {
     /// `vkGetInstanceProcAddr` of the engine's loader.
     pub get_instance_proc_addr: RawGetInstanceProcAddr,
@@ -323,6 +329,7 @@ impl Device {
             device,
             queue,
             queue_family: chosen.family,
+            queue_index: 0,
             enabled_extensions: enabled,
             features,
             has_debug_utils,
@@ -372,6 +379,7 @@ impl Device {
             device,
             queue,
             queue_family: desc.queue_family_index,
+            queue_index: desc.queue_index,
             enabled_extensions: desc.enabled_extensions,
             features,
             has_debug_utils: desc.debug_utils,
@@ -428,8 +436,18 @@ impl Device {
         let command_pool = unsafe { p.device.create_command_pool(&pool_info, None) }
             .call("vkCreateCommandPool")?;
         let shared = Arc::new(Shared {
-            _entry: p.entry,
+            entry: p.entry,
             instance: p.instance,
+            physical: p.physical,
+            queue_family: p.queue_family,
+            queue_index: p.queue_index,
+            enabled_extensions: p.enabled_extensions,
+            enabled_features: EnabledFeatures {
+                geometry_shader: p.features.geometry_shader != 0,
+                fragment_stores_and_atomics: p.features.fragment_stores_and_atomics != 0,
+                depth_clamp: p.features.depth_clamp != 0,
+                shader_float64: p.features.shader_float64 != 0,
+            },
             device: p.device,
             queue: p.queue,
             caps,
@@ -444,6 +462,28 @@ impl Device {
             shared,
             command_pool,
         })
+    }
+
+    /// This device's objects as raw handles: what another component (such as the plugin's C ABI) needs to
+    /// adopt it with [`Device::adopt`]. Valid while `self` lives.
+    pub fn adopt_desc(&self) -> AdoptDesc {
+        use ash::vk::Handle;
+        let s = &self.shared;
+        // SAFETY: Vulkan's "system" calling convention is C on every 64-bit target and a dispatchable
+        // handle is a pointer, so both function types have the same ABI (the inverse of `adopt`'s).
+        let get_instance_proc_addr: RawGetInstanceProcAddr =
+            unsafe { std::mem::transmute(s.entry.static_fn().get_instance_proc_addr) };
+        AdoptDesc {
+            get_instance_proc_addr,
+            instance: s.instance.handle().as_raw(),
+            physical_device: s.physical.as_raw(),
+            device: s.device.handle().as_raw(),
+            queue_family_index: s.queue_family,
+            queue_index: s.queue_index,
+            enabled_extensions: s.enabled_extensions.clone(),
+            enabled_features: s.enabled_features,
+            debug_utils: s.debug_utils.is_some(),
+        }
     }
 
     /// The device's capabilities.
@@ -528,6 +568,7 @@ struct PartsDesc {
     device: ash::Device,
     queue: vk::Queue,
     queue_family: u32,
+    queue_index: u32,
     enabled_extensions: Vec<String>,
     features: vk::PhysicalDeviceFeatures,
     has_debug_utils: bool,

@@ -182,6 +182,11 @@ impl<'a> Encoder<'a> {
         Self::new(device, ash::vk::Handle::from_raw(command_buffer))
     }
 
+    /// The `VkCommandBuffer` handle, for recording through a component that speaks raw Vulkan (a C ABI).
+    pub fn raw_handle(&self) -> u64 {
+        ash::vk::Handle::as_raw(self.cmd)
+    }
+
     fn d(&self) -> &ash::Device {
         &self.device.shared.device
     }
@@ -197,6 +202,12 @@ impl<'a> Encoder<'a> {
             self.d()
                 .cmd_reset_query_pool(self.cmd, t.pool, 0, t.capacity * 2)
         };
+        self.timer = Some(timer.clone());
+    }
+
+    /// Goes on timing passes with `timer` after the passes an earlier command buffer of the same submission
+    /// order recorded with it (no reset: the queries were reset by that command buffer's `attach_timer`).
+    pub fn continue_timer(&mut self, timer: &GpuTimer) {
         self.timer = Some(timer.clone());
     }
 
@@ -483,14 +494,28 @@ impl<'a> Encoder<'a> {
 
     /// Copies all layers of `image` (in `CopySource` state) tightly packed into `buffer`.
     pub fn copy_image_to_buffer(&mut self, image: &Image, buffer: &Buffer) -> Result<()> {
-        if buffer.size() < image.byte_size() {
+        self.copy_image_to_buffer_at(image, buffer, 0)
+    }
+
+    /// [`Encoder::copy_image_to_buffer`] at byte `offset` (a multiple of 4) of `buffer`.
+    pub fn copy_image_to_buffer_at(
+        &mut self,
+        image: &Image,
+        buffer: &Buffer,
+        offset: u64,
+    ) -> Result<()> {
+        let fits = offset
+            .checked_add(image.byte_size())
+            .is_some_and(|end| end <= buffer.size());
+        if !fits || !offset.is_multiple_of(4) {
             return Err(RhiError::InvalidArgument(format!(
-                "read-back buffer of {} bytes is smaller than the image ({} bytes)",
+                "read-back of {} bytes at offset {offset} does not fit a buffer of {} bytes (or the offset is not a multiple of 4)",
+                image.byte_size(),
                 buffer.size(),
-                image.byte_size()
             )));
         }
         let region = vk::BufferImageCopy::default()
+            .buffer_offset(offset)
             .image_subresource(
                 vk::ImageSubresourceLayers::default()
                     .aspect_mask(image.format().aspect())

@@ -476,6 +476,11 @@ impl Buffer {
         self.size
     }
 
+    /// The `VkBuffer` handle, for handing the buffer to a component that speaks raw Vulkan (a C ABI).
+    pub fn raw_handle(&self) -> u64 {
+        ash::vk::Handle::as_raw(self.raw)
+    }
+
     /// Writes `data` at `offset` into a host-visible buffer.
     pub fn write(&mut self, offset: u64, data: &[u8]) -> Result<()> {
         let size = self.size;
@@ -527,6 +532,14 @@ impl Image {
     /// Declared usage.
     pub fn usage(&self) -> ImageUsage {
         self.usage
+    }
+    /// The `VkImage` handle, for handing the image to a component that speaks raw Vulkan (a C ABI).
+    pub fn raw_handle(&self) -> u64 {
+        ash::vk::Handle::as_raw(self.raw)
+    }
+    /// The `VkImageUsageFlags` the image was created with.
+    pub fn raw_usage(&self) -> u32 {
+        image_usage_to_vk(self.usage).as_raw()
     }
     /// Bytes needed to read back all layers tightly packed.
     pub fn byte_size(&self) -> u64 {

@@ -516,6 +516,64 @@ static HrtsResult run_frame(HrtsContext *ctx, float *vis) {
     return r;
 }
 
+/* Records one frame pass by pass (one hrts_record_passes call per HrtsPass, into one command buffer), or
+ * as an engine splits it: the light-space passes in a first submission, the screen-space passes and the
+ * output copy in a second one. Reads the visibility back into `vis`. */
+static HrtsResult run_frame_in_parts(HrtsContext *ctx, float *vis, int one_by_one) {
+    VkCommandBuffer cmd = begin();
+    HrtsFrame f = frame(cmd);
+    HrtsResult r = HRTS_RESULT_OK;
+    if (one_by_one) {
+        for (uint32_t pass = 0; pass < HRTS_PASS_COUNT && r == HRTS_RESULT_OK; pass++)
+            r = hrts_record_passes(ctx, &f, 1u << pass);
+    } else {
+        r = hrts_record_passes(ctx, &f, HRTS_PASS_MASK_LIGHT_SPACE);
+        submit_and_wait(cmd);
+        cmd = begin();
+        f = frame(cmd);
+        if (r == HRTS_RESULT_OK) r = hrts_record_passes(ctx, &f, HRTS_PASS_MASK_SCREEN_SPACE);
+    }
+    Buf back = make_host_buffer(sizeof(float) * W * H, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    if (r == HRTS_RESULT_OK) {
+        VkBufferImageCopy region;
+        memset(&region, 0, sizeof region);
+        region.imageSubresource.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+        region.imageSubresource.layerCount = 1;
+        region.imageExtent.width = W;
+        region.imageExtent.height = H;
+        region.imageExtent.depth = 1;
+        vkCmdCopyImageToBuffer(cmd, out_img.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, back.buffer, 1, &region);
+    }
+    submit_and_wait(cmd);
+    if (vis) memcpy(vis, back.map, sizeof(float) * W * H);
+    free_buffer(back);
+    return r;
+}
+
+/* Reads a plugin resource of the last complete frame back through hrts_record_resource_readback. */
+static HrtsResult read_resource(HrtsContext *ctx, uint32_t resource, float *out, size_t bytes) {
+    Buf back = make_host_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    VkCommandBuffer cmd = begin();
+    HrtsResourceReadback rb;
+    memset(&rb, 0, sizeof rb);
+    rb.struct_size = sizeof rb;
+    rb.command_buffer = (uint64_t)(uintptr_t)cmd;
+    rb.resource = resource;
+    rb.buffer = (uint64_t)(uintptr_t)back.buffer;
+    rb.buffer_size = bytes;
+    HrtsResult r = hrts_record_resource_readback(ctx, &rb);
+    submit_and_wait(cmd);
+    if (r == HRTS_RESULT_OK) memcpy(out, back.map, bytes);
+    free_buffer(back);
+    return r;
+}
+
+static int differing(const float *a, const float *b) {
+    int n = 0;
+    for (int i = 0; i < W * H; i++) n += memcmp(&a[i], &b[i], sizeof(float)) != 0;
+    return n;
+}
+
 /* Pixels whose plugin visibility differs from the exact shadow (near-edge pixels counted apart). */
 static int count_mismatches(const float *vis, double tol, int *near_edge, int *shadowed, int *lit) {
     int mismatches = 0;
@@ -737,6 +795,62 @@ static void misuse(HrtsContext *ctx, const HrtsVulkanDevice *vk) {
     rep.struct_size = 1;
     expect(ctx, hrts_get_frame_report(ctx, &rep), HRTS_RESULT_ERROR_STRUCT_SIZE, "report(wrong size)"), cases++;
 
+    /* pass-by-pass recording and read-back */
+    c = cfg;
+    c.pcss_filter = 5;
+    expect(ctx, hrts_configure(ctx, &c), HRTS_RESULT_ERROR_INVALID_ENUM, "configure(unknown PCSS filter)"), cases++;
+    c = cfg;
+    c.extra_outputs = 1u << 20;
+    expect(ctx, hrts_configure(ctx, &c), HRTS_RESULT_ERROR_INVALID_ENUM, "configure(unknown extra output)"), cases++;
+    c = cfg;
+    c.pcss_min_filter_radius = 64.0f;
+    expect(ctx, hrts_configure(ctx, &c), HRTS_RESULT_ERROR_INVALID_ARGUMENT, "configure(min filter radius > max)"), cases++;
+    c = cfg;
+    c.shadow_map_slope_bias = INFINITY;
+    expect(ctx, hrts_configure(ctx, &c), HRTS_RESULT_ERROR_INVALID_ARGUMENT, "configure(infinite slope bias)"), cases++;
+    CHECK(run_frame(ctx, NULL) == HRTS_RESULT_OK, "frame: %s", hrts_last_error(ctx));
+    cmd = begin();
+    f = frame(cmd);
+    expect(ctx, hrts_record_passes(ctx, &f, 0), HRTS_RESULT_ERROR_INVALID_ARGUMENT, "passes(empty mask)"), cases++;
+    expect(ctx, hrts_record_passes(ctx, &f, 1u << 20), HRTS_RESULT_ERROR_INVALID_ARGUMENT, "passes(unknown pass bit)"), cases++;
+    expect(ctx, hrts_record_passes(ctx, &f, HRTS_PASS_MASK_SCREEN_SPACE), HRTS_RESULT_ERROR_INVALID_STATE,
+           "passes(screen space before the light-space passes of the frame)"), cases++;
+    CHECK(hrts_record_passes(ctx, &f, HRTS_PASS_MASK_LIGHT_SPACE) == HRTS_RESULT_OK, "light space: %s", hrts_last_error(ctx));
+    HrtsFrame moved = f;
+    moved.camera_position[1] += 1.0f;
+    expect(ctx, hrts_record_passes(ctx, &moved, HRTS_PASS_MASK_SCREEN_SPACE), HRTS_RESULT_ERROR_INVALID_ARGUMENT,
+           "passes(camera moved within a frame)"), cases++;
+    expect(ctx, hrts_record_passes(ctx, &f, 1u << HRTS_PASS_OUTPUT_COPY), HRTS_RESULT_ERROR_INVALID_STATE,
+           "passes(output copy before the ray trace)"), cases++;
+    f.depth_layout = 0;
+    expect(ctx, hrts_record_passes(ctx, &f, HRTS_PASS_MASK_SCREEN_SPACE), HRTS_RESULT_ERROR_INVALID_ARGUMENT,
+           "passes(undefined depth layout)"), cases++;
+    f = frame(cmd);
+    HrtsFrameReport open_rep;
+    memset(&open_rep, 0, sizeof open_rep);
+    open_rep.struct_size = sizeof open_rep;
+    expect(ctx, hrts_get_frame_report(ctx, &open_rep), HRTS_RESULT_ERROR_INVALID_STATE, "report(frame half recorded)"), cases++;
+    static float scratch[W * H];
+    expect(ctx, read_resource(ctx, HRTS_RESOURCE_RT_VISIBILITY, scratch, sizeof scratch), HRTS_RESULT_ERROR_INVALID_STATE,
+           "readback(frame half recorded)"), cases++;
+    CHECK(hrts_record_passes(ctx, &f, HRTS_PASS_MASK_SCREEN_SPACE) == HRTS_RESULT_OK, "screen space: %s", hrts_last_error(ctx));
+    submit_and_wait(cmd);
+    expect(ctx, read_resource(ctx, 99, scratch, sizeof scratch), HRTS_RESULT_ERROR_INVALID_ENUM, "readback(unknown resource)"), cases++;
+    expect(ctx, read_resource(ctx, HRTS_RESOURCE_PCSS, scratch, sizeof scratch), HRTS_RESULT_ERROR_INVALID_STATE,
+           "readback(resource the mode does not allocate)"), cases++;
+    expect(ctx, read_resource(ctx, HRTS_RESOURCE_RT_VISIBILITY, scratch, 64), HRTS_RESULT_ERROR_INVALID_ARGUMENT,
+           "readback(buffer too small)"), cases++;
+    HrtsResourceReadback rb;
+    memset(&rb, 0, sizeof rb);
+    rb.struct_size = sizeof rb;
+    rb.command_buffer = 1;
+    rb.resource = HRTS_RESOURCE_RT_VISIBILITY;
+    expect(ctx, hrts_record_resource_readback(ctx, &rb), HRTS_RESULT_ERROR_NULL_POINTER, "readback(NULL buffer)"), cases++;
+    HrtsResourceInfo info;
+    memset(&info, 0, sizeof info);
+    info.struct_size = sizeof info;
+    expect(ctx, hrts_get_resource_info(ctx, 12, &info), HRTS_RESULT_ERROR_INVALID_ENUM, "resource info(unknown resource)"), cases++;
+
     /* a destroyed context is detected */
     HrtsContext *gone = create_context(vk);
     CHECK(hrts_context_destroy(gone) == HRTS_RESULT_OK, "destroy");
@@ -819,6 +933,41 @@ int main(void) {
     printf("hybrid: %d soft pixels, %d halo pixels, %d out of [0,1]\n", soft, halo, out_of_range);
     CHECK(halo == 0 && out_of_range == 0, "hybrid: %d halo, %d out of range", halo, out_of_range);
     CHECK(soft > 0, "hybrid shows no penumbra");
+
+    /* the passes one by one, and split over two submissions as an engine places them, give the same bits */
+    static float parts[W * H];
+    CHECK(run_frame_in_parts(ctx, parts, 1) == HRTS_RESULT_OK, "hybrid pass by pass: %s", hrts_last_error(ctx));
+    int diff_one = differing(parts, blend);
+    CHECK(run_frame_in_parts(ctx, parts, 0) == HRTS_RESULT_OK, "hybrid in two submissions: %s", hrts_last_error(ctx));
+    int diff_two = differing(parts, blend);
+    printf("hybrid recorded pass by pass: %d px differ; light/screen space in two submissions: %d px differ\n",
+           diff_one, diff_two);
+    CHECK(diff_one == 0 && diff_two == 0, "per-pass recording differs: %d / %d px", diff_one, diff_two);
+    CHECK(hrts_get_frame_report(ctx, &rep) == HRTS_RESULT_OK, "report: %s", hrts_last_error(ctx));
+    CHECK(rep.pass_status[HRTS_PASS_RAY_TRACE] == HRTS_PASS_STATUS_RAN && rep.pass_status[HRTS_PASS_PCSS] == HRTS_PASS_STATUS_RAN &&
+              rep.pass_status[HRTS_PASS_BLEND] == HRTS_PASS_STATUS_RAN && rep.pass_status[HRTS_PASS_OUTPUT_COPY] == HRTS_PASS_STATUS_RAN,
+          "hybrid report: passes that ran");
+    CHECK(rep.pass_status[HRTS_PASS_PRIM_BUFFER] == HRTS_PASS_STATUS_UP_TO_DATE, "static geometry: prim buffer %u",
+          rep.pass_status[HRTS_PASS_PRIM_BUFFER]);
+    CHECK(rep.pass_status[HRTS_PASS_SHADOW_MAP_TEST] == HRTS_PASS_STATUS_NOT_IN_PLAN && rep.pass_status[HRTS_PASS_FXAA] == HRTS_PASS_STATUS_NOT_IN_PLAN,
+          "hybrid without antialiasing: no shadow-map test, no FXAA");
+    CHECK(rep.output_resource == HRTS_RESOURCE_HYBRID && rep.resource_bytes[HRTS_RESOURCE_HYBRID] == sizeof(float) * W * H &&
+              rep.resource_bytes[HRTS_RESOURCE_SHADOW_MAP_VISIBILITY] == 0,
+          "hybrid report: resources");
+
+    /* the ray-traced visibility of the hybrid frame, read back, is the hard shadow, bit for bit */
+    HrtsResourceInfo info;
+    memset(&info, 0, sizeof info);
+    info.struct_size = sizeof info;
+    CHECK(hrts_get_resource_info(ctx, HRTS_RESOURCE_RT_VISIBILITY, &info) == HRTS_RESULT_OK && info.allocated &&
+              info.width == W && info.height == H && info.layers == 1 && info.format == VK_FORMAT_R32_SFLOAT &&
+              info.bytes == sizeof(float) * W * H,
+          "resource info: %s", hrts_last_error(ctx));
+    static float rt[W * H];
+    CHECK(read_resource(ctx, HRTS_RESOURCE_RT_VISIBILITY, rt, sizeof rt) == HRTS_RESULT_OK, "readback: %s", hrts_last_error(ctx));
+    int diff_rt = differing(rt, vis);
+    printf("ray-traced visibility read back from the hybrid frame: %d px differ from the hard-mode output\n", diff_rt);
+    CHECK(diff_rt == 0, "read-back ray-traced visibility differs in %d px", diff_rt);
     CHECK(hrts_configure(ctx, &cfg) == HRTS_RESULT_OK, "configure back: %s", hrts_last_error(ctx));
 
     /* the same scene from the engine's own Vulkan buffers: float4 positions (stride 16) at byte offset 64,
