@@ -2,10 +2,11 @@
 //! PCSS + Ray Trace, FXAA — for ~10K, ~65K and ~240K triangles at 1920×1080, shadow map 3K×3K and
 //! primitive map 1K×1K×32/64, next to the talk's GTX 980 column. GPU timestamps, medians over frames.
 
+use crate::plugin::PluginRenderer;
 use crate::render::{median_timings, RenderOptions, SoftShadowArgs};
 use crate::View;
 use anyhow::{Context, Result};
-use passes::{FaceMode, PrimitiveMapConfig, RasterRequest, ShadowMode, ShadowRenderer};
+use passes::{FaceMode, PrimitiveMapConfig, RasterRequest, ShadowMode};
 use rhi::{ConservativeRasterTier, Device};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -124,8 +125,7 @@ fn run(
     };
     let mut config = options.shadow_config(view);
     config.extra_outputs = passes::ResourceSet::EMPTY;
-    let geometry = view.upload(device)?;
-    let mut renderer = ShadowRenderer::new(device, geometry, view.width, view.height, config)?;
+    let mut renderer = PluginRenderer::new(device, view, config)?;
     let inputs = view.frame_inputs();
     let mut reports = Vec::new();
     for _ in 0..args.frames.max(2) {

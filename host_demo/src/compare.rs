@@ -4,13 +4,14 @@
 
 use crate::images::{lerp_factor_preview, write_png_compact, Canvas};
 use crate::output::{shade_preview, write_png};
+use crate::plugin::PluginRenderer;
 use crate::render::{default_world_space_scale, median_timings};
 use crate::{parse_vec3, View};
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
 use passes::{
     FrameImages, HybridConfig, PcssConfig, PenumbraFilter, PrimitiveMapConfig, RasterRequest,
-    ResourceId, ResourceSet, ShadowConfig, ShadowMapConfig, ShadowMode, ShadowRenderer,
+    ResourceId, ResourceSet, ShadowConfig, ShadowMapConfig, ShadowMode,
 };
 use rhi::Device;
 use scene::Camera;
@@ -305,8 +306,7 @@ fn render_panel(
     let Some(first) = views.first() else {
         bail!("no view to render");
     };
-    let geometry = first.upload(device).context("uploading the scene")?;
-    let mut renderer = ShadowRenderer::new(device, geometry, first.width, first.height, *config)?;
+    let mut renderer = PluginRenderer::new(device, first, *config)?;
     let inputs = first.frame_inputs();
     let mut reports = Vec::new();
     for _ in 0..frames.max(1) {

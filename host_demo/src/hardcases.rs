@@ -18,12 +18,12 @@
 
 use crate::accuracy::{absolute_tolerance, compare_map_with, compare_visibility};
 use crate::output::write_png;
+use crate::plugin::PluginRenderer;
 use crate::View;
 use anyhow::{anyhow, bail, Context, Result};
 use glam::{DMat4, DVec2, DVec3, Mat4};
 use passes::{
-    FaceMode, FrameImages, FrameInputs, Light, PrimitiveMapConfig, RasterRequest, ShadowRenderer,
-    GUARD_VALUE,
+    FaceMode, FrameImages, FrameInputs, Light, PrimitiveMapConfig, RasterRequest, GUARD_VALUE,
 };
 use reference::{FaceSelection, RefScene};
 use rhi::Device;
@@ -301,9 +301,8 @@ fn measure(
         raster: RasterRequest::Auto,
         guard_layer: case.map.guard_layer,
     };
-    let geometry = view.upload(device).context("uploading")?;
-    let mut renderer = ShadowRenderer::new(device, geometry, frame.width, frame.height, config)
-        .context("creating the renderer")?;
+    let mut renderer =
+        PluginRenderer::new(device, &view, config).context("creating the renderer")?;
     let report = renderer.render(device, &inputs).context("rendering")?;
     let images = renderer.read_back(device, true).context("reading back")?;
     o.raster_path = report.raster_path.name();

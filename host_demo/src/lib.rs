@@ -7,11 +7,12 @@ pub mod compare;
 pub mod hardcases;
 pub mod images;
 pub mod output;
+pub mod plugin;
 pub mod render;
 pub mod report;
 pub mod tiers;
 
-use glam::{Mat4, Vec3};
+use glam::{DVec3, Mat4, Vec3};
 use passes::{Draw, FrameInputs, Geometry, Light, PassError};
 use rhi::Device;
 use scene::{Aabb, Camera, DirectionalLight, Scene};
@@ -84,8 +85,14 @@ impl View {
             &positions,
             &self.scene.indices,
             &draws,
-            self.scene.bounds().center().as_dvec3(),
+            self.frame_origin(),
         )
+    }
+
+    /// The frame origin: the centre of the scene's bounds in f32, as the plugin derives it from the bounds
+    /// an engine passes (`HrtsVulkanGeometry::bounds`).
+    pub fn frame_origin(&self) -> DVec3 {
+        self.scene.bounds().center().as_dvec3()
     }
 }
 

@@ -2,12 +2,13 @@
 
 use crate::images::lerp_factor_preview;
 use crate::output::{shade_preview, write_exr_rgba, write_exr_scalar, write_png};
+use crate::plugin::PluginRenderer;
 use crate::{focus_bounds, View};
 use anyhow::{Context, Result};
 use passes::{
     FaceMode, FrameReport, HybridConfig, PassId, PassStatus, PcssConfig, PenumbraFilter,
     PrimitiveMapConfig, RasterRequest, ResourceId, ResourceSet, ShadowConfig, ShadowMapConfig,
-    ShadowMode, ShadowRenderer, SkipReason,
+    ShadowMode, SkipReason,
 };
 use rhi::Device;
 use serde::Serialize;
@@ -271,10 +272,9 @@ pub fn render_to_folder(
     out: &Path,
 ) -> Result<FrameReport> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let geometry = view.upload(device).context("uploading the scene")?;
     let config = options.shadow_config(view);
-    let mut renderer = ShadowRenderer::new(device, geometry, view.width, view.height, config)
-        .context("creating the shadow passes")?;
+    let mut renderer =
+        PluginRenderer::new(device, view, config).context("creating the shadow passes")?;
     let inputs = view.frame_inputs();
     let mut reports = Vec::new();
     for _ in 0..options.frames.max(1) {
@@ -380,8 +380,11 @@ pub fn render_to_folder(
         .with_context(|| format!("writing {}/frame.json", out.display()))?;
 
     println!(
-        "device: {} ({}, {})",
-        caps.device_name, caps.device_type, caps.driver
+        "device: {} ({}, {}); shadows through the plugin's C ABI, {}",
+        caps.device_name,
+        caps.device_type,
+        caps.driver,
+        crate::plugin::api_version()
     );
     if report.status(PassId::PrimitiveMap) == Some(PassStatus::Skipped(SkipReason::NotRequested)) {
         println!(

@@ -4,12 +4,13 @@
 
 use crate::accuracy::compare_visibility;
 use crate::bench::median_of;
+use crate::plugin::PluginRenderer;
 use crate::render::median_timings;
 use crate::View;
 use anyhow::{Context, Result};
 use passes::{
     FaceMode, PrimitiveMapConfig, RasterRequest, ResourceId, ResourceSet, ShadowConfig,
-    ShadowMapConfig, ShadowMode, ShadowRenderer,
+    ShadowMapConfig, ShadowMode,
 };
 use reference::RefScene;
 use rhi::Device;
@@ -51,13 +52,7 @@ fn render(
     std::collections::BTreeMap<String, f64>,
     u32,
 )> {
-    let mut r = ShadowRenderer::new(
-        device,
-        view.upload(device)?,
-        view.width,
-        view.height,
-        config,
-    )?;
+    let mut r = PluginRenderer::new(device, view, config)?;
     let inputs = view.frame_inputs();
     let mut reports = Vec::new();
     for _ in 0..frames.max(2) {

@@ -4,10 +4,11 @@
 //! builds primitive maps that are compared with the exact conservative binning.
 
 use crate::accuracy::{compare_map_excusing, MapComparison, EXTRA_MARGIN_TEXELS};
+use crate::plugin::PluginRenderer;
 use crate::View;
 use anyhow::Result;
 use glam::DVec4;
-use passes::{choose_raster_path, FaceMode, PrimitiveMapConfig, RasterRequest, ShadowRenderer};
+use passes::{choose_raster_path, FaceMode, PrimitiveMapConfig, RasterRequest};
 use reference::{FaceSelection, RefScene};
 use rhi::Device;
 
@@ -100,13 +101,7 @@ pub fn tier_matrix(
                 raster: request,
                 guard_layer: false,
             };
-            let mut renderer = ShadowRenderer::new(
-                device,
-                view.upload(device)?,
-                view.width,
-                view.height,
-                config,
-            )?;
+            let mut renderer = PluginRenderer::new(device, view, config)?;
             let report = renderer.render(device, &view.frame_inputs())?;
             let images = renderer.read_back(device, true)?;
             let tier1 = request == RasterRequest::EmulateTier1;

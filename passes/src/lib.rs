@@ -29,10 +29,11 @@ pub use prim_buffer::{Draw, Geometry, IndexFormat, IndexLayout, VertexLayout};
 pub use primitive_map::{
     choose_raster_path, FaceMode, PrimitiveMapConfig, RasterPath, RasterRequest, GUARD_VALUE,
 };
-pub use renderer::{FrameImages, ShadowRenderer};
+pub use renderer::{read_images, FrameImages, FrameOutput, ShadowRenderer};
 pub use shadow_map::ShadowMapConfig;
 pub use shadow_pipeline::{
-    FrameInputs, FrameReport, ResourceReport, ShadowConfig, ShadowInputs, ShadowPipeline,
+    camera_in_frame, FrameInputs, FrameReport, ResourceReport, ShadowConfig, ShadowInputs,
+    ShadowPipeline,
 };
 
 mod shaders {

@@ -212,6 +212,21 @@ impl Geometry {
     pub fn triangle_count(&self) -> u32 {
         self.triangle_count
     }
+
+    /// The vertex buffer and its layout.
+    pub fn vertices(&self) -> (&Buffer, VertexLayout) {
+        (&self.vertices, self.vertex)
+    }
+
+    /// The index buffer and its layout.
+    pub fn indices(&self) -> (&Buffer, IndexLayout) {
+        (&self.indices, self.index)
+    }
+
+    /// The draws.
+    pub fn draws(&self) -> &[Draw] {
+        &self.draws
+    }
 }
 
 /// The prim buffer and the compute pass that fills it.

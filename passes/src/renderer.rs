@@ -14,6 +14,7 @@ use rhi::{Barrier, BufferUsage, Device, Image, MemoryLocation, ResourceState as 
 
 /// Everything the frame produced, read back to the host. Row-major, y = 0 at the top. Outputs the plan
 /// did not produce are empty.
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct FrameImages {
     /// World position (frame origin added back in f64), w = 1 on geometry.
     pub position: Vec<[f32; 4]>,
@@ -151,140 +152,162 @@ impl ShadowRenderer {
 
     /// Reads back the last frame's outputs (the index map only if `with_indices`).
     pub fn read_back(&self, device: &Device, with_indices: bool) -> Result<FrameImages, PassError> {
-        let g = &self.targets;
         let p = &self.pipeline;
-        let uav = |r: ResourceId| p.image(r).map(|image| (image, S::UnorderedAccess));
-        let mut wanted: Vec<(Option<(&Image, S)>, Slot)> = vec![
-            (Some((&g.position, S::RenderTarget)), Slot::Position),
-            (Some((&g.normal, S::ShaderResource)), Slot::Normal),
-            (Some((&g.depth, S::ShaderResource)), Slot::Depth),
-            (uav(ResourceId::RtVisibility), Slot::Visibility),
-            (uav(ResourceId::BlockerDistance), Slot::BlockerDistance),
-            (uav(ResourceId::Occupancy), Slot::Occupancy),
-            (uav(ResourceId::PrimCountMap), Slot::Counts),
-            (
-                uav(ResourceId::ShadowMapVisibility),
-                Slot::ShadowMapVisibility,
-            ),
-            (uav(ResourceId::Pcss), Slot::Pcss),
-            (uav(ResourceId::RtAntialiased), Slot::Antialiased),
-            (uav(ResourceId::LerpFactor), Slot::LerpFactor),
-            (uav(ResourceId::Hybrid), Slot::Hybrid),
-            (Some((p.output(), S::UnorderedAccess)), Slot::Output),
-        ];
-        if with_indices {
-            wanted.push((uav(ResourceId::PrimIndexMap), Slot::Indices));
-        }
-        let list: Vec<(&Image, S, Slot)> = wanted
-            .into_iter()
-            .filter_map(|(found, slot)| found.map(|(image, state)| (image, state, slot)))
-            .collect();
-        let buffers = list
-            .iter()
-            .map(|(img, _, _)| {
-                device.create_buffer(
-                    "read-back",
-                    img.byte_size(),
-                    BufferUsage::COPY_DST,
-                    MemoryLocation::GpuToCpu,
-                )
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        // The final output is one of the images above: transition each image once.
-        let mut distinct: Vec<(&Image, S)> = Vec::new();
-        for &(image, state, _) in &list {
-            if !distinct.iter().any(|(i, _)| std::ptr::eq(*i, image)) {
-                distinct.push((image, state));
-            }
-        }
-        device.submit_and_wait(|enc| {
-            let to_copy: Vec<Barrier<'_>> = distinct
+        let mut wanted = self.targets.outputs();
+        wanted.extend(
+            FrameOutput::PIPELINE
                 .iter()
-                .map(|&(image, before)| Barrier::Image {
-                    image,
-                    before,
-                    after: S::CopySource,
-                })
-                .collect();
-            enc.barriers(&to_copy);
-            for ((img, _, _), buf) in list.iter().zip(&buffers) {
-                enc.copy_image_to_buffer(img, buf)?;
-            }
-            let back: Vec<Barrier<'_>> = distinct
-                .iter()
-                .map(|&(image, after)| Barrier::Image {
-                    image,
-                    before: S::CopySource,
-                    after,
-                })
-                .collect();
-            enc.barriers(&back);
-            enc.barriers(&[Barrier::Global {
-                before: S::CopyDest,
-                after: S::HostRead,
-            }]);
-            Ok(())
-        })?;
-        let mut images = FrameImages {
-            position: Vec::new(),
-            normal: Vec::new(),
-            depth: Vec::new(),
-            visibility: Vec::new(),
-            blocker_distance: Vec::new(),
-            occupancy: Vec::new(),
-            counts: Vec::new(),
-            indices: Vec::new(),
-            shadow_map_visibility: Vec::new(),
-            pcss: Vec::new(),
-            antialiased: Vec::new(),
-            lerp_factor: Vec::new(),
-            hybrid: Vec::new(),
-            output: Vec::new(),
-        };
-        let origin = p.geometry().origin();
-        for ((_, _, slot), buffer) in list.iter().zip(&buffers) {
-            let bytes = buffer.read()?;
-            let floats = || bytemuck::pod_collect_to_vec::<u8, f32>(bytes);
-            match slot {
-                Slot::Position => {
-                    images.position = to_world(bytemuck::pod_collect_to_vec(bytes), origin)
-                }
-                Slot::Normal => images.normal = bytemuck::pod_collect_to_vec(bytes),
-                Slot::Depth => images.depth = floats(),
-                Slot::Visibility => images.visibility = floats(),
-                Slot::BlockerDistance => images.blocker_distance = floats(),
-                Slot::Occupancy => images.occupancy = bytemuck::pod_collect_to_vec(bytes),
-                Slot::Counts => images.counts = bytemuck::pod_collect_to_vec(bytes),
-                Slot::Indices => images.indices = bytemuck::pod_collect_to_vec(bytes),
-                Slot::ShadowMapVisibility => images.shadow_map_visibility = floats(),
-                Slot::Pcss => images.pcss = floats(),
-                Slot::Antialiased => images.antialiased = floats(),
-                Slot::LerpFactor => images.lerp_factor = floats(),
-                Slot::Hybrid => images.hybrid = floats(),
-                Slot::Output => images.output = floats(),
-            }
+                .filter(|(_, r)| with_indices || *r != ResourceId::PrimIndexMap)
+                .filter_map(|&(output, r)| {
+                    p.image(r).map(|image| (image, S::UnorderedAccess, output))
+                }),
+        );
+        wanted.push((p.output(), S::UnorderedAccess, FrameOutput::Output));
+        let images: Vec<(&Image, S)> = wanted.iter().map(|&(i, s, _)| (i, s)).collect();
+        let bytes = read_images(device, &images)?;
+        let mut frame = FrameImages::default();
+        for ((_, _, output), bytes) in wanted.iter().zip(&bytes) {
+            frame.insert(*output, bytes, p.geometry().origin());
         }
-        Ok(images)
+        Ok(frame)
     }
 }
 
+impl GBufferTargets {
+    /// The G-buffer images, their state after a frame, and where they go in [`FrameImages`].
+    pub fn outputs(&self) -> Vec<(&Image, S, FrameOutput)> {
+        vec![
+            (&self.position, S::RenderTarget, FrameOutput::Position),
+            (&self.normal, S::ShaderResource, FrameOutput::Normal),
+            (&self.depth, S::ShaderResource, FrameOutput::Depth),
+        ]
+    }
+}
+
+/// Copies `images` (each in the given state, restored afterwards) into host buffers, waits, and returns
+/// their bytes (all layers, tightly packed). An image listed twice is read twice.
+pub fn read_images(device: &Device, images: &[(&Image, S)]) -> Result<Vec<Vec<u8>>, PassError> {
+    let buffers = images
+        .iter()
+        .map(|(img, _)| {
+            device.create_buffer(
+                "read-back",
+                img.byte_size(),
+                BufferUsage::COPY_DST,
+                MemoryLocation::GpuToCpu,
+            )
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    // Transition each image once.
+    let mut distinct: Vec<(&Image, S)> = Vec::new();
+    for &(image, state) in images {
+        if !distinct.iter().any(|(i, _)| std::ptr::eq(*i, image)) {
+            distinct.push((image, state));
+        }
+    }
+    device.submit_and_wait(|enc| {
+        let to_copy: Vec<Barrier<'_>> = distinct
+            .iter()
+            .map(|&(image, before)| Barrier::Image {
+                image,
+                before,
+                after: S::CopySource,
+            })
+            .collect();
+        enc.barriers(&to_copy);
+        for ((img, _), buf) in images.iter().zip(&buffers) {
+            enc.copy_image_to_buffer(img, buf)?;
+        }
+        let back: Vec<Barrier<'_>> = distinct
+            .iter()
+            .map(|&(image, after)| Barrier::Image {
+                image,
+                before: S::CopySource,
+                after,
+            })
+            .collect();
+        enc.barriers(&back);
+        enc.barriers(&[Barrier::Global {
+            before: S::CopyDest,
+            after: S::HostRead,
+        }]);
+        Ok(())
+    })?;
+    buffers.iter().map(|b| Ok(b.read()?.to_vec())).collect()
+}
+
 /// Where a read-back image goes in [`FrameImages`].
-#[derive(Clone, Copy)]
-enum Slot {
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameOutput {
+    /// [`FrameImages::position`] (read in frame coordinates; the origin is added back).
     Position,
+    /// [`FrameImages::normal`].
     Normal,
+    /// [`FrameImages::depth`].
     Depth,
+    /// [`FrameImages::visibility`].
     Visibility,
+    /// [`FrameImages::blocker_distance`].
     BlockerDistance,
+    /// [`FrameImages::occupancy`].
     Occupancy,
+    /// [`FrameImages::counts`].
     Counts,
+    /// [`FrameImages::indices`].
     Indices,
+    /// [`FrameImages::shadow_map_visibility`].
     ShadowMapVisibility,
+    /// [`FrameImages::pcss`].
     Pcss,
+    /// [`FrameImages::antialiased`].
     Antialiased,
+    /// [`FrameImages::lerp_factor`].
     LerpFactor,
+    /// [`FrameImages::hybrid`].
     Hybrid,
+    /// [`FrameImages::output`].
     Output,
+}
+
+impl FrameOutput {
+    /// The pipeline resources read back into [`FrameImages`].
+    pub const PIPELINE: [(FrameOutput, ResourceId); 10] = [
+        (Self::Visibility, ResourceId::RtVisibility),
+        (Self::BlockerDistance, ResourceId::BlockerDistance),
+        (Self::Occupancy, ResourceId::Occupancy),
+        (Self::Counts, ResourceId::PrimCountMap),
+        (Self::ShadowMapVisibility, ResourceId::ShadowMapVisibility),
+        (Self::Pcss, ResourceId::Pcss),
+        (Self::Antialiased, ResourceId::RtAntialiased),
+        (Self::LerpFactor, ResourceId::LerpFactor),
+        (Self::Hybrid, ResourceId::Hybrid),
+        (Self::Indices, ResourceId::PrimIndexMap),
+    ];
+}
+
+impl FrameImages {
+    /// Stores the read-back `bytes` of `output`; `origin` is the frame origin of the position image.
+    pub fn insert(&mut self, output: FrameOutput, bytes: &[u8], origin: DVec3) {
+        let floats = || bytemuck::pod_collect_to_vec::<u8, f32>(bytes);
+        match output {
+            FrameOutput::Position => {
+                self.position = to_world(bytemuck::pod_collect_to_vec(bytes), origin)
+            }
+            FrameOutput::Normal => self.normal = bytemuck::pod_collect_to_vec(bytes),
+            FrameOutput::Depth => self.depth = floats(),
+            FrameOutput::Visibility => self.visibility = floats(),
+            FrameOutput::BlockerDistance => self.blocker_distance = floats(),
+            FrameOutput::Occupancy => self.occupancy = bytemuck::pod_collect_to_vec(bytes),
+            FrameOutput::Counts => self.counts = bytemuck::pod_collect_to_vec(bytes),
+            FrameOutput::Indices => self.indices = bytemuck::pod_collect_to_vec(bytes),
+            FrameOutput::ShadowMapVisibility => self.shadow_map_visibility = floats(),
+            FrameOutput::Pcss => self.pcss = floats(),
+            FrameOutput::Antialiased => self.antialiased = floats(),
+            FrameOutput::LerpFactor => self.lerp_factor = floats(),
+            FrameOutput::Hybrid => self.hybrid = floats(),
+            FrameOutput::Output => self.output = floats(),
+        }
+    }
 }
 
 fn into_rhi(e: PassError) -> rhi::RhiError {

@@ -24,7 +24,7 @@ use crate::ray_trace::{RayTraceInputs, RayTracePass, RAY_OFFSET_FLOAT_BOUND, RAY
 use crate::screen_pass::visibility_image;
 use crate::shadow_map::{ShadowMapConfig, ShadowMapPass};
 use crate::PassError;
-use glam::{Mat4, UVec4, Vec3, Vec4};
+use glam::{DMat4, DVec3, Mat4, UVec4, Vec3, Vec4};
 use rhi::{
     Barrier, Buffer, BufferUsage, Device, Encoder, GpuTimer, Image, MemoryLocation, PassTiming,
     ResourceState as S,
@@ -169,8 +169,6 @@ pub struct ShadowInputs<'a> {
 
 /// Derived per-frame constants.
 struct FrameConstants {
-    view_proj_rel: Mat4,
-    camera_frame: Vec3,
     light: LightFrame,
     map: PrimMapPush,
     ray: RayTraceConstants,
@@ -470,20 +468,15 @@ impl ShadowPipeline {
     /// Camera-relative view-projection and the camera in frame coordinates (for a host G-buffer that
     /// rasterizes the prim buffer).
     pub fn camera_in_frame(&self, inputs: &FrameInputs) -> Result<(Mat4, Vec3), PassError> {
-        let c = self.constants(inputs)?;
-        Ok((c.view_proj_rel, c.camera_frame))
+        camera_in_frame(inputs, self.geometry.origin())
     }
 
     fn constants(&self, inputs: &FrameInputs) -> Result<FrameConstants, PassError> {
-        let cam = inputs.camera_position.as_dvec3();
-        let camera_rel = inputs.proj.as_dmat4() * rebased(inputs.view, cam);
-        let view_proj_rel = camera_rel.as_mat4();
-        let inv_view_proj_rel = camera_rel.inverse().as_mat4();
         let origin = self.geometry.origin();
+        let (_, camera_frame) = camera_in_frame(inputs, origin)?;
+        let inv_view_proj_rel = camera_relative(inputs).inverse().as_mat4();
         let light = LightFrame::new(&inputs.light, origin)?;
-        let camera_frame = (cam - origin).as_vec3();
-        if !view_proj_rel.is_finite() || !inv_view_proj_rel.is_finite() || !camera_frame.is_finite()
-        {
+        if !inv_view_proj_rel.is_finite() {
             return Err(PassError::InvalidConfig(
                 "camera matrices are not finite or invertible".into(),
             ));
@@ -501,8 +494,6 @@ impl ShadowPipeline {
         let sm = self.config.shadow_map;
         let pc = self.config.pcss;
         Ok(FrameConstants {
-            view_proj_rel,
-            camera_frame,
             light,
             map: PrimMapPush {
                 light_view_proj: light.view_proj,
@@ -874,6 +865,25 @@ impl ShadowPipeline {
             output: self.plan.final_output(),
         })
     }
+}
+
+/// Camera-relative view-projection (view translated to the camera in f64) and the camera position in
+/// the coordinates of the frame whose origin is `origin`: what a G-buffer rasterizing the prim buffer
+/// (triangles relative to `origin`) needs.
+pub fn camera_in_frame(inputs: &FrameInputs, origin: DVec3) -> Result<(Mat4, Vec3), PassError> {
+    let view_proj_rel = camera_relative(inputs).as_mat4();
+    let camera_frame = (inputs.camera_position.as_dvec3() - origin).as_vec3();
+    if !view_proj_rel.is_finite() || !camera_frame.is_finite() {
+        return Err(PassError::InvalidConfig(
+            "camera matrices are not finite".into(),
+        ));
+    }
+    Ok((view_proj_rel, camera_frame))
+}
+
+/// The view-projection of coordinates relative to the camera, in f64.
+fn camera_relative(inputs: &FrameInputs) -> DMat4 {
+    inputs.proj.as_dmat4() * rebased(inputs.view, inputs.camera_position.as_dvec3())
 }
 
 /// PCSS receiver-plane tolerance, in texels of the receiver plane's depth slope: covers the rasterizer's

@@ -27,7 +27,7 @@
 #define HRTS_RESOURCE_COUNT 12
 
 // Maximum passes in a report.
-#define HRTS_MAX_REPORTED_PASSES 16
+#define HRTS_MAX_REPORTED_PASSES 32
 
 // Result of every call. Append-only: values never change meaning.
 typedef enum HrtsResult {
@@ -436,6 +436,9 @@ typedef struct HrtsConfig {
   // Resources to produce besides those the mode needs, for `hrts_record_resource_readback` (bit
   // `1 << HrtsResource`; default 0). E.g. the shadow-map visibility for comparisons.
   uint32_t extra_outputs;
+  // Debug: the index map gets one more layer, filled with `0xFFFFFFFF` and never written: a read-back
+  // of `HRTS_RESOURCE_PRIM_INDEX_MAP` shows any write past d (default false).
+  bool guard_layer;
 } HrtsConfig;
 
 // One draw of the geometry.
@@ -496,7 +499,8 @@ typedef struct HrtsVulkanGeometry {
   const struct HrtsDraw *draws;
   // Number of draws.
   uint32_t draw_count;
-  // World-space bounds of all draws (min xyz, max xyz): the frame origin is their centre.
+  // World-space bounds of all draws (min xyz, max xyz): the frame origin is their centre (rounded to
+  // f32, so that vertex minus origin is exact for f32 vertices).
   float bounds[6];
 } HrtsVulkanGeometry;
 
@@ -623,6 +627,8 @@ typedef struct HrtsFrameReport {
   uint64_t resource_bytes[HRTS_RESOURCE_COUNT];
   // The `HrtsResource` copied into the output image.
   uint32_t output_resource;
+  // Bytes of the prim buffer (triangles in frame coordinates; 0 if the plan has none).
+  uint64_t prim_buffer_bytes;
 } HrtsFrameReport;
 
 #ifdef __cplusplus

@@ -9,7 +9,8 @@ use passes::{
     ResourceSet, ShadowConfig, ShadowInputs, ShadowMode, ShadowPipeline, SkipReason, VertexLayout,
 };
 use rhi::{
-    Barrier, Device, Encoder, Format, Image, ImageDesc, ImageUsage, ResourceState as S, RhiError,
+    Barrier, BufferUsage, Device, Encoder, Format, Image, ImageDesc, ImageUsage,
+    ResourceState as S, RhiError,
 };
 
 /// An error to return through the C ABI: a result code and a message.
@@ -80,6 +81,13 @@ pub(crate) fn check_size<T>(size: u32, name: &str) -> ApiResult<()> {
         ));
     }
     Ok(())
+}
+
+/// The frame origin of geometry within `lo..hi`: the centre, rounded to f32. Then the frame coordinates
+/// of f32 world positions near it (vertex minus origin) are differences of numbers on the same f32 grid,
+/// and computing them loses nothing.
+fn frame_origin(lo: DVec3, hi: DVec3) -> DVec3 {
+    ((lo + hi) * 0.5).as_vec3().as_dvec3()
 }
 
 fn finite(values: &[f32], what: &str) -> ApiResult<()> {
@@ -460,7 +468,7 @@ impl Context {
             positions,
             indices,
             draws,
-            origin: (lo + hi) * 0.5,
+            origin: frame_origin(lo, hi),
         });
         self.invalidate();
         Ok(())
@@ -506,7 +514,7 @@ impl Context {
             indices: (g.index_buffer, g.index_buffer_size),
             index,
             draws,
-            origin: (lo + hi) * 0.5,
+            origin: frame_origin(lo, hi),
         };
         geometry_from(&self.device, &source)?;
         self.geometry = Some(source);
@@ -734,9 +742,12 @@ impl Context {
         }
         out.pass_status[HrtsPass::OutputCopy as usize] = HrtsPassStatus::Ran as u32;
         out.resource_bytes = [0; HRTS_RESOURCE_COUNT];
+        out.prim_buffer_bytes = 0;
         for r in &report.resources {
             if let Some(i) = RESOURCES.iter().position(|&id| id == r.resource) {
                 out.resource_bytes[i] = r.bytes;
+            } else if r.resource == ResourceId::PrimBuffer {
+                out.prim_buffer_bytes = r.bytes;
             }
         }
         out.output_resource = resource_index(report.output)?;
@@ -801,7 +812,10 @@ impl Context {
             )));
         }
         // SAFETY: the engine guarantees a live buffer of `buffer_size` bytes with TRANSFER_DST usage.
-        let buffer = unsafe { self.device.external_buffer(r.buffer, r.buffer_size)? };
+        let buffer = unsafe {
+            self.device
+                .external_buffer(r.buffer, r.buffer_size, BufferUsage::COPY_DST)?
+        };
         let state = if id == ResourceId::ShadowMap {
             S::ShaderResource
         } else {
@@ -875,8 +889,8 @@ fn geometry_from(device: &Device, source: &GeometrySource) -> ApiResult<Geometry
             // SAFETY: the engine guarantees its buffers are live and of the stated sizes (contract).
             let (vb, ib) = unsafe {
                 (
-                    device.external_buffer(vertices.0, vertices.1)?,
-                    device.external_buffer(indices.0, indices.1)?,
+                    device.external_buffer(vertices.0, vertices.1, BufferUsage::STORAGE)?,
+                    device.external_buffer(indices.0, indices.1, BufferUsage::STORAGE)?,
                 )
             };
             Geometry::from_buffers(vb, *vertex, ib, *index, draws, *origin)?
@@ -1021,7 +1035,8 @@ fn frame_inputs(f: &HrtsFrame) -> ApiResult<FrameInputs> {
         "light_type",
         "HrtsLightType",
     )?;
-    let direction = dir.normalize();
+    // Passed on as given: the passes normalise in f64 (normalising here in f32 would round twice).
+    let direction = dir;
     let light = if spot {
         Light::Spot {
             position: Vec3::from_array(f.light_position),
@@ -1165,7 +1180,7 @@ fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
             depth: c.map_depth,
             faces,
             raster,
-            guard_layer: false,
+            guard_layer: c.guard_layer,
         },
         ..ShadowConfig::default()
     };
@@ -1226,5 +1241,104 @@ pub(crate) fn config_defaults(out: &mut HrtsConfig) -> ApiResult<()> {
     out.shadow_map_slope_bias = d.shadow_map.slope_bias;
     out.dynamic_geometry = !d.static_geometry;
     out.extra_outputs = 0;
+    out.guard_layer = d.map.guard_layer;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn c_pass_values_are_the_pipeline_order() {
+        let pairs = [
+            (HrtsPass::PrimBuffer, PassId::PrimBuffer),
+            (HrtsPass::ShadowMap, PassId::ShadowMap),
+            (HrtsPass::PrimitiveMap, PassId::PrimitiveMap),
+            (HrtsPass::Occupancy, PassId::Occupancy),
+            (HrtsPass::RayTrace, PassId::RayTrace),
+            (HrtsPass::ShadowMapTest, PassId::ShadowMapTest),
+            (HrtsPass::Pcss, PassId::Pcss),
+            (HrtsPass::Fxaa, PassId::Fxaa),
+            (HrtsPass::LerpFactor, PassId::LerpFactor),
+            (HrtsPass::Blend, PassId::Blend),
+            (HrtsPass::FillLit, PassId::FillLit),
+        ];
+        assert_eq!(pairs.len(), PassId::ALL.len());
+        for (c, rust) in pairs {
+            assert_eq!(pass_from_index(c as u32), Some(rust));
+        }
+        assert_eq!(pass_from_index(HrtsPass::OutputCopy as u32), None);
+        assert_eq!(HrtsPass::OutputCopy as usize + 1, HRTS_PASS_COUNT);
+        assert_eq!(HRTS_PASS_MASK_ALL, (1 << HRTS_PASS_COUNT) - 1);
+        assert_eq!(
+            HRTS_PASS_MASK_LIGHT_SPACE | HRTS_PASS_MASK_SCREEN_SPACE,
+            HRTS_PASS_MASK_ALL
+        );
+        assert_eq!(HRTS_PASS_MASK_LIGHT_SPACE & HRTS_PASS_MASK_SCREEN_SPACE, 0);
+        assert_eq!(HRTS_PASS_MASK_LIGHT_SPACE & DEPTH_NORMAL_READERS, 0);
+    }
+
+    #[test]
+    fn c_resource_values_name_the_pipeline_resources() {
+        let pairs = [
+            (HrtsResource::ShadowMap, ResourceId::ShadowMap),
+            (HrtsResource::PrimCountMap, ResourceId::PrimCountMap),
+            (HrtsResource::PrimIndexMap, ResourceId::PrimIndexMap),
+            (HrtsResource::Occupancy, ResourceId::Occupancy),
+            (HrtsResource::RtVisibility, ResourceId::RtVisibility),
+            (HrtsResource::BlockerDistance, ResourceId::BlockerDistance),
+            (
+                HrtsResource::ShadowMapVisibility,
+                ResourceId::ShadowMapVisibility,
+            ),
+            (HrtsResource::Pcss, ResourceId::Pcss),
+            (HrtsResource::RtAntialiased, ResourceId::RtAntialiased),
+            (HrtsResource::LerpFactor, ResourceId::LerpFactor),
+            (HrtsResource::Hybrid, ResourceId::Hybrid),
+            (HrtsResource::Lit, ResourceId::Lit),
+        ];
+        assert_eq!(pairs.len(), HRTS_RESOURCE_COUNT);
+        for (c, rust) in pairs {
+            assert_eq!(resource_id(c as u32).ok(), Some(rust));
+            assert_eq!(resource_index(rust).ok(), Some(c as u32));
+        }
+        assert!(resource_id(HRTS_RESOURCE_COUNT as u32).is_err());
+    }
+
+    #[test]
+    fn default_config_round_trips() {
+        let mut c: HrtsConfig = blank_config();
+        config_defaults(&mut c).expect("defaults");
+        assert_eq!(shadow_config(&c).expect("valid"), ShadowConfig::default());
+    }
+
+    fn blank_config() -> HrtsConfig {
+        HrtsConfig {
+            struct_size: std::mem::size_of::<HrtsConfig>() as u32,
+            mode: 0,
+            antialiasing: false,
+            static_light: false,
+            map_size: 0,
+            map_depth: 0,
+            faces: 0,
+            raster_path: 0,
+            shadow_map_size: 0,
+            pcss_angular_radius: 0.0,
+            pcss_spot_radius: 0.0,
+            pcss_blocker_search_taps: 0,
+            pcss_pcf_taps: 0,
+            hybrid_world_space_scale: 0.0,
+            hybrid_hard_shadow_percentage: 0.0,
+            pcss_filter: 0,
+            pcss_max_search_radius: 0.0,
+            pcss_min_filter_radius: 0.0,
+            pcss_max_filter_radius: 0.0,
+            shadow_map_constant_bias: 0.0,
+            shadow_map_slope_bias: 0.0,
+            dynamic_geometry: false,
+            extra_outputs: 0,
+            guard_layer: false,
+        }
+    }
 }

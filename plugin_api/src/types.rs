@@ -336,6 +336,9 @@ pub struct HrtsConfig {
     /// Resources to produce besides those the mode needs, for `hrts_record_resource_readback` (bit
     /// `1 << HrtsResource`; default 0). E.g. the shadow-map visibility for comparisons.
     pub extra_outputs: u32,
+    /// Debug: the index map gets one more layer, filled with `0xFFFFFFFF` and never written: a read-back
+    /// of `HRTS_RESOURCE_PRIM_INDEX_MAP` shows any write past d (default false).
+    pub guard_layer: bool,
 }
 
 /// One draw of the geometry.
@@ -400,7 +403,8 @@ pub struct HrtsVulkanGeometry {
     pub draws: *const HrtsDraw,
     /// Number of draws.
     pub draw_count: u32,
-    /// World-space bounds of all draws (min xyz, max xyz): the frame origin is their centre.
+    /// World-space bounds of all draws (min xyz, max xyz): the frame origin is their centre (rounded to
+    /// f32, so that vertex minus origin is exact for f32 vertices).
     pub bounds: [f32; 6],
 }
 
@@ -510,7 +514,7 @@ pub struct HrtsPassTiming {
 }
 
 /// Maximum passes in a report.
-pub const HRTS_MAX_REPORTED_PASSES: usize = 16;
+pub const HRTS_MAX_REPORTED_PASSES: usize = 32;
 
 /// What the last completed frame did. Read it after the engine's submission has completed.
 #[repr(C)]
@@ -539,6 +543,8 @@ pub struct HrtsFrameReport {
     pub resource_bytes: [u64; HRTS_RESOURCE_COUNT],
     /// The `HrtsResource` copied into the output image.
     pub output_resource: u32,
+    /// Bytes of the prim buffer (triangles in frame coordinates; 0 if the plan has none).
+    pub prim_buffer_bytes: u64,
 }
 
 /// A copy of a plugin resource into an engine buffer, recorded after a complete frame.

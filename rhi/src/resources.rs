@@ -363,18 +363,25 @@ impl Device {
         })
     }
 
-    /// Wraps an engine's `VkBuffer` of `size` bytes (created with at least `STORAGE_BUFFER` usage).
+    /// Wraps an engine's `VkBuffer` of `size` bytes, to be used as `usage` says (a storage buffer must fit
+    /// `maxStorageBufferRange`).
     ///
     /// # Safety
-    /// `handle` must be a live `VkBuffer` of this device of at least `size` bytes, outliving the result.
-    pub unsafe fn external_buffer(&self, handle: u64, size: u64) -> Result<Buffer> {
+    /// `handle` must be a live `VkBuffer` of this device of at least `size` bytes, created with `usage`,
+    /// outliving the result.
+    pub unsafe fn external_buffer(
+        &self,
+        handle: u64,
+        size: u64,
+        usage: BufferUsage,
+    ) -> Result<Buffer> {
         if handle == 0 || size == 0 {
             return Err(RhiError::InvalidArgument(
                 "external buffer is null or empty".into(),
             ));
         }
         let limit = self.shared.caps.max_storage_buffer_range;
-        if size > limit {
+        if usage.contains(BufferUsage::STORAGE) && size > limit {
             return Err(RhiError::Limit {
                 what: "external storage buffer".into(),
                 value: size,

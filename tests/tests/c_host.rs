@@ -3,64 +3,10 @@
 //! fills depth and normal images itself, records the plugin into its command buffer and checks the
 //! visibility against the exact shadow, then runs the misuse cases and 100 create/destroy cycles.
 
-use std::path::{Path, PathBuf};
+mod native;
+
+use native::{compiler, library_dir, run, workspace};
 use std::process::Command;
-
-fn workspace() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-/// The folder holding `libhrts.so` for this build profile (target/<profile>), building the plugin's
-/// shared library there first: `cargo test` builds only the rlib of a dependency.
-fn library_dir() -> PathBuf {
-    let exe = std::env::current_exe().expect("test executable path");
-    let dir = exe
-        .parent()
-        .and_then(Path::parent)
-        .expect("target/<profile>/deps/<test>")
-        .to_path_buf();
-    let target = dir.parent().expect("target/<profile>").to_path_buf();
-    let profile = match dir.file_name().and_then(|n| n.to_str()) {
-        Some("debug") => "dev".to_owned(),
-        Some(other) => other.to_owned(),
-        None => panic!("unexpected target folder {}", dir.display()),
-    };
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    run(Command::new(cargo)
-        .args([
-            "build",
-            "-p",
-            "plugin_api",
-            "--profile",
-            &profile,
-            "--target-dir",
-        ])
-        .arg(&target)
-        .current_dir(workspace()));
-    assert!(
-        dir.join("libhrts.so").exists(),
-        "libhrts.so not found in {} after building plugin_api",
-        dir.display()
-    );
-    dir
-}
-
-fn compiler(name: &str) -> String {
-    std::env::var(name.to_uppercase()).unwrap_or_else(|_| name.to_owned())
-}
-
-fn run(cmd: &mut Command) -> std::process::Output {
-    let out = cmd
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"));
-    assert!(
-        out.status.success(),
-        "{cmd:?} failed\nstdout:\n{}\nstderr:\n{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
 
 #[test]
 fn header_compiles_as_c99_and_cxx() {

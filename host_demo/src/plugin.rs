@@ -1,0 +1,553 @@
+//! The demo's frames through the plugin's C ABI, the way an engine integrates it. The demo owns the
+//! device, the scene's vertex and index buffers, a G-buffer and the visibility image; the plugin adopts
+//! the device (`hrts_context_create`), reads the scene from the demo's buffers
+//! (`hrts_set_geometry_vulkan`) and records into the demo's command buffer (`hrts_record_passes`): the
+//! light-space passes before the G-buffer, the screen-space passes and the output copy after it. Debug
+//! images come back through `hrts_record_resource_readback`, the report through `hrts_get_frame_report`.
+//! So what the demo shows is what an integrator gets.
+
+use crate::View;
+use anyhow::{bail, Context as _, Result};
+use hrts::*;
+use passes::gbuffer::{GBufferPass, GBufferTargets};
+use passes::gpu_types::{GBufferPush, MapStats};
+use passes::prim_buffer::PrimBufferPass;
+use passes::{
+    camera_in_frame, read_images, FaceMode, FrameImages, FrameInputs, FrameOutput, FrameReport,
+    Geometry, Light, PassId, PassStatus, PenumbraFilter, RasterPath, RasterRequest, ResourceId,
+    ResourceReport, ShadowConfig, ShadowMode, SkipReason,
+};
+use rhi::{
+    Barrier, BufferUsage, ConservativeRasterTier, Device, Format, GpuTimer, Image, ImageDesc,
+    ImageUsage, MemoryLocation, PassTiming, ResourceState as S,
+};
+use std::ffi::{c_char, CStr, CString};
+
+/// The plugin's resources by `HrtsResource` value.
+const RESOURCES: [(HrtsResource, ResourceId); HRTS_RESOURCE_COUNT] = [
+    (HrtsResource::ShadowMap, ResourceId::ShadowMap),
+    (HrtsResource::PrimCountMap, ResourceId::PrimCountMap),
+    (HrtsResource::PrimIndexMap, ResourceId::PrimIndexMap),
+    (HrtsResource::Occupancy, ResourceId::Occupancy),
+    (HrtsResource::RtVisibility, ResourceId::RtVisibility),
+    (HrtsResource::BlockerDistance, ResourceId::BlockerDistance),
+    (
+        HrtsResource::ShadowMapVisibility,
+        ResourceId::ShadowMapVisibility,
+    ),
+    (HrtsResource::Pcss, ResourceId::Pcss),
+    (HrtsResource::RtAntialiased, ResourceId::RtAntialiased),
+    (HrtsResource::LerpFactor, ResourceId::LerpFactor),
+    (HrtsResource::Hybrid, ResourceId::Hybrid),
+    (HrtsResource::Lit, ResourceId::Lit),
+];
+
+fn hrts_resource(id: ResourceId) -> Option<HrtsResource> {
+    RESOURCES.iter().find(|(_, r)| *r == id).map(|&(h, _)| h)
+}
+
+/// "libhrts API major.minor.patch", as the loaded library reports it.
+pub fn api_version() -> String {
+    let v = hrts_get_api_version();
+    format!(
+        "libhrts API {}.{}.{}",
+        v >> 22,
+        (v >> 12) & 0x3ff,
+        v & 0xfff
+    )
+}
+
+/// A live plugin context, destroyed on drop.
+struct Context(*mut HrtsContext);
+
+impl Context {
+    /// Turns a result code into an error carrying the context's message.
+    fn check(&self, call: &str, result: HrtsResult) -> Result<()> {
+        if result == HrtsResult::Ok {
+            return Ok(());
+        }
+        // SAFETY: `self.0` is live; both strings are NUL-terminated and outlive this statement.
+        let (name, message) = unsafe {
+            (
+                CStr::from_ptr(hrts_result_name(result as i32)),
+                CStr::from_ptr(hrts_last_error(self.0)),
+            )
+        };
+        bail!(
+            "{call}: {} ({})",
+            name.to_string_lossy(),
+            message.to_string_lossy()
+        )
+    }
+}
+
+impl Drop for Context {
+    fn drop(&mut self) {
+        // SAFETY: created by hrts_context_create and destroyed only here; the demo waited for its GPU work.
+        unsafe { hrts_context_destroy(self.0) };
+    }
+}
+
+/// The demo frame driven through the C ABI.
+pub struct PluginRenderer {
+    context: Context,
+    geometry: Geometry,
+    prim_buffer: PrimBufferPass,
+    gbuffer: GBufferPass,
+    targets: GBufferTargets,
+    output: Image,
+    timer: GpuTimer,
+    dynamic_geometry: bool,
+    frames: u64,
+    native_tier: ConservativeRasterTier,
+}
+
+impl PluginRenderer {
+    /// Uploads `view`'s scene into the demo's buffers, creates the G-buffer and the visibility image for
+    /// its size, and a plugin context on `device` configured with `config`.
+    pub fn new(device: &Device, view: &View, config: impl Into<ShadowConfig>) -> Result<Self> {
+        let config = config.into();
+        let (width, height) = (view.width, view.height);
+        if width == 0 || height == 0 {
+            bail!("frame size must be non-zero");
+        }
+        let geometry = view.upload(device).context("uploading the scene")?;
+        let prim_buffer = PrimBufferPass::new(device, &geometry)?;
+        let gbuffer = GBufferPass::new(device, prim_buffer.prims())?;
+        let targets = GBufferTargets::new(device, width, height)?;
+        let output = device.create_image(&ImageDesc {
+            name: "visibility",
+            format: Format::R32Float,
+            width,
+            height,
+            layers: 1,
+            usage: ImageUsage::COPY_DST | ImageUsage::COPY_SRC | ImageUsage::SAMPLED,
+        })?;
+        let context = create_context(device)?;
+        let hrts_config = c_config(&config)?;
+        // SAFETY: live context, valid struct.
+        context.check("hrts_configure", unsafe {
+            hrts_configure(context.0, &hrts_config)
+        })?;
+        set_geometry(&context, &geometry, view)?;
+        let t = &targets;
+        let c_targets = HrtsTargets {
+            struct_size: size_of::<HrtsTargets>() as u32,
+            width,
+            height,
+            depth_image: t.depth.raw_handle(),
+            depth_usage: t.depth.raw_usage(),
+            normal_image: t.normal.raw_handle(),
+            normal_usage: t.normal.raw_usage(),
+            output_image: output.raw_handle(),
+            output_usage: output.raw_usage(),
+        };
+        // SAFETY: live context; the images live as long as the renderer, which destroys the context first.
+        context.check("hrts_set_targets", unsafe {
+            hrts_set_targets(context.0, &c_targets)
+        })?;
+        Ok(Self {
+            context,
+            geometry,
+            prim_buffer,
+            gbuffer,
+            targets,
+            output,
+            timer: device.create_timer(4)?,
+            dynamic_geometry: !config.static_geometry,
+            frames: 0,
+            native_tier: device.capabilities().conservative_raster_tier,
+        })
+    }
+
+    /// Renders one frame and waits for it: the demo's prim buffer (first frame, or every frame with
+    /// dynamic geometry), the plugin's light-space passes, the demo's G-buffer, the plugin's screen-space
+    /// passes and output copy. Returns the plugin's report plus the G-buffer's GPU time.
+    pub fn render(&mut self, device: &Device, inputs: &FrameInputs) -> Result<FrameReport> {
+        let (view_proj_rel, camera_frame) = camera_in_frame(inputs, self.geometry.origin())?;
+        let push = GBufferPush {
+            view_proj_rel,
+            camera_pos: camera_frame.extend(1.0),
+        };
+        let tris = self.geometry.triangle_count();
+        let rebuild_prims = self.frames == 0 || self.dynamic_geometry;
+        let t = &self.targets;
+        device.submit_and_wait(|enc| {
+            if rebuild_prims {
+                self.prim_buffer
+                    .record(enc, &self.geometry)
+                    .map_err(recording_error)?;
+                enc.barriers(&[Barrier::Uav]);
+            }
+            enc.attach_timer(&self.timer);
+            let frame = c_frame(enc.raw_handle(), inputs);
+            self.record_passes(&frame, HRTS_PASS_MASK_LIGHT_SPACE)?;
+            let undefined_to = |image, after| Barrier::Image {
+                image,
+                before: S::Undefined,
+                after,
+            };
+            enc.barriers(&[
+                undefined_to(&t.position, S::RenderTarget),
+                undefined_to(&t.normal, S::RenderTarget),
+                undefined_to(&t.depth, S::DepthWrite),
+            ]);
+            self.gbuffer
+                .record(enc, t, &push, tris)
+                .map_err(recording_error)?;
+            enc.barriers(&[
+                Barrier::Image {
+                    image: &t.normal,
+                    before: S::RenderTarget,
+                    after: S::ShaderResource,
+                },
+                Barrier::Image {
+                    image: &t.depth,
+                    before: S::DepthWrite,
+                    after: S::ShaderResource,
+                },
+            ]);
+            self.record_passes(&frame, HRTS_PASS_MASK_SCREEN_SPACE)
+        })?;
+        self.frames += 1;
+        let mut report = self.report()?;
+        report.timings.extend(self.timer.resolve()?);
+        Ok(report)
+    }
+
+    fn record_passes(&self, frame: &HrtsFrame, mask: u32) -> rhi::Result<()> {
+        // SAFETY: live context; the command buffer is recording outside a render pass.
+        let result = unsafe { hrts_record_passes(self.context.0, frame, mask) };
+        self.context
+            .check("hrts_record_passes", result)
+            .map_err(recording_error)
+    }
+
+    /// The plugin's report of the last frame, as the Rust [`FrameReport`].
+    fn report(&self) -> Result<FrameReport> {
+        // SAFETY: plain-old-data C struct; every field is valid zeroed.
+        let mut r: HrtsFrameReport = unsafe { std::mem::zeroed() };
+        r.struct_size = size_of::<HrtsFrameReport>() as u32;
+        // SAFETY: live context, valid out pointer.
+        self.context.check("hrts_get_frame_report", unsafe {
+            hrts_get_frame_report(self.context.0, &mut r)
+        })?;
+        let timings = r.passes[..r.pass_count as usize]
+            .iter()
+            .map(|p| PassTiming {
+                // SAFETY: the plugin NUL-terminates every name within the array.
+                name: unsafe { CStr::from_ptr(p.name.as_ptr()) }
+                    .to_string_lossy()
+                    .into_owned(),
+                ms: p.milliseconds,
+            })
+            .collect();
+        let raster_path = match r.raster_path {
+            v if v == HrtsRasterPath::Software as u32 => RasterPath::Software,
+            v if v == HrtsRasterPath::EmulatedTier1 as u32 => RasterPath::EmulatedTier1 {
+                native: self.native_tier,
+            },
+            _ => RasterPath::Hardware(match r.tier {
+                1 => ConservativeRasterTier::Tier1,
+                2 => ConservativeRasterTier::Tier2,
+                _ => ConservativeRasterTier::Tier3,
+            }),
+        };
+        let passes = PassId::ALL
+            .iter()
+            .map(|&p| {
+                let status = match r.pass_status[p as usize] {
+                    s if s == HrtsPassStatus::Ran as u32 => PassStatus::Ran,
+                    s if s == HrtsPassStatus::UpToDate as u32 => {
+                        PassStatus::Skipped(SkipReason::UpToDate)
+                    }
+                    _ => PassStatus::Skipped(SkipReason::NotRequested),
+                };
+                (p, status)
+            })
+            .collect();
+        let mut resources: Vec<ResourceReport> = RESOURCES
+            .iter()
+            .filter(|&&(h, _)| r.resource_bytes[h as usize] > 0)
+            .map(|&(h, resource)| ResourceReport {
+                resource,
+                bytes: r.resource_bytes[h as usize],
+            })
+            .collect();
+        if r.prim_buffer_bytes > 0 {
+            resources.insert(
+                0,
+                ResourceReport {
+                    resource: ResourceId::PrimBuffer,
+                    bytes: r.prim_buffer_bytes,
+                },
+            );
+        }
+        let output = RESOURCES
+            .iter()
+            .find(|(h, _)| *h as u32 == r.output_resource)
+            .map(|&(_, id)| id)
+            .context("the report names an unknown output resource")?;
+        Ok(FrameReport {
+            timings,
+            raster_path,
+            stats: MapStats {
+                overflowed_texels: r.overflowed_texels,
+                max_count: r.max_count,
+                occupied_texels: r.occupied_texels,
+                stored_entries: r.stored_entries,
+            },
+            passes,
+            resources,
+            output,
+        })
+    }
+
+    /// Reads back the last frame: the demo's G-buffer and visibility image, and every plugin resource of
+    /// [`FrameImages`] the configuration allocates (the index map only if `with_indices`) through
+    /// `hrts_record_resource_readback`.
+    pub fn read_back(&self, device: &Device, with_indices: bool) -> Result<FrameImages> {
+        let mut own = self.targets.outputs();
+        own.push((&self.output, S::ShaderResource, FrameOutput::Output));
+        let images: Vec<(&Image, S)> = own.iter().map(|&(i, s, _)| (i, s)).collect();
+        let origin = self.geometry.origin();
+        let mut frame = FrameImages::default();
+        for ((_, _, output), bytes) in own.iter().zip(read_images(device, &images)?) {
+            frame.insert(*output, &bytes, origin);
+        }
+        let mut wanted = Vec::new();
+        for &(output, id) in FrameOutput::PIPELINE
+            .iter()
+            .filter(|(_, r)| with_indices || *r != ResourceId::PrimIndexMap)
+        {
+            let resource = hrts_resource(id).context("a read-back resource has no C value")?;
+            // SAFETY: plain-old-data C struct; every field is valid zeroed.
+            let mut info: HrtsResourceInfo = unsafe { std::mem::zeroed() };
+            info.struct_size = size_of::<HrtsResourceInfo>() as u32;
+            // SAFETY: live context, valid out pointer.
+            self.context.check("hrts_get_resource_info", unsafe {
+                hrts_get_resource_info(self.context.0, resource as u32, &mut info)
+            })?;
+            if info.allocated {
+                let buffer = device.create_buffer(
+                    id.name(),
+                    info.bytes,
+                    BufferUsage::COPY_DST,
+                    MemoryLocation::GpuToCpu,
+                )?;
+                wanted.push((output, resource, buffer));
+            }
+        }
+        device.submit_and_wait(|enc| {
+            for (_, resource, buffer) in &wanted {
+                let readback = HrtsResourceReadback {
+                    struct_size: size_of::<HrtsResourceReadback>() as u32,
+                    command_buffer: enc.raw_handle(),
+                    resource: *resource as u32,
+                    buffer: buffer.raw_handle(),
+                    buffer_size: buffer.size(),
+                    offset: 0,
+                };
+                // SAFETY: live context; recording command buffer; the buffer outlives the submission.
+                let result = unsafe { hrts_record_resource_readback(self.context.0, &readback) };
+                self.context
+                    .check("hrts_record_resource_readback", result)
+                    .map_err(recording_error)?;
+            }
+            Ok(())
+        })?;
+        for (output, _, buffer) in &wanted {
+            frame.insert(*output, buffer.read()?, origin);
+        }
+        Ok(frame)
+    }
+}
+
+/// An error while recording, in the form `Device::submit_and_wait` passes on.
+fn recording_error(e: impl std::fmt::Display) -> rhi::RhiError {
+    rhi::RhiError::InvalidArgument(format!("{e:#}"))
+}
+
+/// A context adopting `device`.
+fn create_context(device: &Device) -> Result<Context> {
+    let desc = device.adopt_desc();
+    let names = desc
+        .enabled_extensions
+        .iter()
+        .map(|n| CString::new(n.as_str()))
+        .collect::<Result<Vec<_>, _>>()?;
+    let name_ptrs: Vec<*const c_char> = names.iter().map(|n| n.as_ptr()).collect();
+    let f = desc.enabled_features;
+    let vulkan = HrtsVulkanDevice {
+        struct_size: size_of::<HrtsVulkanDevice>() as u32,
+        get_instance_proc_addr: Some(desc.get_instance_proc_addr),
+        instance: desc.instance,
+        physical_device: desc.physical_device,
+        device: desc.device,
+        queue_family_index: desc.queue_family_index,
+        queue_index: desc.queue_index,
+        enabled_extensions: name_ptrs.as_ptr(),
+        enabled_extension_count: name_ptrs.len() as u32,
+        geometry_shader: f.geometry_shader,
+        fragment_stores_and_atomics: f.fragment_stores_and_atomics,
+        depth_clamp: f.depth_clamp,
+        debug_utils: desc.debug_utils,
+    };
+    let info = HrtsContextCreateInfo {
+        struct_size: size_of::<HrtsContextCreateInfo>() as u32,
+        api_version: HRTS_API_VERSION,
+        vulkan: &vulkan,
+        device_name_filter: std::ptr::null(),
+        enable_validation: false,
+    };
+    let mut context = std::ptr::null_mut();
+    // SAFETY: valid structs; the names outlive the call; the device outlives the context (the renderer
+    // that holds it borrows nothing but is dropped before the demo's device by every caller).
+    let result = unsafe { hrts_context_create(&info, &mut context) };
+    if result != HrtsResult::Ok {
+        // SAFETY: NULL context: the thread's last error.
+        let message = unsafe { CStr::from_ptr(hrts_last_error(std::ptr::null())) };
+        bail!(
+            "hrts_context_create: {:?} ({})",
+            result,
+            message.to_string_lossy()
+        );
+    }
+    Ok(Context(context))
+}
+
+/// Hands the demo's vertex and index buffers to the plugin, with the scene bounds of `view` (the plugin's
+/// frame origin is their centre, as the demo's).
+fn set_geometry(context: &Context, geometry: &Geometry, view: &View) -> Result<()> {
+    let (vertices, vertex) = geometry.vertices();
+    let (indices, index) = geometry.indices();
+    let draws: Vec<HrtsDraw> = geometry
+        .draws()
+        .iter()
+        .map(|d| HrtsDraw {
+            first_index: d.first_index,
+            index_count: d.index_count,
+            transform: d.model.to_cols_array(),
+        })
+        .collect();
+    let bounds = view.scene.bounds();
+    let mut b = [0.0f32; 6];
+    b[..3].copy_from_slice(&bounds.min.to_array());
+    b[3..].copy_from_slice(&bounds.max.to_array());
+    let g = HrtsVulkanGeometry {
+        struct_size: size_of::<HrtsVulkanGeometry>() as u32,
+        vertex_buffer: vertices.raw_handle(),
+        vertex_buffer_size: vertices.size(),
+        vertex_offset: vertex.offset,
+        vertex_stride: vertex.stride,
+        vertex_count: vertex.count,
+        index_buffer: indices.raw_handle(),
+        index_buffer_size: indices.size(),
+        index_offset: index.offset,
+        index_type: match index.format {
+            passes::IndexFormat::U16 => HrtsIndexType::Uint16,
+            passes::IndexFormat::U32 => HrtsIndexType::Uint32,
+        } as u32,
+        index_count: index.count,
+        draws: draws.as_ptr(),
+        draw_count: draws.len() as u32,
+        bounds: b,
+    };
+    // SAFETY: live context; the buffers live as long as the renderer, which destroys the context first.
+    context.check("hrts_set_geometry_vulkan", unsafe {
+        hrts_set_geometry_vulkan(context.0, &g)
+    })
+}
+
+/// The C configuration of `config`: every field the C ABI has.
+fn c_config(config: &ShadowConfig) -> Result<HrtsConfig> {
+    let extra_outputs = config
+        .extra_outputs
+        .iter()
+        .filter(|&r| r != ResourceId::PrimBuffer)
+        .map(|r| {
+            hrts_resource(r)
+                .map(|h| 1u32 << h as u32)
+                .with_context(|| format!("{} cannot be requested through the C ABI", r.name()))
+        })
+        .sum::<Result<u32>>()?;
+    Ok(HrtsConfig {
+        struct_size: size_of::<HrtsConfig>() as u32,
+        mode: match config.mode {
+            ShadowMode::None => HrtsShadowMode::None,
+            ShadowMode::Hard => HrtsShadowMode::Hard,
+            ShadowMode::Soft => HrtsShadowMode::Soft,
+            ShadowMode::Hybrid => HrtsShadowMode::Hybrid,
+        } as u32,
+        antialiasing: config.antialiasing,
+        static_light: config.static_light,
+        map_size: config.map.size,
+        map_depth: config.map.depth,
+        faces: match config.map.faces {
+            FaceMode::Both => HrtsFaces::Both,
+            FaceMode::FrontOnly => HrtsFaces::FrontOnly,
+        } as u32,
+        raster_path: match config.map.raster {
+            RasterRequest::Auto => HrtsRasterPath::Auto,
+            RasterRequest::Hardware => HrtsRasterPath::Hardware,
+            RasterRequest::Software => HrtsRasterPath::Software,
+            RasterRequest::EmulateTier1 => HrtsRasterPath::EmulatedTier1,
+        } as u32,
+        shadow_map_size: config.shadow_map.size,
+        pcss_angular_radius: config.pcss.angular_radius,
+        pcss_spot_radius: config.pcss.spot_radius,
+        pcss_blocker_search_taps: config.pcss.blocker_search_taps,
+        pcss_pcf_taps: config.pcss.pcf_taps,
+        hybrid_world_space_scale: config.hybrid.world_space_scale,
+        hybrid_hard_shadow_percentage: config.hybrid.hard_shadow_percentage,
+        pcss_filter: match config.pcss.filter {
+            PenumbraFilter::Shrinking => HrtsPenumbraFilter::Shrinking,
+            PenumbraFilter::Standard => HrtsPenumbraFilter::Standard,
+        } as u32,
+        pcss_max_search_radius: config.pcss.max_search_radius,
+        pcss_min_filter_radius: config.pcss.min_filter_radius,
+        pcss_max_filter_radius: config.pcss.max_filter_radius,
+        shadow_map_constant_bias: config.shadow_map.constant_bias,
+        shadow_map_slope_bias: config.shadow_map.slope_bias,
+        dynamic_geometry: !config.static_geometry,
+        extra_outputs,
+        guard_layer: config.map.guard_layer,
+    })
+}
+
+/// The C frame of `inputs`, recorded into `command_buffer`; depth and normal are sampled
+/// (`SHADER_READ_ONLY_OPTIMAL`) and the visibility image is left ready for sampling.
+fn c_frame(command_buffer: u64, inputs: &FrameInputs) -> HrtsFrame {
+    let (light_type, position, direction, view_proj) = match inputs.light {
+        Light::Directional {
+            direction,
+            view_proj,
+        } => (HrtsLightType::Directional, [0.0; 3], direction, view_proj),
+        Light::Spot {
+            position,
+            direction,
+            view_proj,
+        } => (
+            HrtsLightType::Spot,
+            position.to_array(),
+            direction,
+            view_proj,
+        ),
+    };
+    let sampled = S::ShaderResource.raw_layout();
+    HrtsFrame {
+        struct_size: size_of::<HrtsFrame>() as u32,
+        command_buffer,
+        view: inputs.view.to_cols_array(),
+        proj: inputs.proj.to_cols_array(),
+        camera_position: inputs.camera_position.to_array(),
+        light_type: light_type as u32,
+        light_position: position,
+        light_direction: direction.to_array(),
+        light_view_proj: view_proj.to_cols_array(),
+        depth_layout: sampled,
+        normal_layout: sampled,
+        output_layout_before: S::Undefined.raw_layout(),
+        output_layout_after: sampled,
+    }
+}

@@ -1,0 +1,205 @@
+//! The demo drives the plugin through its C ABI (`host_demo::plugin::PluginRenderer`). Its frames equal,
+//! bit for bit, the frames of the Rust passes driven directly (`passes::ShadowRenderer`), for every
+//! output both produce, and its report says the same: what the demo shows is what integrators get.
+
+mod common;
+
+use common::*;
+use host_demo::plugin::PluginRenderer;
+use host_demo::View;
+use passes::{
+    FrameImages, FrameReport, PassId, PassStatus, PrimitiveMapConfig, RasterRequest, ResourceId,
+    ResourceSet, ShadowConfig, ShadowMode, ShadowRenderer,
+};
+use rhi::Device;
+
+/// Elements that differ in their bits, per output (outputs empty on both sides are skipped).
+fn differences(a: &FrameImages, b: &FrameImages) -> Vec<(&'static str, usize)> {
+    fn bits<T: Copy>(v: &[T]) -> Vec<u8> {
+        // SAFETY: plain numbers and arrays of numbers, read as their bytes.
+        unsafe { std::slice::from_raw_parts(v.as_ptr().cast::<u8>(), std::mem::size_of_val(v)) }
+            .to_vec()
+    }
+    fn count(a: Vec<u8>, b: Vec<u8>, size: usize) -> usize {
+        if a.len() != b.len() {
+            return usize::MAX;
+        }
+        a.chunks(size)
+            .zip(b.chunks(size))
+            .filter(|(x, y)| x != y)
+            .count()
+    }
+    vec![
+        ("position", count(bits(&a.position), bits(&b.position), 16)),
+        ("normal", count(bits(&a.normal), bits(&b.normal), 16)),
+        ("depth", count(bits(&a.depth), bits(&b.depth), 4)),
+        (
+            "visibility",
+            count(bits(&a.visibility), bits(&b.visibility), 4),
+        ),
+        (
+            "blocker distance",
+            count(bits(&a.blocker_distance), bits(&b.blocker_distance), 4),
+        ),
+        (
+            "occupancy",
+            count(bits(&a.occupancy), bits(&b.occupancy), 4),
+        ),
+        ("counts", count(bits(&a.counts), bits(&b.counts), 4)),
+        ("indices", count(bits(&a.indices), bits(&b.indices), 4)),
+        (
+            "shadow-map visibility",
+            count(
+                bits(&a.shadow_map_visibility),
+                bits(&b.shadow_map_visibility),
+                4,
+            ),
+        ),
+        ("pcss", count(bits(&a.pcss), bits(&b.pcss), 4)),
+        (
+            "antialiased",
+            count(bits(&a.antialiased), bits(&b.antialiased), 4),
+        ),
+        (
+            "lerp factor",
+            count(bits(&a.lerp_factor), bits(&b.lerp_factor), 4),
+        ),
+        ("hybrid", count(bits(&a.hybrid), bits(&b.hybrid), 4)),
+        ("output", count(bits(&a.output), bits(&b.output), 4)),
+    ]
+}
+
+fn both(
+    device: &Device,
+    view: &View,
+    config: ShadowConfig,
+    frames: usize,
+    with_indices: bool,
+) -> [(FrameReport, FrameImages); 2] {
+    let inputs = view.frame_inputs();
+    let geometry = view.upload(device).expect("upload");
+    let mut direct = ShadowRenderer::new(device, geometry, view.width, view.height, config)
+        .expect("Rust renderer");
+    let mut plugin = PluginRenderer::new(device, view, config).expect("plugin renderer");
+    let mut out = Vec::new();
+    let mut last_direct = None;
+    let mut last_plugin = None;
+    for _ in 0..frames {
+        last_direct = Some(direct.render(device, &inputs).expect("Rust frame"));
+        last_plugin = Some(plugin.render(device, &inputs).expect("plugin frame"));
+    }
+    out.push((
+        last_direct.expect("a frame"),
+        direct.read_back(device, with_indices).expect("read back"),
+    ));
+    out.push((
+        last_plugin.expect("a frame"),
+        plugin.read_back(device, with_indices).expect("read back"),
+    ));
+    out.try_into().unwrap_or_else(|_| unreachable!())
+}
+
+fn check(name: &str, view: &View, config: ShadowConfig, frames: usize, with_indices: bool) {
+    let device = device();
+    let [(direct_report, direct), (plugin_report, plugin)] =
+        both(&device, view, config, frames, with_indices);
+    let diffs = differences(&direct, &plugin);
+    println!("{name}: differing elements per output {diffs:?}");
+    assert!(
+        diffs.iter().all(|&(_, n)| n == 0),
+        "{name}: the C ABI path differs from the Rust path: {diffs:?}"
+    );
+    assert!(!plugin.output.is_empty() && !plugin.depth.is_empty());
+    assert_eq!(
+        direct_report.raster_path, plugin_report.raster_path,
+        "{name}"
+    );
+    assert_eq!(direct_report.stats, plugin_report.stats, "{name}");
+    // The Rust demo renderer keeps the prim buffer for its G-buffer in every mode; the plugin builds it
+    // only when a pass of its plan reads it (the demo, as an engine, draws from its own buffers).
+    let without_prims = |r: &FrameReport| -> Vec<(PassId, PassStatus)> {
+        r.passes
+            .iter()
+            .copied()
+            .filter(|(p, _)| *p != PassId::PrimBuffer)
+            .collect()
+    };
+    assert_eq!(
+        without_prims(&direct_report),
+        without_prims(&plugin_report),
+        "{name}"
+    );
+    if config.mode == ShadowMode::None {
+        assert!(
+            plugin_report
+                .passes
+                .iter()
+                .all(|&(p, s)| (s == PassStatus::Ran) == (p == PassId::FillLit)),
+            "{name}: the plugin runs only the fill: {:?}",
+            plugin_report.passes
+        );
+    }
+    assert_eq!(direct_report.output, plugin_report.output, "{name}");
+    let images = |r: &FrameReport| -> Vec<(ResourceId, u64)> {
+        r.resources
+            .iter()
+            .filter(|r| r.resource != ResourceId::PrimBuffer)
+            .map(|r| (r.resource, r.bytes))
+            .collect()
+    };
+    assert_eq!(images(&direct_report), images(&plugin_report), "{name}");
+    for pass in ["ray trace", "gbuffer", "output copy"] {
+        assert!(
+            !config.mode.eq(&ShadowMode::Hybrid)
+                || plugin_report.timings.iter().any(|t| t.name == pass),
+            "{name}: no GPU time for '{pass}' in {:?}",
+            plugin_report.timings
+        );
+    }
+    assert_no_validation_errors(&device);
+}
+
+#[test]
+fn hybrid_with_comparison_outputs_matches_bit_for_bit() {
+    let view = View::framed(scene::procedural_default(), 200, 140);
+    let config = ShadowConfig {
+        map: PrimitiveMapConfig {
+            size: 512,
+            depth: 16,
+            raster: RasterRequest::Software,
+            ..PrimitiveMapConfig::default()
+        },
+        extra_outputs: ResourceSet::of(&[
+            ResourceId::ShadowMapVisibility,
+            ResourceId::RtVisibility,
+            ResourceId::LerpFactor,
+        ]),
+        ..ShadowConfig::default()
+    };
+    // Two frames: the second skips the up-to-date prim buffer on both paths.
+    check("hybrid, procedural scene", &view, config, 2, false);
+}
+
+#[test]
+fn hard_shadows_of_a_real_mesh_match_bit_for_bit_with_the_index_map() {
+    let bunny = scene::load_obj(&model("02_stanford_bunny_69k.obj")).expect("bunny loads");
+    let view = View::framed(bunny.with_ground_plane(), 160, 120);
+    let config = ShadowConfig::from(PrimitiveMapConfig {
+        size: 256,
+        depth: 8,
+        ..PrimitiveMapConfig::default()
+    });
+    check("hard, bunny with overflow", &view, config, 1, true);
+}
+
+#[test]
+fn soft_and_none_modes_match() {
+    let view = View::framed(scene::procedural_default(), 128, 96);
+    for mode in [ShadowMode::Soft, ShadowMode::None] {
+        let config = ShadowConfig {
+            mode,
+            ..ShadowConfig::default()
+        };
+        check(mode.name(), &view, config, 1, false);
+    }
+}
