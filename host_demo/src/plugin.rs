@@ -23,29 +23,6 @@ use rhi::{
 };
 use std::ffi::{c_char, CStr, CString};
 
-/// The plugin's resources by `HrtsResource` value.
-const RESOURCES: [(HrtsResource, ResourceId); HRTS_RESOURCE_COUNT] = [
-    (HrtsResource::ShadowMap, ResourceId::ShadowMap),
-    (HrtsResource::PrimCountMap, ResourceId::PrimCountMap),
-    (HrtsResource::PrimIndexMap, ResourceId::PrimIndexMap),
-    (HrtsResource::Occupancy, ResourceId::Occupancy),
-    (HrtsResource::RtVisibility, ResourceId::RtVisibility),
-    (HrtsResource::BlockerDistance, ResourceId::BlockerDistance),
-    (
-        HrtsResource::ShadowMapVisibility,
-        ResourceId::ShadowMapVisibility,
-    ),
-    (HrtsResource::Pcss, ResourceId::Pcss),
-    (HrtsResource::RtAntialiased, ResourceId::RtAntialiased),
-    (HrtsResource::LerpFactor, ResourceId::LerpFactor),
-    (HrtsResource::Hybrid, ResourceId::Hybrid),
-    (HrtsResource::Lit, ResourceId::Lit),
-];
-
-fn hrts_resource(id: ResourceId) -> Option<HrtsResource> {
-    RESOURCES.iter().find(|(_, r)| *r == id).map(|&(h, _)| h)
-}
-
 /// "libhrts API major.minor.patch", as the loaded library reports it.
 pub fn api_version() -> String {
     let v = hrts_get_api_version();
@@ -266,12 +243,13 @@ impl PluginRenderer {
                 (p, status)
             })
             .collect();
-        let mut resources: Vec<ResourceReport> = RESOURCES
-            .iter()
-            .filter(|&&(h, _)| r.resource_bytes[h as usize] > 0)
-            .map(|&(h, resource)| ResourceReport {
-                resource,
-                bytes: r.resource_bytes[h as usize],
+        let mut resources: Vec<ResourceReport> = (0..HRTS_RESOURCE_COUNT as u32)
+            .filter(|&h| r.resource_bytes[h as usize] > 0)
+            .filter_map(|h| {
+                resource_from_c(h).map(|resource| ResourceReport {
+                    resource,
+                    bytes: r.resource_bytes[h as usize],
+                })
             })
             .collect();
         if r.prim_buffer_bytes > 0 {
@@ -283,10 +261,7 @@ impl PluginRenderer {
                 },
             );
         }
-        let output = RESOURCES
-            .iter()
-            .find(|(h, _)| *h as u32 == r.output_resource)
-            .map(|&(_, id)| id)
+        let output = resource_from_c(r.output_resource)
             .context("the report names an unknown output resource")?;
         Ok(FrameReport {
             timings,
@@ -320,13 +295,13 @@ impl PluginRenderer {
             .iter()
             .filter(|(_, r)| with_indices || *r != ResourceId::PrimIndexMap)
         {
-            let resource = hrts_resource(id).context("a read-back resource has no C value")?;
+            let resource = resource_to_c(id).context("a read-back resource has no C value")?;
             // SAFETY: plain-old-data C struct; every field is valid zeroed.
             let mut info: HrtsResourceInfo = unsafe { std::mem::zeroed() };
             info.struct_size = size_of::<HrtsResourceInfo>() as u32;
             // SAFETY: live context, valid out pointer.
             self.context.check("hrts_get_resource_info", unsafe {
-                hrts_get_resource_info(self.context.0, resource as u32, &mut info)
+                hrts_get_resource_info(self.context.0, resource, &mut info)
             })?;
             if info.allocated {
                 let buffer = device.create_buffer(
@@ -343,7 +318,7 @@ impl PluginRenderer {
                 let readback = HrtsResourceReadback {
                     struct_size: size_of::<HrtsResourceReadback>() as u32,
                     command_buffer: enc.raw_handle(),
-                    resource: *resource as u32,
+                    resource: *resource,
                     buffer: buffer.raw_handle(),
                     buffer_size: buffer.size(),
                     offset: 0,
@@ -466,8 +441,8 @@ fn c_config(config: &ShadowConfig) -> Result<HrtsConfig> {
         .iter()
         .filter(|&r| r != ResourceId::PrimBuffer)
         .map(|r| {
-            hrts_resource(r)
-                .map(|h| 1u32 << h as u32)
+            resource_to_c(r)
+                .map(|h| 1u32 << h)
                 .with_context(|| format!("{} cannot be requested through the C ABI", r.name()))
         })
         .sum::<Result<u32>>()?;

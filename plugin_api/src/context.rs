@@ -848,7 +848,7 @@ impl Context {
     }
 }
 
-fn resource_id(value: u32) -> ApiResult<ResourceId> {
+pub(crate) fn resource_id(value: u32) -> ApiResult<ResourceId> {
     RESOURCES.get(value as usize).copied().ok_or_else(|| {
         ApiError::new(
             HrtsResult::ErrorInvalidEnum,
@@ -857,7 +857,7 @@ fn resource_id(value: u32) -> ApiResult<ResourceId> {
     })
 }
 
-fn resource_index(id: ResourceId) -> ApiResult<u32> {
+pub(crate) fn resource_index(id: ResourceId) -> ApiResult<u32> {
     RESOURCES
         .iter()
         .position(|&r| r == id)

@@ -106,6 +106,16 @@ fn deref_mut<'a, T>(p: *mut T, name: &str) -> ApiResult<&'a mut T> {
         .ok_or_else(|| ApiError::new(HrtsResult::ErrorNullPointer, format!("{name} is NULL")))
 }
 
+/// For Rust hosts linking the rlib: the pipeline resource an `HrtsResource` value names.
+pub fn resource_from_c(value: u32) -> Option<passes::ResourceId> {
+    context::resource_id(value).ok()
+}
+
+/// For Rust hosts linking the rlib: the `HrtsResource` value of a pipeline resource, if it has one.
+pub fn resource_to_c(id: passes::ResourceId) -> Option<u32> {
+    context::resource_index(id).ok()
+}
+
 /// The library's `HRTS_API_VERSION`.
 #[no_mangle]
 pub extern "C" fn hrts_get_api_version() -> u32 {

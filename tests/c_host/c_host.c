@@ -494,11 +494,8 @@ static void upload_gbuffer(void) {
     free_buffer(normal);
 }
 
-/* Records one plugin frame, submits it and reads the visibility image back into `vis`. */
-static HrtsResult run_frame(HrtsContext *ctx, float *vis) {
-    VkCommandBuffer cmd = begin();
-    HrtsFrame f = frame(cmd);
-    HrtsResult r = hrts_record_frame(ctx, &f);
+/* Copies the visibility image into `vis` (if the recording succeeded), submits `cmd` and waits. */
+static HrtsResult finish_frame(VkCommandBuffer cmd, HrtsResult r, float *vis) {
     Buf back = make_host_buffer(sizeof(float) * W * H, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     if (r == HRTS_RESULT_OK) {
         VkBufferImageCopy region;
@@ -511,9 +508,17 @@ static HrtsResult run_frame(HrtsContext *ctx, float *vis) {
         vkCmdCopyImageToBuffer(cmd, out_img.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, back.buffer, 1, &region);
     }
     submit_and_wait(cmd);
-    if (vis) memcpy(vis, back.map, sizeof(float) * W * H);
+    if (vis && r == HRTS_RESULT_OK) memcpy(vis, back.map, sizeof(float) * W * H);
     free_buffer(back);
     return r;
+}
+
+/* Records one plugin frame, submits it and reads the visibility image back into `vis`. */
+static HrtsResult run_frame(HrtsContext *ctx, float *vis) {
+    VkCommandBuffer cmd = begin();
+    HrtsFrame f = frame(cmd);
+    HrtsResult r = hrts_record_frame(ctx, &f);
+    return finish_frame(cmd, r, vis);
 }
 
 /* Records one frame pass by pass (one hrts_record_passes call per HrtsPass, into one command buffer), or
@@ -533,21 +538,7 @@ static HrtsResult run_frame_in_parts(HrtsContext *ctx, float *vis, int one_by_on
         f = frame(cmd);
         if (r == HRTS_RESULT_OK) r = hrts_record_passes(ctx, &f, HRTS_PASS_MASK_SCREEN_SPACE);
     }
-    Buf back = make_host_buffer(sizeof(float) * W * H, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-    if (r == HRTS_RESULT_OK) {
-        VkBufferImageCopy region;
-        memset(&region, 0, sizeof region);
-        region.imageSubresource.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
-        region.imageSubresource.layerCount = 1;
-        region.imageExtent.width = W;
-        region.imageExtent.height = H;
-        region.imageExtent.depth = 1;
-        vkCmdCopyImageToBuffer(cmd, out_img.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, back.buffer, 1, &region);
-    }
-    submit_and_wait(cmd);
-    if (vis) memcpy(vis, back.map, sizeof(float) * W * H);
-    free_buffer(back);
-    return r;
+    return finish_frame(cmd, r, vis);
 }
 
 /* Reads a plugin resource of the last complete frame back through hrts_record_resource_readback. */
