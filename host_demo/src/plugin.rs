@@ -13,9 +13,8 @@ use passes::gbuffer::{GBufferPass, GBufferTargets};
 use passes::gpu_types::{GBufferPush, MapStats};
 use passes::prim_buffer::PrimBufferPass;
 use passes::{
-    camera_in_frame, read_images, FaceMode, FrameImages, FrameInputs, FrameOutput, FrameReport,
-    Geometry, Light, PassId, PassStatus, PenumbraFilter, RasterPath, RasterRequest, ResourceId,
-    ResourceReport, ShadowConfig, ShadowMode, SkipReason,
+    camera_in_frame, read_images, FrameImages, FrameInputs, FrameOutput, FrameReport, Geometry,
+    Light, PassId, PassStatus, RasterPath, ResourceId, ResourceReport, ShadowConfig, SkipReason,
 };
 use rhi::{
     Barrier, BufferUsage, ConservativeRasterTier, Device, Format, GpuTimer, Image, ImageDesc,
@@ -101,7 +100,7 @@ impl PluginRenderer {
             usage: ImageUsage::COPY_DST | ImageUsage::COPY_SRC | ImageUsage::SAMPLED,
         })?;
         let context = create_context(device)?;
-        let hrts_config = c_config(&config)?;
+        let hrts_config = config_to_c(&config).map_err(anyhow::Error::msg)?;
         // SAFETY: live context, valid struct.
         context.check("hrts_configure", unsafe {
             hrts_configure(context.0, &hrts_config)
@@ -431,62 +430,6 @@ fn set_geometry(context: &Context, geometry: &Geometry, view: &View) -> Result<(
     // SAFETY: live context; the buffers live as long as the renderer, which destroys the context first.
     context.check("hrts_set_geometry_vulkan", unsafe {
         hrts_set_geometry_vulkan(context.0, &g)
-    })
-}
-
-/// The C configuration of `config`: every field the C ABI has.
-fn c_config(config: &ShadowConfig) -> Result<HrtsConfig> {
-    let extra_outputs = config
-        .extra_outputs
-        .iter()
-        .filter(|&r| r != ResourceId::PrimBuffer)
-        .map(|r| {
-            resource_to_c(r)
-                .map(|h| 1u32 << h)
-                .with_context(|| format!("{} cannot be requested through the C ABI", r.name()))
-        })
-        .sum::<Result<u32>>()?;
-    Ok(HrtsConfig {
-        struct_size: size_of::<HrtsConfig>() as u32,
-        mode: match config.mode {
-            ShadowMode::None => HrtsShadowMode::None,
-            ShadowMode::Hard => HrtsShadowMode::Hard,
-            ShadowMode::Soft => HrtsShadowMode::Soft,
-            ShadowMode::Hybrid => HrtsShadowMode::Hybrid,
-        } as u32,
-        antialiasing: config.antialiasing,
-        static_light: config.static_light,
-        map_size: config.map.size,
-        map_depth: config.map.depth,
-        faces: match config.map.faces {
-            FaceMode::Both => HrtsFaces::Both,
-            FaceMode::FrontOnly => HrtsFaces::FrontOnly,
-        } as u32,
-        raster_path: match config.map.raster {
-            RasterRequest::Auto => HrtsRasterPath::Auto,
-            RasterRequest::Hardware => HrtsRasterPath::Hardware,
-            RasterRequest::Software => HrtsRasterPath::Software,
-            RasterRequest::EmulateTier1 => HrtsRasterPath::EmulatedTier1,
-        } as u32,
-        shadow_map_size: config.shadow_map.size,
-        pcss_angular_radius: config.pcss.angular_radius,
-        pcss_spot_radius: config.pcss.spot_radius,
-        pcss_blocker_search_taps: config.pcss.blocker_search_taps,
-        pcss_pcf_taps: config.pcss.pcf_taps,
-        hybrid_world_space_scale: config.hybrid.world_space_scale,
-        hybrid_hard_shadow_percentage: config.hybrid.hard_shadow_percentage,
-        pcss_filter: match config.pcss.filter {
-            PenumbraFilter::Shrinking => HrtsPenumbraFilter::Shrinking,
-            PenumbraFilter::Standard => HrtsPenumbraFilter::Standard,
-        } as u32,
-        pcss_max_search_radius: config.pcss.max_search_radius,
-        pcss_min_filter_radius: config.pcss.min_filter_radius,
-        pcss_max_filter_radius: config.pcss.max_filter_radius,
-        shadow_map_constant_bias: config.shadow_map.constant_bias,
-        shadow_map_slope_bias: config.shadow_map.slope_bias,
-        dynamic_geometry: !config.static_geometry,
-        extra_outputs,
-        guard_layer: config.map.guard_layer,
     })
 }
 

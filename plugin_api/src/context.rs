@@ -1103,58 +1103,63 @@ fn taps(value: u32, field: &str) -> ApiResult<u32> {
     }
 }
 
+/// `HrtsShadowMode` values and the modes they name (both directions use this one table).
+const MODES: [(u32, ShadowMode); 4] = [
+    (HrtsShadowMode::None as u32, ShadowMode::None),
+    (HrtsShadowMode::Hard as u32, ShadowMode::Hard),
+    (HrtsShadowMode::Soft as u32, ShadowMode::Soft),
+    (HrtsShadowMode::Hybrid as u32, ShadowMode::Hybrid),
+];
+
+/// `HrtsFaces` values.
+const FACES: [(u32, FaceMode); 2] = [
+    (HrtsFaces::Both as u32, FaceMode::Both),
+    (HrtsFaces::FrontOnly as u32, FaceMode::FrontOnly),
+];
+
+/// `HrtsRasterPath` values as requests.
+const RASTER_REQUESTS: [(u32, RasterRequest); 4] = [
+    (HrtsRasterPath::Auto as u32, RasterRequest::Auto),
+    (HrtsRasterPath::Hardware as u32, RasterRequest::Hardware),
+    (HrtsRasterPath::Software as u32, RasterRequest::Software),
+    (
+        HrtsRasterPath::EmulatedTier1 as u32,
+        RasterRequest::EmulateTier1,
+    ),
+];
+
+/// `HrtsPenumbraFilter` values.
+const FILTERS: [(u32, PenumbraFilter); 2] = [
+    (
+        HrtsPenumbraFilter::Shrinking as u32,
+        PenumbraFilter::Shrinking,
+    ),
+    (
+        HrtsPenumbraFilter::Standard as u32,
+        PenumbraFilter::Standard,
+    ),
+];
+
+/// The C value of `value` in `table` (every table covers its whole Rust enum).
+fn c_value<T: PartialEq>(value: T, table: &[(u32, T)]) -> u32 {
+    table
+        .iter()
+        .find(|(_, t)| *t == value)
+        .map_or(u32::MAX, |&(c, _)| c)
+}
+
 /// The plugin's configuration from the C one (every field checked).
 fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
     check_size::<HrtsConfig>(c.struct_size, "HrtsConfig")?;
-    let mode = enum_value(
-        c.mode,
-        &[
-            (HrtsShadowMode::None as u32, ShadowMode::None),
-            (HrtsShadowMode::Hard as u32, ShadowMode::Hard),
-            (HrtsShadowMode::Soft as u32, ShadowMode::Soft),
-            (HrtsShadowMode::Hybrid as u32, ShadowMode::Hybrid),
-        ],
-        "mode",
-        "HrtsShadowMode",
-    )?;
-    let faces = enum_value(
-        c.faces,
-        &[
-            (HrtsFaces::Both as u32, FaceMode::Both),
-            (HrtsFaces::FrontOnly as u32, FaceMode::FrontOnly),
-        ],
-        "faces",
-        "HrtsFaces",
-    )?;
+    let mode = enum_value(c.mode, &MODES, "mode", "HrtsShadowMode")?;
+    let faces = enum_value(c.faces, &FACES, "faces", "HrtsFaces")?;
     let raster = enum_value(
         c.raster_path,
-        &[
-            (HrtsRasterPath::Auto as u32, RasterRequest::Auto),
-            (HrtsRasterPath::Hardware as u32, RasterRequest::Hardware),
-            (HrtsRasterPath::Software as u32, RasterRequest::Software),
-            (
-                HrtsRasterPath::EmulatedTier1 as u32,
-                RasterRequest::EmulateTier1,
-            ),
-        ],
+        &RASTER_REQUESTS,
         "raster_path",
         "HrtsRasterPath",
     )?;
-    let filter = enum_value(
-        c.pcss_filter,
-        &[
-            (
-                HrtsPenumbraFilter::Shrinking as u32,
-                PenumbraFilter::Shrinking,
-            ),
-            (
-                HrtsPenumbraFilter::Standard as u32,
-                PenumbraFilter::Standard,
-            ),
-        ],
-        "pcss_filter",
-        "HrtsPenumbraFilter",
-    )?;
+    let filter = enum_value(c.pcss_filter, &FILTERS, "pcss_filter", "HrtsPenumbraFilter")?;
     if c.extra_outputs >> HRTS_RESOURCE_COUNT != 0 {
         return Err(ApiError::new(
             HrtsResult::ErrorInvalidEnum,
@@ -1207,41 +1212,49 @@ fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
     Ok(config)
 }
 
+/// The C configuration of `config`, the inverse of [`shadow_config`]. Fails if an extra output has no
+/// `HrtsResource` value.
+pub(crate) fn config_to_c(config: &ShadowConfig) -> ApiResult<HrtsConfig> {
+    let extra_outputs = config.extra_outputs.iter().try_fold(0u32, |bits, r| {
+        resource_index(r).map(|i| bits | 1 << i).map_err(|_| {
+            invalid(format!(
+                "{} cannot be requested through the C ABI",
+                r.name()
+            ))
+        })
+    })?;
+    Ok(HrtsConfig {
+        struct_size: std::mem::size_of::<HrtsConfig>() as u32,
+        mode: c_value(config.mode, &MODES),
+        antialiasing: config.antialiasing,
+        static_light: config.static_light,
+        map_size: config.map.size,
+        map_depth: config.map.depth,
+        faces: c_value(config.map.faces, &FACES),
+        raster_path: c_value(config.map.raster, &RASTER_REQUESTS),
+        shadow_map_size: config.shadow_map.size,
+        pcss_angular_radius: config.pcss.angular_radius,
+        pcss_spot_radius: config.pcss.spot_radius,
+        pcss_blocker_search_taps: config.pcss.blocker_search_taps,
+        pcss_pcf_taps: config.pcss.pcf_taps,
+        hybrid_world_space_scale: config.hybrid.world_space_scale,
+        hybrid_hard_shadow_percentage: config.hybrid.hard_shadow_percentage,
+        pcss_filter: c_value(config.pcss.filter, &FILTERS),
+        pcss_max_search_radius: config.pcss.max_search_radius,
+        pcss_min_filter_radius: config.pcss.min_filter_radius,
+        pcss_max_filter_radius: config.pcss.max_filter_radius,
+        shadow_map_constant_bias: config.shadow_map.constant_bias,
+        shadow_map_slope_bias: config.shadow_map.slope_bias,
+        dynamic_geometry: !config.static_geometry,
+        extra_outputs,
+        guard_layer: config.map.guard_layer,
+    })
+}
+
 /// Fills `out` with the defaults of [`ShadowConfig::default`].
 pub(crate) fn config_defaults(out: &mut HrtsConfig) -> ApiResult<()> {
     check_size::<HrtsConfig>(out.struct_size, "HrtsConfig")?;
-    let d = ShadowConfig::default();
-    out.mode = match d.mode {
-        ShadowMode::None => HrtsShadowMode::None,
-        ShadowMode::Hard => HrtsShadowMode::Hard,
-        ShadowMode::Soft => HrtsShadowMode::Soft,
-        ShadowMode::Hybrid => HrtsShadowMode::Hybrid,
-    } as u32;
-    out.antialiasing = d.antialiasing;
-    out.static_light = d.static_light;
-    out.map_size = d.map.size;
-    out.map_depth = d.map.depth;
-    out.faces = HrtsFaces::Both as u32;
-    out.raster_path = HrtsRasterPath::Auto as u32;
-    out.shadow_map_size = d.shadow_map.size;
-    out.pcss_angular_radius = d.pcss.angular_radius;
-    out.pcss_spot_radius = d.pcss.spot_radius;
-    out.pcss_blocker_search_taps = d.pcss.blocker_search_taps;
-    out.pcss_pcf_taps = d.pcss.pcf_taps;
-    out.hybrid_world_space_scale = d.hybrid.world_space_scale;
-    out.hybrid_hard_shadow_percentage = d.hybrid.hard_shadow_percentage;
-    out.pcss_filter = match d.pcss.filter {
-        PenumbraFilter::Shrinking => HrtsPenumbraFilter::Shrinking,
-        PenumbraFilter::Standard => HrtsPenumbraFilter::Standard,
-    } as u32;
-    out.pcss_max_search_radius = d.pcss.max_search_radius;
-    out.pcss_min_filter_radius = d.pcss.min_filter_radius;
-    out.pcss_max_filter_radius = d.pcss.max_filter_radius;
-    out.shadow_map_constant_bias = d.shadow_map.constant_bias;
-    out.shadow_map_slope_bias = d.shadow_map.slope_bias;
-    out.dynamic_geometry = !d.static_geometry;
-    out.extra_outputs = 0;
-    out.guard_layer = d.map.guard_layer;
+    *out = config_to_c(&ShadowConfig::default())?;
     Ok(())
 }
 
@@ -1307,38 +1320,26 @@ mod tests {
     }
 
     #[test]
-    fn default_config_round_trips() {
-        let mut c: HrtsConfig = blank_config();
+    fn configurations_round_trip_through_c() {
+        let mut c = config_to_c(&ShadowConfig::default()).expect("defaults");
         config_defaults(&mut c).expect("defaults");
         assert_eq!(shadow_config(&c).expect("valid"), ShadowConfig::default());
-    }
-
-    fn blank_config() -> HrtsConfig {
-        HrtsConfig {
-            struct_size: std::mem::size_of::<HrtsConfig>() as u32,
-            mode: 0,
+        let mut other = ShadowConfig {
+            mode: ShadowMode::Soft,
             antialiasing: false,
-            static_light: false,
-            map_size: 0,
-            map_depth: 0,
-            faces: 0,
-            raster_path: 0,
-            shadow_map_size: 0,
-            pcss_angular_radius: 0.0,
-            pcss_spot_radius: 0.0,
-            pcss_blocker_search_taps: 0,
-            pcss_pcf_taps: 0,
-            hybrid_world_space_scale: 0.0,
-            hybrid_hard_shadow_percentage: 0.0,
-            pcss_filter: 0,
-            pcss_max_search_radius: 0.0,
-            pcss_min_filter_radius: 0.0,
-            pcss_max_filter_radius: 0.0,
-            shadow_map_constant_bias: 0.0,
-            shadow_map_slope_bias: 0.0,
-            dynamic_geometry: false,
-            extra_outputs: 0,
-            guard_layer: false,
-        }
+            static_geometry: false,
+            static_light: true,
+            extra_outputs: ResourceSet::of(&[ResourceId::RtVisibility, ResourceId::Lit]),
+            ..ShadowConfig::default()
+        };
+        other.map.faces = FaceMode::FrontOnly;
+        other.map.raster = RasterRequest::EmulateTier1;
+        other.map.guard_layer = true;
+        other.pcss.filter = PenumbraFilter::Standard;
+        other.shadow_map.slope_bias = 2.5;
+        let c = config_to_c(&other).expect("representable");
+        assert_eq!(shadow_config(&c).expect("valid"), other);
+        other.extra_outputs = ResourceSet::of(&[ResourceId::PrimBuffer]);
+        assert!(config_to_c(&other).is_err());
     }
 }

@@ -116,6 +116,12 @@ pub fn resource_to_c(id: passes::ResourceId) -> Option<u32> {
     context::resource_index(id).ok()
 }
 
+/// For Rust hosts linking the rlib: the C configuration of a Rust one (the inverse of what
+/// `hrts_configure` reads), or why it has none.
+pub fn config_to_c(config: &passes::ShadowConfig) -> Result<HrtsConfig, String> {
+    context::config_to_c(config).map_err(|e| e.message)
+}
+
 /// The library's `HRTS_API_VERSION`.
 #[no_mangle]
 pub extern "C" fn hrts_get_api_version() -> u32 {
