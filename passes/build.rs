@@ -32,6 +32,8 @@ fn stage_of(path: &Path) -> ShaderStage {
         Some("geom") => ShaderStage::Geometry,
         Some("frag") => ShaderStage::Fragment,
         Some("comp") => ShaderStage::Compute,
+        Some("rgen") => ShaderStage::RayGeneration,
+        Some("rmiss") => ShaderStage::Miss,
         other => panic!("unknown shader stage {other:?} for {}", path.display()),
     }
 }

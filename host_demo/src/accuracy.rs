@@ -2,99 +2,87 @@
 //! against exact conservative binning, and ray-traced visibility against exact visibility.
 
 use crate::View;
-use glam::DVec3;
-use passes::{FrameImages, FrameInputs, PrimitiveMapConfig};
+use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
+use passes::{FrameImages, PrimitiveMapConfig, GUARD_WORDS};
 use reference::{
     conservative_texel_sets, overlaps_texel_with_margin, reference_visibility, FaceSelection,
     Light, PixelClass, RefScene, VisibilityParams,
 };
 
-/// Margin (texels) within which an extra primitive-map entry is legitimate: the software path accepts
-/// texels grown by 1/512 texel; allow the f32 projection error on top.
-pub const EXTRA_MARGIN_TEXELS: f64 = 1.0 / 256.0;
+/// Margin (texels) within which an extra primitive-map entry is legitimate: every binning path accepts
+/// texels grown by 1/512 texel plus the f32 projection error bound, and bins a sliver thinner than 1/16
+/// texel as the segment of its longest edge grown by its thickness.
+pub const EXTRA_MARGIN_TEXELS: f64 = 1.0 / 16.0 + 1.0 / 128.0;
 
 /// Outcome of comparing a GPU primitive map with the exact conservative sets.
 #[derive(Debug, Default, PartialEq, Eq)]
 pub struct MapComparison {
-    /// Texels compared (not overflowed).
+    /// Texels compared (their lists fit the capacity).
     pub texels: usize,
-    /// Required triangles absent from a texel's list.
+    /// Required triangles absent from a texel's list (counted only for maps built without receiver
+    /// culling; see [`passes::PrimitiveMapConfig::receiver_culling`]).
     pub missing: usize,
     /// Entries beyond the exact set but within the path's margin of the texel.
     pub extra_within_margin: usize,
     /// Entries out of range, duplicated, or not touching the texel even with the margin.
     pub garbage: usize,
-    /// Texels whose count exceeded d (their lists are checked for garbage only).
-    pub overflowed: usize,
-    /// Required triangles absent from a texel's list that the path is allowed to drop (see
-    /// [`compare_map_excusing`]); not counted in `missing`.
-    pub missing_excused: usize,
+    /// Texels whose list did not fit the entry capacity (traced exhaustively; not compared).
+    pub past_capacity: usize,
+    /// Zero-area triangles (two equal vertices) absent from lists: culled by design, never a blocker.
+    pub missing_degenerate: usize,
 }
 
-/// Compares every texel's list with the exact conservative set, for the light matrix fitted to the view.
+/// The light matrix (world to light NDC) of the primitive map's fitted grid: the report's frame-to-texel
+/// transform, with the frame origin and the texel-to-NDC scale composed in f64.
+pub fn fitted_light_matrix(map_to_texels: Mat4, origin: DVec3, n: u32) -> DMat4 {
+    let to_ndc = DMat4::from_cols(
+        DVec4::new(2.0 / f64::from(n), 0.0, 0.0, 0.0),
+        DVec4::new(0.0, 2.0 / f64::from(n), 0.0, 0.0),
+        DVec4::new(0.0, 0.0, 1.0, 0.0),
+        DVec4::new(-1.0, -1.0, 0.0, 1.0),
+    );
+    to_ndc * map_to_texels.as_dmat4() * DMat4::from_translation(-origin)
+}
+
+/// Compares every texel's list with the exact conservative set of the fitted grid (`light`: see
+/// [`fitted_light_matrix`]): entries must lie within [`EXTRA_MARGIN_TEXELS`] of their texel (every
+/// binning path grows texels by 1/512 texel plus its rounding bound). Missing triangles are looked for
+/// only in a map built without receiver culling; with it, only the entries are checked (garbage).
 pub fn compare_map(
     rs: &RefScene,
-    view: &View,
+    light: DMat4,
+    light_direction: Vec3,
     config: &PrimitiveMapConfig,
     images: &FrameImages,
     faces: FaceSelection,
-) -> MapComparison {
-    compare_map_with(rs, &view.frame_inputs(), config, images, faces)
-}
-
-/// [`compare_map`] for the light matrix and direction of `inputs` (e.g. a light matrix that is not fitted
-/// to the scene).
-pub fn compare_map_with(
-    rs: &RefScene,
-    inputs: &FrameInputs,
-    config: &PrimitiveMapConfig,
-    images: &FrameImages,
-    faces: FaceSelection,
-) -> MapComparison {
-    compare_map_excusing(
-        rs,
-        inputs,
-        config,
-        images,
-        faces,
-        EXTRA_MARGIN_TEXELS,
-        &|_| false,
-    )
-}
-
-/// [`compare_map_with`] for a path whose coverage may exceed the exact set by `margin` texels (1/256 for
-/// the software path and Tier 2/3 hardware, 1/2 for Tier 1), where a missing triangle for which
-/// `excused` is true is counted in `missing_excused` instead of `missing` (e.g. triangles D3D12 Tier 1
-/// may cull after snapping).
-pub fn compare_map_excusing(
-    rs: &RefScene,
-    inputs: &FrameInputs,
-    config: &PrimitiveMapConfig,
-    images: &FrameImages,
-    faces: FaceSelection,
-    margin: f64,
-    excused: &dyn Fn(u32) -> bool,
 ) -> MapComparison {
     let n = config.size;
-    let d = config.depth as usize;
-    let sets = conservative_texel_sets(
-        rs,
-        inputs.light.view_proj(),
-        inputs.light.direction(),
-        n,
-        faces,
-    );
+    let sets = conservative_texel_sets(rs, light, light_direction, n, faces);
     let tri_count = rs.triangle_count() as u32;
-    let plane = (n * n) as usize;
+    let degenerate = |i: u32| {
+        let [a, b, c] = rs.triangle(i as usize);
+        a == b || b == c || c == a
+    };
+    let guard = if config.guard {
+        GUARD_WORDS as usize
+    } else {
+        0
+    };
+    let capacity = images.list_entries.len().saturating_sub(guard);
     let mut c = MapComparison::default();
     for y in 0..n {
         for x in 0..n {
             let t = (y * n + x) as usize;
-            let count = images.counts[t] as usize;
-            let stored: Vec<u32> = (0..count.min(d))
-                .map(|s| images.indices[s * plane + t])
-                .collect();
-            let mut sorted = stored.clone();
+            let (begin, end) = (
+                images.list_offsets[t] as usize,
+                images.list_offsets[t + 1] as usize,
+            );
+            if end > capacity {
+                c.past_capacity += 1;
+                continue;
+            }
+            let stored = &images.list_entries[begin..end];
+            let mut sorted = stored.to_vec();
             sorted.sort_unstable();
             sorted.dedup();
             c.garbage += stored.len() - sorted.len();
@@ -103,22 +91,20 @@ pub fn compare_map_excusing(
                 if i >= tri_count {
                     c.garbage += 1;
                 } else if exact.binary_search(&i).is_err() {
-                    if overlaps_texel_with_margin(rs, inputs.light.view_proj(), n, i, x, y, margin)
-                    {
+                    if overlaps_texel_with_margin(rs, light, n, i, x, y, EXTRA_MARGIN_TEXELS) {
                         c.extra_within_margin += 1;
                     } else {
                         c.garbage += 1;
                     }
                 }
             }
-            if count > d {
-                c.overflowed += 1;
+            c.texels += 1;
+            if config.receiver_culling {
                 continue;
             }
-            c.texels += 1;
             for &i in exact.iter().filter(|i| sorted.binary_search(i).is_err()) {
-                if excused(i) {
-                    c.missing_excused += 1;
+                if degenerate(i) {
+                    c.missing_degenerate += 1;
                 } else {
                     c.missing += 1;
                 }

@@ -10,8 +10,8 @@ use crate::{parse_vec3, View};
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
 use passes::{
-    FrameImages, HybridConfig, PcssConfig, PenumbraFilter, PrimitiveMapConfig, RasterRequest,
-    ResourceId, ResourceSet, ShadowConfig, ShadowMapConfig, ShadowMode,
+    FrameImages, HybridConfig, PcssConfig, PenumbraFilter, PrimitiveMapConfig, ResourceId,
+    ResourceSet, ShadowConfig, ShadowMapConfig, ShadowMode,
 };
 use rhi::Device;
 use scene::Camera;
@@ -68,10 +68,8 @@ enum Show {
 }
 
 fn panels(wss: f32) -> Vec<Panel> {
-    let map = |depth| PrimitiveMapConfig {
-        size: 1024,
-        depth,
-        raster: RasterRequest::Auto,
+    let map = |size| PrimitiveMapConfig {
+        size,
         ..PrimitiveMapConfig::default()
     };
     let sm = |size| ShadowMapConfig {
@@ -98,16 +96,16 @@ fn panels(wss: f32) -> Vec<Panel> {
         extra_outputs: ResourceSet::of(&[ResourceId::ShadowMapVisibility]),
         ..base
     };
-    let traced = |depth| ShadowConfig {
+    let traced = |size| ShadowConfig {
         mode: ShadowMode::Hard,
         antialiasing: false,
-        map: map(depth),
+        map: map(size),
         ..base
     };
     let hybrid_with = |filter| ShadowConfig {
         mode: ShadowMode::Hybrid,
         antialiasing: true,
-        map: map(64),
+        map: map(1024),
         shadow_map: sm(3072),
         pcss: pcss(filter),
         extra_outputs: ResourceSet::of(&[ResourceId::LerpFactor, ResourceId::RtVisibility]),
@@ -129,18 +127,18 @@ fn panels(wss: f32) -> Vec<Panel> {
             note: "same test and bias (in texels) at 8192x8192",
         },
         Panel {
-            file: "ray_traced_1k_64.png",
-            label: "RAY TRACED 1Kx1Kx64",
-            config: traced(64),
+            file: "ray_traced_1k.png",
+            label: "RAY TRACED 1K",
+            config: traced(1024),
             show: Show::RayTrace,
-            note: "deep primitive map 1024x1024x64, ray-traced visibility, no FXAA",
+            note: "primitive map 1024x1024 fitted to the receivers, exact lists, no FXAA",
         },
         Panel {
-            file: "ray_traced_1k_32.png",
-            label: "RAY TRACED 1Kx1Kx32",
-            config: traced(32),
+            file: "ray_traced_256.png",
+            label: "RAY TRACED 256",
+            config: traced(256),
             show: Show::RayTrace,
-            note: "deep primitive map 1024x1024x32 (overflowed texels are traced exhaustively)",
+            note: "primitive map 256x256: longer lists, the same exact shadow",
         },
         Panel {
             file: "pcss_3k.png",
@@ -264,7 +262,7 @@ pub fn compare_to_folder(device: &Device, args: &CompareArgs) -> Result<()> {
             .filter(|(name, _)| {
                 ["shadow map", "ray trace", "PCSS", "FXAA", "shadow map test"]
                     .contains(&name.as_str())
-                    || name.starts_with("primitive map (")
+                    || name.starts_with("primitive map")
             })
             .map(|(name, ms)| format!("{name} {ms:.2} ms"))
             .collect();

@@ -11,19 +11,20 @@
 //! - **contact gap**: the largest screen distance between a lit receiver in a contact shadow and the
 //!   footprint edge it should start at (peter-panning), which must stay below one pixel;
 //! - **differing pixels** from the untransformed scene, for translated and scaled copies;
-//! - the guard layer past slot d, which must hold [`GUARD_VALUE`] everywhere.
+//! - the guard words past the entry capacity, which must hold [`GUARD_VALUE`] everywhere.
 //!
 //! The integration test `tests/tests/hard_cases.rs` calls [`run_cases`] too, so the table and the tests
 //! cannot drift apart.
 
-use crate::accuracy::{absolute_tolerance, compare_map_with, compare_visibility};
+use crate::accuracy::{absolute_tolerance, compare_map, compare_visibility, fitted_light_matrix};
 use crate::output::write_png;
 use crate::plugin::PluginRenderer;
 use crate::View;
 use anyhow::{anyhow, bail, Context, Result};
 use glam::{DMat4, DVec2, DVec3, Mat4};
 use passes::{
-    FaceMode, FrameImages, FrameInputs, Light, PrimitiveMapConfig, RasterRequest, GUARD_VALUE,
+    BinningRequest, FaceMode, FrameImages, FrameInputs, Light, PrimitiveMapConfig,
+    DEFAULT_ENTRY_BUDGET, GUARD_VALUE, GUARD_WORDS,
 };
 use reference::{FaceSelection, RefScene};
 use rhi::Device;
@@ -94,7 +95,7 @@ pub struct Outcome {
     /// What stopped the case, if anything did.
     pub error: Option<String>,
     /// Raster path used.
-    pub raster_path: &'static str,
+    pub binning_path: &'static str,
     /// Wall-clock seconds (render, read-back and all comparisons).
     pub seconds: f64,
 }
@@ -232,10 +233,18 @@ impl Outcome {
 /// with that case's image. With `previews`, writes a shaded PNG per case there (analytic failures red).
 pub fn run_cases(device: &Device, cases: &[HardCase], previews: Option<&Path>) -> Vec<Outcome> {
     let mut bases = HashMap::new();
-    cases
+    let bar = crate::progress(cases.len() as u64, "hard cases");
+    let outcomes = cases
         .iter()
-        .map(|c| run_case(device, c, &mut bases, previews))
-        .collect()
+        .map(|c| {
+            bar.set_message(c.name);
+            let o = run_case(device, c, &mut bases, previews);
+            bar.inc(1);
+            o
+        })
+        .collect();
+    bar.finish_and_clear();
+    outcomes
 }
 
 /// Visibility images and near-edge masks of the cases run so far, by name.
@@ -292,22 +301,39 @@ fn measure(
     }
     let config = PrimitiveMapConfig {
         size: case.map.size,
-        depth: case.map.depth,
         faces: if case.map.front_faces_only {
             FaceMode::FrontOnly
         } else {
             FaceMode::Both
         },
-        raster: RasterRequest::Auto,
-        guard_layer: case.map.guard_layer,
+        binning: BinningRequest::Auto,
+        entry_budget: case
+            .map
+            .entry_budget
+            .map_or(DEFAULT_ENTRY_BUDGET, |entries| {
+                (u64::from(entries)
+                    + if case.map.guard {
+                        u64::from(GUARD_WORDS)
+                    } else {
+                        0
+                    })
+                    * 4
+            }),
+        guard: case.map.guard,
+        receiver_culling: case.map.receiver_culling,
+        ..PrimitiveMapConfig::default()
     };
     let mut renderer =
         PluginRenderer::new(device, &view, config).context("creating the renderer")?;
-    let report = renderer.render(device, &inputs).context("rendering")?;
+    let mut report = renderer.render(device, &inputs).context("rendering")?;
+    if report.stats.texels_past_capacity > 0 && case.map.overflow == Overflow::Forbidden {
+        // The lists grew to what this frame needed: the next frame, as an engine's would, fits.
+        report = renderer.render(device, &inputs).context("rendering")?;
+    }
     let images = renderer.read_back(device, true).context("reading back")?;
-    o.raster_path = report.raster_path.name();
-    o.overflowed_texels = report.stats.overflowed_texels;
-    o.max_count = report.stats.max_count;
+    o.binning_path = report.binning_path.name();
+    o.overflowed_texels = report.stats.texels_past_capacity;
+    o.max_count = report.stats.longest_list;
     o.overflow = Some(case.map.overflow);
 
     let rs = RefScene::new(&view.scene);
@@ -324,17 +350,32 @@ fn measure(
         FaceMode::FrontOnly => FaceSelection::FrontOnly,
         FaceMode::Both => FaceSelection::Both,
     };
-    let m = compare_map_with(&rs, &inputs, &config, &images, faces);
+    let light = fitted_light_matrix(
+        report.map_to_texels,
+        renderer.geometry().origin(),
+        config.size,
+    );
+    let m = compare_map(
+        &rs,
+        light,
+        inputs.light.direction(),
+        &config,
+        &images,
+        faces,
+    );
     o.map_missing = m.missing;
     o.map_garbage = m.garbage;
-    if config.guard_layer {
-        let plane = (config.size * config.size) as usize;
-        let layer = config.depth as usize * plane;
-        let guard = images
-            .indices
-            .get(layer..layer + plane)
-            .ok_or_else(|| anyhow!("the index read-back has no guard layer"))?;
-        o.guard_written = Some(guard.iter().filter(|&&i| i != GUARD_VALUE).count());
+    if config.guard {
+        let capacity = images
+            .list_entries
+            .len()
+            .saturating_sub(GUARD_WORDS as usize);
+        o.guard_written = Some(
+            images.list_entries[capacity..]
+                .iter()
+                .filter(|&&i| i != GUARD_VALUE)
+                .count(),
+        );
     }
 
     let probe = Probe::new(&view, &inputs, &images);
@@ -706,12 +747,9 @@ pub struct HardcasesArgs {
     /// texel-boundaries, frustum-border, coplanar, thin-geometry, models, non-finite, overflow.
     #[arg(long, value_parser = parse_family)]
     pub family: Vec<Family>,
-    /// Leave out the heavy cases, as the integration tests do.
+    /// The models folder (default: `HRTS_MODELS`, else `../shared/models` beside the checkout).
     #[arg(long)]
-    pub skip_heavy: bool,
-    /// The shared model folder.
-    #[arg(long, default_value = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/models"))]
-    pub models: PathBuf,
+    pub models: Option<PathBuf>,
     /// Write a shaded preview PNG of every case into this folder (pixels failing an analytic check in red).
     #[arg(long)]
     pub previews: Option<PathBuf>,
@@ -741,17 +779,20 @@ pub fn run_cli(
     } else {
         args.family.clone()
     };
+    let models = match &args.models {
+        Some(dir) => dir.clone(),
+        None => scene::models_dir().map_err(anyhow::Error::msg)?,
+    };
     let cases: Vec<HardCase> = families
         .iter()
-        .flat_map(|&f| scene::hard_cases::family(f, &args.models))
-        .filter(|c| !(args.skip_heavy && c.heavy))
+        .flat_map(|&f| scene::hard_cases::family(f, &models))
         .collect();
     let start = Instant::now();
     let outcomes = run_cases(&device, &cases, args.previews.as_deref());
     let caps = device.capabilities();
     let path = outcomes
         .iter()
-        .map(|o| o.raster_path)
+        .map(|o| o.binning_path)
         .find(|p| !p.is_empty())
         .unwrap_or("none");
     println!(
@@ -960,7 +1001,7 @@ mod tests {
         let pass = Outcome {
             name: "a | b",
             pixels: 10,
-            raster_path: "software",
+            binning_path: "software",
             ..Outcome::default()
         };
         let rejected = Outcome {

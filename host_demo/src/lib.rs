@@ -7,7 +7,9 @@ pub mod compare;
 pub mod hardcases;
 pub mod images;
 pub mod output;
+pub mod peer;
 pub mod plugin;
+pub mod ray_dump;
 pub mod render;
 pub mod report;
 pub mod tiers;
@@ -94,6 +96,15 @@ impl View {
     pub fn frame_origin(&self) -> DVec3 {
         self.scene.bounds().center().as_dvec3()
     }
+}
+
+/// A progress bar of `len` steps on stderr for long runs (hidden when stderr is not a terminal).
+pub fn progress(len: u64, what: &str) -> indicatif::ProgressBar {
+    let style = indicatif::ProgressStyle::with_template("{msg} {bar:30} {pos}/{len} ({elapsed})")
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+    indicatif::ProgressBar::new(len)
+        .with_style(style)
+        .with_message(what.to_owned())
 }
 
 /// Bounds of every object but one named "ground" (all of the scene if that is all there is).

@@ -3,9 +3,9 @@
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 use glam::Vec3;
-use host_demo::render::{parse_faces, parse_raster, render_to_folder, RenderOptions};
+use host_demo::render::{parse_binning, parse_faces, render_to_folder, RenderOptions};
 use host_demo::{parse_vec3, View};
-use passes::{FaceMode, PrimitiveMapConfig, RasterRequest};
+use passes::{BinningRequest, FaceMode, PrimitiveMapConfig};
 use rhi::Device;
 use scene::{Camera, DirectionalLight};
 use std::path::PathBuf;
@@ -82,21 +82,27 @@ struct RenderArgs {
     /// Camera target "x,y,z" (default: the scene centre).
     #[arg(long, value_parser = parse_vec3)]
     camera_target: Option<Vec3>,
-    /// Primitive map size N (N×N texels).
+    /// Primitive map size N: texels per side of the light-space grid fitted to the visible receivers (moves
+    /// cost, never exactness).
     #[arg(long, default_value_t = 1024)]
     map_size: u32,
-    /// Primitive map depth d (triangles per texel).
-    #[arg(long, default_value_t = 32)]
-    map_depth: u32,
+    /// Largest memory of the primitive map's list entries, in MiB (the lists grow to what frames need).
+    #[arg(long, default_value_t = 256)]
+    map_budget_mb: u32,
     /// Faces stored: both (open geometry) or front (closed meshes only).
     #[arg(long, default_value = "both", value_parser = parse_faces)]
     faces: FaceMode,
-    /// Conservative raster path: auto, hw or sw.
-    #[arg(long, default_value = "auto", value_parser = parse_raster)]
-    raster: RasterRequest,
+    /// Binning path of the primitive map: auto (compute), compute, hw (hardware conservative raster) or
+    /// sw (geometry-shader conservative raster).
+    #[arg(long, default_value = "auto", value_parser = parse_binning)]
+    binning: BinningRequest,
     /// Frames to render (timings are medians over all but the first).
     #[arg(long, default_value_t = 5)]
     frames: u32,
+    /// Also write the frame's shadow rays and triangles (rays.f32, triangles.f32, rays.json) for
+    /// scripts/embree_compare.py.
+    #[arg(long)]
+    dump_rays: bool,
     #[command(flatten)]
     soft: host_demo::render::SoftShadowArgs,
 }
@@ -145,15 +151,19 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
     let options = RenderOptions {
         map: PrimitiveMapConfig {
             size: args.map_size,
-            depth: args.map_depth,
             faces: args.faces,
-            raster: args.raster,
-            guard_layer: false,
+            binning: args.binning,
+            entry_budget: u64::from(args.map_budget_mb) << 20,
+            ..PrimitiveMapConfig::default()
         },
         frames: args.frames,
         soft: args.soft.clone(),
     };
     render_to_folder(&device, &view, &options, &args.out)?;
+    if args.dump_rays {
+        let dump = host_demo::ray_dump::write_ray_dump(&view, &view.frame_inputs(), &args.out)?;
+        println!("ray dump: {dump:?}");
+    }
     host_demo::check_validation(&device)
 }
 
@@ -185,13 +195,12 @@ fn main() -> ExitCode {
                 &d,
                 &host_demo::tiers::standard_scenes(models)?,
                 256,
-                1024,
             )?;
             println!("{}", host_demo::tiers::markdown(&d, &rows));
             if rows.iter().all(|r| r.passed()) {
                 Ok(())
             } else {
-                bail!("a raster path missed triangles of the exact conservative set")
+                bail!("a binning path missed triangles of the exact conservative set")
             }
         }),
     };

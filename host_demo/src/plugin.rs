@@ -8,17 +8,19 @@
 
 use crate::View;
 use anyhow::{bail, Context as _, Result};
+use glam::Mat4;
 use hrts::*;
 use passes::gbuffer::{GBufferPass, GBufferTargets};
-use passes::gpu_types::{GBufferPush, MapStats};
+use passes::gpu_types::GBufferPush;
 use passes::prim_buffer::PrimBufferPass;
+use passes::MapStats;
 use passes::{
-    camera_in_frame, read_images, FrameImages, FrameInputs, FrameOutput, FrameReport, Geometry,
-    Light, PassId, PassStatus, RasterPath, ResourceId, ResourceReport, ShadowConfig, SkipReason,
+    camera_in_frame, read_images, BinningPath, FrameImages, FrameInputs, FrameOutput, FrameReport,
+    Geometry, Light, PassId, PassStatus, ResourceId, ResourceReport, ShadowConfig, SkipReason,
 };
 use rhi::{
-    Barrier, BufferUsage, ConservativeRasterTier, Device, Format, GpuTimer, Image, ImageDesc,
-    ImageUsage, MemoryLocation, PassTiming, ResourceState as S,
+    Barrier, Buffer, BufferUsage, ConservativeRasterTier, Device, Format, GpuTimer, Image,
+    ImageDesc, ImageUsage, MemoryLocation, PassTiming, ResourceState as S,
 };
 use std::ffi::{c_char, CStr, CString};
 
@@ -136,9 +138,27 @@ impl PluginRenderer {
         })
     }
 
-    /// Renders one frame and waits for it: the demo's prim buffer (first frame, or every frame with
-    /// dynamic geometry), the plugin's light-space passes, the demo's G-buffer, the plugin's screen-space
-    /// passes and output copy. Returns the plugin's report plus the G-buffer's GPU time.
+    /// The demo's prim buffer (`GpuTriangle`s relative to the frame origin), filled by the first frame.
+    pub fn prims(&self) -> &Buffer {
+        self.prim_buffer.prims()
+    }
+
+    /// The demo's G-buffer; after a frame, depth and normal are in `ShaderResource` state.
+    pub fn targets(&self) -> &GBufferTargets {
+        &self.targets
+    }
+
+    /// The scene's geometry as uploaded.
+    pub fn geometry(&self) -> &Geometry {
+        &self.geometry
+    }
+
+    /// Renders one frame and waits for it, in two submissions: the demo's prim buffer (first frame, or
+    /// every frame with dynamic geometry), the plugin's light-space passes and the demo's G-buffer; then
+    /// the plugin's screen-space passes (primitive map, ray trace, soft shadows) and output copy. Returns
+    /// the plugin's report plus the G-buffer's GPU time and [`SCREEN_SPACE_WALL`], the host's wall clock
+    /// of the second submission (what a CPU device such as lavapipe spends on it: its timestamps do not
+    /// see compute work).
     pub fn render(&mut self, device: &Device, inputs: &FrameInputs) -> Result<FrameReport> {
         let (view_proj_rel, camera_frame) = camera_in_frame(inputs, self.geometry.origin())?;
         let push = GBufferPush {
@@ -183,11 +203,21 @@ impl PluginRenderer {
                     after: S::ShaderResource,
                 },
             ]);
+            Ok(())
+        })?;
+        let start = std::time::Instant::now();
+        device.submit_and_wait(|enc| {
+            let frame = c_frame(enc.raw_handle(), inputs);
             self.record_passes(&frame, HRTS_PASS_MASK_SCREEN_SPACE)
         })?;
+        let wall = start.elapsed().as_secs_f64() * 1e3;
         self.frames += 1;
         let mut report = self.report()?;
         report.timings.extend(self.timer.resolve()?);
+        report.timings.push(PassTiming {
+            name: SCREEN_SPACE_WALL.into(),
+            ms: wall,
+        });
         Ok(report)
     }
 
@@ -218,12 +248,13 @@ impl PluginRenderer {
                 ms: p.milliseconds,
             })
             .collect();
-        let raster_path = match r.raster_path {
-            v if v == HrtsRasterPath::Software as u32 => RasterPath::Software,
-            v if v == HrtsRasterPath::EmulatedTier1 as u32 => RasterPath::EmulatedTier1 {
+        let binning_path = match r.binning_path {
+            v if v == HrtsBinningPath::Software as u32 => BinningPath::Software,
+            v if v == HrtsBinningPath::Compute as u32 => BinningPath::Compute,
+            v if v == HrtsBinningPath::EmulatedTier1 as u32 => BinningPath::EmulatedTier1 {
                 native: self.native_tier,
             },
-            _ => RasterPath::Hardware(match r.tier {
+            _ => BinningPath::Hardware(match r.tier {
                 1 => ConservativeRasterTier::Tier1,
                 2 => ConservativeRasterTier::Tier2,
                 _ => ConservativeRasterTier::Tier3,
@@ -264,13 +295,18 @@ impl PluginRenderer {
             .context("the report names an unknown output resource")?;
         Ok(FrameReport {
             timings,
-            raster_path,
+            binning_path,
             stats: MapStats {
-                overflowed_texels: r.overflowed_texels,
-                max_count: r.max_count,
-                occupied_texels: r.occupied_texels,
-                stored_entries: r.stored_entries,
+                receiver_pixels: r.receiver_pixels,
+                receiver_texels: r.receiver_texels,
+                triangles_binned: r.triangles_binned,
+                texels_with_list: r.texels_with_list,
+                longest_list: r.longest_list,
+                entries: r.entries,
+                capacity: r.entry_capacity,
+                texels_past_capacity: r.texels_past_capacity,
             },
+            map_to_texels: Mat4::from_cols_array(&r.map_to_texels),
             passes,
             resources,
             output,
@@ -278,9 +314,9 @@ impl PluginRenderer {
     }
 
     /// Reads back the last frame: the demo's G-buffer and visibility image, and every plugin resource of
-    /// [`FrameImages`] the configuration allocates (the index map only if `with_indices`) through
+    /// [`FrameImages`] the configuration allocates (the list entries only if `with_entries`) through
     /// `hrts_record_resource_readback`.
-    pub fn read_back(&self, device: &Device, with_indices: bool) -> Result<FrameImages> {
+    pub fn read_back(&self, device: &Device, with_entries: bool) -> Result<FrameImages> {
         let mut own = self.targets.outputs();
         own.push((&self.output, S::ShaderResource, FrameOutput::Output));
         let images: Vec<(&Image, S)> = own.iter().map(|&(i, s, _)| (i, s)).collect();
@@ -289,11 +325,16 @@ impl PluginRenderer {
         for ((_, _, output), bytes) in own.iter().zip(read_images(device, &images)?) {
             frame.insert(*output, &bytes, origin);
         }
-        let mut wanted = Vec::new();
-        for &(output, id) in FrameOutput::PIPELINE
+        let mut sources: Vec<(Destination, ResourceId)> = FrameOutput::PIPELINE
             .iter()
-            .filter(|(_, r)| with_indices || *r != ResourceId::PrimIndexMap)
-        {
+            .map(|&(output, id)| (Destination::Image(output), id))
+            .collect();
+        sources.push((Destination::ListOffsets, ResourceId::PrimListOffsets));
+        if with_entries {
+            sources.push((Destination::ListEntries, ResourceId::PrimListEntries));
+        }
+        let mut wanted = Vec::new();
+        for &(output, id) in &sources {
             let resource = resource_to_c(id).context("a read-back resource has no C value")?;
             // SAFETY: plain-old-data C struct; every field is valid zeroed.
             let mut info: HrtsResourceInfo = unsafe { std::mem::zeroed() };
@@ -331,11 +372,31 @@ impl PluginRenderer {
             Ok(())
         })?;
         for (output, _, buffer) in &wanted {
-            frame.insert(*output, buffer.read()?, origin);
+            let bytes = buffer.read()?;
+            match *output {
+                Destination::Image(image) => frame.insert(image, bytes, origin),
+                Destination::ListOffsets => {
+                    frame.list_offsets = bytemuck::pod_collect_to_vec(bytes)
+                }
+                Destination::ListEntries => {
+                    frame.list_entries = bytemuck::pod_collect_to_vec(bytes)
+                }
+            }
         }
         Ok(frame)
     }
 }
+
+/// Where a read-back resource goes in [`FrameImages`].
+#[derive(Clone, Copy)]
+enum Destination {
+    Image(FrameOutput),
+    ListOffsets,
+    ListEntries,
+}
+
+/// Timing name of the host's wall clock around the screen-space submission of a frame.
+pub const SCREEN_SPACE_WALL: &str = "screen-space submission (wall clock)";
 
 /// An error while recording, in the form `Device::submit_and_wait` passes on.
 fn recording_error(e: impl std::fmt::Display) -> rhi::RhiError {

@@ -6,8 +6,8 @@ use crate::plugin::PluginRenderer;
 use crate::{focus_bounds, View};
 use anyhow::{Context, Result};
 use passes::{
-    FaceMode, FrameReport, HybridConfig, PassId, PassStatus, PcssConfig, PenumbraFilter,
-    PrimitiveMapConfig, RasterRequest, ResourceId, ResourceSet, ShadowConfig, ShadowMapConfig,
+    BinningRequest, FaceMode, FrameReport, HybridConfig, PassId, PassStatus, PcssConfig,
+    PenumbraFilter, PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig, ShadowMapConfig,
     ShadowMode, SkipReason,
 };
 use rhi::Device;
@@ -148,14 +148,20 @@ struct LightJson {
 #[derive(Serialize)]
 struct MapJson {
     size: u32,
-    depth: u32,
     faces: &'static str,
-    raster_path: &'static str,
+    binning_path: &'static str,
     tier: &'static str,
-    overflowed_texels: u32,
-    max_count: u32,
-    occupied_texels: u32,
-    stored_entries: u32,
+    /// Frame coordinates to homogeneous texel space, fitted to the receivers (16 floats, column-major).
+    to_texels: [f32; 16],
+    receiver_pixels: u32,
+    receiver_texels: u32,
+    triangles_binned: u32,
+    texels_with_list: u32,
+    entries: u32,
+    mean_list: f64,
+    longest_list: u32,
+    entry_capacity: u32,
+    texels_past_capacity: u32,
     memory_bytes: u64,
 }
 
@@ -277,9 +283,12 @@ pub fn render_to_folder(
         PluginRenderer::new(device, view, config).context("creating the shadow passes")?;
     let inputs = view.frame_inputs();
     let mut reports = Vec::new();
+    let bar = crate::progress(u64::from(options.frames.max(1)), "frames");
     for _ in 0..options.frames.max(1) {
         reports.push(renderer.render(device, &inputs).context("rendering")?);
+        bar.inc(1);
     }
+    bar.finish_and_clear();
     let images = renderer.read_back(device, false).context("reading back")?;
     let (w, h, n) = (view.width, view.height, options.map.size);
     write_exr_rgba(&out.join("position.exr"), w, h, &images.position)?;
@@ -340,18 +349,23 @@ pub fn render_to_folder(
         },
         primitive_map: MapJson {
             size: n,
-            depth: options.map.depth,
             faces: match options.map.faces {
                 FaceMode::Both => "both",
                 FaceMode::FrontOnly => "front",
             },
-            raster_path: report.raster_path.name(),
-            tier: report.raster_path.tier().name(),
-            overflowed_texels: stats.overflowed_texels,
-            max_count: stats.max_count,
-            occupied_texels: stats.occupied_texels,
-            stored_entries: stats.stored_entries,
-            memory_bytes: options.map.memory_bytes(),
+            binning_path: report.binning_path.name(),
+            tier: report.binning_path.tier().name(),
+            to_texels: report.map_to_texels.to_cols_array(),
+            receiver_pixels: stats.receiver_pixels,
+            receiver_texels: stats.receiver_texels,
+            triangles_binned: stats.triangles_binned,
+            texels_with_list: stats.texels_with_list,
+            entries: stats.entries,
+            mean_list: stats.mean_list(),
+            longest_list: stats.longest_list,
+            entry_capacity: stats.capacity,
+            texels_past_capacity: stats.texels_past_capacity,
+            memory_bytes: map_bytes(&report),
         },
         shadows: SoftJson {
             mode: s.mode.name(),
@@ -395,25 +409,27 @@ pub fn render_to_folder(
         );
     } else {
         println!(
-            "scene: {} triangles, {}x{} px; primitive map {}x{}x{} ({} path, tier {}), {} overflowed texels, max count {}",
+            "scene: {} triangles, {}x{} px; primitive map {n}x{n} fitted to {} receiver texels ({} binning, tier {}): \
+             {} of {} triangles binned, {} entries in {} lists (mean {:.1}, longest {}), {:.1} MiB",
             view.scene.triangle_count(),
             w,
             h,
-            n,
-            n,
-            options.map.depth,
-            report.raster_path.name(),
-            report.raster_path.tier().name(),
-            stats.overflowed_texels,
-            stats.max_count
+            stats.receiver_texels,
+            report.binning_path.name(),
+            report.binning_path.tier().name(),
+            stats.triangles_binned,
+            view.scene.triangle_count(),
+            stats.entries,
+            stats.texels_with_list,
+            stats.mean_list(),
+            stats.longest_list,
+            map_bytes(&report) as f64 / f64::from(1 << 20)
         );
-        if stats.overflowed_texels > 0 {
+        if stats.texels_past_capacity > 0 {
             println!(
-                "note: {} texels hold more than d = {} triangles; they stay exact but are traced against every \
-                 triangle (slow): --map-depth {} avoids it",
-                stats.overflowed_texels,
-                options.map.depth,
-                stats.max_count.next_power_of_two()
+                "note: {} texels did not fit the entry capacity of {} this frame; they stayed exact, traced \
+                 against every triangle, and the lists grow to fit from the next frame on",
+                stats.texels_past_capacity, stats.capacity
             );
         }
     }
@@ -505,13 +521,31 @@ pub fn filter_name(f: PenumbraFilter) -> &'static str {
     }
 }
 
-/// Parses the raster request of the command line.
-pub fn parse_raster(s: &str) -> Result<RasterRequest, String> {
+/// Bytes of the primitive map's resources in a frame report.
+pub fn map_bytes(report: &FrameReport) -> u64 {
+    report
+        .resources
+        .iter()
+        .filter(|r| {
+            matches!(
+                r.resource,
+                ResourceId::PrimListOffsets | ResourceId::PrimListEntries | ResourceId::Occupancy
+            )
+        })
+        .map(|r| r.bytes)
+        .sum()
+}
+
+/// Parses the binning request of the command line.
+pub fn parse_binning(s: &str) -> Result<BinningRequest, String> {
     match s {
-        "auto" => Ok(RasterRequest::Auto),
-        "hw" | "hardware" => Ok(RasterRequest::Hardware),
-        "sw" | "software" => Ok(RasterRequest::Software),
-        _ => Err(format!("unknown raster path '{s}' (auto, hw, sw)")),
+        "auto" => Ok(BinningRequest::Auto),
+        "compute" => Ok(BinningRequest::Compute),
+        "hw" | "hardware" => Ok(BinningRequest::Hardware),
+        "sw" | "software" => Ok(BinningRequest::Software),
+        _ => Err(format!(
+            "unknown binning path '{s}' (auto, compute, hw, sw)"
+        )),
     }
 }
 

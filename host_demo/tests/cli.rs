@@ -91,7 +91,7 @@ fn missing_file_and_bad_options_are_clear_errors() {
     assert_clean_failure(&output, &stderr, "--light-dir");
     let output = host_demo(&[
         "render",
-        "--map-depth",
+        "--map-budget-mb",
         "0",
         "--width",
         "16",
@@ -101,7 +101,7 @@ fn missing_file_and_bad_options_are_clear_errors() {
         dir.to_str().unwrap(),
     ]);
     let stderr = String::from_utf8_lossy(&output.stderr);
-    assert_clean_failure(&output, &stderr, "depth");
+    assert_clean_failure(&output, &stderr, "budget");
 }
 
 #[test]
@@ -155,8 +155,10 @@ fn render_writes_every_output() {
     assert_eq!(json["camera"]["proj"].as_array().unwrap().len(), 16);
     assert_eq!(json["light"]["type"], "directional");
     assert_eq!(json["primitive_map"]["size"], 128);
-    assert_eq!(json["primitive_map"]["raster_path"], "software");
-    assert!(json["primitive_map"]["overflowed_texels"].is_u64());
+    assert_eq!(json["primitive_map"]["binning_path"], "compute");
+    assert_eq!(json["primitive_map"]["texels_past_capacity"], 0);
+    assert!(json["primitive_map"]["entries"].as_u64().unwrap() > 0);
+    assert!(json["primitive_map"]["longest_list"].as_u64().unwrap() > 0);
     assert!(json["gpu_ms"]["ray trace"].as_f64().unwrap() > 0.0);
     assert!(!json["device"]["name"].as_str().unwrap().is_empty());
 }

@@ -1,30 +1,46 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Occupancy view of the deep primitive map — black empty, grey levels count/d, white full (count == d),
-// red where the list overflowed (count > d) — and the map statistics of the frame report.
-#include "map_stats.glsl"
+// Occupancy view of the primitive map and its statistics for the frame report. Colours: black without a
+// list, grey levels the list length on a log scale (white at OCCUPANCY_WHITE entries or more), dark blue
+// texels with ray origins but an empty list, red texels past the entry capacity (traced exhaustively).
+#include "map_state.glsl"
+
+#define OCCUPANCY_WHITE 256.0
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(set = 0, binding = 0, r32ui) uniform readonly uimage2D count_map;
-layout(set = 0, binding = 1, rgba8) uniform writeonly image2D occupancy;
-layout(set = 0, binding = 2) buffer Stats { MapStats stats; };
-layout(push_constant) uniform Push { uint size; uint depth; } pc;
+layout(set = 0, binding = 0) readonly buffer Offsets { uint offsets[]; };
+layout(set = 0, binding = 1) readonly buffer Receivers { uint receiver[]; };
+layout(set = 0, binding = 2, rgba8) uniform writeonly image2D occupancy;
+layout(set = 0, binding = 3) buffer State { MapState ms; };
+layout(push_constant) uniform Push { uint size; } pc;
 
 void main() {
-    ivec2 t = ivec2(gl_GlobalInvocationID.xy);
-    if (t.x >= int(pc.size) || t.y >= int(pc.size)) {
+    uvec2 t = gl_GlobalInvocationID.xy;
+    if (t.x >= pc.size || t.y >= pc.size) {
         return;
     }
-    uint count = imageLoad(count_map, t).r;
-    bool overflow = count > pc.depth;
-    vec4 colour = overflow ? vec4(1.0, 0.0, 0.0, 1.0) : vec4(vec3(float(count) / float(pc.depth)), 1.0);
-    imageStore(occupancy, t, colour);
-    if (count > 0u) {
-        atomicAdd(stats.occupied_texels, 1u);
-        atomicAdd(stats.stored_entries, min(count, pc.depth));
-        atomicMax(stats.max_count, count);
+    uint texel = t.y * pc.size + t.x;
+    uint count = offsets[texel + 1u] - offsets[texel];
+    bool past = offsets[texel + 1u] > ms.totals.z;
+    bool receives = receiver[texel] != 0u;
+    vec4 colour = vec4(vec3(min(log2(1.0 + float(count)) / log2(1.0 + OCCUPANCY_WHITE), 1.0)), 1.0);
+    if (past) {
+        colour = vec4(1.0, 0.0, 0.0, 1.0);
+    } else if (count == 0u && receives) {
+        colour = vec4(0.0, 0.0, 0.25, 1.0);
     }
-    if (overflow) {
-        atomicAdd(stats.overflowed_texels, 1u);
+    imageStore(occupancy, ivec2(t), colour);
+    if (count > 0u) {
+        atomicAdd(ms.stats.x, 1u);
+        atomicMax(ms.stats.y, count);
+    }
+    if (past && count > 0u) {
+        atomicAdd(ms.stats.z, 1u);
+    }
+    if (receives) {
+        atomicAdd(ms.stats.w, 1u);
+    }
+    if (texel == 0u) {
+        ms.totals.y = offsets[pc.size * pc.size];
     }
 }

@@ -4,11 +4,11 @@
 // that are degenerate after the rasterizer snaps vertices to its sub-pixel grid (8 bits: 1/256 texel).
 // This pass snaps the same way and drops those triangles; everything else goes to the hardware
 // conservative rasterizer unchanged. The zero-area test uses exact 64-bit integer products.
-#include "prim_map_push.glsl"
+#include "map_push.glsl"
 
 layout(triangles) in;
 layout(triangle_strip, max_vertices = 3) out;
-layout(push_constant) uniform Push { PrimMapPush pc; };
+layout(push_constant) uniform Push { MapPush pc; };
 
 // Exact sign of a.x * b.y - a.y * b.x for integer vectors.
 int cross_sign(ivec2 a, ivec2 b) {

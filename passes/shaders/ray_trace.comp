@@ -12,7 +12,8 @@
 //   `precise` so that a shared edge gives exactly opposite values in both triangles: a ray through an edge
 //   or vertex of a closed mesh always hits at least one triangle. Zero-determinant (degenerate or
 //   edge-on) triangles are rejected without dividing.
-// - Overflowed texels (count > d) are traced exhaustively against the whole prim buffer: exact, slower.
+// - The list of the ray origin's texel holds every triangle that may cross the ray (see map_bin.glsl);
+//   texels past the entry capacity are traced exhaustively against the whole prim buffer: exact, slower.
 // - Directional light: the ray runs along -light_dir without end. Spot light: the ray runs from the offset
 //   origin to the light position and only hits before it count (t < distance). The texel is the ray
 //   origin's under the light's projection: orthographic or perspective, every point of the shadow ray
@@ -20,6 +21,7 @@
 //   the centre of projection.
 #include "triangle.glsl"
 #include "ray_trace_constants.glsl"
+#include "map_state.glsl"
 
 #define CONSIDER1(i) if ((i) < total) { consider((i), nearest); }
 #define CONSIDER4(i) CONSIDER1(i) CONSIDER1((i) + 1u) CONSIDER1((i) + 2u) CONSIDER1((i) + 3u)
@@ -28,11 +30,14 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform Constants { RayTraceConstants k; };
 layout(set = 0, binding = 1) uniform sampler2D depth_tex;
 layout(set = 0, binding = 2) uniform sampler2D normal_tex;
-layout(set = 0, binding = 3, r32ui) uniform readonly uimage2D count_map;
-layout(set = 0, binding = 4, r32ui) uniform readonly uimage2DArray index_map;
-layout(set = 0, binding = 5) readonly buffer Prims { Triangle tris[]; };
-layout(set = 0, binding = 6, r32f) uniform writeonly image2D visibility;
-layout(set = 0, binding = 7, r32f) uniform writeonly image2D blocker;
+layout(set = 0, binding = 3) readonly buffer State { MapState ms; };
+layout(set = 0, binding = 4) readonly buffer PixelTexels { uint pixel_texel[]; };
+layout(set = 0, binding = 5) readonly buffer Offsets { uint offsets[]; };
+layout(set = 0, binding = 6) readonly buffer Entries { uint entries[]; };
+layout(set = 0, binding = 7) readonly buffer Prims { Triangle tris[]; };
+layout(set = 0, binding = 8, r32f) uniform writeonly image2D visibility;
+layout(set = 0, binding = 9, r32f) uniform writeonly image2D blocker;
+#include "shadow_ray.glsl"
 
 // Ray in Woop's sheared space.
 int kx, ky, kz;
@@ -126,60 +131,31 @@ void main() {
     if (px.x >= int(k.dims.x) || px.y >= int(k.dims.y)) {
         return;
     }
-    float depth = texelFetch(depth_tex, px, 0).r;
-    vec4 normal = texelFetch(normal_tex, px, 0);
-    if (depth <= 0.0 || normal.w == 0.0) {
-        write(px, 1.0, -1.0);   // background: lit, no blocker
+    vec3 o, dir;
+    float t_max;
+    int ray = shadow_ray(px, o, dir, t_max);
+    if (ray != SHADOW_RAY_TRACE) {
+        write(px, ray == SHADOW_RAY_LIT ? 1.0 : 0.0, ray == SHADOW_RAY_LIT ? -1.0 : 0.0);
         return;
-    }
-    vec2 ndc = (vec2(px) + 0.5) / vec2(k.dims.xy) * 2.0 - 1.0;
-    vec4 h = k.inv_view_proj_rel * vec4(ndc, depth, 1.0);
-    vec3 rel = h.xyz / h.w;
-    vec3 p = k.camera_pos.xyz + rel;
-    bool spot = k.light_pos.w != 0.0;
-    vec3 to_light = spot ? k.light_pos.xyz - p : -k.light_dir.xyz;
-    vec3 n = normal.xyz;
-    if (dot(n, to_light) <= 0.0) {
-        write(px, 0.0, 0.0);    // the visible side faces away from the light
-        return;
-    }
-    vec3 ap = abs(p);
-    float delta = length(rel) * k.offset.x * k.offset.y + max(max(ap.x, ap.y), ap.z) * k.offset.z;
-    vec3 o = p + n * delta;
-    // Hits count only before t_max: the light position for a spot light, nowhere for a directional one.
-    float t_max = 1.0 / 0.0;
-    vec3 dir = to_light;
-    if (spot) {
-        vec3 d = k.light_pos.xyz - o;
-        t_max = length(d);
-        if (!(t_max > 0.0)) {
-            write(px, 1.0, -1.0);   // the receiver is at the emitter
-            return;
-        }
-        dir = d / t_max;
     }
     setup_ray(o, dir);
-
-    vec4 lc = k.light_view_proj * vec4(o, 1.0);
-    if (!(lc.w > 0.0)) {
-        write(px, 1.0, -1.0);   // behind a spot light: outside its frustum
+    // The texel the receiver pass placed this ray origin in (the one whose list it filled).
+    uint texel = pixel_texel[uint(px.y) * k.dims.x + uint(px.x)];
+    if (texel == TEXEL_OUTSIDE) {
+        write(px, 1.0, -1.0);   // outside the light's frustum: no recorded occluder
         return;
     }
-    vec2 uv = (lc.xy / lc.w * 0.5 + 0.5) * float(k.dims.z);
-    if (any(lessThan(uv, vec2(0.0))) || any(greaterThanEqual(uv, vec2(float(k.dims.z))))) {
-        write(px, 1.0, -1.0);   // outside the light's map: no recorded occluder
-        return;
-    }
-    ivec2 texel = ivec2(uv);
-    uint count = imageLoad(count_map, texel).r;
     float nearest = t_max;
-    if (count <= k.dims.w) {
-        for (uint i = 0u; i < count; ++i) {
-            consider(imageLoad(index_map, ivec3(texel, int(i))).r, nearest);
+    uint begin = texel == TEXEL_NO_RAY ? 0u : offsets[texel];
+    uint end = texel == TEXEL_NO_RAY ? 0u : offsets[texel + 1u];
+    if (texel != TEXEL_NO_RAY && end <= ms.totals.z) {
+        for (uint i = begin; i < end; ++i) {
+            consider(entries[i], nearest);
         }
     } else {
-        // Unrolled 16x by hand: llvmpipe (lavapipe) silently ends a shader's loops after 65535 iterations
-        // in total, which would drop every triangle past that index; unrolled, its cap is 1M triangles.
+        // Past the entry capacity (or, never seen, a pixel the receiver pass gave no ray): exhaustive and
+        // exact. Unrolled 16x by hand: llvmpipe (lavapipe) silently ends a shader's loops after 65535
+        // iterations in total, which would drop every triangle past that index; unrolled, its cap is 1M.
         uint total = min(k.misc.y, uint(tris.length()));
         for (uint base = 0u; base < total; base += 16u) {
             CONSIDER4(base) CONSIDER4(base + 4u) CONSIDER4(base + 8u) CONSIDER4(base + 12u)

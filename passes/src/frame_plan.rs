@@ -71,9 +71,10 @@ ids!(
         PrimBuffer = "prim buffer",
         /// Depth from the light (the conventional shadow map), square, for PCSS.
         ShadowMap = "shadow map",
-        /// Clear and conservative raster of the deep primitive map.
+        /// The primitive map: receivers placed and fitted, triangles culled, counted, scanned and binned into
+        /// exact per-texel lists.
         PrimitiveMap = "primitive map",
-        /// Occupancy view and statistics of the primitive map (overflow goes into the frame report).
+        /// Occupancy view and statistics of the primitive map (entries, list lengths, capacity).
         Occupancy = "occupancy",
         /// Shadow rays through the primitive map: hard visibility and blocker distance.
         RayTrace = "ray trace",
@@ -107,10 +108,10 @@ ids!(
         PrimBuffer = "prim buffer",
         /// Light-space depth, `D32_SFLOAT`, size².
         ShadowMap = "shadow map",
-        /// Prim count map, N² `u32`.
-        PrimCountMap = "prim count map",
-        /// Prim index map, N²·d `u32`.
-        PrimIndexMap = "prim index map",
+        /// Primitive map list offsets, N² + 1 `u32` (with the receiver map, per-pixel texels and the fit).
+        PrimListOffsets = "prim list offsets",
+        /// Primitive map list entries: triangle indices, as many as the frame needs.
+        PrimListEntries = "prim list entries",
         /// Occupancy view N² RGBA8 and the map statistics.
         Occupancy = "occupancy",
         /// Ray-traced visibility (1 = lit).
@@ -250,14 +251,19 @@ fn io(pass: PassId, request: &PlanRequest, hard_edge: HardEdge) -> (ResourceSet,
         PassId::PrimBuffer => (vec![R::SceneGeometry], vec![R::PrimBuffer]),
         PassId::ShadowMap => (vec![R::PrimBuffer, R::Light], vec![R::ShadowMap]),
         PassId::PrimitiveMap => (
-            vec![R::PrimBuffer, R::Light],
-            vec![R::PrimCountMap, R::PrimIndexMap],
+            [&screen[..], &[R::PrimBuffer, R::Light]].concat(),
+            vec![R::PrimListOffsets, R::PrimListEntries],
         ),
-        PassId::Occupancy => (vec![R::PrimCountMap], vec![R::Occupancy]),
+        PassId::Occupancy => (vec![R::PrimListOffsets], vec![R::Occupancy]),
         PassId::RayTrace => (
             [
                 &screen[..],
-                &[R::PrimBuffer, R::PrimCountMap, R::PrimIndexMap, R::Light],
+                &[
+                    R::PrimBuffer,
+                    R::PrimListOffsets,
+                    R::PrimListEntries,
+                    R::Light,
+                ],
             ]
             .concat(),
             vec![R::RtVisibility, R::BlockerDistance],
@@ -503,8 +509,8 @@ mod tests {
         assert_eq!(p.hard_edge(), HardEdge::ShadowMap);
         assert!(!p.reads(P::Pcss).contains(R::RtVisibility));
         for r in [
-            R::PrimCountMap,
-            R::PrimIndexMap,
+            R::PrimListOffsets,
+            R::PrimListEntries,
             R::RtVisibility,
             R::Occupancy,
         ] {
@@ -590,14 +596,23 @@ mod tests {
         let valid = p.resources();
         let screen_only = ResourceSet::of(&[R::Depth, R::Normal]);
         let s = p.schedule(screen_only, valid);
+        // The primitive map is fitted to the receivers in the depth buffer: it follows the camera.
         assert_eq!(
             ran(&s),
-            &[P::RayTrace, P::Pcss, P::Fxaa, P::LerpFactor, P::Blend]
+            &[
+                P::PrimitiveMap,
+                P::Occupancy,
+                P::RayTrace,
+                P::Pcss,
+                P::Fxaa,
+                P::LerpFactor,
+                P::Blend
+            ]
         );
-        for pass in [P::PrimBuffer, P::ShadowMap, P::PrimitiveMap, P::Occupancy] {
+        for pass in [P::PrimBuffer, P::ShadowMap] {
             assert!(s.contains(&(pass, PassStatus::Skipped(SkipReason::UpToDate))));
         }
-        // A moving light re-renders both light-space maps but not the prim buffer.
+        // A moving light re-renders the shadow map but not the prim buffer.
         let s = p.schedule(screen_only.with(R::Light), valid);
         assert_eq!(ran(&s)[..3], [P::ShadowMap, P::PrimitiveMap, P::Occupancy]);
         // Dynamic geometry rebuilds everything downstream of the prim buffer.

@@ -46,22 +46,30 @@ pub struct GBufferPush {
     pub camera_pos: Vec4,
 }
 
-/// Push constants of the primitive-map raster (`prim_map_push.glsl`).
+/// Push constants of the primitive-map passes (`map_push.glsl`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
-pub struct PrimMapPush {
+pub struct MapPush {
     /// Light view-projection in frame coordinates.
     pub light_view_proj: Mat4,
-    /// Direction towards the light (xyz).
+    /// Direction towards the light (xyz, directional); w: 1 for a spot light.
     pub to_light: Vec4,
     /// Map size N.
     pub size: u32,
-    /// Map depth d.
-    pub depth: u32,
-    /// 1 = store only triangles facing the light.
+    /// Pass-specific mode.
+    pub mode: u32,
+    /// 1 = keep only triangles facing the light.
     pub front_only: u32,
-    /// Padding.
-    pub pad: u32,
+    /// Triangles in the prim buffer.
+    pub triangles: u32,
+    /// Entry capacity.
+    pub capacity: u32,
+    /// Threads of the binning dispatch.
+    pub tile_threads: u32,
+    /// 1 = guard words follow the entries.
+    pub guard: u32,
+    /// 1 = bin only into texels with ray origins, and skip triangles behind all of them.
+    pub cull: u32,
 }
 
 /// Constants of the ray trace (`ray_trace_constants.glsl`).
@@ -76,7 +84,7 @@ pub struct RayTraceConstants {
     pub camera_pos: Vec4,
     /// Direction the light travels (xyz, unit).
     pub light_dir: Vec4,
-    /// Screen width, height, map N, d.
+    /// Screen width, height, map N, unused.
     pub dims: UVec4,
     /// x: radians per pixel, y: ray-origin offset in pixels, z: relative float bound of |P|.
     pub offset: Vec4,
@@ -86,28 +94,69 @@ pub struct RayTraceConstants {
     pub light_pos: Vec4,
 }
 
-/// Push constants of the occupancy view (`occupancy.comp`).
+/// The primitive map's per-frame GPU state (`map_state.glsl`), read back for the frame report.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-pub struct OccupancyPush {
-    /// Map size N.
-    pub size: u32,
-    /// Map depth d.
-    pub depth: u32,
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct MapState {
+    /// Frame coordinates to homogeneous texel space, fitted to the receivers.
+    pub to_texels: Mat4,
+    /// Ordered-float light NDC bounds of the ray origins (min x, min y, max x, max y).
+    pub bounds: UVec4,
+    /// x: pixels with a shadow ray, y: ordered largest texel error of a ray origin, z: ordered largest
+    /// depth key of the ray origins.
+    pub receivers: UVec4,
+    /// x: 1 when the map has receivers.
+    pub fit: Vec4,
+    /// x: bin items, y: entries needed, z: entry capacity, w: triangles binned (kept by the culling).
+    pub totals: UVec4,
+    /// x: texels with a list, y: longest list, z: texels past the capacity, w: texels with receivers.
+    pub stats: UVec4,
 }
 
-/// Statistics written by the occupancy pass (`occupancy.comp`).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+/// What the primitive map held in a frame (decoded from [`MapState`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct MapStats {
-    /// Texels whose count exceeds d.
-    pub overflowed_texels: u32,
-    /// Largest count of any texel.
-    pub max_count: u32,
-    /// Texels with at least one triangle.
-    pub occupied_texels: u32,
-    /// Sum of min(count, d): stored indices.
-    pub stored_entries: u32,
+    /// Pixels that traced a shadow ray.
+    pub receiver_pixels: u32,
+    /// Texels holding at least one ray origin.
+    pub receiver_texels: u32,
+    /// Triangles the setup kept (not culled as degenerate, back-facing, outside or behind every receiver).
+    pub triangles_binned: u32,
+    /// Texels holding at least one triangle.
+    pub texels_with_list: u32,
+    /// Longest list of any texel.
+    pub longest_list: u32,
+    /// Entries (texel, triangle) the frame needed.
+    pub entries: u32,
+    /// Entries the map could hold this frame (it grows to fit from the next frame on, within its budget).
+    pub capacity: u32,
+    /// Texels whose list did not fit the capacity: traced exhaustively (exact, slower).
+    pub texels_past_capacity: u32,
+}
+
+impl MapStats {
+    /// Decodes the statistics of a read-back [`MapState`].
+    pub fn from_state(s: &MapState) -> Self {
+        Self {
+            receiver_pixels: s.receivers.x,
+            receiver_texels: s.stats.w,
+            triangles_binned: s.totals.w,
+            texels_with_list: s.stats.x,
+            longest_list: s.stats.y,
+            entries: s.totals.y,
+            capacity: s.totals.z,
+            texels_past_capacity: s.stats.z,
+        }
+    }
+
+    /// Mean list length over the texels holding a list.
+    pub fn mean_list(&self) -> f64 {
+        if self.texels_with_list == 0 {
+            0.0
+        } else {
+            f64::from(self.entries) / f64::from(self.texels_with_list)
+        }
+    }
 }
 
 /// A light in frame coordinates, as light-space passes read it (`light.glsl`).
@@ -197,14 +246,14 @@ const _: () = {
     assert!(std::mem::size_of::<PrimBufferPush>() == 96);
     assert!(std::mem::offset_of!(PrimBufferPush, first_index) == 64);
     assert!(std::mem::size_of::<GBufferPush>() == 80);
-    assert!(std::mem::size_of::<PrimMapPush>() == 96);
-    assert!(std::mem::offset_of!(PrimMapPush, size) == 80);
+    assert!(std::mem::size_of::<MapPush>() == 112);
+    assert!(std::mem::offset_of!(MapPush, size) == 80);
     assert!(std::mem::size_of::<RayTraceConstants>() == 224);
     assert!(std::mem::offset_of!(RayTraceConstants, light_pos) == 208);
     assert!(std::mem::offset_of!(RayTraceConstants, dims) == 160);
     assert!(std::mem::offset_of!(RayTraceConstants, offset) == 176);
-    assert!(std::mem::size_of::<OccupancyPush>() == 8);
-    assert!(std::mem::size_of::<MapStats>() == 16);
+    assert!(std::mem::size_of::<MapState>() == 144);
+    assert!(std::mem::offset_of!(MapState, totals) == 112);
     assert!(std::mem::size_of::<GpuLight>() == 208);
     assert!(std::mem::offset_of!(GpuLight, params) == 192);
     assert!(std::mem::size_of::<ShadowMapPush>() == 64);

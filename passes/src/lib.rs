@@ -13,6 +13,8 @@ pub mod prim_buffer;
 pub mod primitive_map;
 pub mod ray_trace;
 pub mod renderer;
+pub mod rt_peer;
+mod scan;
 mod screen_pass;
 pub mod shadow_map;
 pub mod shadow_pipeline;
@@ -22,12 +24,14 @@ pub use frame_plan::{
     FramePlan, PassId, PassStatus, PenumbraFilter, PlanRequest, ResourceId, ResourceSet,
     ShadowMode, SkipReason,
 };
+pub use gpu_types::MapStats;
 pub use hybrid::HybridConfig;
 pub use light::Light;
 pub use pcss::PcssConfig;
 pub use prim_buffer::{Draw, Geometry, IndexFormat, IndexLayout, VertexLayout};
 pub use primitive_map::{
-    choose_raster_path, FaceMode, PrimitiveMapConfig, RasterPath, RasterRequest, GUARD_VALUE,
+    choose_binning_path, BinningPath, BinningRequest, FaceMode, PrimitiveMapConfig,
+    DEFAULT_ENTRY_BUDGET, GUARD_VALUE, GUARD_WORDS, MIN_ENTRY_BUDGET,
 };
 pub use renderer::{read_images, FrameImages, FrameOutput, ShadowRenderer};
 pub use shadow_map::ShadowMapConfig;

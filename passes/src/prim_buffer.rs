@@ -243,7 +243,9 @@ impl PrimBufferPass {
         let prims = device.create_buffer(
             "prim buffer",
             bytes,
-            BufferUsage::STORAGE | BufferUsage::COPY_SRC,
+            BufferUsage::STORAGE
+                | BufferUsage::COPY_SRC
+                | device.acceleration_structure_input_usage(),
             MemoryLocation::GpuOnly,
         )?;
         let pipeline = device.create_compute_pipeline(

@@ -1,14 +1,33 @@
-//! The deep primitive map: an N×N count map (atomic), an N×N×d index map, filled by conservative
-//! rasterization of the prim buffer in light space, and its occupancy view.
+//! The deep primitive map, with no fixed depth: exact variable-length per-texel lists of the triangles
+//! that may shadow each texel's ray origins, in a light-space grid fitted to what the camera sees.
 //!
-//! Reads: prim buffer. Writes: count map, index map (raster); occupancy image, map statistics (occupancy).
+//! Per frame, all on the GPU (no host round trip):
+//! 1. receivers: every pixel's shadow-ray origin is placed in light space; the map is fitted to their
+//!    bounds, and each texel records whether it holds ray origins and how deep the deepest one lies;
+//! 2. setup: each triangle is culled (zero area with two equal vertices, back-facing in front-only mode,
+//!    outside every receiver texel, or farther from the light than every ray origin) or projected, with a
+//!    rigorous bound on its projection error, and split into 4×4-texel tiles of its bounding box;
+//! 3. count, scan, fill: the (triangle, texel) pairs that pass the exact conservative overlap test are
+//!    counted per texel, the counts are prefix-summed into list offsets, and the lists are filled. Memory
+//!    is proportional to the entries; nothing is ever dropped. Texels whose list would pass the entry
+//!    capacity are traced exhaustively (exact, slower), reported, and the capacity grows for the next frame
+//!    within the memory budget.
+//!
+//! The count and fill run in a compute shader (load-balanced over tiles) or, for the tier-fallback paths,
+//! through the rasterizer: hardware conservative raster at the device's tier, the geometry-shader software
+//! path, or tier-1 emulation. Every path applies the same exact test and builds the same lists.
+//!
+//! Reads: prim buffer, depth, normal. Writes: receiver map, per-pixel texels, list offsets, list entries,
+//! map state (fit, statistics); occupancy image (occupancy pass).
 
-use crate::gpu_types::{MapStats, OccupancyPush, PrimMapPush};
+use crate::gpu_types::{MapPush, MapState, RayTraceConstants};
+use crate::scan::{PrefixScan, ScanPipeline};
 use crate::{shader, PassError};
+use bytemuck::Zeroable;
 use rhi::{
-    BindGroup, BindingKind, Buffer, BufferUsage, Capabilities, ComputePipeline,
+    Barrier, BindGroup, BindingKind, Buffer, BufferUsage, Capabilities, ComputePipeline,
     ConservativeRasterTier, Device, Encoder, Format, GraphicsPipeline, GraphicsPipelineDesc, Image,
-    ImageDesc, ImageUsage, MemoryLocation, Resource,
+    ImageDesc, ImageUsage, MemoryLocation, Resource, ResourceState as S,
 };
 
 /// Which faces of the scene are stored.
@@ -24,24 +43,28 @@ pub enum FaceMode {
     FrontOnly,
 }
 
-/// How the caller wants conservative rasterization done.
+/// How the caller wants the (triangle, texel) pairs found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum RasterRequest {
-    /// Hardware where the device has a tier, else software.
+pub enum BinningRequest {
+    /// The compute path: fastest on every device measured (an NVIDIA H100 and lavapipe).
     #[default]
     Auto,
-    /// Force hardware (fails without `VK_EXT_conservative_rasterization`).
+    /// Force the compute path.
+    Compute,
+    /// Hardware conservative raster (fails without `VK_EXT_conservative_rasterization`).
     Hardware,
-    /// Force the geometry-shader path.
+    /// The geometry-shader software conservative raster.
     Software,
     /// Hardware conservative raster made to behave like D3D12 Tier 1 (1/2 px uncertainty, post-snap
     /// degenerate triangles culled) on a device with a better tier: for tier-fallback tests.
     EmulateTier1,
 }
 
-/// The conservative-raster path in use.
+/// The binning path in use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum RasterPath {
+pub enum BinningPath {
+    /// Compute-shader binning over 4×4-texel tiles of each triangle's bounding box.
+    Compute,
     /// `VK_EXT_conservative_rasterization` overestimation at the device's tier.
     Hardware(ConservativeRasterTier),
     /// Geometry-shader dilation + exact per-texel overlap test (GPU Gems 2, ch. 42).
@@ -53,81 +76,126 @@ pub enum RasterPath {
     },
 }
 
-impl RasterPath {
-    /// "hardware" or "software".
+impl BinningPath {
+    /// "compute", "hardware", "software" or "hardware (tier-1 emulation)".
     pub fn name(self) -> &'static str {
         match self {
+            Self::Compute => "compute",
             Self::Hardware(_) => "hardware",
             Self::Software => "software",
             Self::EmulatedTier1 { .. } => "hardware (tier-1 emulation)",
         }
     }
-    /// The tier used ("none" for software).
+
+    /// Short label of the path in pass names: "compute", "HW CR", "SW CR", "HW CR tier-1".
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Compute => "compute",
+            Self::Hardware(_) => "HW CR",
+            Self::Software => "SW CR",
+            Self::EmulatedTier1 { .. } => "HW CR tier-1",
+        }
+    }
+
+    /// The conservative-raster tier used ("none" for the software and compute paths).
     pub fn tier(self) -> ConservativeRasterTier {
         match self {
             Self::Hardware(t) => t,
-            Self::Software => ConservativeRasterTier::NotSupported,
+            Self::Compute | Self::Software => ConservativeRasterTier::NotSupported,
             Self::EmulatedTier1 { .. } => ConservativeRasterTier::Tier1,
         }
     }
 }
 
-/// Chooses the raster path from the device's capabilities (pure; unit-tested).
-pub fn choose_raster_path(
+/// Chooses the binning path from the device's capabilities (pure; unit-tested).
+pub fn choose_binning_path(
     caps: &Capabilities,
-    request: RasterRequest,
-) -> Result<RasterPath, PassError> {
+    request: BinningRequest,
+) -> Result<BinningPath, PassError> {
     let hw = caps.conservative_raster_tier;
-    let sw_ok = caps.geometry_shader;
-    match request {
-        RasterRequest::Hardware if hw == ConservativeRasterTier::NotSupported => Err(PassError::Unsupported(
-            "hardware conservative rasterization (VK_EXT_conservative_rasterization)".into(),
-        )),
-        RasterRequest::Hardware => Ok(RasterPath::Hardware(hw)),
-        RasterRequest::Software if !sw_ok => {
-            Err(PassError::Unsupported("geometry shaders (software conservative rasterization)".into()))
+    let gs = caps.geometry_shader;
+    let fragment_atomics = caps.fragment_stores_and_atomics;
+    let raster = |path| {
+        if fragment_atomics {
+            Ok(path)
+        } else {
+            Err(PassError::Unsupported(
+                "fragmentStoresAndAtomics (raster binning writes from fragment shaders)".into(),
+            ))
         }
-        RasterRequest::Software => Ok(RasterPath::Software),
-        RasterRequest::EmulateTier1 if hw == ConservativeRasterTier::NotSupported || !sw_ok => Err(PassError::Unsupported(
-            "tier-1 emulation needs hardware conservative rasterization and geometry shaders".into(),
+    };
+    match request {
+        BinningRequest::Auto | BinningRequest::Compute => Ok(BinningPath::Compute),
+        BinningRequest::Hardware if hw == ConservativeRasterTier::NotSupported => {
+            Err(PassError::Unsupported(
+                "hardware conservative rasterization (VK_EXT_conservative_rasterization)".into(),
+            ))
+        }
+        BinningRequest::Hardware => raster(BinningPath::Hardware(hw)),
+        BinningRequest::Software if !gs => Err(PassError::Unsupported(
+            "geometry shaders (software conservative rasterization)".into(),
         )),
-        RasterRequest::EmulateTier1 => Ok(RasterPath::EmulatedTier1 { native: hw }),
-        RasterRequest::Auto if hw != ConservativeRasterTier::NotSupported => Ok(RasterPath::Hardware(hw)),
-        RasterRequest::Auto if sw_ok => Ok(RasterPath::Software),
-        RasterRequest::Auto => Err(PassError::Unsupported(
-            "conservative rasterization: neither VK_EXT_conservative_rasterization nor geometry shaders".into(),
-        )),
+        BinningRequest::Software => raster(BinningPath::Software),
+        BinningRequest::EmulateTier1 if hw == ConservativeRasterTier::NotSupported || !gs => {
+            Err(PassError::Unsupported(
+                "tier-1 emulation needs hardware conservative rasterization and geometry shaders"
+                    .into(),
+            ))
+        }
+        BinningRequest::EmulateTier1 => raster(BinningPath::EmulatedTier1 { native: hw }),
     }
 }
 
-/// Size and behaviour of the deep primitive map.
+/// Size and behaviour of the primitive map. No setting trades exactness: every one only moves cost.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PrimitiveMapConfig {
-    /// N: texels per side.
+    /// N: texels per side of the light-space grid fitted to the receivers (default 1024).
     pub size: u32,
-    /// d: triangle slots per texel.
-    pub depth: u32,
     /// Faces stored.
     pub faces: FaceMode,
-    /// Raster path request.
-    pub raster: RasterRequest,
-    /// Allocate one extra index layer past d, filled with `GUARD_VALUE` every frame, that no pass may
-    /// write: tests read it back to prove overflow never writes out of bounds. Costs N² u32 and a clear.
-    pub guard_layer: bool,
+    /// Binning path request.
+    pub binning: BinningRequest,
+    /// Largest memory the list entries may take, in bytes (default 256 MiB, capped by the device's largest
+    /// storage buffer). The entries start small and grow to what frames need; past the budget, texels
+    /// that do not fit are traced exhaustively (exact) and counted in the report.
+    pub entry_budget: u64,
+    /// Entries the lists start with (0: estimated from the grid and the triangles). An engine that knows
+    /// its scene can size them up front and avoid the one exhaustive frame of a growth.
+    pub initial_entries: u32,
+    /// Bin only into texels holding ray origins, and skip triangles wholly behind all of a texel's origins
+    /// (default true). Off, every texel of the fitted grid gets every triangle overlapping it: a debug mode
+    /// whose lists tests compare with exact conservative binning.
+    pub receiver_culling: bool,
+    /// Debug: `GUARD_WORDS` words after the entry capacity, filled with `GUARD_VALUE` every frame, that no
+    /// pass may write: tests read them back to prove the fill never writes out of bounds.
+    pub guard: bool,
 }
 
-/// Value of every index slot cleared in guard mode (never a valid prim-buffer index).
+/// Value of every guard word (never a valid prim-buffer index).
 pub const GUARD_VALUE: u32 = u32::MAX;
 
+/// Guard words after the entries in guard mode.
+pub const GUARD_WORDS: u32 = 4096;
+
+/// Default [`PrimitiveMapConfig::entry_budget`].
+pub const DEFAULT_ENTRY_BUDGET: u64 = 256 << 20;
+
+/// Smallest [`PrimitiveMapConfig::entry_budget`]: 1024 entries.
+pub const MIN_ENTRY_BUDGET: u64 = 4096;
+
+/// Threads of the compute binning dispatch (a grid-stride loop over the bin items).
+const BIN_THREADS: u32 = 64 * 4096;
+
 impl Default for PrimitiveMapConfig {
-    /// The talk's 1K×1K×32.
     fn default() -> Self {
         Self {
             size: 1024,
-            depth: 32,
             faces: FaceMode::Both,
-            raster: RasterRequest::Auto,
-            guard_layer: false,
+            binning: BinningRequest::Auto,
+            entry_budget: DEFAULT_ENTRY_BUDGET,
+            initial_entries: 0,
+            receiver_culling: true,
+            guard: false,
         }
     }
 }
@@ -135,165 +203,358 @@ impl Default for PrimitiveMapConfig {
 impl PrimitiveMapConfig {
     /// Checks the configuration against the device limits.
     pub fn validate(&self, caps: &Capabilities) -> Result<(), PassError> {
-        if self.size == 0 || self.size > caps.max_image_dimension_2d {
+        let max = caps.max_image_dimension_2d.min(u32::from(u16::MAX));
+        if self.size == 0 || self.size > max {
             return Err(PassError::InvalidConfig(format!(
-                "primitive map size {} must be in 1..={}",
-                self.size, caps.max_image_dimension_2d
+                "primitive map size {} must be in 1..={max}",
+                self.size
             )));
         }
-        if self.depth == 0 || self.depth + u32::from(self.guard_layer) > caps.max_image_array_layers
-        {
+        let grid = u64::from(self.size) * u64::from(self.size) * 4 + 4;
+        if grid > caps.max_storage_buffer_range {
             return Err(PassError::InvalidConfig(format!(
-                "primitive map depth {} must be in 1..={}",
-                self.depth, caps.max_image_array_layers
+                "primitive map size {}: its {} bytes of list offsets exceed the device's largest storage \
+                 buffer ({} bytes)",
+                self.size, grid, caps.max_storage_buffer_range
+            )));
+        }
+        if self.entry_budget < MIN_ENTRY_BUDGET {
+            return Err(PassError::InvalidConfig(format!(
+                "primitive map entry budget {} bytes is below the minimum of {MIN_ENTRY_BUDGET} bytes",
+                self.entry_budget
             )));
         }
         Ok(())
     }
 
-    /// Bytes of the count map plus the index map.
-    pub fn memory_bytes(&self) -> u64 {
-        u64::from(self.size)
-            * u64::from(self.size)
-            * 4
-            * (1 + u64::from(self.depth + u32::from(self.guard_layer)))
+    /// Most entries the budget and the device allow.
+    pub fn max_entries(&self, caps: &Capabilities) -> u32 {
+        let guard = if self.guard {
+            u64::from(GUARD_WORDS)
+        } else {
+            0
+        };
+        let bytes = self.entry_budget.min(caps.max_storage_buffer_range);
+        (bytes / 4)
+            .saturating_sub(guard)
+            .min(u64::from(u32::MAX - GUARD_WORDS)) as u32
     }
+
+    /// The entry capacity a map starts with for `triangles`: [`PrimitiveMapConfig::initial_entries`], else
+    /// two entries per texel (a ground plane under everything) plus four per triangle; within the budget.
+    pub fn starting_entries(&self, caps: &Capabilities, triangles: u32) -> u32 {
+        let n2 = u64::from(self.size) * u64::from(self.size);
+        let estimate = match self.initial_entries {
+            0 => (2 * n2 + 4 * u64::from(triangles)).max(65536),
+            given => u64::from(given),
+        };
+        estimate.min(u64::from(self.max_entries(caps))).max(1) as u32
+    }
+}
+
+/// What the map's passes read from outside it.
+pub struct PrimitiveMapInputs<'a> {
+    /// The prim buffer.
+    pub prims: &'a Buffer,
+    /// Triangles in the prim buffer.
+    pub triangles: u32,
+    /// Reversed-Z depth (`ShaderResource` state when the map is built).
+    pub depth: &'a Image,
+    /// Camera-facing geometric normal, w = 0 on background (`ShaderResource` state).
+    pub normal: &'a Image,
+}
+
+/// The binning pipelines of the path in use.
+enum Binner {
+    Compute(ComputePipeline),
+    Raster(GraphicsPipeline),
 }
 
 /// The primitive map's resources and passes.
 pub struct PrimitiveMap {
     config: PrimitiveMapConfig,
-    path: RasterPath,
-    raster: GraphicsPipeline,
-    raster_group: BindGroup,
+    path: BinningPath,
+    triangles: u32,
+    screen: (u32, u32),
+    capacity: u32,
+    fit: ComputePipeline,
+    receivers_pipeline: ComputePipeline,
+    setup: ComputePipeline,
+    scan: ScanPipeline,
+    binner: Binner,
     occupancy_pipeline: ComputePipeline,
+    fit_group: BindGroup,
+    receivers_group: BindGroup,
+    setup_group: BindGroup,
+    bin_group: BindGroup,
     occupancy_group: BindGroup,
-    /// N×N `R32_UINT`: triangles touching each texel (may exceed d: overflow).
-    pub count: Image,
-    /// N×N×d `R32_UINT` array: prim-buffer indices, layer = slot.
-    pub indices: Image,
+    tile_scan: PrefixScan,
+    offset_scan: PrefixScan,
+    constants: Buffer,
+    bin_tris: Buffer,
+    tile_offsets: Buffer,
+    /// The map's per-frame state ([`MapState`]): fitted transform, totals, statistics.
+    pub state: Buffer,
+    /// N² `u32`: 0 where no ray origin lies, else the ordered largest depth key of the texel's origins.
+    pub receivers: Buffer,
+    /// One `u32` per screen pixel: the texel of its ray origin (or a no-ray / outside marker).
+    pub pixel_texels: Buffer,
+    /// N² + 1 `u32` per-texel counts during the build (zero between frames).
+    counts: Buffer,
+    /// N² + 1 `u32`: texel t's list is `entries[offsets[t] .. offsets[t + 1]]`.
+    pub offsets: Buffer,
+    /// The lists' triangle indices (capacity `u32`, plus the guard words in guard mode).
+    pub entries: Buffer,
     /// N×N `RGBA8` occupancy view.
     pub occupancy: Image,
-    /// `MapStats`, GPU-written by the occupancy pass.
-    pub stats: Buffer,
 }
 
 impl PrimitiveMap {
-    /// Creates the map for `prims` with the path chosen from the device's capabilities.
+    /// Creates the map for `inputs`, with the binning path chosen from the device's capabilities.
     pub fn new(
         device: &Device,
-        prims: &Buffer,
+        inputs: &PrimitiveMapInputs<'_>,
         config: PrimitiveMapConfig,
     ) -> Result<Self, PassError> {
         let caps = device.capabilities();
         config.validate(caps)?;
-        if !caps.fragment_stores_and_atomics {
-            return Err(PassError::Unsupported("fragmentStoresAndAtomics".into()));
-        }
-        let path = choose_raster_path(caps, config.raster)?;
+        let path = choose_binning_path(caps, config.binning)?;
         let n = config.size;
-        let uint_image = |name, layers, usage| ImageDesc {
-            name,
-            format: Format::R32Uint,
-            width: n,
-            height: n,
-            layers,
-            usage,
+        let n2 = u64::from(n) * u64::from(n);
+        let (width, height) = (inputs.depth.width(), inputs.depth.height());
+        let storage = |name, bytes: u64, usage| {
+            device.create_buffer(
+                name,
+                bytes.max(4),
+                BufferUsage::STORAGE | usage,
+                MemoryLocation::GpuOnly,
+            )
         };
-        let count = device.create_image(&uint_image(
-            "prim count map",
-            1,
-            ImageUsage::STORAGE | ImageUsage::COPY_DST | ImageUsage::COPY_SRC,
-        ))?;
-        let indices = device.create_image(&uint_image(
-            "prim index map",
-            config.depth + u32::from(config.guard_layer),
-            ImageUsage::STORAGE | ImageUsage::COPY_DST | ImageUsage::COPY_SRC,
-        ))?;
+        let copy = BufferUsage::COPY_DST | BufferUsage::COPY_SRC;
+        let tris = u64::from(inputs.triangles);
+        let constants = device.create_buffer_init(
+            "primitive map constants",
+            bytemuck::bytes_of(&RayTraceConstants::zeroed()),
+            BufferUsage::UNIFORM,
+        )?;
+        let state = storage(
+            "primitive map state",
+            std::mem::size_of::<MapState>() as u64,
+            copy,
+        )?;
+        let receivers = storage("primitive map receivers", n2 * 4, copy)?;
+        let pixel_texels = storage(
+            "primitive map pixel texels",
+            u64::from(width) * u64::from(height) * 4,
+            copy,
+        )?;
+        let bin_tris = storage("primitive map triangles", tris * 48, BufferUsage::default())?;
+        let tile_offsets = storage(
+            "primitive map tile offsets",
+            (tris + 1) * 4,
+            BufferUsage::default(),
+        )?;
+        let counts = storage("primitive map counts", (n2 + 1) * 4, copy)?;
+        let offsets = storage("primitive map list offsets", (n2 + 1) * 4, copy)?;
+        let capacity = config.starting_entries(caps, inputs.triangles);
+        let entries = Self::create_entries(device, &config, capacity)?;
         let occupancy = device.create_image(&ImageDesc {
-            name: "prim map occupancy",
+            name: "primitive map occupancy",
             format: Format::Rgba8Unorm,
             width: n,
             height: n,
             layers: 1,
             usage: ImageUsage::STORAGE | ImageUsage::COPY_SRC,
         })?;
-        let stats = device.create_buffer(
-            "prim map stats",
-            std::mem::size_of::<MapStats>() as u64,
-            BufferUsage::STORAGE | BufferUsage::COPY_DST | BufferUsage::COPY_SRC,
-            MemoryLocation::GpuOnly,
+        let push = std::mem::size_of::<MapPush>() as u32;
+        let buffers = |count| vec![BindingKind::StorageBuffer; count];
+        let fit = device.create_compute_pipeline(
+            "map fit",
+            &shader("map_fit.comp")?,
+            &buffers(1),
+            push,
         )?;
-        let (geometry, fragment, extra) = match path {
-            RasterPath::Software => (
-                Some(shader("prim_map_sw.geom")?),
-                shader("prim_map_sw.frag")?,
-                None,
-            ),
-            RasterPath::Hardware(_) => (None, shader("prim_map_hw.frag")?, Some(0.0)),
-            RasterPath::EmulatedTier1 { .. } => {
-                let extra = (0.5 - caps.primitive_overestimation_size)
-                    .clamp(0.0, caps.max_extra_primitive_overestimation_size);
-                (
-                    Some(shader("prim_map_snap.geom")?),
-                    shader("prim_map_hw.frag")?,
-                    Some(extra),
-                )
-            }
-        };
-        let raster = device.create_graphics_pipeline(&GraphicsPipelineDesc {
-            name: "primitive map",
-            vertex: &shader("prim_map.vert")?,
-            geometry: geometry.as_deref(),
-            fragment: &fragment,
-            bindings: &[
-                BindingKind::StorageBuffer,
-                BindingKind::StorageImage,
-                BindingKind::StorageImage,
-            ],
-            push_constant_size: std::mem::size_of::<PrimMapPush>() as u32,
-            color_formats: &[],
-            depth: None,
-            conservative_extra_overestimation: extra,
-            depth_clamp: true,
-        })?;
-        let raster_group = device.create_bind_group(
-            raster.layout(),
+        let receivers_pipeline = device.create_compute_pipeline(
+            "map receivers",
+            &shader("map_receivers.comp")?,
             &[
-                Resource::Buffer(prims),
-                Resource::Image(&count),
-                Resource::Image(&indices),
+                BindingKind::UniformBuffer,
+                BindingKind::SampledImage,
+                BindingKind::SampledImage,
+                BindingKind::StorageBuffer,
+                BindingKind::StorageBuffer,
+                BindingKind::StorageBuffer,
             ],
+            push,
         )?;
+        let setup = device.create_compute_pipeline(
+            "map setup",
+            &shader("map_setup.comp")?,
+            &buffers(4),
+            push,
+        )?;
+        let scan = ScanPipeline::new(device)?;
+        let binner = match path {
+            BinningPath::Compute => Binner::Compute(device.create_compute_pipeline(
+                "map bin",
+                &shader("map_bin.comp")?,
+                &buffers(6),
+                push,
+            )?),
+            raster => Binner::Raster(Self::raster_pipeline(device, raster)?),
+        };
         let occupancy_pipeline = device.create_compute_pipeline(
             "occupancy",
             &shader("occupancy.comp")?,
             &[
-                BindingKind::StorageImage,
+                BindingKind::StorageBuffer,
+                BindingKind::StorageBuffer,
                 BindingKind::StorageImage,
                 BindingKind::StorageBuffer,
             ],
-            std::mem::size_of::<OccupancyPush>() as u32,
+            std::mem::size_of::<u32>() as u32,
+        )?;
+        let fit_group = device.create_bind_group(fit.layout(), &[Resource::Buffer(&state)])?;
+        let receivers_group = device.create_bind_group(
+            receivers_pipeline.layout(),
+            &[
+                Resource::Buffer(&constants),
+                Resource::Image(inputs.depth),
+                Resource::Image(inputs.normal),
+                Resource::Buffer(&state),
+                Resource::Buffer(&receivers),
+                Resource::Buffer(&pixel_texels),
+            ],
+        )?;
+        let setup_group = device.create_bind_group(
+            setup.layout(),
+            &[
+                Resource::Buffer(inputs.prims),
+                Resource::Buffer(&state),
+                Resource::Buffer(&bin_tris),
+                Resource::Buffer(&tile_offsets),
+            ],
+        )?;
+        let bin_group = Self::bin_group(
+            device,
+            &binner,
+            &bin_tris,
+            &tile_offsets,
+            &receivers,
+            &counts,
+            &offsets,
+            &entries,
         )?;
         let occupancy_group = device.create_bind_group(
             occupancy_pipeline.layout(),
             &[
-                Resource::Image(&count),
+                Resource::Buffer(&offsets),
+                Resource::Buffer(&receivers),
                 Resource::Image(&occupancy),
-                Resource::Buffer(&stats),
+                Resource::Buffer(&state),
             ],
         )?;
+        let tile_scan = PrefixScan::new(device, &scan, &tile_offsets, inputs.triangles + 1)?;
+        let offset_scan = PrefixScan::new(device, &scan, &offsets, (n2 + 1) as u32)?;
         Ok(Self {
             config,
             path,
-            raster,
-            raster_group,
+            triangles: inputs.triangles,
+            screen: (width, height),
+            capacity,
+            fit,
+            receivers_pipeline,
+            setup,
+            scan,
+            binner,
             occupancy_pipeline,
+            fit_group,
+            receivers_group,
+            setup_group,
+            bin_group,
             occupancy_group,
-            count,
-            indices,
+            tile_scan,
+            offset_scan,
+            constants,
+            bin_tris,
+            tile_offsets,
+            state,
+            receivers,
+            pixel_texels,
+            counts,
+            offsets,
+            entries,
             occupancy,
-            stats,
+        })
+    }
+
+    fn create_entries(
+        device: &Device,
+        config: &PrimitiveMapConfig,
+        capacity: u32,
+    ) -> Result<Buffer, PassError> {
+        let guard = if config.guard { GUARD_WORDS } else { 0 };
+        Ok(device.create_buffer(
+            "primitive map list entries",
+            (u64::from(capacity) + u64::from(guard)) * 4,
+            BufferUsage::STORAGE | BufferUsage::COPY_DST | BufferUsage::COPY_SRC,
+            MemoryLocation::GpuOnly,
+        )?)
+    }
+
+    fn raster_pipeline(device: &Device, path: BinningPath) -> Result<GraphicsPipeline, PassError> {
+        let caps = device.capabilities();
+        let (geometry, extra) = match path {
+            BinningPath::Software => (Some(shader("prim_map_sw.geom")?), None),
+            BinningPath::EmulatedTier1 { .. } => {
+                let extra = (0.5 - caps.primitive_overestimation_size)
+                    .clamp(0.0, caps.max_extra_primitive_overestimation_size);
+                (Some(shader("prim_map_snap.geom")?), Some(extra))
+            }
+            _ => (None, Some(0.0)),
+        };
+        Ok(device.create_graphics_pipeline(&GraphicsPipelineDesc {
+            name: "primitive map raster",
+            vertex: &shader("prim_map.vert")?,
+            geometry: geometry.as_deref(),
+            fragment: &shader("prim_map_raster.frag")?,
+            bindings: &[BindingKind::StorageBuffer; 5],
+            push_constant_size: std::mem::size_of::<MapPush>() as u32,
+            color_formats: &[],
+            depth: None,
+            conservative_extra_overestimation: extra,
+            depth_clamp: false,
+        })?)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn bin_group(
+        device: &Device,
+        binner: &Binner,
+        bin_tris: &Buffer,
+        tile_offsets: &Buffer,
+        receivers: &Buffer,
+        counts: &Buffer,
+        offsets: &Buffer,
+        entries: &Buffer,
+    ) -> Result<BindGroup, PassError> {
+        let b = Resource::Buffer;
+        Ok(match binner {
+            Binner::Compute(p) => device.create_bind_group(
+                p.layout(),
+                &[
+                    b(bin_tris),
+                    b(tile_offsets),
+                    b(receivers),
+                    b(counts),
+                    b(offsets),
+                    b(entries),
+                ],
+            )?,
+            Binner::Raster(p) => device.create_bind_group(
+                p.layout(),
+                &[b(bin_tris), b(receivers), b(counts), b(offsets), b(entries)],
+            )?,
         })
     }
 
@@ -302,60 +563,187 @@ impl PrimitiveMap {
         &self.config
     }
 
-    /// The raster path in use.
-    pub fn path(&self) -> RasterPath {
+    /// The binning path in use.
+    pub fn path(&self) -> BinningPath {
         self.path
     }
 
-    /// Clears the count map and the statistics (and, in guard mode, the index map to `GUARD_VALUE`);
-    /// count and index maps must be in `CopyDest` state.
-    pub fn record_clear(&self, enc: &mut Encoder<'_>) {
-        enc.begin_pass("primitive map clear");
-        enc.clear_uint(&self.count, 0);
-        if self.config.guard_layer {
-            enc.clear_uint(&self.indices, GUARD_VALUE);
-        }
-        enc.fill_buffer(&self.stats, 0);
-        enc.end_pass();
+    /// Entries the lists can hold now.
+    pub fn capacity(&self) -> u32 {
+        self.capacity
     }
 
-    /// Rasterizes `triangle_count` prim-buffer triangles; count and index maps in `UnorderedAccess` state.
-    pub fn record_raster(
-        &self,
-        enc: &mut Encoder<'_>,
-        push: &PrimMapPush,
-        triangle_count: u32,
-    ) -> Result<(), PassError> {
-        let name = match self.path {
-            RasterPath::Hardware(_) => "primitive map (HW CR)",
-            RasterPath::Software => "primitive map (SW CR)",
-            RasterPath::EmulatedTier1 { .. } => "primitive map (HW CR, tier-1 emulation)",
+    /// Bytes the map holds on the GPU.
+    pub fn bytes(&self) -> u64 {
+        [
+            &self.state,
+            &self.receivers,
+            &self.pixel_texels,
+            &self.bin_tris,
+            &self.tile_offsets,
+            &self.counts,
+            &self.offsets,
+            &self.entries,
+        ]
+        .iter()
+        .map(|b| b.size())
+        .sum::<u64>()
+            + self.occupancy.byte_size()
+    }
+
+    /// Grows the entry capacity to hold `needed` entries (with a quarter to spare, within the budget), when a
+    /// frame needed more than it had. Returns whether the entries were reallocated: then whatever else
+    /// reads [`PrimitiveMap::entries`] must be rebound.
+    ///
+    /// # Safety
+    /// No submitted frame that uses the map may still be pending on the GPU.
+    pub unsafe fn grow(&mut self, device: &Device, needed: u32) -> Result<bool, PassError> {
+        let max = self.config.max_entries(device.capabilities());
+        if needed <= self.capacity || self.capacity >= max {
+            return Ok(false);
+        }
+        let capacity = (u64::from(needed) * 5 / 4).min(u64::from(max)) as u32;
+        self.entries = Self::create_entries(device, &self.config, capacity)?;
+        self.capacity = capacity;
+        let binding = match self.binner {
+            Binner::Compute(_) => 5,
+            Binner::Raster(_) => 4,
         };
-        enc.begin_pass(name);
-        enc.begin_rendering((self.config.size, self.config.size), &[], None);
-        enc.draw(
-            &self.raster,
-            &self.raster_group,
-            bytemuck::bytes_of(push),
-            triangle_count * 3,
+        // SAFETY: the caller guarantees that no pending frame uses the group.
+        unsafe { device.rebind_buffer(&mut self.bin_group, binding, &self.entries)? };
+        Ok(true)
+    }
+
+    /// Records the build of the lists for this frame's receivers. Depth and normal must be in
+    /// `ShaderResource` state; the map's buffers are visible to storage reads afterwards.
+    pub fn record(
+        &mut self,
+        enc: &mut Encoder<'_>,
+        constants: &RayTraceConstants,
+        push: &MapPush,
+    ) -> Result<(), PassError> {
+        self.constants.write(0, bytemuck::bytes_of(constants))?;
+        let n = self.config.size;
+        let push = MapPush {
+            size: n,
+            triangles: self.triangles,
+            capacity: self.capacity,
+            tile_threads: BIN_THREADS,
+            guard: u32::from(self.config.guard),
+            cull: u32::from(self.config.receiver_culling),
+            ..*push
+        };
+        let with_mode = |mode| MapPush { mode, ..push };
+        let pixels = [self.screen.0.div_ceil(8), self.screen.1.div_ceil(8), 1];
+
+        enc.begin_pass("primitive map: receivers");
+        enc.fill_buffer(&self.receivers, 0);
+        enc.fill_buffer(&self.counts, 0);
+        if self.config.guard {
+            enc.fill_buffer(&self.entries, GUARD_VALUE);
+        }
+        enc.barriers(&[Barrier::Global {
+            before: S::CopyDest,
+            after: S::UnorderedAccess,
+        }]);
+        enc.dispatch(
+            &self.fit,
+            &self.fit_group,
+            bytemuck::bytes_of(&with_mode(0)),
+            [1, 1, 1],
         )?;
-        enc.end_rendering();
+        enc.barriers(&[Barrier::Uav]);
+        enc.dispatch(
+            &self.receivers_pipeline,
+            &self.receivers_group,
+            bytemuck::bytes_of(&with_mode(0)),
+            pixels,
+        )?;
+        enc.barriers(&[Barrier::Uav]);
+        enc.dispatch(
+            &self.fit,
+            &self.fit_group,
+            bytemuck::bytes_of(&with_mode(1)),
+            [1, 1, 1],
+        )?;
+        enc.barriers(&[Barrier::Uav]);
+        enc.dispatch(
+            &self.receivers_pipeline,
+            &self.receivers_group,
+            bytemuck::bytes_of(&with_mode(1)),
+            pixels,
+        )?;
+        enc.barriers(&[Barrier::Uav]);
+        enc.end_pass();
+
+        enc.begin_pass("primitive map: setup");
+        enc.dispatch(
+            &self.setup,
+            &self.setup_group,
+            bytemuck::bytes_of(&push),
+            [(self.triangles + 1).div_ceil(64), 1, 1],
+        )?;
+        enc.barriers(&[Barrier::Uav]);
+        self.tile_scan.record(enc, &self.scan)?;
+        enc.end_pass();
+
+        let label = self.path.label();
+        enc.begin_pass(&format!("primitive map: count ({label})"));
+        self.record_bin(enc, &with_mode(0))?;
+        enc.end_pass();
+
+        enc.begin_pass("primitive map: scan");
+        enc.barriers(&[Barrier::Global {
+            before: S::UnorderedAccess,
+            after: S::CopySource,
+        }]);
+        enc.copy_buffer(&self.counts, &self.offsets)?;
+        enc.barriers(&[Barrier::Global {
+            before: S::CopyDest,
+            after: S::UnorderedAccess,
+        }]);
+        self.offset_scan.record(enc, &self.scan)?;
+        enc.end_pass();
+
+        enc.begin_pass(&format!("primitive map: fill ({label})"));
+        self.record_bin(enc, &with_mode(1))?;
         enc.end_pass();
         Ok(())
     }
 
-    /// Writes the occupancy view and the map statistics.
+    fn record_bin(&self, enc: &mut Encoder<'_>, push: &MapPush) -> Result<(), PassError> {
+        match &self.binner {
+            Binner::Compute(p) => {
+                enc.dispatch(
+                    p,
+                    &self.bin_group,
+                    bytemuck::bytes_of(push),
+                    [BIN_THREADS / 64, 1, 1],
+                )?;
+            }
+            Binner::Raster(p) => {
+                enc.begin_rendering((self.config.size, self.config.size), &[], None);
+                enc.draw(
+                    p,
+                    &self.bin_group,
+                    bytemuck::bytes_of(push),
+                    self.triangles * 3,
+                )?;
+                enc.end_rendering();
+            }
+        }
+        enc.barriers(&[Barrier::Uav]);
+        Ok(())
+    }
+
+    /// Writes the occupancy view and the map statistics into the state.
     pub fn record_occupancy(&self, enc: &mut Encoder<'_>) -> Result<(), PassError> {
         enc.begin_pass("occupancy");
         let n = self.config.size;
-        let push = OccupancyPush {
-            size: n,
-            depth: self.config.depth,
-        };
         enc.dispatch(
             &self.occupancy_pipeline,
             &self.occupancy_group,
-            bytemuck::bytes_of(&push),
+            bytemuck::bytes_of(&n),
             [n.div_ceil(8), n.div_ceil(8), 1],
         )?;
         enc.end_pass();
@@ -393,40 +781,52 @@ mod tests {
     }
 
     #[test]
-    fn auto_prefers_hardware_then_software() {
-        let t3 = caps(ConservativeRasterTier::Tier3, true);
-        assert_eq!(
-            choose_raster_path(&t3, RasterRequest::Auto).unwrap(),
-            RasterPath::Hardware(ConservativeRasterTier::Tier3)
-        );
-        let lavapipe = caps(ConservativeRasterTier::NotSupported, true);
-        assert_eq!(
-            choose_raster_path(&lavapipe, RasterRequest::Auto).unwrap(),
-            RasterPath::Software
-        );
-        let neither = caps(ConservativeRasterTier::NotSupported, false);
-        assert!(matches!(
-            choose_raster_path(&neither, RasterRequest::Auto),
-            Err(PassError::Unsupported(_))
-        ));
+    fn auto_is_compute_everywhere() {
+        for tier in [
+            ConservativeRasterTier::Tier3,
+            ConservativeRasterTier::NotSupported,
+        ] {
+            for gs in [true, false] {
+                assert_eq!(
+                    choose_binning_path(&caps(tier, gs), BinningRequest::Auto).unwrap(),
+                    BinningPath::Compute
+                );
+            }
+        }
     }
 
     #[test]
     fn forced_paths_fail_clearly_without_the_feature() {
         let lavapipe = caps(ConservativeRasterTier::NotSupported, true);
         assert!(matches!(
-            choose_raster_path(&lavapipe, RasterRequest::Hardware),
+            choose_binning_path(&lavapipe, BinningRequest::Hardware),
             Err(PassError::Unsupported(_))
         ));
         let no_gs = caps(ConservativeRasterTier::Tier1, false);
         assert!(matches!(
-            choose_raster_path(&no_gs, RasterRequest::Software),
+            choose_binning_path(&no_gs, BinningRequest::Software),
             Err(PassError::Unsupported(_))
         ));
         let t1 = caps(ConservativeRasterTier::Tier1, true);
         assert_eq!(
-            choose_raster_path(&t1, RasterRequest::Software).unwrap(),
-            RasterPath::Software
+            choose_binning_path(&t1, BinningRequest::Software).unwrap(),
+            BinningPath::Software
+        );
+        assert_eq!(
+            choose_binning_path(&t1, BinningRequest::Hardware).unwrap(),
+            BinningPath::Hardware(ConservativeRasterTier::Tier1)
+        );
+        let no_atomics = Capabilities {
+            fragment_stores_and_atomics: false,
+            ..t1.clone()
+        };
+        assert!(matches!(
+            choose_binning_path(&no_atomics, BinningRequest::Software),
+            Err(PassError::Unsupported(_))
+        ));
+        assert_eq!(
+            choose_binning_path(&no_atomics, BinningRequest::Compute).unwrap(),
+            BinningPath::Compute
         );
     }
 
@@ -434,18 +834,18 @@ mod tests {
     fn tier1_emulation_needs_hardware_and_geometry_shaders() {
         let t3 = caps(ConservativeRasterTier::Tier3, true);
         assert_eq!(
-            choose_raster_path(&t3, RasterRequest::EmulateTier1).unwrap(),
-            RasterPath::EmulatedTier1 {
+            choose_binning_path(&t3, BinningRequest::EmulateTier1).unwrap(),
+            BinningPath::EmulatedTier1 {
                 native: ConservativeRasterTier::Tier3
             }
         );
         let lavapipe = caps(ConservativeRasterTier::NotSupported, true);
         assert!(matches!(
-            choose_raster_path(&lavapipe, RasterRequest::EmulateTier1),
+            choose_binning_path(&lavapipe, BinningRequest::EmulateTier1),
             Err(PassError::Unsupported(_))
         ));
         assert_eq!(
-            RasterPath::EmulatedTier1 {
+            BinningPath::EmulatedTier1 {
                 native: ConservativeRasterTier::Tier3
             }
             .tier(),
@@ -458,11 +858,34 @@ mod tests {
         let c = caps(ConservativeRasterTier::NotSupported, true);
         let ok = PrimitiveMapConfig::default();
         assert!(ok.validate(&c).is_ok());
-        assert_eq!(ok.memory_bytes(), 1024 * 1024 * 4 * 33);
-        assert!(PrimitiveMapConfig { depth: 0, ..ok }.validate(&c).is_err());
         assert!(PrimitiveMapConfig { size: 0, ..ok }.validate(&c).is_err());
-        assert!(PrimitiveMapConfig { depth: 4096, ..ok }
+        // 8192² offsets need 256 MiB: more than this device's 128 MiB storage buffers.
+        assert!(PrimitiveMapConfig { size: 8192, ..ok }
             .validate(&c)
             .is_err());
+        assert!(PrimitiveMapConfig {
+            entry_budget: 1024,
+            ..ok
+        }
+        .validate(&c)
+        .is_err());
+        // The budget is capped by the largest storage buffer, less the guard words.
+        assert_eq!(ok.max_entries(&c), (1 << 27) / 4);
+        let guarded = PrimitiveMapConfig { guard: true, ..ok };
+        assert_eq!(guarded.max_entries(&c), (1 << 27) / 4 - GUARD_WORDS);
+        // Two entries per texel plus four per triangle, at least 64K, within the budget.
+        assert_eq!(ok.starting_entries(&c, 1000), 2 * 1024 * 1024 + 4000);
+        let small = PrimitiveMapConfig { size: 16, ..ok };
+        assert_eq!(small.starting_entries(&c, 10), 65536);
+        let tight = PrimitiveMapConfig {
+            entry_budget: 1 << 20,
+            ..ok
+        };
+        assert_eq!(tight.starting_entries(&c, 1_000_000), (1 << 20) / 4);
+        let sized = PrimitiveMapConfig {
+            initial_entries: 1000,
+            ..ok
+        };
+        assert_eq!(sized.starting_entries(&c, 1_000_000), 1000);
     }
 }

@@ -1,8 +1,10 @@
 //! Per-pixel shadow rays through the deep primitive map: visibility (1 = lit) and blocker distance.
 //!
-//! Reads: depth, normal, count map, index map, prim buffer, constants. Writes: visibility, blocker distance.
+//! Reads: depth, normal, the primitive map (state, per-pixel texels, list offsets and entries), prim buffer,
+//! constants. Writes: visibility, blocker distance.
 
 use crate::gpu_types::RayTraceConstants;
+use crate::primitive_map::PrimitiveMap;
 use crate::{shader, PassError};
 use bytemuck::Zeroable;
 use rhi::{
@@ -19,16 +21,17 @@ pub const RAY_OFFSET_PIXELS: f32 = 1.0 / 64.0;
 /// the rounding of camera + reconstructed offset, and of the stored vertices (4 ulps).
 pub const RAY_OFFSET_FLOAT_BOUND: f32 = 4.0 * f32::EPSILON;
 
+/// Binding of the list entries in `ray_trace.comp`.
+const ENTRIES_BINDING: u32 = 6;
+
 /// Inputs of the ray trace.
 pub struct RayTraceInputs<'a> {
     /// Reversed-Z depth (`ShaderResource` state).
     pub depth: &'a Image,
     /// Camera-facing geometric normal, w = 0 on background (`ShaderResource` state).
     pub normal: &'a Image,
-    /// Count map (`UnorderedAccess`).
-    pub count: &'a Image,
-    /// Index map (`UnorderedAccess`).
-    pub indices: &'a Image,
+    /// The primitive map built this frame.
+    pub map: &'a PrimitiveMap,
     /// Prim buffer.
     pub prims: &'a Buffer,
 }
@@ -75,23 +78,28 @@ impl RayTracePass {
                 BindingKind::UniformBuffer,
                 BindingKind::SampledImage,
                 BindingKind::SampledImage,
-                BindingKind::StorageImage,
-                BindingKind::StorageImage,
+                BindingKind::StorageBuffer,
+                BindingKind::StorageBuffer,
+                BindingKind::StorageBuffer,
+                BindingKind::StorageBuffer,
                 BindingKind::StorageBuffer,
                 BindingKind::StorageImage,
                 BindingKind::StorageImage,
             ],
             0,
         )?;
+        let b = Resource::Buffer;
         let group = device.create_bind_group(
             pipeline.layout(),
             &[
-                Resource::Buffer(&constants),
+                b(&constants),
                 Resource::Image(inputs.depth),
                 Resource::Image(inputs.normal),
-                Resource::Image(inputs.count),
-                Resource::Image(inputs.indices),
-                Resource::Buffer(inputs.prims),
+                b(&inputs.map.state),
+                b(&inputs.map.pixel_texels),
+                b(&inputs.map.offsets),
+                b(&inputs.map.entries),
+                b(inputs.prims),
                 Resource::Image(&visibility),
                 Resource::Image(&blocker_distance),
             ],
@@ -103,6 +111,20 @@ impl RayTracePass {
             visibility,
             blocker_distance,
         })
+    }
+
+    /// Points the ray trace at the primitive map's entries after [`PrimitiveMap::grow`] reallocated them.
+    ///
+    /// # Safety
+    /// No submitted frame that uses this pass may still be pending on the GPU.
+    pub unsafe fn rebind_entries(
+        &mut self,
+        device: &Device,
+        map: &PrimitiveMap,
+    ) -> Result<(), PassError> {
+        // SAFETY: the caller guarantees no pending use of the group.
+        unsafe { device.rebind_buffer(&mut self.group, ENTRIES_BINDING, &map.entries)? };
+        Ok(())
     }
 
     /// Updates the constants (host-visible; call while no submitted frame uses them) and records the pass.

@@ -10,7 +10,7 @@ use crate::shadow_pipeline::{
 };
 use crate::PassError;
 use glam::DVec3;
-use rhi::{Barrier, BufferUsage, Device, Image, MemoryLocation, ResourceState as S};
+use rhi::{Barrier, Buffer, BufferUsage, Device, Image, MemoryLocation, ResourceState as S};
 
 /// Everything the frame produced, read back to the host. Row-major, y = 0 at the top. Outputs the plan
 /// did not produce are empty.
@@ -28,10 +28,10 @@ pub struct FrameImages {
     pub blocker_distance: Vec<f32>,
     /// Occupancy view, N×N RGBA8.
     pub occupancy: Vec<[u8; 4]>,
-    /// Count map, N×N.
-    pub counts: Vec<u32>,
-    /// Index map, layer-major: `indices[(slot * N + y) * N + x]`; empty unless requested.
-    pub indices: Vec<u32>,
+    /// Primitive map list offsets, N² + 1: texel t's list is `list_entries[offsets[t] .. offsets[t + 1]]`.
+    pub list_offsets: Vec<u32>,
+    /// Primitive map list entries (triangle indices); empty unless requested.
+    pub list_entries: Vec<u32>,
     /// Classic single-tap shadow-map visibility.
     pub shadow_map_visibility: Vec<f32>,
     /// PCSS visibility.
@@ -150,18 +150,13 @@ impl ShadowRenderer {
         self.pipeline.report()
     }
 
-    /// Reads back the last frame's outputs (the index map only if `with_indices`).
-    pub fn read_back(&self, device: &Device, with_indices: bool) -> Result<FrameImages, PassError> {
+    /// Reads back the last frame's outputs (the primitive map's list entries only if `with_entries`).
+    pub fn read_back(&self, device: &Device, with_entries: bool) -> Result<FrameImages, PassError> {
         let p = &self.pipeline;
         let mut wanted = self.targets.outputs();
-        wanted.extend(
-            FrameOutput::PIPELINE
-                .iter()
-                .filter(|(_, r)| with_indices || *r != ResourceId::PrimIndexMap)
-                .filter_map(|&(output, r)| {
-                    p.image(r).map(|image| (image, S::UnorderedAccess, output))
-                }),
-        );
+        wanted.extend(FrameOutput::PIPELINE.iter().filter_map(|&(output, r)| {
+            p.image(r).map(|image| (image, S::UnorderedAccess, output))
+        }));
         wanted.push((p.output(), S::UnorderedAccess, FrameOutput::Output));
         let images: Vec<(&Image, S)> = wanted.iter().map(|&(i, s, _)| (i, s)).collect();
         let bytes = read_images(device, &images)?;
@@ -169,6 +164,20 @@ impl ShadowRenderer {
         for ((_, _, output), bytes) in wanted.iter().zip(&bytes) {
             frame.insert(*output, bytes, p.geometry().origin());
         }
+        let mut lists = vec![ResourceId::PrimListOffsets];
+        if with_entries {
+            lists.push(ResourceId::PrimListEntries);
+        }
+        let buffers: Vec<&Buffer> = lists.iter().filter_map(|&r| p.buffer(r)).collect();
+        let mut words = read_buffers(device, &buffers)?.into_iter();
+        frame.list_offsets = words
+            .next()
+            .map(|b| bytemuck::pod_collect_to_vec(&b))
+            .unwrap_or_default();
+        frame.list_entries = words
+            .next()
+            .map(|b| bytemuck::pod_collect_to_vec(&b))
+            .unwrap_or_default();
         Ok(frame)
     }
 }
@@ -236,6 +245,37 @@ pub fn read_images(device: &Device, images: &[(&Image, S)]) -> Result<Vec<Vec<u8
     buffers.iter().map(|b| Ok(b.read()?.to_vec())).collect()
 }
 
+/// Copies `buffers` (storage writes made visible by the frame's last UAV barrier) into host memory, waits,
+/// and returns their bytes.
+pub fn read_buffers(device: &Device, buffers: &[&Buffer]) -> Result<Vec<Vec<u8>>, PassError> {
+    let staging = buffers
+        .iter()
+        .map(|b| {
+            device.create_buffer(
+                "read-back",
+                b.size(),
+                BufferUsage::COPY_DST,
+                MemoryLocation::GpuToCpu,
+            )
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    device.submit_and_wait(|enc| {
+        enc.barriers(&[Barrier::Global {
+            before: S::UnorderedAccess,
+            after: S::CopySource,
+        }]);
+        for (src, dst) in buffers.iter().zip(&staging) {
+            enc.copy_buffer(src, dst)?;
+        }
+        enc.barriers(&[Barrier::Global {
+            before: S::CopyDest,
+            after: S::HostRead,
+        }]);
+        Ok(())
+    })?;
+    staging.iter().map(|b| Ok(b.read()?.to_vec())).collect()
+}
+
 /// Where a read-back image goes in [`FrameImages`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FrameOutput {
@@ -251,10 +291,6 @@ pub enum FrameOutput {
     BlockerDistance,
     /// [`FrameImages::occupancy`].
     Occupancy,
-    /// [`FrameImages::counts`].
-    Counts,
-    /// [`FrameImages::indices`].
-    Indices,
     /// [`FrameImages::shadow_map_visibility`].
     ShadowMapVisibility,
     /// [`FrameImages::pcss`].
@@ -271,17 +307,15 @@ pub enum FrameOutput {
 
 impl FrameOutput {
     /// The pipeline resources read back into [`FrameImages`].
-    pub const PIPELINE: [(FrameOutput, ResourceId); 10] = [
+    pub const PIPELINE: [(FrameOutput, ResourceId); 8] = [
         (Self::Visibility, ResourceId::RtVisibility),
         (Self::BlockerDistance, ResourceId::BlockerDistance),
         (Self::Occupancy, ResourceId::Occupancy),
-        (Self::Counts, ResourceId::PrimCountMap),
         (Self::ShadowMapVisibility, ResourceId::ShadowMapVisibility),
         (Self::Pcss, ResourceId::Pcss),
         (Self::Antialiased, ResourceId::RtAntialiased),
         (Self::LerpFactor, ResourceId::LerpFactor),
         (Self::Hybrid, ResourceId::Hybrid),
-        (Self::Indices, ResourceId::PrimIndexMap),
     ];
 }
 
@@ -298,8 +332,6 @@ impl FrameImages {
             FrameOutput::Visibility => self.visibility = floats(),
             FrameOutput::BlockerDistance => self.blocker_distance = floats(),
             FrameOutput::Occupancy => self.occupancy = bytemuck::pod_collect_to_vec(bytes),
-            FrameOutput::Counts => self.counts = bytemuck::pod_collect_to_vec(bytes),
-            FrameOutput::Indices => self.indices = bytemuck::pod_collect_to_vec(bytes),
             FrameOutput::ShadowMapVisibility => self.shadow_map_visibility = floats(),
             FrameOutput::Pcss => self.pcss = floats(),
             FrameOutput::Antialiased => self.antialiased = floats(),

@@ -12,18 +12,22 @@ use crate::frame_plan::{
     ShadowMode,
 };
 use crate::fxaa::FxaaPass;
-use crate::gpu_types::{MapStats, PcssConstants, PrimMapPush, RayTraceConstants, ShadowMapPush};
+use crate::gpu_types::{
+    MapPush, MapState, MapStats, PcssConstants, RayTraceConstants, ShadowMapPush,
+};
 use crate::hybrid::{BlendPass, HybridConfig, LerpFactorPass};
 use crate::light::{rebased, Light, LightFrame};
 use crate::pcss::{PcssConfig, PcssInputs, PcssKind, PcssPass};
 use crate::prim_buffer::{Geometry, PrimBufferPass};
 use crate::primitive_map::{
-    choose_raster_path, FaceMode, PrimitiveMap, PrimitiveMapConfig, RasterPath,
+    choose_binning_path, BinningPath, FaceMode, PrimitiveMap, PrimitiveMapConfig,
+    PrimitiveMapInputs,
 };
 use crate::ray_trace::{RayTraceInputs, RayTracePass, RAY_OFFSET_FLOAT_BOUND, RAY_OFFSET_PIXELS};
 use crate::screen_pass::visibility_image;
 use crate::shadow_map::{ShadowMapConfig, ShadowMapPass};
 use crate::PassError;
+use bytemuck::Zeroable;
 use glam::{DMat4, DVec3, Mat4, UVec4, Vec3, Vec4};
 use rhi::{
     Barrier, Buffer, BufferUsage, Device, Encoder, GpuTimer, Image, MemoryLocation, PassTiming,
@@ -126,11 +130,14 @@ pub struct ResourceReport {
 pub struct FrameReport {
     /// GPU time per pass that ran this frame, in recording order.
     pub timings: Vec<PassTiming>,
-    /// The conservative-raster path of the primitive map (the path the device would use when the plan
-    /// has no primitive map; software if it has none).
-    pub raster_path: RasterPath,
+    /// The binning path of the primitive map (the path the device would use when the plan has no
+    /// primitive map; compute if it has none).
+    pub binning_path: BinningPath,
     /// Statistics of the primitive map as last built (zero without a primitive map).
     pub stats: MapStats,
+    /// The primitive map's fitted transform, frame coordinates to homogeneous texel space, as last built
+    /// (zero without a primitive map).
+    pub map_to_texels: Mat4,
     /// Every pass of the linear order: ran this frame, or skipped and why.
     pub passes: Vec<(PassId, PassStatus)>,
     /// Every resource the pipeline allocated, with its size.
@@ -170,7 +177,7 @@ pub struct ShadowInputs<'a> {
 /// Derived per-frame constants.
 struct FrameConstants {
     light: LightFrame,
-    map: PrimMapPush,
+    map: MapPush,
     ray: RayTraceConstants,
     pcss: PcssConstants,
 }
@@ -202,11 +209,13 @@ pub struct ShadowPipeline {
     lit: Option<Image>,
     timer: GpuTimer,
     stats_readback: Buffer,
-    raster_path: RasterPath,
+    binning_path: BinningPath,
     /// Resources whose contents are valid from an earlier recording.
     valid: ResourceSet,
     /// The light of the last recording that rendered the light-space maps.
     maps_light: Option<Light>,
+    /// Whether `stats_readback` holds the state of a recorded map build (it is uninitialised before).
+    map_state_recorded: bool,
     /// The frame of the last `begin_frame`.
     frame: Option<FrameState>,
     /// Storage writes recorded and not yet followed by a UAV barrier.
@@ -261,13 +270,19 @@ impl ShadowPipeline {
             None
         };
         let map = if runs(PassId::PrimitiveMap) {
-            Some(PrimitiveMap::new(device, need_prims()?, config.map)?)
+            let map_inputs = PrimitiveMapInputs {
+                prims: need_prims()?,
+                triangles: geometry.triangle_count(),
+                depth: inputs.depth,
+                normal: inputs.normal,
+            };
+            Some(PrimitiveMap::new(device, &map_inputs, config.map)?)
         } else {
             None
         };
-        let raster_path = match &map {
+        let binning_path = match &map {
             Some(m) => m.path(),
-            None => choose_raster_path(caps, config.map.raster).unwrap_or(RasterPath::Software),
+            None => choose_binning_path(caps, config.map.binning).unwrap_or(BinningPath::Compute),
         };
         let ray = match (&map, runs(PassId::RayTrace)) {
             (Some(m), true) => Some(RayTracePass::new(
@@ -275,8 +290,7 @@ impl ShadowPipeline {
                 &RayTraceInputs {
                     depth: inputs.depth,
                     normal: inputs.normal,
-                    count: &m.count,
-                    indices: &m.indices,
+                    map: m,
                     prims: need_prims()?,
                 },
                 width,
@@ -346,10 +360,10 @@ impl ShadowPipeline {
         } else {
             None
         };
-        let timer = device.create_timer(32)?;
+        let timer = device.create_timer(48)?;
         let stats_readback = device.create_buffer(
-            "stats read-back",
-            std::mem::size_of::<MapStats>() as u64,
+            "map state read-back",
+            std::mem::size_of::<MapState>() as u64,
             BufferUsage::COPY_DST,
             MemoryLocation::GpuToCpu,
         )?;
@@ -369,7 +383,8 @@ impl ShadowPipeline {
             lit,
             timer,
             stats_readback,
-            raster_path,
+            binning_path,
+            map_state_recorded: false,
             valid: ResourceSet::EMPTY,
             maps_light: None,
             frame: None,
@@ -418,8 +433,6 @@ impl ShadowPipeline {
         use ResourceId as R;
         match resource {
             R::ShadowMap => self.shadow_map.as_ref().map(|s| &s.depth),
-            R::PrimCountMap => self.map.as_ref().map(|m| &m.count),
-            R::PrimIndexMap => self.map.as_ref().map(|m| &m.indices),
             R::Occupancy => self.map.as_ref().map(|m| &m.occupancy),
             R::RtVisibility => self.ray.as_ref().map(|r| &r.visibility),
             R::BlockerDistance => self.ray.as_ref().map(|r| &r.blocker_distance),
@@ -429,19 +442,39 @@ impl ShadowPipeline {
             R::LerpFactor => self.lerp.as_ref().map(|l| &l.output),
             R::Hybrid => self.blend.as_ref().map(|b| &b.output),
             R::Lit => self.lit.as_ref(),
-            R::SceneGeometry | R::Light | R::Depth | R::Normal | R::PrimBuffer => None,
+            R::SceneGeometry
+            | R::Light
+            | R::Depth
+            | R::Normal
+            | R::PrimBuffer
+            | R::PrimListOffsets
+            | R::PrimListEntries => None,
+        }
+    }
+
+    /// The buffer holding `resource`, if the plan allocated it: the primitive map's list offsets
+    /// (N² + 1 `u32`: texel t's list is `entries[offsets[t] .. offsets[t + 1]]`) and list entries.
+    pub fn buffer(&self, resource: ResourceId) -> Option<&Buffer> {
+        match resource {
+            ResourceId::PrimListOffsets => self.map.as_ref().map(|m| &m.offsets),
+            ResourceId::PrimListEntries => self.map.as_ref().map(|m| &m.entries),
+            ResourceId::PrimBuffer => self.prims(),
+            _ => None,
         }
     }
 
     /// Bytes of `resource` if the pipeline allocated it.
     fn resource_bytes(&self, resource: ResourceId) -> Option<u64> {
         match resource {
-            ResourceId::PrimBuffer => self.prim_buffer.as_ref().map(|p| p.prims().size()),
-            ResourceId::Occupancy => self
+            ResourceId::PrimListOffsets => self
                 .map
                 .as_ref()
-                .map(|m| m.occupancy.byte_size() + m.stats.size()),
-            r => self.image(r).map(Image::byte_size),
+                .map(|m| m.bytes() - m.entries.size() - m.occupancy.byte_size()),
+            ResourceId::Occupancy => self.map.as_ref().map(|m| m.occupancy.byte_size()),
+            r => self
+                .buffer(r)
+                .map(Buffer::size)
+                .or_else(|| self.image(r).map(Image::byte_size)),
         }
     }
 
@@ -495,20 +528,19 @@ impl ShadowPipeline {
         let pc = self.config.pcss;
         Ok(FrameConstants {
             light,
-            map: PrimMapPush {
+            map: MapPush {
                 light_view_proj: light.view_proj,
-                to_light: (-dir).extend(0.0),
+                to_light: (-dir).extend(if light.position.is_some() { 1.0 } else { 0.0 }),
                 size: cfg.size,
-                depth: cfg.depth,
                 front_only,
-                pad: 0,
+                ..MapPush::zeroed()
             },
             ray: RayTraceConstants {
                 inv_view_proj_rel,
                 light_view_proj: light.view_proj,
                 camera_pos: camera_frame.extend(1.0),
                 light_dir: dir.extend(0.0),
-                dims: UVec4::new(self.width, self.height, cfg.size, cfg.depth),
+                dims: UVec4::new(self.width, self.height, cfg.size, 0),
                 offset: Vec4::new(
                     radians_per_pixel,
                     RAY_OFFSET_PIXELS,
@@ -727,26 +759,13 @@ impl ShadowPipeline {
                 }
             }
             PassId::PrimitiveMap => {
-                if let Some(map) = &self.map {
-                    let transition = |image, before, after| Barrier::Image {
-                        image,
-                        before,
-                        after,
-                    };
-                    enc.barriers(&[
-                        transition(&map.count, S::Undefined, S::CopyDest),
-                        transition(&map.indices, S::Undefined, S::CopyDest),
-                    ]);
-                    map.record_clear(enc);
-                    enc.barriers(&[
-                        transition(&map.count, S::CopyDest, S::UnorderedAccess),
-                        transition(&map.indices, S::CopyDest, S::UnorderedAccess),
-                        Barrier::Global {
-                            before: S::CopyDest,
-                            after: S::UnorderedAccess,
-                        },
-                    ]);
-                    map.record_raster(enc, &c.map, tris)?;
+                self.grow_map(enc.device())?;
+                if let Some(map) = self.map.as_mut() {
+                    enc.barriers(&[Barrier::Global {
+                        before: S::UnorderedAccess,
+                        after: S::CopyDest,
+                    }]);
+                    map.record(enc, &c.ray, &c.map)?;
                 }
             }
             PassId::Occupancy => {
@@ -761,7 +780,8 @@ impl ShadowPipeline {
                         before: S::UnorderedAccess,
                         after: S::CopySource,
                     }]);
-                    enc.copy_buffer(&map.stats, &self.stats_readback)?;
+                    enc.copy_buffer(&map.state, &self.stats_readback)?;
+                    self.map_state_recorded = true;
                     enc.barriers(&[Barrier::Global {
                         before: S::CopyDest,
                         after: S::HostRead,
@@ -841,12 +861,33 @@ impl ShadowPipeline {
         }
     }
 
-    fn report_with(&self, timings: Vec<PassTiming>) -> Result<FrameReport, PassError> {
-        let stats: MapStats = if self.map.is_some() {
-            bytemuck::pod_read_unaligned(self.stats_readback.read()?)
-        } else {
-            MapStats::default()
+    /// The map state of the last frame that built the primitive map (zero before the first).
+    fn last_map_state(&self) -> Result<MapState, PassError> {
+        if !self.map_state_recorded {
+            return Ok(MapState::zeroed());
+        }
+        Ok(bytemuck::pod_read_unaligned(self.stats_readback.read()?))
+    }
+
+    /// Grows the primitive map's entries when the last frame needed more than they hold, and rebinds the
+    /// ray trace to them. Under the recording contract that frame has completed.
+    fn grow_map(&mut self, device: &Device) -> Result<(), PassError> {
+        let needed = self.last_map_state()?.totals.y;
+        let Some(map) = self.map.as_mut() else {
+            return Ok(());
         };
+        // SAFETY: the recording contract: the frames that used the map have completed.
+        if unsafe { map.grow(device, needed)? } {
+            if let Some(ray) = self.ray.as_mut() {
+                // SAFETY: as above.
+                unsafe { ray.rebind_entries(device, map)? };
+            }
+        }
+        Ok(())
+    }
+
+    fn report_with(&self, timings: Vec<PassTiming>) -> Result<FrameReport, PassError> {
+        let state = self.last_map_state()?;
         let resources = self
             .plan
             .resources()
@@ -858,8 +899,9 @@ impl ShadowPipeline {
             .collect();
         Ok(FrameReport {
             timings,
-            raster_path: self.raster_path,
-            stats,
+            binning_path: self.binning_path,
+            stats: MapStats::from_state(&state),
+            map_to_texels: state.to_texels,
             passes: self.statuses.clone(),
             resources,
             output: self.plan.final_output(),

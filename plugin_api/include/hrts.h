@@ -9,16 +9,18 @@
 
 // Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 // version differs.
-#define HRTS_API_VERSION ((1 << 22) | (1 << 12))
+#define HRTS_API_VERSION (2 << 22)
 
 // Number of `HrtsPass` values.
 #define HRTS_PASS_COUNT 12
 
-// The light-space passes (they read neither depth nor normal: record them before the engine's depth).
-#define HRTS_PASS_MASK_LIGHT_SPACE 15
+// The light-space passes (they read neither depth nor normal: record them before the engine's depth):
+// prim buffer and shadow map.
+#define HRTS_PASS_MASK_LIGHT_SPACE 3
 
-// The screen-space passes and the output copy (after the engine's depth and normal).
-#define HRTS_PASS_MASK_SCREEN_SPACE 4080
+// The passes that read the engine's depth and normal, and the output copy: the primitive map is fitted to
+// the receivers the camera sees, so it comes after the depth too.
+#define HRTS_PASS_MASK_SCREEN_SPACE 4092
 
 // Every pass.
 #define HRTS_PASS_MASK_ALL 4095
@@ -60,26 +62,28 @@ typedef enum HrtsResult {
 } HrtsResult;
 
 // Conservative-rasterization path (input field values and report values).
-enum HrtsRasterPath
+enum HrtsBinningPath
 #if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
   : uint32_t
 #endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
  {
-  // Hardware where the device has a tier, else the geometry-shader path.
-  HRTS_RASTER_PATH_AUTO = 0,
-  // `VK_EXT_conservative_rasterization`.
-  HRTS_RASTER_PATH_HARDWARE = 1,
+  // The compute path (the fastest measured on every device).
+  HRTS_BINNING_PATH_AUTO = 0,
+  // Hardware conservative raster (`VK_EXT_conservative_rasterization`).
+  HRTS_BINNING_PATH_HARDWARE = 1,
   // Geometry-shader dilation + exact per-texel test.
-  HRTS_RASTER_PATH_SOFTWARE = 2,
+  HRTS_BINNING_PATH_SOFTWARE = 2,
   // Hardware conservative raster made to behave like D3D12 Tier 1 (1/2 px uncertainty, post-snap
   // degenerate triangles culled) on a device with a better tier: for tier-fallback tests.
-  HRTS_RASTER_PATH_EMULATED_TIER1 = 3,
+  HRTS_BINNING_PATH_EMULATED_TIER1 = 3,
+  // Compute-shader binning over 4×4-texel tiles of each triangle's bounding box.
+  HRTS_BINNING_PATH_COMPUTE = 4,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
-typedef enum HrtsRasterPath HrtsRasterPath;
+typedef enum HrtsBinningPath HrtsBinningPath;
 #else
-typedef uint32_t HrtsRasterPath;
+typedef uint32_t HrtsBinningPath;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
@@ -252,11 +256,12 @@ enum HrtsResource
  {
   // Light-space depth, `D32_SFLOAT`, shadow_map_size².
   HRTS_RESOURCE_SHADOW_MAP = 0,
-  // Triangle count per texel, `R32_UINT`, N².
-  HRTS_RESOURCE_PRIM_COUNT_MAP = 1,
-  // Triangle indices, `R32_UINT`, N² × d layers (layer-major).
-  HRTS_RESOURCE_PRIM_INDEX_MAP = 2,
-  // Occupancy view, `R8G8B8A8_UNORM`, N² (red: overflowed texel).
+  // Primitive map list offsets, a buffer of N² + 1 `uint32_t` (`R32_UINT`, width N² + 1): texel
+  // t = y·N + x holds entries [offsets[t], offsets[t + 1]).
+  HRTS_RESOURCE_PRIM_LIST_OFFSETS = 1,
+  // Primitive map list entries, a buffer of `uint32_t` triangle indices (`R32_UINT`, width = capacity).
+  HRTS_RESOURCE_PRIM_LIST_ENTRIES = 2,
+  // Occupancy view, `R8G8B8A8_UNORM`, N² (grey: list length on a log scale; red: past the capacity).
   HRTS_RESOURCE_OCCUPANCY = 3,
   // Ray-traced visibility, `R32_SFLOAT`, 1 = lit.
   HRTS_RESOURCE_RT_VISIBILITY = 4,
@@ -363,8 +368,8 @@ typedef struct HrtsCapabilities {
   uint32_t struct_size;
   // D3D12 conservative-raster tier: 0 none, 1..3.
   uint32_t conservative_raster_tier;
-  // Raster path `HRTS_RASTER_PATH_AUTO` resolves to (`HrtsRasterPath`).
-  uint32_t default_raster_path;
+  // Binning path `HRTS_BINNING_PATH_AUTO` resolves to (`HrtsBinningPath`).
+  uint32_t default_binning_path;
   // Geometry shaders available (software path possible).
   bool geometry_shader;
   // Timestamp queries available (per-pass GPU times in the report).
@@ -377,8 +382,8 @@ typedef struct HrtsCapabilities {
   bool fragment_shader_interlock;
   // Largest primitive map size N.
   uint32_t max_map_size;
-  // Largest primitive map depth d.
-  uint32_t max_map_depth;
+  // Largest primitive-map entry budget in KiB (the device's largest storage buffer).
+  uint32_t max_map_entry_budget_kib;
   // `maxStorageBufferRange` in bytes.
   uint64_t max_storage_buffer_range;
   // Device name (NUL-terminated, truncated to fit).
@@ -396,14 +401,18 @@ typedef struct HrtsConfig {
   bool antialiasing;
   // The light does not move between frames: the shadow and primitive maps are kept (default false).
   bool static_light;
-  // Primitive map N (texels per side), 1..=max_map_size (default 1024).
+  // Primitive map N: texels per side of the light-space grid fitted to the receivers each frame,
+  // 1..=max_map_size (default 1024). It moves cost, never exactness.
   uint32_t map_size;
-  // Primitive map d (triangles per texel), 1..=max_map_depth (default 32).
-  uint32_t map_depth;
+  // Largest memory of the primitive map's list entries in KiB, at least 4 (default 262144 = 256 MiB,
+  // capped by the device's largest storage buffer). The lists take what the frame needs and grow to
+  // fit; a texel whose list does not fit is traced against every triangle (exact, slower) and counted
+  // in the report.
+  uint32_t map_entry_budget_kib;
   // `HrtsFaces` (default both).
   uint32_t faces;
-  // `HrtsRasterPath` (default auto).
-  uint32_t raster_path;
+  // `HrtsBinningPath` (default auto).
+  uint32_t binning_path;
   // Shadow map size (default 3072, as in the talk).
   uint32_t shadow_map_size;
   // PCSS: angular radius of a directional emitter in radians (default 0.02).
@@ -436,9 +445,15 @@ typedef struct HrtsConfig {
   // Resources to produce besides those the mode needs, for `hrts_record_resource_readback` (bit
   // `1 << HrtsResource`; default 0). E.g. the shadow-map visibility for comparisons.
   uint32_t extra_outputs;
-  // Debug: the index map gets one more layer, filled with `0xFFFFFFFF` and never written: a read-back
-  // of `HRTS_RESOURCE_PRIM_INDEX_MAP` shows any write past d (default false).
-  bool guard_layer;
+  // Debug: 4096 words after the list entries, filled with `0xFFFFFFFF` and never written: a read-back of
+  // `HRTS_RESOURCE_PRIM_LIST_ENTRIES` shows any write past the capacity (default false).
+  bool guard_entries;
+  // Debug: bin every texel of the fitted grid, not only those holding ray origins, and keep triangles
+  // behind every ray origin: lists comparable with exact conservative binning (default false).
+  bool debug_bin_all_texels;
+  // Entries the primitive map's lists start with (default 0: estimated from map_size and the
+  // triangles). An engine that knows its scene can size them and avoid the frame of a growth.
+  uint32_t map_initial_entries;
 } HrtsConfig;
 
 // One draw of the geometry.
@@ -605,22 +620,22 @@ typedef struct HrtsPassTiming {
 typedef struct HrtsFrameReport {
   // `sizeof(HrtsFrameReport)`, set by the caller.
   uint32_t struct_size;
-  // `HrtsRasterPath` used (hardware or software).
-  uint32_t raster_path;
-  // Conservative-raster tier used (0 for software).
+  // `HrtsBinningPath` used.
+  uint32_t binning_path;
+  // Conservative-raster tier used (0 for the compute and software paths).
   uint32_t tier;
-  // Texels whose triangle count exceeded d (traced exhaustively).
-  uint32_t overflowed_texels;
-  // Largest triangle count of any texel.
-  uint32_t max_count;
+  // Texels whose list did not fit the entry capacity (traced exhaustively: exact, slower).
+  uint32_t texels_past_capacity;
+  // Longest list of any texel.
+  uint32_t longest_list;
   // Number of valid entries in `passes`.
   uint32_t pass_count;
   // Per-pass GPU times.
   struct HrtsPassTiming passes[HRTS_MAX_REPORTED_PASSES];
   // Texels holding at least one triangle.
-  uint32_t occupied_texels;
-  // Triangle indices stored in the map (sum over texels of min(count, d)).
-  uint32_t stored_entries;
+  uint32_t texels_with_list;
+  // Entries (texel, triangle) the frame needed.
+  uint32_t entries;
   // `HrtsPassStatus` of each `HrtsPass` this frame.
   uint32_t pass_status[HRTS_PASS_COUNT];
   // Bytes of each `HrtsResource` the plugin allocated (0: not allocated).
@@ -629,6 +644,17 @@ typedef struct HrtsFrameReport {
   uint32_t output_resource;
   // Bytes of the prim buffer (triangles in frame coordinates; 0 if the plan has none).
   uint64_t prim_buffer_bytes;
+  // Entries the lists could hold this frame (they grow to fit from the next frame on).
+  uint32_t entry_capacity;
+  // Pixels that traced a shadow ray.
+  uint32_t receiver_pixels;
+  // Primitive-map texels holding at least one ray origin.
+  uint32_t receiver_texels;
+  // Triangles binned (not culled as degenerate, back-facing, outside or behind every receiver).
+  uint32_t triangles_binned;
+  // The primitive map's fit this frame: frame coordinates to homogeneous texel space, 16 floats,
+  // column-major (frame coordinates are world minus the geometry's origin).
+  float map_to_texels[16];
 } HrtsFrameReport;
 
 #ifdef __cplusplus

@@ -4,8 +4,8 @@
 use crate::types::*;
 use glam::{DVec3, Mat4, Vec3};
 use passes::{
-    Draw, FaceMode, FrameInputs, Geometry, IndexFormat, IndexLayout, Light, PassError, PassId,
-    PassStatus, PenumbraFilter, PrimitiveMapConfig, RasterPath, RasterRequest, ResourceId,
+    BinningPath, BinningRequest, Draw, FaceMode, FrameInputs, Geometry, IndexFormat, IndexLayout,
+    Light, PassError, PassId, PassStatus, PenumbraFilter, PrimitiveMapConfig, ResourceId,
     ResourceSet, ShadowConfig, ShadowInputs, ShadowMode, ShadowPipeline, SkipReason, VertexLayout,
 };
 use rhi::{
@@ -150,8 +150,8 @@ const DEPTH_NORMAL_READERS: u32 = 1 << HrtsPass::RayTrace as u32
 /// The plugin's resources by their C value (`HrtsResource`), in that order.
 const RESOURCES: [ResourceId; HRTS_RESOURCE_COUNT] = [
     ResourceId::ShadowMap,
-    ResourceId::PrimCountMap,
-    ResourceId::PrimIndexMap,
+    ResourceId::PrimListOffsets,
+    ResourceId::PrimListEntries,
     ResourceId::Occupancy,
     ResourceId::RtVisibility,
     ResourceId::BlockerDistance,
@@ -359,19 +359,18 @@ impl Context {
     pub(crate) fn capabilities(&self, out: &mut HrtsCapabilities) -> ApiResult<()> {
         check_size::<HrtsCapabilities>(out.struct_size, "HrtsCapabilities")?;
         let caps = self.device.capabilities();
-        let default_path = match passes::choose_raster_path(caps, RasterRequest::Auto) {
-            Ok(RasterPath::Hardware(_)) => HrtsRasterPath::Hardware as u32,
-            _ => HrtsRasterPath::Software as u32,
-        };
+        let default_path = passes::choose_binning_path(caps, BinningRequest::Auto)
+            .map_or(HrtsBinningPath::Compute, binning_path_to_c);
         out.conservative_raster_tier = caps.conservative_raster_tier as u32;
-        out.default_raster_path = default_path;
+        out.default_binning_path = default_path as u32;
         out.geometry_shader = caps.geometry_shader;
         out.timestamps = caps.timestamps;
         out.ray_query = caps.ray_query;
         out.ray_tracing_pipeline = caps.ray_tracing_pipeline;
         out.fragment_shader_interlock = caps.fragment_shader_interlock;
         out.max_map_size = caps.max_image_dimension_2d;
-        out.max_map_depth = caps.max_image_array_layers - 1;
+        out.max_map_entry_budget_kib =
+            (caps.max_storage_buffer_range >> 10).min(u64::from(u32::MAX)) as u32;
         out.max_storage_buffer_range = caps.max_storage_buffer_range;
         out.device_name = [0; 128];
         for (dst, src) in out
@@ -388,9 +387,7 @@ impl Context {
         let config = shadow_config(c)?;
         let caps = self.device.capabilities();
         config.map.validate(caps)?;
-        if config.map.raster != RasterRequest::Auto {
-            passes::choose_raster_path(caps, config.map.raster)?;
-        }
+        passes::choose_binning_path(caps, config.map.binning)?;
         if config.shadow_map.size == 0 || config.shadow_map.size > caps.max_image_dimension_2d {
             return Err(invalid(format!(
                 "shadow_map_size {} must be within 1..={}",
@@ -714,16 +711,18 @@ impl Context {
                 "the last recorded frame has not completed on the GPU: read the report after its fence signalled",
             )
         })?;
-        out.raster_path = match report.raster_path {
-            RasterPath::Hardware(_) => HrtsRasterPath::Hardware,
-            RasterPath::EmulatedTier1 { .. } => HrtsRasterPath::EmulatedTier1,
-            RasterPath::Software => HrtsRasterPath::Software,
-        } as u32;
-        out.tier = report.raster_path.tier() as u32;
-        out.overflowed_texels = report.stats.overflowed_texels;
-        out.max_count = report.stats.max_count;
-        out.occupied_texels = report.stats.occupied_texels;
-        out.stored_entries = report.stats.stored_entries;
+        out.binning_path = binning_path_to_c(report.binning_path) as u32;
+        out.tier = report.binning_path.tier() as u32;
+        let st = &report.stats;
+        out.texels_past_capacity = st.texels_past_capacity;
+        out.longest_list = st.longest_list;
+        out.texels_with_list = st.texels_with_list;
+        out.entries = st.entries;
+        out.entry_capacity = st.capacity;
+        out.receiver_pixels = st.receiver_pixels;
+        out.receiver_texels = st.receiver_texels;
+        out.triangles_binned = st.triangles_binned;
+        out.map_to_texels = report.map_to_texels.to_cols_array();
         out.pass_count = report.timings.len().min(HRTS_MAX_REPORTED_PASSES) as u32;
         for (slot, t) in out.passes.iter_mut().zip(&report.timings) {
             slot.name = [0; 32];
@@ -762,8 +761,8 @@ impl Context {
         check_size::<HrtsResourceInfo>(out.struct_size, "HrtsResourceInfo")?;
         let id = resource_id(resource)?;
         let built = self.ensure_built()?;
-        match built.pipeline.image(id) {
-            Some(image) => {
+        match (built.pipeline.image(id), built.pipeline.buffer(id)) {
+            (Some(image), _) => {
                 out.allocated = true;
                 out.width = image.width();
                 out.height = image.height();
@@ -771,7 +770,15 @@ impl Context {
                 out.format = image.format().raw_vk();
                 out.bytes = image.byte_size();
             }
-            None => {
+            (None, Some(buffer)) => {
+                out.allocated = true;
+                out.width = (buffer.size() / 4).min(u64::from(u32::MAX)) as u32;
+                out.height = 1;
+                out.layers = 1;
+                out.format = Format::R32Uint.raw_vk();
+                out.bytes = buffer.size();
+            }
+            (None, None) => {
                 out.allocated = false;
                 (out.width, out.height, out.layers, out.format, out.bytes) = (0, 0, 0, 0, 0);
             }
@@ -789,24 +796,29 @@ impl Context {
         }
         let id = resource_id(r.resource)?;
         let built = self.finished_frame()?;
-        let image = built.pipeline.image(id).ok_or_else(|| {
-            ApiError::new(
-                HrtsResult::ErrorInvalidState,
-                format!(
-                    "{} is not allocated by this configuration: add it to extra_outputs",
-                    id.name()
-                ),
-            )
-        })?;
+        let (image, list) = (built.pipeline.image(id), built.pipeline.buffer(id));
+        let bytes = match (image, list) {
+            (Some(image), _) => image.byte_size(),
+            (None, Some(list)) => list.size(),
+            (None, None) => {
+                return Err(ApiError::new(
+                    HrtsResult::ErrorInvalidState,
+                    format!(
+                        "{} is not allocated by this configuration: add it to extra_outputs",
+                        id.name()
+                    ),
+                ))
+            }
+        };
         let fits = r
             .offset
-            .checked_add(image.byte_size())
+            .checked_add(bytes)
             .is_some_and(|end| end <= r.buffer_size);
         if !fits || !r.offset.is_multiple_of(4) {
             return Err(invalid(format!(
                 "{} needs {} bytes at a multiple-of-4 offset: offset {} in a buffer of {} bytes does not do",
                 id.name(),
-                image.byte_size(),
+                bytes,
                 r.offset,
                 r.buffer_size
             )));
@@ -823,18 +835,30 @@ impl Context {
         };
         // SAFETY: as for `record_passes`.
         let mut enc = unsafe { Encoder::from_raw_handle(&self.device, r.command_buffer) };
-        enc.barriers(&[Barrier::Image {
-            image,
-            before: state,
-            after: S::CopySource,
-        }]);
-        enc.copy_image_to_buffer_at(image, &buffer, r.offset)?;
+        match (image, list) {
+            (Some(image), _) => {
+                enc.barriers(&[Barrier::Image {
+                    image,
+                    before: state,
+                    after: S::CopySource,
+                }]);
+                enc.copy_image_to_buffer_at(image, &buffer, r.offset)?;
+                enc.barriers(&[Barrier::Image {
+                    image,
+                    before: S::CopySource,
+                    after: state,
+                }]);
+            }
+            (None, Some(list)) => {
+                enc.barriers(&[Barrier::Global {
+                    before: S::UnorderedAccess,
+                    after: S::CopySource,
+                }]);
+                enc.copy_buffer_at(list, &buffer, r.offset)?;
+            }
+            (None, None) => {}
+        }
         enc.barriers(&[
-            Barrier::Image {
-                image,
-                before: S::CopySource,
-                after: state,
-            },
             Barrier::Global {
                 before: S::CopyDest,
                 after: S::Engine(0),
@@ -1117,14 +1141,25 @@ const FACES: [(u32, FaceMode); 2] = [
     (HrtsFaces::FrontOnly as u32, FaceMode::FrontOnly),
 ];
 
-/// `HrtsRasterPath` values as requests.
-const RASTER_REQUESTS: [(u32, RasterRequest); 4] = [
-    (HrtsRasterPath::Auto as u32, RasterRequest::Auto),
-    (HrtsRasterPath::Hardware as u32, RasterRequest::Hardware),
-    (HrtsRasterPath::Software as u32, RasterRequest::Software),
+/// The C value of a binning path in use.
+fn binning_path_to_c(path: BinningPath) -> HrtsBinningPath {
+    match path {
+        BinningPath::Compute => HrtsBinningPath::Compute,
+        BinningPath::Hardware(_) => HrtsBinningPath::Hardware,
+        BinningPath::Software => HrtsBinningPath::Software,
+        BinningPath::EmulatedTier1 { .. } => HrtsBinningPath::EmulatedTier1,
+    }
+}
+
+/// `HrtsBinningPath` values as requests.
+const BINNING_REQUESTS: [(u32, BinningRequest); 5] = [
+    (HrtsBinningPath::Auto as u32, BinningRequest::Auto),
+    (HrtsBinningPath::Compute as u32, BinningRequest::Compute),
+    (HrtsBinningPath::Hardware as u32, BinningRequest::Hardware),
+    (HrtsBinningPath::Software as u32, BinningRequest::Software),
     (
-        HrtsRasterPath::EmulatedTier1 as u32,
-        RasterRequest::EmulateTier1,
+        HrtsBinningPath::EmulatedTier1 as u32,
+        BinningRequest::EmulateTier1,
     ),
 ];
 
@@ -1153,12 +1188,19 @@ fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
     check_size::<HrtsConfig>(c.struct_size, "HrtsConfig")?;
     let mode = enum_value(c.mode, &MODES, "mode", "HrtsShadowMode")?;
     let faces = enum_value(c.faces, &FACES, "faces", "HrtsFaces")?;
-    let raster = enum_value(
-        c.raster_path,
-        &RASTER_REQUESTS,
-        "raster_path",
-        "HrtsRasterPath",
+    let binning = enum_value(
+        c.binning_path,
+        &BINNING_REQUESTS,
+        "binning_path",
+        "HrtsBinningPath",
     )?;
+    if u64::from(c.map_entry_budget_kib) << 10 < passes::MIN_ENTRY_BUDGET {
+        return Err(invalid(format!(
+            "map_entry_budget_kib {} is below the minimum of {}",
+            c.map_entry_budget_kib,
+            passes::MIN_ENTRY_BUDGET >> 10
+        )));
+    }
     let filter = enum_value(c.pcss_filter, &FILTERS, "pcss_filter", "HrtsPenumbraFilter")?;
     if c.extra_outputs >> HRTS_RESOURCE_COUNT != 0 {
         return Err(ApiError::new(
@@ -1182,10 +1224,12 @@ fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
         extra_outputs,
         map: PrimitiveMapConfig {
             size: c.map_size,
-            depth: c.map_depth,
             faces,
-            raster,
-            guard_layer: c.guard_layer,
+            binning,
+            entry_budget: u64::from(c.map_entry_budget_kib) << 10,
+            guard: c.guard_entries,
+            receiver_culling: !c.debug_bin_all_texels,
+            initial_entries: c.map_initial_entries,
         },
         ..ShadowConfig::default()
     };
@@ -1229,9 +1273,9 @@ pub(crate) fn config_to_c(config: &ShadowConfig) -> ApiResult<HrtsConfig> {
         antialiasing: config.antialiasing,
         static_light: config.static_light,
         map_size: config.map.size,
-        map_depth: config.map.depth,
+        map_entry_budget_kib: (config.map.entry_budget >> 10).min(u64::from(u32::MAX)) as u32,
         faces: c_value(config.map.faces, &FACES),
-        raster_path: c_value(config.map.raster, &RASTER_REQUESTS),
+        binning_path: c_value(config.map.binning, &BINNING_REQUESTS),
         shadow_map_size: config.shadow_map.size,
         pcss_angular_radius: config.pcss.angular_radius,
         pcss_spot_radius: config.pcss.spot_radius,
@@ -1247,7 +1291,9 @@ pub(crate) fn config_to_c(config: &ShadowConfig) -> ApiResult<HrtsConfig> {
         shadow_map_slope_bias: config.shadow_map.slope_bias,
         dynamic_geometry: !config.static_geometry,
         extra_outputs,
-        guard_layer: config.map.guard_layer,
+        guard_entries: config.map.guard,
+        debug_bin_all_texels: !config.map.receiver_culling,
+        map_initial_entries: config.map.initial_entries,
     })
 }
 
@@ -1296,8 +1342,8 @@ mod tests {
     fn c_resource_values_name_the_pipeline_resources() {
         let pairs = [
             (HrtsResource::ShadowMap, ResourceId::ShadowMap),
-            (HrtsResource::PrimCountMap, ResourceId::PrimCountMap),
-            (HrtsResource::PrimIndexMap, ResourceId::PrimIndexMap),
+            (HrtsResource::PrimListOffsets, ResourceId::PrimListOffsets),
+            (HrtsResource::PrimListEntries, ResourceId::PrimListEntries),
             (HrtsResource::Occupancy, ResourceId::Occupancy),
             (HrtsResource::RtVisibility, ResourceId::RtVisibility),
             (HrtsResource::BlockerDistance, ResourceId::BlockerDistance),
@@ -1333,8 +1379,8 @@ mod tests {
             ..ShadowConfig::default()
         };
         other.map.faces = FaceMode::FrontOnly;
-        other.map.raster = RasterRequest::EmulateTier1;
-        other.map.guard_layer = true;
+        other.map.binning = BinningRequest::EmulateTier1;
+        other.map.guard = true;
         other.pcss.filter = PenumbraFilter::Standard;
         other.shadow_map.slope_bias = 2.5;
         let c = config_to_c(&other).expect("representable");

@@ -6,7 +6,7 @@ use std::ffi::c_char;
 
 /// Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 /// version differs.
-pub const HRTS_API_VERSION: u32 = 1 << 22 | 1 << 12;
+pub const HRTS_API_VERSION: u32 = 2 << 22;
 
 /// Result of every call. Append-only: values never change meaning.
 #[repr(C)]
@@ -43,16 +43,18 @@ pub enum HrtsResult {
 /// Conservative-rasterization path (input field values and report values).
 #[repr(u32)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum HrtsRasterPath {
-    /// Hardware where the device has a tier, else the geometry-shader path.
+pub enum HrtsBinningPath {
+    /// The compute path (the fastest measured on every device).
     Auto = 0,
-    /// `VK_EXT_conservative_rasterization`.
+    /// Hardware conservative raster (`VK_EXT_conservative_rasterization`).
     Hardware = 1,
     /// Geometry-shader dilation + exact per-texel test.
     Software = 2,
     /// Hardware conservative raster made to behave like D3D12 Tier 1 (1/2 px uncertainty, post-snap
     /// degenerate triangles culled) on a device with a better tier: for tier-fallback tests.
     EmulatedTier1 = 3,
+    /// Compute-shader binning over 4×4-texel tiles of each triangle's bounding box.
+    Compute = 4,
 }
 
 /// How PCSS shapes the penumbra.
@@ -98,10 +100,12 @@ pub enum HrtsPass {
 
 /// Number of `HrtsPass` values.
 pub const HRTS_PASS_COUNT: usize = 12;
-/// The light-space passes (they read neither depth nor normal: record them before the engine's depth).
-pub const HRTS_PASS_MASK_LIGHT_SPACE: u32 = 0xF;
-/// The screen-space passes and the output copy (after the engine's depth and normal).
-pub const HRTS_PASS_MASK_SCREEN_SPACE: u32 = 0xFF0;
+/// The light-space passes (they read neither depth nor normal: record them before the engine's depth):
+/// prim buffer and shadow map.
+pub const HRTS_PASS_MASK_LIGHT_SPACE: u32 = 0x3;
+/// The passes that read the engine's depth and normal, and the output copy: the primitive map is fitted to
+/// the receivers the camera sees, so it comes after the depth too.
+pub const HRTS_PASS_MASK_SCREEN_SPACE: u32 = 0xFFC;
 /// Every pass.
 pub const HRTS_PASS_MASK_ALL: u32 = 0xFFF;
 
@@ -124,11 +128,12 @@ pub enum HrtsPassStatus {
 pub enum HrtsResource {
     /// Light-space depth, `D32_SFLOAT`, shadow_map_size².
     ShadowMap = 0,
-    /// Triangle count per texel, `R32_UINT`, N².
-    PrimCountMap = 1,
-    /// Triangle indices, `R32_UINT`, N² × d layers (layer-major).
-    PrimIndexMap = 2,
-    /// Occupancy view, `R8G8B8A8_UNORM`, N² (red: overflowed texel).
+    /// Primitive map list offsets, a buffer of N² + 1 `uint32_t` (`R32_UINT`, width N² + 1): texel
+    /// t = y·N + x holds entries [offsets[t], offsets[t + 1]).
+    PrimListOffsets = 1,
+    /// Primitive map list entries, a buffer of `uint32_t` triangle indices (`R32_UINT`, width = capacity).
+    PrimListEntries = 2,
+    /// Occupancy view, `R8G8B8A8_UNORM`, N² (grey: list length on a log scale; red: past the capacity).
     Occupancy = 3,
     /// Ray-traced visibility, `R32_SFLOAT`, 1 = lit.
     RtVisibility = 4,
@@ -262,8 +267,8 @@ pub struct HrtsCapabilities {
     pub struct_size: u32,
     /// D3D12 conservative-raster tier: 0 none, 1..3.
     pub conservative_raster_tier: u32,
-    /// Raster path `HRTS_RASTER_PATH_AUTO` resolves to (`HrtsRasterPath`).
-    pub default_raster_path: u32,
+    /// Binning path `HRTS_BINNING_PATH_AUTO` resolves to (`HrtsBinningPath`).
+    pub default_binning_path: u32,
     /// Geometry shaders available (software path possible).
     pub geometry_shader: bool,
     /// Timestamp queries available (per-pass GPU times in the report).
@@ -276,8 +281,8 @@ pub struct HrtsCapabilities {
     pub fragment_shader_interlock: bool,
     /// Largest primitive map size N.
     pub max_map_size: u32,
-    /// Largest primitive map depth d.
-    pub max_map_depth: u32,
+    /// Largest primitive-map entry budget in KiB (the device's largest storage buffer).
+    pub max_map_entry_budget_kib: u32,
     /// `maxStorageBufferRange` in bytes.
     pub max_storage_buffer_range: u64,
     /// Device name (NUL-terminated, truncated to fit).
@@ -296,14 +301,18 @@ pub struct HrtsConfig {
     pub antialiasing: bool,
     /// The light does not move between frames: the shadow and primitive maps are kept (default false).
     pub static_light: bool,
-    /// Primitive map N (texels per side), 1..=max_map_size (default 1024).
+    /// Primitive map N: texels per side of the light-space grid fitted to the receivers each frame,
+    /// 1..=max_map_size (default 1024). It moves cost, never exactness.
     pub map_size: u32,
-    /// Primitive map d (triangles per texel), 1..=max_map_depth (default 32).
-    pub map_depth: u32,
+    /// Largest memory of the primitive map's list entries in KiB, at least 4 (default 262144 = 256 MiB,
+    /// capped by the device's largest storage buffer). The lists take what the frame needs and grow to
+    /// fit; a texel whose list does not fit is traced against every triangle (exact, slower) and counted
+    /// in the report.
+    pub map_entry_budget_kib: u32,
     /// `HrtsFaces` (default both).
     pub faces: u32,
-    /// `HrtsRasterPath` (default auto).
-    pub raster_path: u32,
+    /// `HrtsBinningPath` (default auto).
+    pub binning_path: u32,
     /// Shadow map size (default 3072, as in the talk).
     pub shadow_map_size: u32,
     /// PCSS: angular radius of a directional emitter in radians (default 0.02).
@@ -336,9 +345,15 @@ pub struct HrtsConfig {
     /// Resources to produce besides those the mode needs, for `hrts_record_resource_readback` (bit
     /// `1 << HrtsResource`; default 0). E.g. the shadow-map visibility for comparisons.
     pub extra_outputs: u32,
-    /// Debug: the index map gets one more layer, filled with `0xFFFFFFFF` and never written: a read-back
-    /// of `HRTS_RESOURCE_PRIM_INDEX_MAP` shows any write past d (default false).
-    pub guard_layer: bool,
+    /// Debug: 4096 words after the list entries, filled with `0xFFFFFFFF` and never written: a read-back of
+    /// `HRTS_RESOURCE_PRIM_LIST_ENTRIES` shows any write past the capacity (default false).
+    pub guard_entries: bool,
+    /// Debug: bin every texel of the fitted grid, not only those holding ray origins, and keep triangles
+    /// behind every ray origin: lists comparable with exact conservative binning (default false).
+    pub debug_bin_all_texels: bool,
+    /// Entries the primitive map's lists start with (default 0: estimated from map_size and the
+    /// triangles). An engine that knows its scene can size them and avoid the frame of a growth.
+    pub map_initial_entries: u32,
 }
 
 /// One draw of the geometry.
@@ -521,22 +536,22 @@ pub const HRTS_MAX_REPORTED_PASSES: usize = 32;
 pub struct HrtsFrameReport {
     /// `sizeof(HrtsFrameReport)`, set by the caller.
     pub struct_size: u32,
-    /// `HrtsRasterPath` used (hardware or software).
-    pub raster_path: u32,
-    /// Conservative-raster tier used (0 for software).
+    /// `HrtsBinningPath` used.
+    pub binning_path: u32,
+    /// Conservative-raster tier used (0 for the compute and software paths).
     pub tier: u32,
-    /// Texels whose triangle count exceeded d (traced exhaustively).
-    pub overflowed_texels: u32,
-    /// Largest triangle count of any texel.
-    pub max_count: u32,
+    /// Texels whose list did not fit the entry capacity (traced exhaustively: exact, slower).
+    pub texels_past_capacity: u32,
+    /// Longest list of any texel.
+    pub longest_list: u32,
     /// Number of valid entries in `passes`.
     pub pass_count: u32,
     /// Per-pass GPU times.
     pub passes: [HrtsPassTiming; HRTS_MAX_REPORTED_PASSES],
     /// Texels holding at least one triangle.
-    pub occupied_texels: u32,
-    /// Triangle indices stored in the map (sum over texels of min(count, d)).
-    pub stored_entries: u32,
+    pub texels_with_list: u32,
+    /// Entries (texel, triangle) the frame needed.
+    pub entries: u32,
     /// `HrtsPassStatus` of each `HrtsPass` this frame.
     pub pass_status: [u32; HRTS_PASS_COUNT],
     /// Bytes of each `HrtsResource` the plugin allocated (0: not allocated).
@@ -545,6 +560,17 @@ pub struct HrtsFrameReport {
     pub output_resource: u32,
     /// Bytes of the prim buffer (triangles in frame coordinates; 0 if the plan has none).
     pub prim_buffer_bytes: u64,
+    /// Entries the lists could hold this frame (they grow to fit from the next frame on).
+    pub entry_capacity: u32,
+    /// Pixels that traced a shadow ray.
+    pub receiver_pixels: u32,
+    /// Primitive-map texels holding at least one ray origin.
+    pub receiver_texels: u32,
+    /// Triangles binned (not culled as degenerate, back-facing, outside or behind every receiver).
+    pub triangles_binned: u32,
+    /// The primitive map's fit this frame: frame coordinates to homogeneous texel space, 16 floats,
+    /// column-major (frame coordinates are world minus the geometry's origin).
+    pub map_to_texels: [f32; 16],
 }
 
 /// A copy of a plugin resource into an engine buffer, recorded after a complete frame.

@@ -1,6 +1,6 @@
 //! Exact conservative binning of triangles into light-space texels.
 
-use glam::{DMat4, DVec2, DVec3, Mat4, Vec3};
+use glam::{DMat4, DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 
 use crate::exact::orient2d;
@@ -82,7 +82,7 @@ impl TexelSets {
 /// total number of entries and `n * n` must fit in `u32`.
 pub fn conservative_texel_sets(
     scene: &RefScene,
-    light_view_proj: Mat4,
+    light_view_proj: DMat4,
     light_direction: Vec3,
     n: u32,
     faces: FaceSelection,
@@ -161,7 +161,7 @@ pub fn conservative_texel_sets(
 /// clip `w <= 0` or a non-finite projection), whose footprint is unbounded.
 pub fn overlaps_texel_with_margin(
     scene: &RefScene,
-    light_view_proj: Mat4,
+    light_view_proj: DMat4,
     n: u32,
     tri: u32,
     x: u32,
@@ -195,9 +195,9 @@ struct Projection {
 }
 
 impl Projection {
-    fn new(light_view_proj: Mat4, n: u32) -> Self {
+    fn new(light_view_proj: DMat4, n: u32) -> Self {
         Self {
-            matrix: light_view_proj.as_dmat4(),
+            matrix: light_view_proj,
             n: f64::from(n),
         }
     }

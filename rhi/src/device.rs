@@ -4,6 +4,7 @@ use crate::caps::{
     device_extensions, device_type_name, has_extension, read_capabilities, Capabilities,
 };
 use crate::error::{Result, RhiError, VkResultExt};
+use crate::raytracing::{ray_tracing_missing, RayTracingDevice, RayTracingFeatures};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use std::ffi::{c_void, CStr};
@@ -112,6 +113,8 @@ pub(crate) struct Shared {
     pub(crate) allocator: ManuallyDrop<Mutex<Allocator>>,
     pub(crate) debug_utils: Option<ash::ext::debug_utils::Device>,
     pub(crate) nearest_sampler: vk::Sampler,
+    /// Acceleration structures and ray-tracing pipelines, or why they are unavailable.
+    pub(crate) ray_tracing: std::result::Result<RayTracingDevice, String>,
     messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     validation: Arc<ValidationLog>,
     owned: bool,
@@ -282,6 +285,19 @@ impl Device {
         if has_extension(&exts, ash::ext::conservative_rasterization::NAME) {
             enable.push(ash::ext::conservative_rasterization::NAME);
         }
+        let rt_missing = ray_tracing_missing(
+            |name| has_extension(&exts, name),
+            ray_tracing_features(&instance, chosen.pd, &exts),
+        );
+        let ray_tracing = rt_missing.is_empty();
+        if ray_tracing {
+            enable.extend(RayTracingDevice::EXTENSIONS);
+        } else {
+            log::info!(
+                "ray tracing unavailable: the device lacks {}",
+                rt_missing.join(", ")
+            );
+        }
         // SAFETY: `chosen.pd` was enumerated from `instance`.
         let supported = unsafe { instance.get_physical_device_features(chosen.pd) };
         let features = vk::PhysicalDeviceFeatures::default()
@@ -295,16 +311,27 @@ impl Device {
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
             .dynamic_rendering(true)
             .synchronization2(true);
+        let mut f12 = vk::PhysicalDeviceVulkan12Features::default().buffer_device_address(true);
+        let mut f_accel = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default()
+            .acceleration_structure(true);
+        let mut f_rt_pipeline =
+            vk::PhysicalDeviceRayTracingPipelineFeaturesKHR::default().ray_tracing_pipeline(true);
         let priorities = [1.0f32];
         let queue_info = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(chosen.family)
             .queue_priorities(&priorities)];
         let enable_ptrs: Vec<*const std::ffi::c_char> = enable.iter().map(|n| n.as_ptr()).collect();
-        let dinfo = vk::DeviceCreateInfo::default()
+        let mut dinfo = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_info)
             .enabled_extension_names(&enable_ptrs)
             .enabled_features(&features)
             .push_next(&mut f13);
+        if ray_tracing {
+            dinfo = dinfo
+                .push_next(&mut f12)
+                .push_next(&mut f_accel)
+                .push_next(&mut f_rt_pipeline);
+        }
         // SAFETY: the chained structs outlive the call; features were checked during selection.
         let device = match unsafe { instance.create_device(chosen.pd, &dinfo, None) } {
             Ok(d) => d,
@@ -336,6 +363,11 @@ impl Device {
             messenger,
             validation,
             owned: true,
+            ray_tracing: if ray_tracing {
+                Ok(())
+            } else {
+                Err(rt_missing.join(", "))
+            },
         })
     }
 
@@ -386,6 +418,11 @@ impl Device {
             messenger: None,
             validation: Arc::new(ValidationLog::default()),
             owned: false,
+            ray_tracing: Err(
+                "an adopted device (the RHI cannot tell whether the engine enabled bufferDeviceAddress, \
+                 accelerationStructure and rayTracingPipeline)"
+                    .into(),
+            ),
         })
     }
 
@@ -410,7 +447,7 @@ impl Device {
             device: p.device.clone(),
             physical_device: p.physical,
             debug_settings: Default::default(),
-            buffer_device_address: false,
+            buffer_device_address: p.ray_tracing.is_ok(),
             allocation_sizes: Default::default(),
         })
         .map_err(|e| RhiError::Allocation {
@@ -435,6 +472,9 @@ impl Device {
         // SAFETY: valid device and queue family.
         let command_pool = unsafe { p.device.create_command_pool(&pool_info, None) }
             .call("vkCreateCommandPool")?;
+        let ray_tracing = p
+            .ray_tracing
+            .map(|()| RayTracingDevice::new(&p.instance, &p.device, p.physical));
         let shared = Arc::new(Shared {
             entry: p.entry,
             instance: p.instance,
@@ -454,6 +494,7 @@ impl Device {
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
             debug_utils,
             nearest_sampler,
+            ray_tracing,
             messenger: p.messenger,
             validation: p.validation,
             owned: p.owned,
@@ -575,6 +616,34 @@ struct PartsDesc {
     messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     validation: Arc<ValidationLog>,
     owned: bool,
+    /// Ok if the device was created with ray tracing enabled, else what is missing.
+    ray_tracing: std::result::Result<(), String>,
+}
+
+/// The ray-tracing features `pd` supports (queried only for the extensions it has).
+fn ray_tracing_features(
+    instance: &ash::Instance,
+    pd: vk::PhysicalDevice,
+    exts: &[String],
+) -> RayTracingFeatures {
+    let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
+    let mut accel = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default();
+    let mut pipeline = vk::PhysicalDeviceRayTracingPipelineFeaturesKHR::default();
+    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f12);
+    if has_extension(exts, ash::khr::acceleration_structure::NAME) {
+        f2 = f2.push_next(&mut accel);
+    }
+    if has_extension(exts, ash::khr::ray_tracing_pipeline::NAME) {
+        f2 = f2.push_next(&mut pipeline);
+    }
+    // SAFETY: `pd` belongs to `instance`; the chain holds only structs of extensions `pd` has and outlives
+    // the call.
+    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+    RayTracingFeatures {
+        buffer_device_address: f12.buffer_device_address == vk::TRUE,
+        acceleration_structure: accel.acceleration_structure == vk::TRUE,
+        ray_tracing_pipeline: pipeline.ray_tracing_pipeline == vk::TRUE,
+    }
 }
 
 /// Why a physical device cannot run the plugin, or None if it can.

@@ -10,8 +10,8 @@ use std::sync::{Arc, Mutex};
 
 /// Records commands into a command buffer (the RHI's own, or an engine's).
 pub struct Encoder<'a> {
-    device: &'a Device,
-    cmd: vk::CommandBuffer,
+    pub(crate) device: &'a Device,
+    pub(crate) cmd: vk::CommandBuffer,
     timer: Option<GpuTimer>,
     open_pass: Option<usize>,
     render_extent: (u32, u32),
@@ -187,6 +187,11 @@ impl<'a> Encoder<'a> {
         ash::vk::Handle::as_raw(self.cmd)
     }
 
+    /// The device this encoder records for.
+    pub fn device(&self) -> &'a Device {
+        self.device
+    }
+
     fn d(&self) -> &ash::Device {
         &self.device.shared.device
     }
@@ -268,6 +273,15 @@ impl<'a> Encoder<'a> {
 
     /// Records barriers (synchronization2).
     pub fn barriers(&mut self, barriers: &[Barrier<'_>]) {
+        self.record_barriers(barriers, |stages| stages);
+    }
+
+    /// Records `barriers` with every stage mask passed through `widen` (e.g. to add ray-tracing stages).
+    pub(crate) fn record_barriers(
+        &mut self,
+        barriers: &[Barrier<'_>],
+        widen: impl Fn(vk::PipelineStageFlags2) -> vk::PipelineStageFlags2,
+    ) {
         let mut memory = Vec::new();
         let mut images = Vec::new();
         for b in barriers {
@@ -306,6 +320,14 @@ impl<'a> Encoder<'a> {
                     );
                 }
             }
+        }
+        for b in &mut memory {
+            b.src_stage_mask = widen(b.src_stage_mask);
+            b.dst_stage_mask = widen(b.dst_stage_mask);
+        }
+        for b in &mut images {
+            b.src_stage_mask = widen(b.src_stage_mask);
+            b.dst_stage_mask = widen(b.dst_stage_mask);
         }
         let dep = vk::DependencyInfo::default()
             .memory_barriers(&memory)
@@ -579,14 +601,22 @@ impl<'a> Encoder<'a> {
 
     /// Copies `src` into `dst` (whole `src`).
     pub fn copy_buffer(&mut self, src: &Buffer, dst: &Buffer) -> Result<()> {
-        if dst.size() < src.size() {
+        self.copy_buffer_at(src, dst, 0)
+    }
+
+    /// Copies the whole of `src` into `dst` at byte `dst_offset`.
+    pub fn copy_buffer_at(&mut self, src: &Buffer, dst: &Buffer, dst_offset: u64) -> Result<()> {
+        if dst_offset
+            .checked_add(src.size())
+            .is_none_or(|end| end > dst.size())
+        {
             return Err(RhiError::InvalidArgument(
-                "copy destination is smaller than the source".into(),
+                "copy destination is smaller than the source at that offset".into(),
             ));
         }
         let region = vk::BufferCopy {
             src_offset: 0,
-            dst_offset: 0,
+            dst_offset,
             size: src.size(),
         };
         // SAFETY: sizes checked; both buffers live with the right usages.
@@ -598,7 +628,7 @@ impl<'a> Encoder<'a> {
     }
 }
 
-fn check_push(push: &[u8], declared: u32) -> Result<()> {
+pub(crate) fn check_push(push: &[u8], declared: u32) -> Result<()> {
     if push.len() as u64 > u64::from(declared) || !push.len().is_multiple_of(4) {
         return Err(RhiError::InvalidArgument(format!(
             "push constants of {} bytes do not fit the layout's {declared} bytes",

@@ -8,6 +8,7 @@ mod device;
 mod encoder;
 mod error;
 mod pipeline;
+mod raytracing;
 mod resources;
 
 pub use caps::Capabilities;
@@ -20,6 +21,9 @@ pub use error::{Result, RhiError};
 pub use pipeline::{
     BindGroup, BindingKind, ComputePipeline, DepthState, GraphicsPipeline, GraphicsPipelineDesc,
     PipelineLayout, Resource,
+};
+pub use raytracing::{
+    BottomLevel, RayTracingPipeline, RayTracingPipelineDesc, TopLevel, TriangleGeometry,
 };
 pub use resources::{
     live_gpu_allocation_bytes, Buffer, BufferUsage, Image, ImageDesc, ImageUsage, MemoryLocation,

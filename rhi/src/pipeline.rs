@@ -3,6 +3,7 @@
 use crate::conv::Format;
 use crate::device::{Device, Shared};
 use crate::error::{Result, RhiError, VkResultExt};
+use crate::raytracing::TopLevel;
 use crate::resources::{Buffer, Image};
 use ash::vk;
 use std::sync::Arc;
@@ -18,6 +19,8 @@ pub enum BindingKind {
     StorageImage,
     /// SRV texture read with `texelFetch` through a nearest sampler (`SHADER_READ_ONLY_OPTIMAL` layout).
     SampledImage,
+    /// Top-level acceleration structure (DXR `RaytracingAccelerationStructure`).
+    AccelerationStructure,
 }
 
 fn descriptor_type(k: BindingKind) -> vk::DescriptorType {
@@ -26,6 +29,7 @@ fn descriptor_type(k: BindingKind) -> vk::DescriptorType {
         BindingKind::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
         BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
         BindingKind::SampledImage => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+        BindingKind::AccelerationStructure => vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
     }
 }
 
@@ -35,11 +39,13 @@ pub enum Resource<'a> {
     Buffer(&'a Buffer),
     /// A whole image (all layers).
     Image(&'a Image),
+    /// A top-level acceleration structure.
+    AccelerationStructure(&'a TopLevel),
 }
 
 /// Descriptor-set layout plus pipeline layout (one set, one push-constant range).
 pub struct PipelineLayout {
-    shared: Arc<Shared>,
+    pub(crate) shared: Arc<Shared>,
     set_layout: vk::DescriptorSetLayout,
     pub(crate) raw: vk::PipelineLayout,
     kinds: Vec<BindingKind>,
@@ -51,6 +57,7 @@ pub struct BindGroup {
     shared: Arc<Shared>,
     pool: vk::DescriptorPool,
     pub(crate) set: vk::DescriptorSet,
+    kinds: Vec<BindingKind>,
 }
 
 /// A compute pipeline.
@@ -115,7 +122,7 @@ impl GraphicsPipeline {
 }
 
 impl Device {
-    fn create_layout(
+    pub(crate) fn create_layout(
         &self,
         kinds: &[BindingKind],
         push_constant_size: u32,
@@ -176,7 +183,7 @@ impl Device {
         })
     }
 
-    fn create_module(&self, spirv: &[u32]) -> Result<ShaderModule> {
+    pub(crate) fn create_module(&self, spirv: &[u32]) -> Result<ShaderModule> {
         // SAFETY: `spirv` is SPIR-V produced by glslang at build time.
         let m = unsafe {
             self.shared
@@ -375,6 +382,7 @@ impl Device {
             shared: self.shared.clone(),
             pool,
             set: vk::DescriptorSet::null(),
+            kinds: layout.kinds.clone(),
         };
         let layouts = [layout.set_layout];
         // SAFETY: the pool has room for exactly this set.
@@ -388,6 +396,7 @@ impl Device {
         .call("vkAllocateDescriptorSets")?[0];
         let mut buffer_infos = Vec::new();
         let mut image_infos = Vec::new();
+        let mut structures = Vec::new();
         for (i, (r, &k)) in resources.iter().zip(&layout.kinds).enumerate() {
             match (r, k) {
                 (Resource::Buffer(b), BindingKind::StorageBuffer | BindingKind::UniformBuffer) => {
@@ -420,6 +429,9 @@ impl Device {
                         .image_view(img.view)
                         .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
                 )),
+                (Resource::AccelerationStructure(tlas), BindingKind::AccelerationStructure) => {
+                    structures.push((i, [tlas.inner.raw]))
+                }
                 _ => {
                     return Err(RhiError::InvalidArgument(format!(
                         "binding {i}: resource does not match {k:?}"
@@ -446,16 +458,68 @@ impl Device {
                     .image_info(std::slice::from_ref(info)),
             );
         }
+        let mut structure_infos: Vec<_> = structures
+            .iter()
+            .map(|(_, raw)| {
+                vk::WriteDescriptorSetAccelerationStructureKHR::default()
+                    .acceleration_structures(raw)
+            })
+            .collect();
+        for ((i, _), info) in structures.iter().zip(&mut structure_infos) {
+            writes.push(
+                vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(*i as u32)
+                    .descriptor_type(vk::DescriptorType::ACCELERATION_STRUCTURE_KHR)
+                    .descriptor_count(1)
+                    .push_next(info),
+            );
+        }
         // SAFETY: all handles are live; the infos outlive the call.
         unsafe { d.update_descriptor_sets(&writes, &[]) };
         group.set = set;
         Ok(group)
     }
+
+    /// Points buffer binding `binding` of `group` at `buffer` (a buffer that replaced the one bound, e.g.
+    /// after growing it).
+    ///
+    /// # Safety
+    /// No command buffer that uses `group` may be pending or recording (the descriptor set is updated in
+    /// place, without update-after-bind).
+    pub unsafe fn rebind_buffer(
+        &self,
+        group: &mut BindGroup,
+        binding: u32,
+        buffer: &Buffer,
+    ) -> Result<()> {
+        let kind = group.kinds.get(binding as usize).copied();
+        if !matches!(
+            kind,
+            Some(BindingKind::StorageBuffer | BindingKind::UniformBuffer)
+        ) {
+            return Err(RhiError::InvalidArgument(format!(
+                "binding {binding} of the group is not a buffer binding"
+            )));
+        }
+        let info = [vk::DescriptorBufferInfo::default()
+            .buffer(buffer.raw)
+            .range(vk::WHOLE_SIZE)];
+        let write = vk::WriteDescriptorSet::default()
+            .dst_set(group.set)
+            .dst_binding(binding)
+            .descriptor_type(descriptor_type(kind.unwrap_or(BindingKind::StorageBuffer)))
+            .buffer_info(&info);
+        // SAFETY: live set and buffer of a matching binding kind; the caller guarantees the set is not in
+        // use by the GPU or a recording.
+        unsafe { self.shared.device.update_descriptor_sets(&[write], &[]) };
+        Ok(())
+    }
 }
 
-struct ShaderModule {
+pub(crate) struct ShaderModule {
     shared: Arc<Shared>,
-    raw: vk::ShaderModule,
+    pub(crate) raw: vk::ShaderModule,
 }
 
 impl Drop for ShaderModule {

@@ -57,6 +57,9 @@ usage_flags!(
         COPY_SRC = 4,
         /// Copy destination.
         COPY_DST = 5,
+        /// Read by acceleration-structure builds through its device address (vertex input). Only on a
+        /// device with ray tracing: see [`Device::acceleration_structure_input_usage`].
+        ACCELERATION_STRUCTURE_INPUT = 6,
     }
 );
 
@@ -88,6 +91,11 @@ pub fn buffer_usage_to_vk(u: BufferUsage) -> vk::BufferUsageFlags {
         (BufferUsage::INDEX, vk::BufferUsageFlags::INDEX_BUFFER),
         (BufferUsage::COPY_SRC, vk::BufferUsageFlags::TRANSFER_SRC),
         (BufferUsage::COPY_DST, vk::BufferUsageFlags::TRANSFER_DST),
+        (
+            BufferUsage::ACCELERATION_STRUCTURE_INPUT,
+            vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS
+                | vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR,
+        ),
     ];
     for (ours, theirs) in map {
         if u.contains(ours) {
@@ -129,6 +137,7 @@ pub struct Buffer {
     pub(crate) raw: vk::Buffer,
     allocation: Option<Allocation>,
     size: u64,
+    pub(crate) usage: vk::BufferUsageFlags,
     owned: bool,
 }
 
@@ -173,11 +182,6 @@ impl Device {
         usage: BufferUsage,
         location: MemoryLocation,
     ) -> Result<Buffer> {
-        if size == 0 {
-            return Err(RhiError::InvalidArgument(format!(
-                "buffer {name} has size 0"
-            )));
-        }
         let limit = self.shared.caps.max_storage_buffer_range;
         if usage.contains(BufferUsage::STORAGE) && size > limit {
             return Err(RhiError::Limit {
@@ -186,10 +190,39 @@ impl Device {
                 limit,
             });
         }
+        if usage.contains(BufferUsage::ACCELERATION_STRUCTURE_INPUT) {
+            self.ray_tracing_support()?;
+        }
+        self.create_raw_buffer(name, size, buffer_usage_to_vk(usage), location)
+    }
+
+    /// The usage a buffer needs to be read by acceleration-structure builds on this device:
+    /// [`BufferUsage::ACCELERATION_STRUCTURE_INPUT`] where ray tracing is enabled, none elsewhere.
+    pub fn acceleration_structure_input_usage(&self) -> BufferUsage {
+        if self.ray_tracing_support().is_ok() {
+            BufferUsage::ACCELERATION_STRUCTURE_INPUT
+        } else {
+            BufferUsage::default()
+        }
+    }
+
+    /// Creates a buffer of `size` bytes with raw Vulkan usage flags.
+    pub(crate) fn create_raw_buffer(
+        &self,
+        name: &str,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        location: MemoryLocation,
+    ) -> Result<Buffer> {
+        if size == 0 {
+            return Err(RhiError::InvalidArgument(format!(
+                "buffer {name} has size 0"
+            )));
+        }
         let d = &self.shared.device;
         let info = vk::BufferCreateInfo::default()
             .size(size)
-            .usage(buffer_usage_to_vk(usage))
+            .usage(usage)
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
         // SAFETY: valid device and create info; the buffer is destroyed in Drop (or below on failure).
         let raw = unsafe { d.create_buffer(&info, None) }.call("vkCreateBuffer")?;
@@ -224,6 +257,7 @@ impl Device {
             raw,
             allocation: Some(allocation),
             size,
+            usage,
             owned: true,
         })
     }
@@ -393,6 +427,7 @@ impl Device {
             raw: ash::vk::Handle::from_raw(handle),
             allocation: None,
             size,
+            usage: buffer_usage_to_vk(usage),
             owned: false,
         })
     }
@@ -486,6 +521,14 @@ impl Buffer {
     /// The `VkBuffer` handle, for handing the buffer to a component that speaks raw Vulkan (a C ABI).
     pub fn raw_handle(&self) -> u64 {
         ash::vk::Handle::as_raw(self.raw)
+    }
+
+    /// The buffer's device address (it must have been created with `SHADER_DEVICE_ADDRESS` usage).
+    pub(crate) fn device_address(&self) -> u64 {
+        let info = vk::BufferDeviceAddressInfo::default().buffer(self.raw);
+        // SAFETY: live buffer; the RHI only asks for addresses of buffers it created with
+        // SHADER_DEVICE_ADDRESS usage on a device with bufferDeviceAddress enabled.
+        unsafe { self.shared.device.get_buffer_device_address(&info) }
     }
 
     /// Writes `data` at `offset` into a host-visible buffer.
@@ -605,6 +648,18 @@ mod tests {
         assert_eq!(
             image_usage_to_vk(ImageUsage::default()),
             vk::ImageUsageFlags::empty()
+        );
+    }
+
+    #[test]
+    fn acceleration_structure_input_is_addressable_build_input() {
+        let b =
+            buffer_usage_to_vk(BufferUsage::STORAGE | BufferUsage::ACCELERATION_STRUCTURE_INPUT);
+        assert_eq!(
+            b,
+            vk::BufferUsageFlags::STORAGE_BUFFER
+                | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS
+                | vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR
         );
     }
 }

@@ -26,7 +26,8 @@
 //! - **thin geometry**: thin closed plates and zero-thickness foliage cards;
 //! - **models**: real models from the shared model folder;
 //! - **non-finite**: NaN/Inf input, which must be rejected at load time;
-//! - **overflow**: primitive-map depths 1 to 4, which must overflow without writing out of bounds.
+//! - **overflow**: entry budgets of 1 to 4 entries per texel, which must be passed without writing out of
+//!   bounds.
 
 use std::f64::consts::TAU;
 use std::path::Path;
@@ -63,7 +64,7 @@ pub enum Family {
     Models,
     /// NaN/Inf input geometry: rejected at load time.
     NonFinite,
-    /// Primitive-map overflow with depths 1 to 4.
+    /// Primitive-map lists past an entry budget of 1 to 4 entries per texel.
     Overflow,
 }
 
@@ -117,14 +118,14 @@ pub struct Frame {
     pub height: u32,
 }
 
-/// Whether the primitive map of a case may or must overflow (more than `depth` triangles in a texel).
+/// Whether the primitive map of a case may or must overflow (lists past the entry capacity).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Overflow {
-    /// No texel may overflow: the case tests the texel lists, not the exhaustive fallback.
+    /// No texel may pass the entry capacity: the case tests the texel lists, not the exhaustive fallback.
     Forbidden,
     /// Overflow is allowed (its fallback is exact).
     Allowed,
-    /// At least one texel must overflow: the case tests the fallback.
+    /// At least one texel must pass the entry capacity: the case tests the fallback.
     Required,
 }
 
@@ -133,24 +134,29 @@ pub enum Overflow {
 pub struct MapSpec {
     /// N: texels per side.
     pub size: u32,
-    /// d: triangle slots per texel.
-    pub depth: u32,
+    /// Entry budget of the primitive map's lists, in entries (past it, texels are traced exhaustively),
+    /// or `None` for the default budget.
+    pub entry_budget: Option<u32>,
     /// Store only light-facing triangles (closed meshes); otherwise both faces.
     pub front_faces_only: bool,
-    /// Allocate the guard layer past `depth`, which must stay untouched.
-    pub guard_layer: bool,
+    /// Allocate guard words past the entry capacity, which must stay untouched.
+    pub guard: bool,
+    /// Bin only into texels with ray origins, and skip triangles behind all of them (the default); off,
+    /// every texel of the fitted grid gets every triangle over it.
+    pub receiver_culling: bool,
     /// Whether overflow is expected.
     pub overflow: Overflow,
 }
 
 impl MapSpec {
     /// Both faces, no guard layer, overflow forbidden.
-    pub const fn new(size: u32, depth: u32) -> Self {
+    pub const fn new(size: u32) -> Self {
         Self {
             size,
-            depth,
+            entry_budget: None,
             front_faces_only: false,
-            guard_layer: false,
+            guard: false,
+            receiver_culling: true,
             overflow: Overflow::Forbidden,
         }
     }
@@ -231,8 +237,6 @@ pub struct HardCase {
     pub map: MapSpec,
     /// What must hold.
     pub expectation: Expectation,
-    /// Slow on a CPU driver: run by the demo's table, left out of the integration tests.
-    pub heavy: bool,
 }
 
 /// Every case of every family, in table order. Model cases read `models` (the shared model folder); a
@@ -291,7 +295,6 @@ fn case(
         frame: FRAME,
         map,
         expectation: Expectation::Renders(Vec::new()),
-        heavy: false,
     }
 }
 
@@ -571,7 +574,7 @@ fn shared_edges() -> Vec<HardCase> {
     let camera = Some(look(Vec3::new(0.0, 0.45, 2.5), Vec3::ZERO));
     let closed = MapSpec {
         front_faces_only: true,
-        ..MapSpec::new(256, 64)
+        ..MapSpec::new(256)
     };
 
     let mut fan = Mesh::default();
@@ -604,7 +607,7 @@ fn shared_edges() -> Vec<HardCase> {
             with(ground(4.0), [fan.object("fan")]),
             down,
             camera,
-            MapSpec::new(256, 128),
+            MapSpec::new(256),
         )
         .checking(vec![Check::Shadowed(Solid::Polygon(rim))]),
         case(
@@ -615,7 +618,7 @@ fn shared_edges() -> Vec<HardCase> {
             with(ground(4.0), [plate_grid.object("plate")]),
             down,
             camera,
-            MapSpec::new(256, 64),
+            MapSpec::new(256),
         )
         .checking(vec![Check::Shadowed(Solid::Polygon(rectangle(
             [-1.0, 1.0],
@@ -701,7 +704,7 @@ fn grazing() -> Vec<HardCase> {
                     (center + normal * 3.0 + bitangent * 3.0).as_vec3(),
                     center.as_vec3(),
                 )),
-                MapSpec::new(256, 128),
+                MapSpec::new(256),
             )
             .checking(vec![Check::Lit(plane_bounds)]),
         );
@@ -724,7 +727,7 @@ fn grazing() -> Vec<HardCase> {
                     (target + outward * 6.0 + DVec3::Z * 5.0).as_vec3(),
                     target.as_vec3(),
                 )),
-                MapSpec::new(256, 128),
+                MapSpec::new(256),
             )
             .checking(vec![Check::Lit(tube_bounds)]),
         );
@@ -754,7 +757,7 @@ fn contact() -> Vec<HardCase> {
                 scene.clone(),
                 travel.as_vec3(),
                 Some(look(Vec3::new(3.0, 1.6, 3.5), Vec3::new(0.9, 0.0, 0.5))),
-                MapSpec::new(256, 32),
+                MapSpec::new(256),
             )
             .checking(vec![Check::Contact(aabb(min, max))])
         })
@@ -785,7 +788,7 @@ fn scale() -> Vec<HardCase> {
     let light = DirectionalLight::slanted().direction;
     let map = MapSpec {
         overflow: Overflow::Allowed,
-        ..MapSpec::new(256, 64)
+        ..MapSpec::new(256)
     };
     let same = |max_differing_pixels| {
         vec![Check::SameAs {
@@ -957,7 +960,7 @@ fn small_triangles() -> Vec<HardCase> {
             with(ground(4.0), [fine.object("fine plate")]),
             light,
             camera,
-            MapSpec::new(128, 64),
+            MapSpec::new(128),
         )
         .checking(vec![Check::Shadowed(Solid::Polygon(rectangle(
             [-0.25, 0.25],
@@ -971,7 +974,7 @@ fn small_triangles() -> Vec<HardCase> {
             with(ground(4.0), [dust.object("dust")]),
             light,
             camera,
-            MapSpec::new(128, 32),
+            MapSpec::new(128),
         ),
         case(
             "needles (aspect 1e5) and slivers",
@@ -984,7 +987,7 @@ fn small_triangles() -> Vec<HardCase> {
             ),
             light,
             camera,
-            MapSpec::new(128, 1024),
+            MapSpec::new(128),
         )
         .checking(vec![Check::Shadowed(Solid::Polygon(rectangle(
             [-0.5, 0.5],
@@ -1003,7 +1006,7 @@ fn small_triangles() -> Vec<HardCase> {
             ),
             light,
             camera,
-            MapSpec::new(128, 64),
+            MapSpec::new(128),
         )
         .checking(vec![Check::Shadowed(Solid::Polygon(rectangle(
             [-0.5, 0.5],
@@ -1059,7 +1062,7 @@ fn texel_blockers(light: DirectionalLight) -> (Scene, Vec<Vec3>) {
 
 fn texel_boundaries() -> Vec<HardCase> {
     let camera = Some(look(Vec3::new(0.0, 0.3, 2.5), Vec3::ZERO));
-    let map = MapSpec::new(TEXEL_MAP, 32);
+    let map = MapSpec::new(TEXEL_MAP);
     let down = DirectionalLight {
         direction: Vec3::NEG_Y,
     };
@@ -1133,7 +1136,7 @@ fn frustum_border() -> Vec<HardCase> {
             scene,
             light.direction,
             Some(look(Vec3::new(0.2, 0.45, 2.6), Vec3::new(0.0, 0.0, -0.2))),
-            MapSpec::new(128, 16),
+            MapSpec::new(128),
         )
         .checking(vec![
             Check::Shadowed(Solid::Polygon(rectangle([-10.0, 10.0], 0.6, [-0.6, -0.1]))),
@@ -1182,7 +1185,7 @@ fn coplanar() -> Vec<HardCase> {
             overlapping,
             light,
             Some(look(Vec3::new(1.2, 1.6, 2.4), Vec3::new(0.3, 0.0, -0.2))),
-            MapSpec::new(128, 16),
+            MapSpec::new(128),
         )
         .checking(vec![
             Check::Shadowed(Solid::Polygon(rectangle([-0.6, 0.2], 0.5, [-0.5, 0.3]))),
@@ -1200,7 +1203,7 @@ fn coplanar() -> Vec<HardCase> {
             Some(look(Vec3::new(2.2, 1.8, 2.4), Vec3::new(0.3, 0.3, 0.2))),
             MapSpec {
                 front_faces_only: true,
-                ..MapSpec::new(128, 16)
+                ..MapSpec::new(128)
             },
         )
         .checking(vec![
@@ -1302,7 +1305,7 @@ fn thin_geometry() -> Vec<HardCase> {
             thin,
             light,
             Some(look(Vec3::new(1.0, 1.7, 2.6), Vec3::new(0.3, 0.2, 0.0))),
-            MapSpec::new(128, 32),
+            MapSpec::new(128),
         )
         .checking(checks),
         case(
@@ -1313,7 +1316,7 @@ fn thin_geometry() -> Vec<HardCase> {
             foliage,
             light,
             Some(look(Vec3::new(0.6, 3.2, 1.8), Vec3::new(0.3, 0.0, -0.3))),
-            MapSpec::new(128, 64),
+            MapSpec::new(128),
         )
         .checking(card_checks),
     ]
@@ -1321,10 +1324,6 @@ fn thin_geometry() -> Vec<HardCase> {
 
 fn real_models(models: &Path) -> Vec<HardCase> {
     let load = |file: &str| load_obj(&models.join(file));
-    let allow_overflow = |size, depth| MapSpec {
-        overflow: Overflow::Allowed,
-        ..MapSpec::new(size, depth)
-    };
     let cornell = case(
         "Cornell box (06)",
         Family::Models,
@@ -1336,7 +1335,7 @@ fn real_models(models: &Path) -> Vec<HardCase> {
             Vec3::new(278.0, 273.0, -800.0),
             Vec3::new(278.0, 273.0, 280.0),
         )),
-        MapSpec::new(256, 16),
+        MapSpec::new(256),
     );
     let veach = case(
         "Veach MIS plates (07)",
@@ -1345,7 +1344,7 @@ fn real_models(models: &Path) -> Vec<HardCase> {
         Scene::default(),
         Vec3::new(0.0, -0.35, -1.0),
         Some(look(Vec3::new(0.0, 2.0, 15.0), Vec3::new(0.0, -2.0, 2.5))),
-        MapSpec::new(256, 16),
+        MapSpec::new(256),
     );
     let pine = case(
         "small pine (08)",
@@ -1354,7 +1353,7 @@ fn real_models(models: &Path) -> Vec<HardCase> {
         Scene::default(),
         DirectionalLight::slanted().direction,
         None,
-        allow_overflow(256, 64),
+        MapSpec::new(256),
     );
     let sponza = case(
         "Sponza (04)",
@@ -1364,25 +1363,20 @@ fn real_models(models: &Path) -> Vec<HardCase> {
         Scene::default(),
         Vec3::new(0.3, -1.0, 0.12),
         Some(look(Vec3::new(-12.0, 2.5, 0.5), Vec3::new(4.0, 4.0, -1.0))),
-        allow_overflow(512, 64),
+        MapSpec::new(512),
     );
-    // 12 to 17 s on lavapipe (2,000 overflowed texels traced against 277K triangles), more than the
-    // rest of the suite together: run by `host_demo hardcases`, not by the integration tests.
-    let conference = HardCase {
-        heavy: true,
-        ..case(
-            "conference room (05)",
-            Family::Models,
-            "The conference room (277K triangles, thin chair legs, large floor).",
-            Scene::default(),
-            Vec3::new(0.35, -1.0, 0.25),
-            Some(look(
-                Vec3::new(-900.0, 400.0, 550.0),
-                Vec3::new(400.0, 80.0, -300.0),
-            )),
-            allow_overflow(512, 64),
-        )
-    };
+    let conference = case(
+        "conference room (05)",
+        Family::Models,
+        "The conference room (277K triangles, thin chair legs, large floor).",
+        Scene::default(),
+        Vec3::new(0.35, -1.0, 0.25),
+        Some(look(
+            Vec3::new(-900.0, 400.0, 550.0),
+            Vec3::new(400.0, 80.0, -300.0),
+        )),
+        MapSpec::new(512),
+    );
     let files = [
         (cornell, load("06_cornell_box/cornell_box.obj")),
         (veach, load("07_veach_mi_plates.obj")),
@@ -1409,9 +1403,8 @@ fn non_finite() -> Vec<HardCase> {
         camera: None,
         light_view_proj: None,
         frame: FRAME,
-        map: MapSpec::new(64, 8),
+        map: MapSpec::new(64),
         expectation: Expectation::RejectedAtLoad,
-        heavy: false,
     };
     let obj = |file: &str, text: &str| parse_obj(text.as_bytes(), Path::new(file));
     let mut in_memory = with(ground(4.0), [solid_box("box", [0.0; 3], [1.0; 3])]);
@@ -1486,27 +1479,28 @@ fn overflow() -> Vec<HardCase> {
         frame.width as f32 / frame.height as f32,
     );
     let mut cases: Vec<HardCase> = [
-        ("overflow d = 1", 1),
-        ("overflow d = 2", 2),
-        ("overflow d = 3", 3),
-        ("overflow d = 4", 4),
+        ("entry budget 1K", 1024),
+        ("entry budget 2K", 2048),
+        ("entry budget 4K", 4096),
+        ("entry budget 8K", 8192),
     ]
     .into_iter()
-    .map(|(name, depth)| HardCase {
+    .map(|(name, budget)| HardCase {
         frame,
         ..case(
             name,
             Family::Overflow,
-            "The demo scene in a 128x128 map of depth 1 to 4 with a guard layer: hundreds of \
-             texels overflow; nothing may be written past slot d and overflowed texels are traced \
-             exhaustively.",
+            "The demo scene in a 128x128 map with an entry budget of 1K to 8K entries and guard \
+             words: texels past the capacity; nothing may be written past it and those texels \
+             are traced exhaustively.",
             scene.clone(),
             DirectionalLight::slanted().direction,
             Some(camera),
             MapSpec {
-                guard_layer: true,
+                guard: true,
                 overflow: Overflow::Required,
-                ..MapSpec::new(128, depth)
+                entry_budget: Some(budget),
+                ..MapSpec::new(128)
             },
         )
     })
@@ -1516,16 +1510,19 @@ fn overflow() -> Vec<HardCase> {
         case(
             "exhaustive fallback vs far slivers",
             Family::Overflow,
-            "A lit ground over a buried grid that overflows its texels (d = 4), light straight \
+            "A lit ground over a buried grid whose lists pass a budget of 1K entries, light straight \
              down, and 1,000 tiny slivers 60 to 100 m away, each along a line through the centre: \
              traced exhaustively, no sliver may shadow the ground.",
             slivers,
             Vec3::NEG_Y,
             Some(look(Vec3::new(0.6, 1.2, 1.6), Vec3::ZERO)),
             MapSpec {
-                guard_layer: true,
+                guard: true,
                 overflow: Overflow::Required,
-                ..MapSpec::new(128, 4)
+                entry_budget: Some(1024),
+                // The buried grid lies behind every ray origin: culled, its lists would stay empty.
+                receiver_culling: false,
+                ..MapSpec::new(128)
             },
         )
         .checking(vec![Check::Lit(lit)]),
@@ -1592,7 +1589,12 @@ mod tests {
         for c in &cases {
             assert!(names.insert(c.name), "duplicate name {}", c.name);
             assert!(c.light_direction.is_finite() && c.light_direction.length() > 0.0);
-            assert!(c.frame.width > 0 && c.frame.height > 0 && c.map.size > 0 && c.map.depth > 0);
+            assert!(
+                c.frame.width > 0
+                    && c.frame.height > 0
+                    && c.map.size > 0
+                    && c.map.entry_budget != Some(0)
+            );
             match (&c.scene, &c.expectation) {
                 (Ok(s), Expectation::Renders(_)) => s.validate().unwrap(),
                 (Err(e), Expectation::RejectedAtLoad) => {

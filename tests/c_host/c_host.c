@@ -636,7 +636,6 @@ static HrtsConfig config(uint32_t mode) {
     cfg.mode = mode;
     cfg.antialiasing = false; /* compare the exact visibility, before FXAA */
     cfg.map_size = 256;
-    cfg.map_depth = 64;
     cfg.shadow_map_size = 1024;
     return cfg;
 }
@@ -690,17 +689,17 @@ static void misuse(HrtsContext *ctx, const HrtsVulkanDevice *vk) {
     c.map_size = 1u << 30;
     expect(ctx, hrts_configure(ctx, &c), HRTS_RESULT_ERROR_INVALID_ARGUMENT, "configure(absurd N)"), cases++;
     c = cfg;
-    c.map_depth = 0;
-    expect(ctx, hrts_configure(ctx, &c), HRTS_RESULT_ERROR_INVALID_ARGUMENT, "configure(d = 0)"), cases++;
+    c.map_entry_budget_kib = 0;
+    expect(ctx, hrts_configure(ctx, &c), HRTS_RESULT_ERROR_INVALID_ARGUMENT, "configure(entry budget 0)"), cases++;
     c = cfg;
-    c.map_depth = 100000;
-    expect(ctx, hrts_configure(ctx, &c), HRTS_RESULT_ERROR_INVALID_ARGUMENT, "configure(absurd d)"), cases++;
+    c.map_entry_budget_kib = 3;
+    expect(ctx, hrts_configure(ctx, &c), HRTS_RESULT_ERROR_INVALID_ARGUMENT, "configure(entry budget below 4 KiB)"), cases++;
     c = cfg;
     c.faces = 7;
     expect(ctx, hrts_configure(ctx, &c), HRTS_RESULT_ERROR_INVALID_ENUM, "configure(unknown faces)"), cases++;
     c = cfg;
-    c.raster_path = 99;
-    expect(ctx, hrts_configure(ctx, &c), HRTS_RESULT_ERROR_INVALID_ENUM, "configure(unknown raster path)"), cases++;
+    c.binning_path = 99;
+    expect(ctx, hrts_configure(ctx, &c), HRTS_RESULT_ERROR_INVALID_ENUM, "configure(unknown binning path)"), cases++;
     c = cfg;
     c.struct_size = 3;
     expect(ctx, hrts_configure(ctx, &c), HRTS_RESULT_ERROR_STRUCT_SIZE, "configure(wrong size)"), cases++;
@@ -804,8 +803,8 @@ static void misuse(HrtsContext *ctx, const HrtsVulkanDevice *vk) {
     f = frame(cmd);
     expect(ctx, hrts_record_passes(ctx, &f, 0), HRTS_RESULT_ERROR_INVALID_ARGUMENT, "passes(empty mask)"), cases++;
     expect(ctx, hrts_record_passes(ctx, &f, 1u << 20), HRTS_RESULT_ERROR_INVALID_ARGUMENT, "passes(unknown pass bit)"), cases++;
-    expect(ctx, hrts_record_passes(ctx, &f, HRTS_PASS_MASK_SCREEN_SPACE), HRTS_RESULT_ERROR_INVALID_STATE,
-           "passes(screen space before the light-space passes of the frame)"), cases++;
+    expect(ctx, hrts_record_passes(ctx, &f, 1u << HRTS_PASS_RAY_TRACE), HRTS_RESULT_ERROR_INVALID_STATE,
+           "passes(ray trace without the frame's primitive map)"), cases++;
     CHECK(hrts_record_passes(ctx, &f, HRTS_PASS_MASK_LIGHT_SPACE) == HRTS_RESULT_OK, "light space: %s", hrts_last_error(ctx));
     HrtsFrame moved = f;
     moved.camera_position[1] += 1.0f;
@@ -895,8 +894,11 @@ int main(void) {
     static float vis[W * H];
     CHECK(run_frame(ctx, vis) == HRTS_RESULT_OK, "record: %s", hrts_last_error(ctx));
     CHECK(hrts_get_frame_report(ctx, &rep) == HRTS_RESULT_OK, "report: %s", hrts_last_error(ctx));
-    printf("frame: %s path, %u overflowed texels, max count %u\n",
-           rep.raster_path == HRTS_RASTER_PATH_HARDWARE ? "hardware" : "software", rep.overflowed_texels, rep.max_count);
+    printf("frame: binning path %u, %u entries in %u lists (longest %u), capacity %u, %u texels past it\n",
+           rep.binning_path, rep.entries, rep.texels_with_list, rep.longest_list, rep.entry_capacity,
+           rep.texels_past_capacity);
+    CHECK(rep.binning_path == HRTS_BINNING_PATH_COMPUTE && rep.entries > 0 && rep.texels_past_capacity == 0,
+          "report of the primitive map");
     for (uint32_t i = 0; i < rep.pass_count; i++) printf("  %-28s %8.3f ms\n", rep.passes[i].name, rep.passes[i].milliseconds);
 
     /* compare with the exact shadow; tolerance 1/16 of the pixel footprint at the farthest point */

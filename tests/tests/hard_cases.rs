@@ -17,29 +17,14 @@
 
 mod common;
 
-use common::{assert_no_validation_errors, device};
+use common::{assert_no_validation_errors, device, models};
 use host_demo::hardcases::{run_cases, table, Outcome};
 use scene::hard_cases::{family, Expectation, Family};
-use std::path::PathBuf;
-
-/// The shared model folder; fails (never skips) when it is missing.
-fn models() -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/models");
-    assert!(
-        dir.is_dir(),
-        "the hard cases read the shared models next to the checkout: {} is missing",
-        dir.display()
-    );
-    dir
-}
 
 /// Runs the light cases of `f` on a validated device, prints their table and checks each.
 fn check_family(f: Family) -> Vec<Outcome> {
     let device = device();
-    let cases: Vec<_> = family(f, &models())
-        .into_iter()
-        .filter(|c| !c.heavy)
-        .collect();
+    let cases: Vec<_> = family(f, &models()).into_iter().collect();
     assert!(!cases.is_empty());
     let outcomes = run_cases(&device, &cases, None);
     println!("{}", table(&outcomes, false));

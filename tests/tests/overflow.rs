@@ -1,74 +1,126 @@
-//! Overflow of the deep primitive map: with a small d nothing is written past slot d (a guard layer stays
-//! untouched), the overflow count is right, the occupancy image is red exactly where counts exceed d, and
-//! the documented fallback (exhaustive trace of overflowed texels) keeps visibility exact.
+//! A primitive map whose lists do not fit: nothing is written past the entry capacity (guard words stay
+//! untouched), the texels that did not fit are counted and shown red, the documented fallback (those
+//! texels traced against every triangle) keeps visibility exact, and the lists grow to fit the next frame
+//! within the memory budget.
 
 mod common;
 
 use common::*;
 use host_demo::View;
-use passes::{PrimitiveMapConfig, RasterRequest, GUARD_VALUE};
+use passes::{
+    FrameInputs, PrimitiveMapConfig, ShadowRenderer, GUARD_VALUE, GUARD_WORDS, MIN_ENTRY_BUDGET,
+};
 use reference::RefScene;
 
-#[test]
-fn small_depth_overflows_safely_and_visibly() {
-    let device = device();
-    let view = View::framed(scene::procedural_default(), 160, 120);
-    let small = PrimitiveMapConfig {
-        size: 128,
-        depth: 2,
-        raster: RasterRequest::Software,
-        guard_layer: true,
-        ..Default::default()
-    };
-    let large = PrimitiveMapConfig {
-        depth: 512,
-        guard_layer: false,
-        ..small
-    };
-    let (report, images) = render(&device, &view, small, true);
-    let (_, reference_counts) = render(&device, &view, large, false);
+fn frames(
+    device: &rhi::Device,
+    view: &View,
+    config: PrimitiveMapConfig,
+    count: usize,
+) -> Vec<(passes::FrameReport, passes::FrameImages)> {
+    let geometry = view.upload(device).expect("upload");
+    let mut r =
+        ShadowRenderer::new(device, geometry, view.width, view.height, config).expect("renderer");
+    let inputs: FrameInputs = view.frame_inputs();
+    (0..count)
+        .map(|_| {
+            let report = r.render(device, &inputs).expect("render");
+            (report, r.read_back(device, true).expect("read back"))
+        })
+        .collect()
+}
 
-    // Counts do not depend on d: the atomic keeps counting past it.
+fn assert_past_capacity_is_safe_and_exact(
+    rs: &RefScene,
+    view: &View,
+    report: &passes::FrameReport,
+    images: &passes::FrameImages,
+) {
+    let st = report.stats;
+    let n = 128usize;
+    let capacity = st.capacity as usize;
+    assert_eq!(images.list_entries.len(), capacity + GUARD_WORDS as usize);
+    let written = images.list_entries[capacity..]
+        .iter()
+        .filter(|&&v| v != GUARD_VALUE)
+        .count();
     assert_eq!(
-        images.counts, reference_counts.counts,
-        "count map differs between d=2 and d=512"
+        written, 0,
+        "{written} guard words were written past the capacity"
     );
-    let d = small.depth;
-    let expected_overflow = images.counts.iter().filter(|&&c| c > d).count() as u32;
-    assert!(
-        expected_overflow > 100,
-        "the scene should overflow d=2 in many texels"
-    );
-    assert_eq!(report.stats.overflowed_texels, expected_overflow);
-    assert_eq!(report.stats.max_count, *images.counts.iter().max().unwrap());
-
-    // Nothing was written past slot d: the guard layer still holds its clear value everywhere.
-    let plane = (small.size * small.size) as usize;
-    let guard = &images.indices[d as usize * plane..(d as usize + 1) * plane];
-    let written = guard.iter().filter(|&&v| v != GUARD_VALUE).count();
-    assert_eq!(written, 0, "{written} texels were written past slot d");
-
-    // Occupancy: red exactly where count > d, white where count == d, black where empty.
-    for (i, (&c, px)) in images.counts.iter().zip(&images.occupancy).enumerate() {
-        let expected = if c > d {
-            [255, 0, 0, 255]
-        } else {
-            let g = (c as f32 / d as f32 * 255.0).round() as u8;
-            [g, g, g, 255]
-        };
-        assert_eq!(*px, expected, "texel {i} with count {c}");
+    // Past capacity: exactly the texels whose list ends beyond it, shown red.
+    let past: Vec<usize> = (0..n * n)
+        .filter(|&t| {
+            images.list_offsets[t + 1] as usize > capacity
+                && images.list_offsets[t + 1] > images.list_offsets[t]
+        })
+        .collect();
+    assert_eq!(st.texels_past_capacity as usize, past.len());
+    for &t in &past {
+        assert_eq!(images.occupancy[t], [255, 0, 0, 255], "texel {t}");
     }
-
-    // Stored entries of overflowed texels are still valid, distinct triangles of that texel.
-    let rs = RefScene::new(&view.scene);
-    let c = compare_map(&rs, &view, &small, &images, reference::FaceSelection::Both);
-    assert_eq!(c.garbage, 0, "{c:?}");
-    assert_eq!(c.missing, 0, "{c:?}");
-
+    assert_eq!(st.entries, images.list_offsets[n * n]);
     // The fallback keeps the ray-traced result exact.
-    let v = compare_visibility(&rs, &view, &images);
-    println!("overflowed {expected_overflow} texels; {c:?}; {v:?}");
+    let v = compare_visibility(rs, view, images);
+    println!(
+        "{st:?}; mismatches {}, near-edge {}",
+        v.mismatches, v.near_edge
+    );
     assert_eq!(v.mismatches, 0, "{:?}", v.examples);
     assert_eq!(v.blocker_mismatches, 0, "{:?}", v.examples);
+}
+
+#[test]
+fn lists_past_a_small_budget_stay_safe_and_exact() {
+    let device = device();
+    let view = View::framed(scene::procedural_default(), 160, 120);
+    let rs = RefScene::new(&view.scene);
+    let config = PrimitiveMapConfig {
+        size: 128,
+        entry_budget: MIN_ENTRY_BUDGET + 4 * u64::from(GUARD_WORDS),
+        guard: true,
+        ..Default::default()
+    };
+    let runs = frames(&device, &view, config, 2);
+    for (report, images) in &runs {
+        let st = report.stats;
+        assert_eq!(st.capacity, 1024, "the budget holds 1024 entries");
+        assert!(st.entries > 10 * st.capacity, "{st:?}");
+        assert!(st.texels_past_capacity > 100, "{st:?}");
+        assert_past_capacity_is_safe_and_exact(&rs, &view, report, images);
+    }
+    assert_no_validation_errors(&device);
+}
+
+#[test]
+fn lists_grow_to_fit_the_next_frame() {
+    let device = device();
+    let view = View::framed(scene::procedural_default(), 160, 120);
+    let rs = RefScene::new(&view.scene);
+    let config = PrimitiveMapConfig {
+        size: 128,
+        initial_entries: 1000,
+        guard: true,
+        ..Default::default()
+    };
+    let runs = frames(&device, &view, config, 3);
+    let (first, first_images) = &runs[0];
+    assert_eq!(first.stats.capacity, 1000);
+    assert!(first.stats.texels_past_capacity > 0, "{:?}", first.stats);
+    assert_past_capacity_is_safe_and_exact(&rs, &view, first, first_images);
+    for (report, images) in &runs[1..] {
+        let st = report.stats;
+        assert_eq!(st.texels_past_capacity, 0, "{st:?}");
+        assert!(
+            st.capacity >= st.entries && st.capacity <= st.entries * 5 / 4 + 1,
+            "{st:?}"
+        );
+        assert_eq!(st.entries, first.stats.entries);
+        assert_eq!(
+            images.visibility, first_images.visibility,
+            "growing changed the shadow"
+        );
+        assert_past_capacity_is_safe_and_exact(&rs, &view, report, images);
+    }
     assert_no_validation_errors(&device);
 }

@@ -8,7 +8,7 @@ use common::*;
 use host_demo::plugin::PluginRenderer;
 use host_demo::View;
 use passes::{
-    FrameImages, FrameReport, PassId, PassStatus, PrimitiveMapConfig, RasterRequest, ResourceId,
+    BinningRequest, FrameImages, FrameReport, PassId, PassStatus, PrimitiveMapConfig, ResourceId,
     ResourceSet, ShadowConfig, ShadowMode, ShadowRenderer,
 };
 use rhi::Device;
@@ -45,8 +45,11 @@ fn differences(a: &FrameImages, b: &FrameImages) -> Vec<(&'static str, usize)> {
             "occupancy",
             count(bits(&a.occupancy), bits(&b.occupancy), 4),
         ),
-        ("counts", count(bits(&a.counts), bits(&b.counts), 4)),
-        ("index lists", index_list_differences(a, b)),
+        (
+            "list offsets",
+            count(bits(&a.list_offsets), bits(&b.list_offsets), 4),
+        ),
+        ("lists", list_differences(a, b)),
         (
             "shadow-map visibility",
             count(
@@ -69,30 +72,22 @@ fn differences(a: &FrameImages, b: &FrameImages) -> Vec<(&'static str, usize)> {
     ]
 }
 
-/// Texels whose stored index list differs as a set. Fragments' atomics may reach a texel in any order on
-/// a GPU, so the order within a list (and which d triangles an overflowed texel keeps, unused by the
-/// exact fallback) is not deterministic; non-overflowed lists must hold the same triangles.
-fn index_list_differences(a: &FrameImages, b: &FrameImages) -> usize {
-    if a.indices.len() != b.indices.len() || a.counts != b.counts {
+/// Texels whose list differs as a set. Atomics may reach a texel in any order on a GPU, so the order
+/// within a list is not deterministic; the lists must hold the same triangles. Lists past the capacity
+/// (unused by the exact fallback) are not compared.
+fn list_differences(a: &FrameImages, b: &FrameImages) -> usize {
+    if a.list_offsets != b.list_offsets || a.list_entries.len() != b.list_entries.len() {
         return usize::MAX;
     }
-    let texels = a.counts.len();
-    if texels == 0 || a.indices.is_empty() {
-        return 0;
-    }
-    let depth = a.indices.len() / texels;
-    let list = |images: &FrameImages, t: usize, n: usize| {
-        let mut l: Vec<u32> = (0..n)
-            .map(|slot| images.indices[slot * texels + t])
-            .collect();
+    let capacity = a.list_entries.len();
+    let list = |images: &FrameImages, t: usize| {
+        let mut l = images.list_entries[a.list_offsets[t] as usize..a.list_offsets[t + 1] as usize]
+            .to_vec();
         l.sort_unstable();
         l
     };
-    (0..texels)
-        .filter(|&t| {
-            let n = a.counts[t] as usize;
-            n <= depth && list(a, t, n) != list(b, t, n)
-        })
+    (0..a.list_offsets.len().saturating_sub(1))
+        .filter(|&t| a.list_offsets[t + 1] as usize <= capacity && list(a, t) != list(b, t))
         .count()
 }
 
@@ -138,7 +133,7 @@ fn check(name: &str, view: &View, config: ShadowConfig, frames: usize, with_indi
     );
     assert!(!plugin.output.is_empty() && !plugin.depth.is_empty());
     assert_eq!(
-        direct_report.raster_path, plugin_report.raster_path,
+        direct_report.binning_path, plugin_report.binning_path,
         "{name}"
     );
     assert_eq!(direct_report.stats, plugin_report.stats, "{name}");
@@ -192,8 +187,7 @@ fn hybrid_with_comparison_outputs_matches_bit_for_bit() {
     let config = ShadowConfig {
         map: PrimitiveMapConfig {
             size: 512,
-            depth: 16,
-            raster: RasterRequest::Software,
+            binning: BinningRequest::Software,
             ..PrimitiveMapConfig::default()
         },
         extra_outputs: ResourceSet::of(&[
@@ -208,15 +202,22 @@ fn hybrid_with_comparison_outputs_matches_bit_for_bit() {
 }
 
 #[test]
-fn hard_shadows_of_a_real_mesh_match_bit_for_bit_with_the_index_map() {
+fn hard_shadows_of_a_real_mesh_match_bit_for_bit_with_the_lists() {
     let bunny = scene::load_obj(&model("02_stanford_bunny_69k.obj")).expect("bunny loads");
     let view = View::framed(bunny.with_ground_plane(), 160, 120);
+    // A budget the lists pass: the exhaustive fallback runs on both paths.
     let config = ShadowConfig::from(PrimitiveMapConfig {
         size: 256,
-        depth: 8,
+        entry_budget: 64 << 10,
         ..PrimitiveMapConfig::default()
     });
-    check("hard, bunny with overflow", &view, config, 1, true);
+    check(
+        "hard, bunny past the entry capacity",
+        &view,
+        config,
+        1,
+        true,
+    );
 }
 
 #[test]

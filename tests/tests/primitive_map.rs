@@ -1,64 +1,85 @@
-//! The software conservative-raster path stores, in every texel, the exact conservative set of triangles
-//! (missing: 0) and nothing else beyond a 1/256-texel margin (garbage: 0), on lavapipe with validation on.
+//! Every binning path stores, in every texel of the fitted grid, the exact conservative set of triangles
+//! (missing: 0, but for zero-area triangles, which are culled) and nothing else beyond a 1/256-texel margin
+//! (garbage: 0), on lavapipe with validation on. Receiver culling is off here so that every texel holds
+//! its whole set; with it on, lists only shrink (only garbage is checked) and visibility stays exact.
 
 mod common;
 
 use common::*;
 use host_demo::View;
-use passes::{FaceMode, PrimitiveMapConfig, RasterRequest};
+use passes::{choose_binning_path, BinningRequest, FaceMode, PrimitiveMapConfig};
 use reference::{FaceSelection, RefScene};
 
-fn check(view: &View, size: u32, depth: u32, faces: FaceMode) {
+fn check(view: &View, size: u32, faces: FaceMode) {
     let device = device();
-    let config = PrimitiveMapConfig {
-        size,
-        depth,
-        faces,
-        raster: RasterRequest::Software,
-        guard_layer: false,
-    };
-    let (report, images) = render(&device, view, config, true);
-    assert_eq!(report.raster_path, passes::RasterPath::Software);
     let rs = RefScene::new(&view.scene);
     let selection = match faces {
         FaceMode::Both => FaceSelection::Both,
         FaceMode::FrontOnly => FaceSelection::FrontOnly,
     };
-    let c = compare_map(&rs, view, &config, &images, selection);
-    println!(
-        "{size}x{size}x{depth} {faces:?}: {c:?}, stats {:?}",
-        report.stats
-    );
-    assert_eq!(
-        c.overflowed, 0,
-        "choose d so that no texel overflows: {:?}",
-        report.stats
-    );
-    assert_eq!(c.texels, (size * size) as usize);
-    assert_eq!(c.missing, 0, "{c:?}");
-    assert_eq!(c.garbage, 0, "{c:?}");
-    assert!(
-        c.extra_within_margin * 100 <= report.stats.stored_entries as usize,
-        "margin extras above 1%: {c:?}"
-    );
+    for binning in [
+        BinningRequest::Compute,
+        BinningRequest::Software,
+        BinningRequest::Hardware,
+    ] {
+        if choose_binning_path(device.capabilities(), binning).is_err() {
+            println!("{binning:?}: not on this device");
+            continue;
+        }
+        for receiver_culling in [false, true] {
+            let config = PrimitiveMapConfig {
+                size,
+                faces,
+                binning,
+                receiver_culling,
+                ..Default::default()
+            };
+            let (report, images) = render(&device, view, config, true);
+            let origin = view.upload(&device).expect("upload").origin();
+            let light = fitted_light_matrix(report.map_to_texels, origin, size);
+            let c = compare_map(
+                &rs,
+                light,
+                view.light.direction,
+                &config,
+                &images,
+                selection,
+            );
+            println!(
+                "{size}² {faces:?} {:?} culling {receiver_culling}: {c:?}, stats {:?}",
+                report.binning_path, report.stats
+            );
+            assert_eq!(c.past_capacity, 0);
+            assert_eq!(c.texels, (size * size) as usize);
+            assert_eq!(c.missing, 0, "{c:?}");
+            assert_eq!(c.garbage, 0, "{c:?}");
+            // Margin extras (texels within the acceptance margin, slivers binned as grown segments) cost a
+            // little time, never exactness: at most 1% of the entries, 2% of the fewer culled ones.
+            let percent = if receiver_culling { 2 } else { 1 };
+            assert!(
+                c.extra_within_margin * 100 <= percent * report.stats.entries as usize,
+                "margin extras above {percent}%: {c:?}"
+            );
+        }
+    }
     assert_no_validation_errors(&device);
 }
 
 #[test]
-fn procedural_scene_software_path_is_exact() {
+fn procedural_scene_lists_are_exact() {
     let view = View::framed(scene::procedural_default(), 64, 64);
-    check(&view, 128, 512, FaceMode::Both);
+    check(&view, 128, FaceMode::Both);
 }
 
 #[test]
 fn procedural_scene_front_faces_only_is_exact() {
     let view = View::framed(scene::procedural_default(), 64, 64);
-    check(&view, 96, 256, FaceMode::FrontOnly);
+    check(&view, 96, FaceMode::FrontOnly);
 }
 
 #[test]
-fn stanford_bunny_software_path_is_exact() {
+fn stanford_bunny_lists_are_exact() {
     let bunny = scene::load_obj(&model("02_stanford_bunny_69k.obj")).expect("bunny loads");
     let view = View::framed(bunny.with_ground_plane(), 64, 64);
-    check(&view, 192, 1024, FaceMode::Both);
+    check(&view, 192, FaceMode::Both);
 }

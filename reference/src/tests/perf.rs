@@ -66,7 +66,7 @@ fn target_size_runs_fast() {
     let start = Instant::now();
     let sets = conservative_texel_sets(
         &reference,
-        light_proj,
+        light_proj.as_dmat4(),
         Vec3::new(0.4, -1.0, -0.3).normalize(),
         256,
         FaceSelection::Both,

@@ -106,7 +106,7 @@ fn brute_overlap(q: [DVec2; 3], x: u32, y: u32) -> bool {
 /// Compares the sets with the oracle for every triangle and texel, and with
 /// `overlaps_texel_with_margin`.
 fn check_against_brute_force(scene: &RefScene, triangles: &[[Vec3; 3]], matrix: Mat4, n: u32) {
-    let sets = conservative_texel_sets(scene, matrix, DOWN, n, FaceSelection::Both);
+    let sets = conservative_texel_sets(scene, matrix.as_dmat4(), DOWN, n, FaceSelection::Both);
     check_csr(&sets, triangles.len());
     for (i, tri) in triangles.iter().enumerate() {
         let q = tri.map(|p| project(matrix, n, p));
@@ -120,11 +120,19 @@ fn check_against_brute_force(scene: &RefScene, triangles: &[[Vec3; 3]], matrix: 
                     "triangle {i} {q:?} texel ({x}, {y})"
                 );
                 assert_eq!(
-                    overlaps_texel_with_margin(scene, matrix, n, id, x, y, 0.0),
+                    overlaps_texel_with_margin(scene, matrix.as_dmat4(), n, id, x, y, 0.0),
                     expected
                 );
                 if expected {
-                    assert!(overlaps_texel_with_margin(scene, matrix, n, id, x, y, 0.5));
+                    assert!(overlaps_texel_with_margin(
+                        scene,
+                        matrix.as_dmat4(),
+                        n,
+                        id,
+                        x,
+                        y,
+                        0.5
+                    ));
                 }
             }
         }
@@ -136,7 +144,13 @@ fn triangle_on_texel_boundaries_touches_neighbours() {
     let n = 8;
     let tri = flat([(2.0, 2.0), (4.0, 2.0), (2.0, 4.0)]);
     let scene = scene_of(&[tri]);
-    let sets = conservative_texel_sets(&scene, grid_matrix(n), DOWN, n, FaceSelection::Both);
+    let sets = conservative_texel_sets(
+        &scene,
+        grid_matrix(n).as_dmat4(),
+        DOWN,
+        n,
+        FaceSelection::Both,
+    );
     check_csr(&sets, 1);
     let mut expected = Vec::new();
     for y in 1..=4 {
@@ -150,9 +164,33 @@ fn triangle_on_texel_boundaries_touches_neighbours() {
     assert!(sets.required[0] && !sets.light_degenerate[0]);
     // A margin reaches the texel just across the hypotenuse corner.
     let matrix = grid_matrix(n);
-    assert!(!overlaps_texel_with_margin(&scene, matrix, n, 0, 4, 3, 0.0));
-    assert!(overlaps_texel_with_margin(&scene, matrix, n, 0, 4, 3, 0.5));
-    assert!(!overlaps_texel_with_margin(&scene, matrix, n, 0, 6, 6, 0.5));
+    assert!(!overlaps_texel_with_margin(
+        &scene,
+        matrix.as_dmat4(),
+        n,
+        0,
+        4,
+        3,
+        0.0
+    ));
+    assert!(overlaps_texel_with_margin(
+        &scene,
+        matrix.as_dmat4(),
+        n,
+        0,
+        4,
+        3,
+        0.5
+    ));
+    assert!(!overlaps_texel_with_margin(
+        &scene,
+        matrix.as_dmat4(),
+        n,
+        0,
+        6,
+        6,
+        0.5
+    ));
 }
 
 #[test]
@@ -161,7 +199,13 @@ fn sub_texel_triangle_and_needle() {
     let small = flat([(5.2, 5.3), (5.6, 5.4), (5.3, 5.8)]);
     let needle = flat([(0.5, 0.5), (7.5, 7.25), (7.5, 7.2501)]);
     let scene = scene_of(&[small, needle]);
-    let sets = conservative_texel_sets(&scene, grid_matrix(n), DOWN, n, FaceSelection::Both);
+    let sets = conservative_texel_sets(
+        &scene,
+        grid_matrix(n).as_dmat4(),
+        DOWN,
+        n,
+        FaceSelection::Both,
+    );
     check_csr(&sets, 2);
     assert_eq!(texels_of(&sets, 0), vec![(5, 5)]);
     let needle_texels = texels_of(&sets, 1);
@@ -180,7 +224,13 @@ fn partly_and_wholly_outside_triangles_are_clipped() {
     let covering = flat([(-100.0, -100.0), (300.0, -100.0), (-100.0, 300.0)]);
     let triangles = [partly, outside, covering];
     let scene = scene_of(&triangles);
-    let sets = conservative_texel_sets(&scene, grid_matrix(n), DOWN, n, FaceSelection::Both);
+    let sets = conservative_texel_sets(
+        &scene,
+        grid_matrix(n).as_dmat4(),
+        DOWN,
+        n,
+        FaceSelection::Both,
+    );
     assert!(!texels_of(&sets, 0).is_empty());
     assert!(texels_of(&sets, 1).is_empty() && sets.required[1]);
     assert_eq!(texels_of(&sets, 2).len(), 64);
@@ -197,7 +247,13 @@ fn edge_on_triangle_is_binned_as_a_segment() {
         Vec3::new(1.0, 2.0, 1.0),
     ];
     let scene = scene_of(&[edge_on]);
-    let both = conservative_texel_sets(&scene, grid_matrix(n), DOWN, n, FaceSelection::Both);
+    let both = conservative_texel_sets(
+        &scene,
+        grid_matrix(n).as_dmat4(),
+        DOWN,
+        n,
+        FaceSelection::Both,
+    );
     assert!(both.light_degenerate[0] && both.required[0]);
     let mut expected = Vec::new();
     for y in 0..=1 {
@@ -207,7 +263,13 @@ fn edge_on_triangle_is_binned_as_a_segment() {
     }
     assert_eq!(texels_of(&both, 0), expected);
     // Not strictly front-facing: neither required nor listed with FrontOnly.
-    let front = conservative_texel_sets(&scene, grid_matrix(n), DOWN, n, FaceSelection::FrontOnly);
+    let front = conservative_texel_sets(
+        &scene,
+        grid_matrix(n).as_dmat4(),
+        DOWN,
+        n,
+        FaceSelection::FrontOnly,
+    );
     assert!(front.light_degenerate[0] && !front.required[0]);
     assert!(texels_of(&front, 0).is_empty());
 }
@@ -220,9 +282,20 @@ fn front_only_skips_back_faces_and_3d_degenerates() {
     let back = flat([(1.0, 1.0), (3.0, 1.5), (1.5, 3.0)]);
     let degenerate = flat([(1.0, 1.0), (2.0, 2.0), (3.0, 3.0)]);
     let scene = scene_of(&[front, back, degenerate]);
-    let both = conservative_texel_sets(&scene, grid_matrix(n), DOWN, n, FaceSelection::Both);
-    let front_only =
-        conservative_texel_sets(&scene, grid_matrix(n), DOWN, n, FaceSelection::FrontOnly);
+    let both = conservative_texel_sets(
+        &scene,
+        grid_matrix(n).as_dmat4(),
+        DOWN,
+        n,
+        FaceSelection::Both,
+    );
+    let front_only = conservative_texel_sets(
+        &scene,
+        grid_matrix(n).as_dmat4(),
+        DOWN,
+        n,
+        FaceSelection::FrontOnly,
+    );
     check_csr(&both, 3);
     check_csr(&front_only, 3);
     assert_eq!(both.required, vec![true, true, false]);
@@ -282,19 +355,47 @@ fn perspective_light_matches_brute_force() {
         Vec3::new(0.0, 0.0, 1.0),
     ];
     let scene = scene_of(&[behind]);
-    let sets = conservative_texel_sets(&scene, matrix, DOWN, n, FaceSelection::Both);
+    let sets = conservative_texel_sets(&scene, matrix.as_dmat4(), DOWN, n, FaceSelection::Both);
     assert!(!sets.required[0] && !sets.light_degenerate[0] && sets.triangles.is_empty());
-    assert!(overlaps_texel_with_margin(&scene, matrix, n, 0, 3, 3, 0.0));
-    assert!(!overlaps_texel_with_margin(&scene, matrix, n, 1, 3, 3, 0.0));
+    assert!(overlaps_texel_with_margin(
+        &scene,
+        matrix.as_dmat4(),
+        n,
+        0,
+        3,
+        3,
+        0.0
+    ));
+    assert!(!overlaps_texel_with_margin(
+        &scene,
+        matrix.as_dmat4(),
+        n,
+        1,
+        3,
+        3,
+        0.0
+    ));
 }
 
 #[test]
 fn texel_lookup_outside_the_grid_is_empty() {
     let scene = scene_of(&[flat([(0.0, 0.0), (8.0, 0.0), (0.0, 8.0)])]);
-    let sets = conservative_texel_sets(&scene, grid_matrix(8), DOWN, 8, FaceSelection::Both);
+    let sets = conservative_texel_sets(
+        &scene,
+        grid_matrix(8).as_dmat4(),
+        DOWN,
+        8,
+        FaceSelection::Both,
+    );
     assert_eq!(sets.texel(0, 0), &[0]);
     assert!(sets.texel(8, 0).is_empty() && sets.texel(0, 8).is_empty());
-    let empty = conservative_texel_sets(&scene, grid_matrix(8), DOWN, 0, FaceSelection::Both);
+    let empty = conservative_texel_sets(
+        &scene,
+        grid_matrix(8).as_dmat4(),
+        DOWN,
+        0,
+        FaceSelection::Both,
+    );
     assert_eq!(empty.offsets, vec![0]);
     assert!(empty.texel(0, 0).is_empty());
 }

@@ -10,16 +10,16 @@ use passes::{FrameImages, FrameReport, PrimitiveMapConfig, ShadowRenderer};
 use rhi::{Device, DeviceDesc};
 use std::path::PathBuf;
 
-/// A model from `../shared/models`; panics (fails the test) if it is missing.
+/// The models folder (`HRTS_MODELS`, else `../shared/models` beside the checkout); fails the test with
+/// a message saying where it looked when the models are missing.
+pub fn models() -> PathBuf {
+    scene::models_dir().unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A model of the models folder; fails the test if it is missing.
 pub fn model(name: &str) -> PathBuf {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/models")
-        .join(name);
-    assert!(
-        p.exists(),
-        "test model {} is missing: tests read the shared models next to the checkout",
-        p.display()
-    );
+    let p = models().join(name);
+    assert!(p.exists(), "test model {} is missing", p.display());
     p
 }
 
@@ -48,12 +48,12 @@ pub fn render(
     device: &Device,
     view: &View,
     config: PrimitiveMapConfig,
-    with_indices: bool,
+    with_entries: bool,
 ) -> (FrameReport, FrameImages) {
     let geometry = view.upload(device).expect("upload");
     let mut r =
         ShadowRenderer::new(device, geometry, view.width, view.height, config).expect("renderer");
     let report = r.render(device, &view.frame_inputs()).expect("render");
-    let images = r.read_back(device, with_indices).expect("read back");
+    let images = r.read_back(device, with_entries).expect("read back");
     (report, images)
 }

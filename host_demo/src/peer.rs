@@ -1,0 +1,102 @@
+//! The ray-tracing-pipeline peer on the demo's frame: the same shadow rays as the primitive-map ray trace,
+//! traced through the GPU's ray-tracing pipeline over acceleration structures the driver builds from the
+//! demo's prim buffer ([`passes::rt_peer::RtPeerPass`]). What a user would pick instead of our technique.
+
+use crate::plugin::PluginRenderer;
+use anyhow::Result;
+use passes::rt_peer::{shadow_ray_constants, RtPeerPass};
+use passes::{read_images, FrameImages, FrameInputs, FrameOutput, PassError};
+use rhi::{Device, ResourceState as S};
+
+/// The name of the peer's build pass (bottom and top level).
+pub const BUILD_PASS: &str = "rt peer build";
+/// The name of the peer's trace pass.
+pub const TRACE_PASS: &str = "rt peer trace";
+
+/// What the peer measured on one frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PeerRun {
+    /// Median GPU milliseconds of a full acceleration-structure build (bottom + top level).
+    pub build_ms: f64,
+    /// Median GPU milliseconds of tracing the frame's shadow rays.
+    pub trace_ms: f64,
+    /// Visibility of the last frame (1 = lit), row-major, y = 0 at the top.
+    pub visibility: Vec<f32>,
+}
+
+/// Builds the acceleration structures and traces the shadow rays of the frame `renderer` last rendered
+/// with `inputs`, `frames` times (at least 2), each frame one submission timed by GPU timestamps. Returns
+/// the medians over the frames after the first and the last frame's visibility. On a device without ray
+/// tracing the error is a [`PassError::Unsupported`] naming what is missing (`downcast_ref` tells it apart).
+pub fn run_peer(
+    device: &Device,
+    renderer: &PluginRenderer,
+    inputs: &FrameInputs,
+    frames: u32,
+) -> Result<PeerRun> {
+    let geometry = renderer.geometry();
+    let targets = renderer.targets();
+    let (width, height) = (targets.depth.width(), targets.depth.height());
+    let constants = shadow_ray_constants(inputs, geometry.origin(), width, height)?;
+    let mut peer = RtPeerPass::new(
+        device,
+        renderer.prims(),
+        geometry.triangle_count(),
+        &targets.depth,
+        &targets.normal,
+        width,
+        height,
+    )?;
+    let timer = device.create_timer(2)?;
+    let (mut build, mut trace) = (Vec::new(), Vec::new());
+    for _ in 0..frames.max(2) {
+        device.submit_and_wait(|enc| {
+            enc.attach_timer(&timer);
+            peer.record_build(enc).map_err(into_rhi)?;
+            peer.record_trace(enc, &constants).map_err(into_rhi)
+        })?;
+        for t in timer.resolve()? {
+            match t.name.as_str() {
+                BUILD_PASS => build.push(t.ms),
+                TRACE_PASS => trace.push(t.ms),
+                _ => {}
+            }
+        }
+    }
+    let mut images = FrameImages::default();
+    for bytes in read_images(device, &[(&peer.visibility, S::UnorderedAccess)])? {
+        images.insert(FrameOutput::Visibility, &bytes, geometry.origin());
+    }
+    Ok(PeerRun {
+        build_ms: steady_median(&build),
+        trace_ms: steady_median(&trace),
+        visibility: images.visibility,
+    })
+}
+
+/// Median of `samples` after the first (warm-up) one; NaN without samples.
+fn steady_median(samples: &[f64]) -> f64 {
+    let mut steady = samples.get(1..).unwrap_or_default().to_vec();
+    steady.sort_by(f64::total_cmp);
+    steady.get(steady.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// A pass's error in the form `Device::submit_and_wait` passes on.
+fn into_rhi(e: PassError) -> rhi::RhiError {
+    match e {
+        PassError::Rhi(r) => r,
+        other => rhi::RhiError::InvalidArgument(other.to_string()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::steady_median;
+
+    #[test]
+    fn median_skips_the_warm_up_frame() {
+        assert_eq!(steady_median(&[100.0, 3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(steady_median(&[100.0, 4.0, 1.0, 2.0, 3.0]), 3.0);
+        assert!(steady_median(&[100.0]).is_nan());
+    }
+}

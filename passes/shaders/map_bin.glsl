@@ -1,0 +1,50 @@
+// The binning test shared by the compute and raster binning paths: whether triangle `t` goes into the
+// list of `texel`. A texel gets a triangle only if a ray origin lies in it (receiver mark), the triangle is
+// not wholly farther from the light than every ray origin of the texel, and the texel square grown by the
+// triangle's margin overlaps the triangle (separating axes: the box axes are the caller's bounding box, the
+// edge normals are tested here, relative to the triangle's own vertices).
+
+// Mirrors the setup pass's output (48 bytes).
+struct BinTri {
+    vec4 ab;        // texel-space a.xy, b.xy (counter-clockwise; a segment's ends in MODE_SEGMENT)
+    vec4 cmd;       // c.xy, margin (texels), min depth key minus its error
+    uvec4 info;     // x: bbox min (x | y << 16), y: bbox max, z: mode, w: tiles per bbox row
+};
+
+#define MODE_TRIANGLE 0u
+#define MODE_SEGMENT 1u
+#define MODE_POINT 2u
+#define MODE_COVER 3u       // a vertex behind a perspective light: every texel of the bbox
+#define BIN_TILE 4u
+
+// A texel is accepted when its square grown by the triangle's margin overlaps it; the margin is at least
+// this many texels (it absorbs the rounding of the edge functions below).
+#define ACCEPT_MARGIN (1.0 / 512.0)
+
+float cross2(vec2 a, vec2 b) { return a.x * b.y - a.y * b.x; }
+
+bool bin_overlaps(BinTri t, vec2 centre) {
+    float grow = 0.5 + t.cmd.z;
+    vec2 a = t.ab.xy, b = t.ab.zw, c = t.cmd.xy;
+    if (t.info.z == MODE_TRIANGLE) {
+        vec2 e0 = b - a, e1 = c - b, e2 = a - c;
+        return cross2(e0, centre - a) + grow * (abs(e0.x) + abs(e0.y)) >= 0.0
+            && cross2(e1, centre - b) + grow * (abs(e1.x) + abs(e1.y)) >= 0.0
+            && cross2(e2, centre - c) + grow * (abs(e2.x) + abs(e2.y)) >= 0.0;
+    }
+    if (t.info.z == MODE_SEGMENT) {
+        vec2 e = b - a;
+        return abs(cross2(e, centre - a)) <= grow * (abs(e.x) + abs(e.y));
+    }
+    return true;    // a point or a cover: the bounding box decided
+}
+
+// `receiver` is the texel's word of the receiver map: 0 without a ray origin, else the ordered largest
+// depth key (plus its error) of the texel's ray origins. Without `cull`, every overlapped texel is accepted
+// (a debug mode whose lists tests compare with exact binning).
+bool bin_accepts(BinTri t, uint receiver, vec2 centre, bool cull) {
+    if (cull && (receiver == 0u || t.cmd.w > unordered(receiver))) {
+        return false;
+    }
+    return bin_overlaps(t, centre);
+}

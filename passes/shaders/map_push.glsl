@@ -1,0 +1,13 @@
+// Mirrors passes::gpu_types::MapPush (112 bytes): push constants of the primitive-map passes.
+struct MapPush {
+    mat4 light_view_proj;   // light view-projection in frame coordinates
+    vec4 to_light;          // xyz: direction towards the light (directional); w: 1 for a spot light
+    uint size;              // N: texels per side
+    uint mode;              // pass-specific mode
+    uint front_only;        // 1: keep only triangles facing the light
+    uint triangles;         // triangles in the prim buffer
+    uint capacity;          // entry capacity
+    uint tile_threads;      // threads of the binning dispatch (grid-stride over the bin items)
+    uint guard;             // 1: guard words follow the entries and must stay untouched
+    uint cull;              // 1: bin only into texels with ray origins, and not behind all of them
+};

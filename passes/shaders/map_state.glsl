@@ -1,0 +1,29 @@
+// Mirrors passes::gpu_types::MapState (144 bytes): the primitive map's per-frame GPU state, written by the
+// map passes and read by the ray trace. The map covers the light-space bounds of the receivers the camera
+// sees (fitted every frame on the GPU), so nothing of it is spent on what no pixel can look up.
+struct MapState {
+    mat4 to_texels;     // frame coordinates -> homogeneous map texel space: texel = floor(xy / w)
+    uvec4 bounds;       // ordered-float light NDC bounds of the ray origins: min x, min y, max x, max y
+    uvec4 receivers;    // x: pixels with a ray, y: ordered max texel-space error of a ray origin's
+                        // projection, z: ordered max depth key (plus error) of the ray origins, w: unused
+    vec4 fit;           // x: 1 when the map has receivers, yzw: unused
+    uvec4 totals;       // x: bin items (4x4 tiles of triangle bounding boxes), y: entries needed,
+                        // z: entry capacity, w: triangles kept by the setup's culling
+    uvec4 stats;        // x: texels with a list, y: longest list, z: texels past the capacity (traced
+                        // exhaustively), w: texels with receivers
+};
+
+// Monotonic float <-> uint encoding for atomicMin/atomicMax on floats; 0 is below every encoded value, so
+// a zero-cleared word means "nothing recorded".
+uint ordered(float f) {
+    uint b = floatBitsToUint(f);
+    return (b & 0x80000000u) != 0u ? ~b : (b | 0x80000000u);
+}
+
+float unordered(uint u) {
+    return uintBitsToFloat((u & 0x80000000u) != 0u ? (u & 0x7FFFFFFFu) : ~u);
+}
+
+// Texel of a pixel's ray origin, written by the receiver pass and read by the ray trace.
+const uint TEXEL_NO_RAY = 0xFFFFFFFFu;      // no shadow ray from this pixel
+const uint TEXEL_OUTSIDE = 0xFFFFFFFEu;     // the ray origin lies outside the light's frustum: lit

@@ -1,0 +1,112 @@
+//! Exclusive prefix sum of a `u32` buffer on the GPU, in place: one level per 1024-fold reduction
+//! (`scan.comp`), then the scanned block totals added back down.
+//!
+//! Reads and writes: the data buffer. Owns: the block-total buffers of each level.
+
+use crate::{shader, PassError};
+use rhi::{
+    Barrier, BindGroup, BindingKind, Buffer, BufferUsage, ComputePipeline, Device, Encoder,
+    MemoryLocation, Resource,
+};
+
+/// Elements one workgroup scans.
+const BLOCK: u64 = 1024;
+
+/// Push constants of `scan.comp`.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ScanPush {
+    n: u32,
+    mode: u32,
+}
+
+/// The scan pipeline, shared by every [`PrefixScan`] of a device.
+pub struct ScanPipeline(ComputePipeline);
+
+impl ScanPipeline {
+    /// Creates the pipeline.
+    pub fn new(device: &Device) -> Result<Self, PassError> {
+        Ok(Self(device.create_compute_pipeline(
+            "prefix scan",
+            &shader("scan.comp")?,
+            &[BindingKind::StorageBuffer, BindingKind::StorageBuffer],
+            std::mem::size_of::<ScanPush>() as u32,
+        )?))
+    }
+}
+
+/// An exclusive scan of the first `n` elements of one buffer: after it, element i holds the sum of the
+/// elements before i.
+pub struct PrefixScan {
+    /// (bind group of level data + its block totals, elements of the level), from the data upwards.
+    levels: Vec<(BindGroup, u32)>,
+    _sums: Vec<Buffer>,
+}
+
+impl PrefixScan {
+    /// Prepares the scan of the first `n` `u32` of `data` (a storage buffer).
+    pub fn new(
+        device: &Device,
+        pipeline: &ScanPipeline,
+        data: &Buffer,
+        n: u32,
+    ) -> Result<Self, PassError> {
+        let mut sums: Vec<Buffer> = Vec::new();
+        let mut counts = vec![n];
+        loop {
+            let blocks = u64::from(*counts.last().unwrap_or(&1))
+                .div_ceil(BLOCK)
+                .max(1);
+            sums.push(device.create_buffer(
+                "scan block totals",
+                blocks * 4,
+                BufferUsage::STORAGE,
+                MemoryLocation::GpuOnly,
+            )?);
+            if blocks == 1 {
+                break;
+            }
+            counts.push(blocks as u32);
+        }
+        let mut levels = Vec::with_capacity(counts.len());
+        for (level, &count) in counts.iter().enumerate() {
+            let input = if level == 0 { data } else { &sums[level - 1] };
+            let group = device.create_bind_group(
+                pipeline.0.layout(),
+                &[Resource::Buffer(input), Resource::Buffer(&sums[level])],
+            )?;
+            levels.push((group, count));
+        }
+        Ok(Self {
+            levels,
+            _sums: sums,
+        })
+    }
+
+    /// Records the scan; the data buffer's earlier writes must be visible (UAV barrier) and its scanned
+    /// values are visible to later storage accesses after the UAV barrier this records last.
+    pub fn record(&self, enc: &mut Encoder<'_>, pipeline: &ScanPipeline) -> Result<(), PassError> {
+        let blocks = |n: u32| u64::from(n).div_ceil(BLOCK).max(1) as u32;
+        for (group, n) in &self.levels {
+            let push = ScanPush { n: *n, mode: 0 };
+            enc.dispatch(
+                &pipeline.0,
+                group,
+                bytemuck::bytes_of(&push),
+                [blocks(*n), 1, 1],
+            )?;
+            enc.barriers(&[Barrier::Uav]);
+        }
+        for (group, n) in self.levels.iter().rev().skip(1) {
+            let push = ScanPush { n: *n, mode: 1 };
+            enc.dispatch(
+                &pipeline.0,
+                group,
+                bytemuck::bytes_of(&push),
+                [blocks(*n), 1, 1],
+            )?;
+            enc.barriers(&[Barrier::Uav]);
+        }
+        Ok(())
+    }
+}
