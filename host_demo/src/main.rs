@@ -50,9 +50,10 @@ enum Command {
     Accuracy(host_demo::report::AccuracyArgs),
     /// The conservative-raster tier matrix: every raster path of the device against exact binning (Markdown).
     Tiers {
-        /// Folder with the test models.
-        #[arg(long, default_value = "../shared/models")]
-        models: PathBuf,
+        /// Folder with the test models (default: `HRTS_MODELS`, else `../shared/models` beside the
+        /// checkout).
+        #[arg(long)]
+        models: Option<PathBuf>,
     },
 }
 
@@ -191,9 +192,13 @@ fn main() -> ExitCode {
             Ok(())
         }),
         Command::Tiers { models } => device(&cli).and_then(|d| {
+            let models = match models {
+                Some(dir) => dir.clone(),
+                None => scene::models_dir().map_err(anyhow::Error::msg)?,
+            };
             let rows = host_demo::tiers::tier_matrix(
                 &d,
-                &host_demo::tiers::standard_scenes(models)?,
+                &host_demo::tiers::standard_scenes(&models)?,
                 256,
             )?;
             println!("{}", host_demo::tiers::markdown(&d, &rows));

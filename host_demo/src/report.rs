@@ -18,9 +18,10 @@ use std::path::PathBuf;
 /// Options of the report.
 #[derive(Debug, Clone, clap::Args)]
 pub struct AccuracyArgs {
-    /// OBJ model (a ground plane is added).
-    #[arg(long, default_value = "../shared/models/02_stanford_bunny_69k.obj")]
-    pub obj: PathBuf,
+    /// OBJ model, a ground plane added (default: the Stanford bunny of the models folder, `HRTS_MODELS`
+    /// or `../shared/models` beside the checkout).
+    #[arg(long)]
+    pub obj: Option<PathBuf>,
     /// Frame width.
     #[arg(long, default_value_t = 640)]
     pub width: u32,
@@ -66,8 +67,14 @@ fn render(
 
 /// Builds the report as Markdown.
 pub fn run_report(device: &Device, args: &AccuracyArgs) -> Result<String> {
-    let scene = scene::load_obj(&args.obj)
-        .with_context(|| format!("loading {}", args.obj.display()))?
+    let obj = match &args.obj {
+        Some(path) => path.clone(),
+        None => scene::models_dir()
+            .map_err(anyhow::Error::msg)?
+            .join("02_stanford_bunny_69k.obj"),
+    };
+    let scene = scene::load_obj(&obj)
+        .with_context(|| format!("loading {}", obj.display()))?
         .with_ground_plane();
     let view = View::framed(scene, args.width, args.height);
     let rs = RefScene::new(&view.scene);
@@ -123,7 +130,7 @@ pub fn run_report(device: &Device, args: &AccuracyArgs) -> Result<String> {
     let caps = device.capabilities();
     let mut s = format!(
         "{} ({} triangles with the ground plane), {}×{} px on {}; wrong = pixels whose lit/shadowed value differs from the exact f64 reference outside near-edge pixels; GPU ms are medians over {} frames.\n\n| method | memory | GPU ms | wrong pixels | near-edge (not compared) |\n|---|---:|---:|---:|---:|\n",
-        args.obj.file_name().and_then(|n| n.to_str()).unwrap_or("model"),
+        obj.file_name().and_then(|n| n.to_str()).unwrap_or("model"),
         view.scene.triangle_count(),
         args.width,
         args.height,

@@ -22,11 +22,12 @@ layout(set = 0, binding = 5) writeonly buffer PixelTexels { uint pixel_texel[]; 
 layout(push_constant) uniform Push { MapPush pc; };
 #include "shadow_ray.glsl"
 
-void main() {
-    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
-    if (px.x >= int(k.dims.x) || px.y >= int(k.dims.y)) {
-        return;
-    }
+// Per-workgroup reductions in shared memory: one global atomic per workgroup instead of one per pixel
+// (every pixel of the frame would otherwise contend for the same few words).
+shared uint group_bounds[4];
+shared uint group_receivers[3];
+
+void place(ivec2 px) {
     uint pixel = uint(px.y) * k.dims.x + uint(px.x);
     vec3 o, dir;
     float t_max;
@@ -36,10 +37,10 @@ void main() {
     bool inside = lc.w > 0.0 && all(greaterThanEqual(ndc, vec2(-1.0))) && all(lessThan(ndc, vec2(1.0)));
     if (pc.mode == 0u) {
         if (traced && inside) {
-            atomicMin(ms.bounds.x, ordered(ndc.x));
-            atomicMin(ms.bounds.y, ordered(ndc.y));
-            atomicMax(ms.bounds.z, ordered(ndc.x));
-            atomicMax(ms.bounds.w, ordered(ndc.y));
+            atomicMin(group_bounds[0], ordered(ndc.x));
+            atomicMin(group_bounds[1], ordered(ndc.y));
+            atomicMax(group_bounds[2], ordered(ndc.x));
+            atomicMax(group_bounds[3], ordered(ndc.y));
         }
         return;
     }
@@ -59,7 +60,41 @@ void main() {
     // Largest depth key of the texel, rounded up by its error bound (and the bound's own rounding).
     float reach = pr.depth + pr.depth_err * 2.0;
     atomicMax(receiver[index], ordered(reach));
-    atomicMax(ms.receivers.y, ordered(max(pr.xy_err.x, pr.xy_err.y)));
-    atomicMax(ms.receivers.z, ordered(reach));
-    atomicAdd(ms.receivers.x, 1u);
+    atomicAdd(group_receivers[0], 1u);
+    atomicMax(group_receivers[1], ordered(max(pr.xy_err.x, pr.xy_err.y)));
+    atomicMax(group_receivers[2], ordered(reach));
+}
+
+void main() {
+    uint lid = gl_LocalInvocationIndex;
+    if (lid == 0u) {
+        group_bounds[0] = 0xFFFFFFFFu;
+        group_bounds[1] = 0xFFFFFFFFu;
+        group_bounds[2] = 0u;
+        group_bounds[3] = 0u;
+        group_receivers[0] = 0u;
+        group_receivers[1] = 0u;
+        group_receivers[2] = 0u;
+    }
+    barrier();
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (px.x < int(k.dims.x) && px.y < int(k.dims.y)) {
+        place(px);
+    }
+    barrier();
+    if (lid != 0u) {
+        return;
+    }
+    if (pc.mode == 0u) {
+        if (group_bounds[0] <= group_bounds[2]) {
+            atomicMin(ms.bounds.x, group_bounds[0]);
+            atomicMin(ms.bounds.y, group_bounds[1]);
+            atomicMax(ms.bounds.z, group_bounds[2]);
+            atomicMax(ms.bounds.w, group_bounds[3]);
+        }
+    } else if (group_receivers[0] > 0u) {
+        atomicAdd(ms.receivers.x, group_receivers[0]);
+        atomicMax(ms.receivers.y, group_receivers[1]);
+        atomicMax(ms.receivers.z, group_receivers[2]);
+    }
 }

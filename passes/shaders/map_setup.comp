@@ -106,20 +106,27 @@ uint setup(uint index, out BinTri bt) {
     return tiles.x * tiles.y;
 }
 
+shared uint group_kept;
+
 void main() {
+    if (gl_LocalInvocationIndex == 0u) {
+        group_kept = 0u;
+    }
+    barrier();
     uint index = gl_GlobalInvocationID.x;
-    if (index > pc.triangles) {
-        return;
-    }
-    if (index == pc.triangles) {
+    if (index < pc.triangles) {
+        BinTri bt;
+        uint tiles = setup(index, bt);
+        bin_tris[index] = bt;
+        tile_counts[index] = tiles;
+        if (tiles > 0u) {
+            atomicAdd(group_kept, 1u);
+        }
+    } else if (index == pc.triangles) {
         tile_counts[index] = 0u;    // the exclusive scan's last element becomes the total
-        return;
     }
-    BinTri bt;
-    uint tiles = setup(index, bt);
-    bin_tris[index] = bt;
-    tile_counts[index] = tiles;
-    if (tiles > 0u) {
-        atomicAdd(ms.totals.w, 1u);
+    barrier();
+    if (gl_LocalInvocationIndex == 0u && group_kept > 0u) {
+        atomicAdd(ms.totals.w, group_kept);
     }
 }

@@ -14,11 +14,10 @@ layout(set = 0, binding = 2, rgba8) uniform writeonly image2D occupancy;
 layout(set = 0, binding = 3) buffer State { MapState ms; };
 layout(push_constant) uniform Push { uint size; } pc;
 
-void main() {
-    uvec2 t = gl_GlobalInvocationID.xy;
-    if (t.x >= pc.size || t.y >= pc.size) {
-        return;
-    }
+// Per-workgroup sums and maximum in shared memory: one global atomic each per workgroup.
+shared uint group_stats[4];
+
+void tally(uvec2 t) {
     uint texel = t.y * pc.size + t.x;
     uint count = offsets[texel + 1u] - offsets[texel];
     bool past = offsets[texel + 1u] > ms.totals.z;
@@ -31,16 +30,35 @@ void main() {
     }
     imageStore(occupancy, ivec2(t), colour);
     if (count > 0u) {
-        atomicAdd(ms.stats.x, 1u);
-        atomicMax(ms.stats.y, count);
+        atomicAdd(group_stats[0], 1u);
+        atomicMax(group_stats[1], count);
     }
     if (past && count > 0u) {
-        atomicAdd(ms.stats.z, 1u);
+        atomicAdd(group_stats[2], 1u);
     }
     if (receives) {
-        atomicAdd(ms.stats.w, 1u);
+        atomicAdd(group_stats[3], 1u);
     }
     if (texel == 0u) {
         ms.totals.y = offsets[pc.size * pc.size];
+    }
+}
+
+void main() {
+    uint lid = gl_LocalInvocationIndex;
+    if (lid < 4u) {
+        group_stats[lid] = 0u;
+    }
+    barrier();
+    uvec2 t = gl_GlobalInvocationID.xy;
+    if (t.x < pc.size && t.y < pc.size) {
+        tally(t);
+    }
+    barrier();
+    if (lid == 0u) {
+        atomicAdd(ms.stats.x, group_stats[0]);
+        atomicMax(ms.stats.y, group_stats[1]);
+        atomicAdd(ms.stats.z, group_stats[2]);
+        atomicAdd(ms.stats.w, group_stats[3]);
     }
 }

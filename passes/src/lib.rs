@@ -14,7 +14,7 @@ pub mod primitive_map;
 pub mod ray_trace;
 pub mod renderer;
 pub mod rt_peer;
-mod scan;
+pub mod scan;
 mod screen_pass;
 pub mod shadow_map;
 pub mod shadow_pipeline;
