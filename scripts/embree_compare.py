@@ -40,7 +40,7 @@ How to run
 ----------
   # 1. Render a frame with the ray trace (mode hard or hybrid) and dump its rays:
   cargo run --release -p host_demo -- render --obj ../shared/models/02_stanford_bunny_69k.obj \\
-      --width 1920 --height 1080 --mode hard --out out/bunny --dump-rays
+      --mode hard --no-antialiasing --no-occupancy --out out/bunny --dump-rays
   # 2. Time Embree on the same rays and compare:
   .dev/embree-venv/bin/python scripts/embree_compare.py out/bunny
   # options: --model NAME (default: the folder's name), --runs N (default 5), --cpu K (the CPU to

@@ -371,7 +371,7 @@ pub fn run_bench(device: &Device, args: &BenchArgs) -> Result<String> {
         out.push_str(&scene_row(m));
     }
     out.push_str(
-        "\nmap build = every `primitive map:` pass (receivers, setup, count, scan, fill); RT pipeline = \
+        "\nmap build = every `primitive map:` pass (fit, receivers, setup, count, scan, fill); RT pipeline = \
          the same shadow rays through VK_KHR_ray_tracing_pipeline over driver-built acceleration \
          structures (any-hit, terminate on first hit), \"—\" where the device has none.\n",
     );

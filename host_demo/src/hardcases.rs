@@ -76,10 +76,10 @@ pub struct Outcome {
     pub differing_pixels: Option<Differing>,
     /// NaN or Inf in visibility or blocker distance.
     pub non_finite: usize,
-    /// Texels whose count exceeded d.
-    pub overflowed_texels: u32,
-    /// Largest texel count.
-    pub max_count: u32,
+    /// Texels whose list did not fit the entry capacity (traced exhaustively).
+    pub texels_past_capacity: u32,
+    /// Longest list.
+    pub longest_list: u32,
     /// What the case expects of overflow.
     pub overflow: Option<Overflow>,
     /// Required triangles missing from texel lists.
@@ -161,10 +161,12 @@ impl Outcome {
             ));
         }
         match self.overflow {
-            Some(Overflow::Forbidden) if self.overflowed_texels > 0 => {
-                f.push("overflow (choose a larger d)".into())
+            Some(Overflow::Forbidden) if self.texels_past_capacity > 0 => {
+                f.push("texels past the entry capacity in the second frame".into())
             }
-            Some(Overflow::Required) if self.overflowed_texels == 0 => f.push("no overflow".into()),
+            Some(Overflow::Required) if self.texels_past_capacity == 0 => {
+                f.push("no texel past the entry capacity".into())
+            }
             _ => {}
         }
         f
@@ -223,7 +225,7 @@ impl Outcome {
             });
         }
         if self.rejected.is_none() && self.error.is_none() {
-            m.push(format!("max count {}", self.max_count));
+            m.push(format!("longest list {}", self.longest_list));
         }
         m.join(", ")
     }
@@ -332,8 +334,8 @@ fn measure(
     }
     let images = renderer.read_back(device, true).context("reading back")?;
     o.binning_path = report.binning_path.name();
-    o.overflowed_texels = report.stats.texels_past_capacity;
-    o.max_count = report.stats.longest_list;
+    o.texels_past_capacity = report.stats.texels_past_capacity;
+    o.longest_list = report.stats.longest_list;
     o.overflow = Some(case.map.overflow);
 
     let rs = RefScene::new(&view.scene);
@@ -796,7 +798,7 @@ pub fn run_cli(
         .find(|p| !p.is_empty())
         .unwrap_or("none");
     println!(
-        "Hard cases on {} ({}), {} conservative raster, validation {}: {:.1} s\n",
+        "Hard cases on {} ({}), {} binning, validation {}: {:.1} s\n",
         caps.device_name,
         caps.driver,
         path,
@@ -822,7 +824,7 @@ pub fn table(outcomes: &[Outcome], markdown: bool) -> String {
         "leaks",
         "acne",
         "NaN/Inf",
-        "overflowed texels",
+        "texels past capacity",
         "map errors",
         "measure",
         "time",
@@ -847,7 +849,7 @@ pub fn table(outcomes: &[Outcome], markdown: bool) -> String {
                 n(o.leaks),
                 n(o.acne),
                 n(o.non_finite),
-                n(o.overflowed_texels as usize),
+                n(o.texels_past_capacity as usize),
                 n(o.map_missing + o.map_garbage),
                 o.measure(),
                 format!("{:.1} s", o.seconds),

@@ -104,6 +104,10 @@ struct RenderArgs {
     /// scripts/embree_compare.py.
     #[arg(long)]
     dump_rays: bool,
+    /// Skip the primitive map's occupancy view (occupancy.png), a debug image: the frame as an engine
+    /// runs it (the map's statistics are gathered anyway).
+    #[arg(long)]
+    no_occupancy: bool,
     #[command(flatten)]
     soft: host_demo::render::SoftShadowArgs,
 }
@@ -159,6 +163,7 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
         },
         frames: args.frames,
         soft: args.soft.clone(),
+        occupancy_view: !args.no_occupancy,
     };
     render_to_folder(&device, &view, &options, &args.out)?;
     if args.dump_rays {

@@ -73,6 +73,8 @@ pub struct RenderOptions {
     pub frames: u32,
     /// Shadow mode, shadow map, PCSS and hybrid settings.
     pub soft: SoftShadowArgs,
+    /// Draw the primitive map's occupancy view (a debug image; the statistics are gathered anyway).
+    pub occupancy_view: bool,
 }
 
 /// The world-space scale of a view's model: the bounding radius of its objects (the ground plane
@@ -107,16 +109,17 @@ impl RenderOptions {
                 world_space_scale: s.wss.unwrap_or_else(|| default_world_space_scale(view)),
                 hard_shadow_percentage: s.phs,
             },
-            extra_outputs: demo_outputs(s.mode),
+            extra_outputs: demo_outputs(s.mode, self.occupancy_view),
         }
     }
 }
 
-/// What the demo writes for a mode: the ray trace and its blocker distance wherever the mode has them, the
-/// shadow-map views wherever it has a shadow map, the hybrid's parts in hybrid mode.
-fn demo_outputs(mode: ShadowMode) -> ResourceSet {
+/// What the demo writes for a mode: the ray trace and its blocker distance wherever the mode has them (and
+/// the occupancy view if asked), the shadow-map views wherever it has a shadow map, the hybrid's parts in
+/// hybrid mode.
+fn demo_outputs(mode: ShadowMode, occupancy_view: bool) -> ResourceSet {
     use ResourceId as R;
-    match mode {
+    let outputs = match mode {
         ShadowMode::None => ResourceSet::EMPTY,
         ShadowMode::Hard => ResourceSet::of(&[R::RtVisibility, R::BlockerDistance]),
         ShadowMode::Soft => ResourceSet::of(&[R::ShadowMapVisibility, R::Pcss]),
@@ -128,6 +131,12 @@ fn demo_outputs(mode: ShadowMode) -> ResourceSet {
             R::LerpFactor,
             R::Hybrid,
         ]),
+    };
+    let traced = matches!(mode, ShadowMode::Hard | ShadowMode::Hybrid);
+    if traced && occupancy_view {
+        outputs.with(R::Occupancy)
+    } else {
+        outputs
     }
 }
 

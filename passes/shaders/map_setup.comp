@@ -13,7 +13,7 @@
 
 layout(local_size_x = 64) in;
 layout(set = 0, binding = 0) readonly buffer Prims { Triangle tris[]; };
-layout(set = 0, binding = 1) coherent buffer State { MapState ms; };
+layout(set = 0, binding = 1) buffer State { MapState ms; };
 layout(set = 0, binding = 2) writeonly buffer BinTris { BinTri bin_tris[]; };
 layout(set = 0, binding = 3) writeonly buffer TileCounts { uint tile_counts[]; };
 layout(push_constant) uniform Push { MapPush pc; };

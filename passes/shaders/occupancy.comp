@@ -1,8 +1,13 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Occupancy view of the primitive map and its statistics for the frame report. Colours: black without a
-// list, grey levels the list length on a log scale (white at OCCUPANCY_WHITE entries or more), dark blue
-// texels with ray origins but an empty list, red texels past the entry capacity (traced exhaustively).
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_basic : require
+// The primitive map's statistics for the frame report and the capacity's growth (entries needed, texels
+// with a list, longest list, texels past the capacity, texels with ray origins), and, when asked, its
+// occupancy view. Colours: black without a list, grey levels the list length on a log scale (white at
+// OCCUPANCY_WHITE entries or more), dark blue texels with ray origins but an empty list, red texels past
+// the entry capacity (traced exhaustively). Each invocation tallies a 2x2 quad of texels; the sums reach
+// memory once per subgroup (shared) and once per workgroup (global).
 #include "map_state.glsl"
 
 #define OCCUPANCY_WHITE 256.0
@@ -12,37 +17,9 @@ layout(set = 0, binding = 0) readonly buffer Offsets { uint offsets[]; };
 layout(set = 0, binding = 1) readonly buffer Receivers { uint receiver[]; };
 layout(set = 0, binding = 2, rgba8) uniform writeonly image2D occupancy;
 layout(set = 0, binding = 3) buffer State { MapState ms; };
-layout(push_constant) uniform Push { uint size; } pc;
+layout(push_constant) uniform Push { uint size; uint view; } pc;
 
-// Per-workgroup sums and maximum in shared memory: one global atomic each per workgroup.
 shared uint group_stats[4];
-
-void tally(uvec2 t) {
-    uint texel = t.y * pc.size + t.x;
-    uint count = offsets[texel + 1u] - offsets[texel];
-    bool past = offsets[texel + 1u] > ms.totals.z;
-    bool receives = receiver[texel] != 0u;
-    vec4 colour = vec4(vec3(min(log2(1.0 + float(count)) / log2(1.0 + OCCUPANCY_WHITE), 1.0)), 1.0);
-    if (past) {
-        colour = vec4(1.0, 0.0, 0.0, 1.0);
-    } else if (count == 0u && receives) {
-        colour = vec4(0.0, 0.0, 0.25, 1.0);
-    }
-    imageStore(occupancy, ivec2(t), colour);
-    if (count > 0u) {
-        atomicAdd(group_stats[0], 1u);
-        atomicMax(group_stats[1], count);
-    }
-    if (past && count > 0u) {
-        atomicAdd(group_stats[2], 1u);
-    }
-    if (receives) {
-        atomicAdd(group_stats[3], 1u);
-    }
-    if (texel == 0u) {
-        ms.totals.y = offsets[pc.size * pc.size];
-    }
-}
 
 void main() {
     uint lid = gl_LocalInvocationIndex;
@@ -50,9 +27,40 @@ void main() {
         group_stats[lid] = 0u;
     }
     barrier();
-    uvec2 t = gl_GlobalInvocationID.xy;
-    if (t.x < pc.size && t.y < pc.size) {
-        tally(t);
+    uint capacity = ms.totals.z;
+    uvec4 mine = uvec4(0u);     // texels with a list, longest list, texels past capacity, with receivers
+    for (uint q = 0u; q < 4u; ++q) {
+        uvec2 t = gl_GlobalInvocationID.xy * 2u + uvec2(q & 1u, q >> 1u);
+        if (t.x >= pc.size || t.y >= pc.size) {
+            continue;
+        }
+        uint texel = t.y * pc.size + t.x;
+        uint end = offsets[texel + 1u];
+        uint count = end - offsets[texel];
+        bool past = count > 0u && end > capacity;
+        bool receives = receiver[texel] != 0u;
+        mine += uvec4(count > 0u ? 1u : 0u, 0u, past ? 1u : 0u, receives ? 1u : 0u);
+        mine.y = max(mine.y, count);
+        if (pc.view != 0u) {
+            vec4 colour = vec4(vec3(min(log2(1.0 + float(count)) / log2(1.0 + OCCUPANCY_WHITE), 1.0)), 1.0);
+            if (past) {
+                colour = vec4(1.0, 0.0, 0.0, 1.0);
+            } else if (count == 0u && receives) {
+                colour = vec4(0.0, 0.0, 0.25, 1.0);
+            }
+            imageStore(occupancy, ivec2(t), colour);
+        }
+        if (texel == 0u) {
+            ms.totals.y = offsets[pc.size * pc.size];
+        }
+    }
+    uvec3 sums = subgroupAdd(mine.xzw);
+    uint longest = subgroupMax(mine.y);
+    if (subgroupElect()) {
+        atomicAdd(group_stats[0], sums.x);
+        atomicMax(group_stats[1], longest);
+        atomicAdd(group_stats[2], sums.y);
+        atomicAdd(group_stats[3], sums.z);
     }
     barrier();
     if (lid == 0u) {

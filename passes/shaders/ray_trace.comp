@@ -148,7 +148,8 @@ void main() {
     float nearest = t_max;
     uint begin = texel == TEXEL_NO_RAY ? 0u : offsets[texel];
     uint end = texel == TEXEL_NO_RAY ? 0u : offsets[texel + 1u];
-    if (texel != TEXEL_NO_RAY && end <= ms.totals.z) {
+    // An empty list is complete wherever it lies; a list is complete when it ends within the capacity.
+    if (texel != TEXEL_NO_RAY && (end <= ms.totals.z || begin == end)) {
         for (uint i = begin; i < end; ++i) {
             consider(entries[i], nearest);
         }

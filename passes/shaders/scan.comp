@@ -1,13 +1,19 @@
 #version 460
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_basic : require
 // Exclusive prefix sum, one level of a multi-level scan over blocks of 1024 u32 (256 threads x 4).
-// mode 0: scans each block in place and writes the block's total to sums[block].
+// mode 0: scans each block of `input` into `data` (the two may be the same buffer) and writes the block's
+//         total to sums[block].
 // mode 1: adds sums[block] (the scanned totals of the level above) to every element of the block.
+// Within a block: each thread sums its 4 elements, subgroups scan the thread totals, the first subgroup
+// scans the subgroup totals.
 layout(local_size_x = 256) in;
-layout(set = 0, binding = 0) buffer Data { uint data[]; };
-layout(set = 0, binding = 1) buffer Sums { uint sums[]; };
+layout(set = 0, binding = 0) readonly buffer Input { uint input_data[]; };
+layout(set = 0, binding = 1) buffer Data { uint data[]; };
+layout(set = 0, binding = 2) buffer Sums { uint sums[]; };
 layout(push_constant) uniform Push { uint n; uint mode; } pc;
 
-shared uint partial[256];
+shared uint subgroup_base[256];
 
 void main() {
     uint lid = gl_LocalInvocationID.x;
@@ -22,21 +28,32 @@ void main() {
         }
         return;
     }
-    uint v[4];
-    uint total = 0u;
+    uvec4 v = uvec4(0u);
     for (uint i = 0u; i < 4u; ++i) {
-        v[i] = base + i < pc.n ? data[base + i] : 0u;
-        total += v[i];
+        if (base + i < pc.n) {
+            v[i] = input_data[base + i];
+        }
     }
-    partial[lid] = total;
+    uint total = v.x + v.y + v.z + v.w;
+    uint inclusive = subgroupInclusiveAdd(total);
+    if (gl_SubgroupInvocationID == gl_SubgroupSize - 1u) {
+        subgroup_base[gl_SubgroupID] = inclusive;
+    }
     barrier();
-    for (uint offset = 1u; offset < 256u; offset <<= 1u) {
-        uint t = lid >= offset ? partial[lid - offset] : 0u;
-        barrier();
-        partial[lid] += t;
-        barrier();
+    if (gl_SubgroupID == 0u) {
+        uint carry = 0u;
+        for (uint first = 0u; first < gl_NumSubgroups; first += gl_SubgroupSize) {
+            uint i = first + gl_SubgroupInvocationID;
+            uint t = i < gl_NumSubgroups ? subgroup_base[i] : 0u;
+            uint s = subgroupInclusiveAdd(t);
+            if (i < gl_NumSubgroups) {
+                subgroup_base[i] = carry + s - t;
+            }
+            carry += subgroupAdd(t);
+        }
     }
-    uint running = partial[lid] - total;
+    barrier();
+    uint running = subgroup_base[gl_SubgroupID] + inclusive - total;
     for (uint i = 0u; i < 4u; ++i) {
         if (base + i < pc.n) {
             data[base + i] = running;
@@ -44,6 +61,6 @@ void main() {
         running += v[i];
     }
     if (lid == 255u) {
-        sums[block] = partial[255];
+        sums[block] = running;
     }
 }

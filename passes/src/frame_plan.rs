@@ -243,6 +243,11 @@ pub struct FramePlan {
     hard_edge: HardEdge,
 }
 
+/// The resources a request asks for: its final output and its extra outputs.
+fn outputs(request: &PlanRequest) -> ResourceSet {
+    request.extra_outputs.with(request.final_output())
+}
+
 /// What a live pass reads and writes under a request.
 fn io(pass: PassId, request: &PlanRequest, hard_edge: HardEdge) -> (ResourceSet, ResourceSet) {
     use ResourceId as R;
@@ -254,7 +259,15 @@ fn io(pass: PassId, request: &PlanRequest, hard_edge: HardEdge) -> (ResourceSet,
             [&screen[..], &[R::PrimBuffer, R::Light]].concat(),
             vec![R::PrimListOffsets, R::PrimListEntries],
         ),
-        PassId::Occupancy => (vec![R::PrimListOffsets], vec![R::Occupancy]),
+        // The statistics always (the frame report), the view only when asked for.
+        PassId::Occupancy => (
+            vec![R::PrimListOffsets],
+            if outputs(request).contains(R::Occupancy) {
+                vec![R::Occupancy]
+            } else {
+                vec![]
+            },
+        ),
         PassId::RayTrace => (
             [
                 &screen[..],
@@ -311,7 +324,7 @@ fn cull(request: &PlanRequest, hard_edge: HardEdge, mut needed: ResourceSet) -> 
 impl FramePlan {
     /// Derives the plan of `request` (pure).
     pub fn derive(request: PlanRequest) -> Self {
-        let outputs = request.extra_outputs.with(request.final_output());
+        let outputs = outputs(&request);
         // First without PCSS's optional read of the ray trace: PCSS takes its hard edge from the ray trace
         // only when something else already needs the ray trace, so asking for soft shadows never pulls in
         // the primitive map.
@@ -500,6 +513,19 @@ mod tests {
         let aa = plan(ShadowMode::Hard, true);
         assert_eq!(aa.final_output(), R::RtAntialiased);
         assert!(aa.runs(P::Fxaa));
+    }
+
+    #[test]
+    fn the_occupancy_view_exists_only_when_asked_for() {
+        let stats_only = plan(ShadowMode::Hard, false);
+        assert!(stats_only.runs(P::Occupancy));
+        assert!(!stats_only.resources().contains(R::Occupancy));
+        let with_view = FramePlan::derive(PlanRequest {
+            extra_outputs: ResourceSet::of(&[R::Occupancy]),
+            ..stats_only.request
+        });
+        assert_eq!(with_view.passes(), stats_only.passes());
+        assert!(with_view.resources().contains(R::Occupancy));
     }
 
     #[test]

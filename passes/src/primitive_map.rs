@@ -112,6 +112,12 @@ pub fn choose_binning_path(
     caps: &Capabilities,
     request: BinningRequest,
 ) -> Result<BinningPath, PassError> {
+    if !caps.compute_subgroup_arithmetic {
+        return Err(PassError::Unsupported(
+            "subgroup arithmetic in compute shaders (the primitive map's reductions and prefix scan)"
+                .into(),
+        ));
+    }
     let hw = caps.conservative_raster_tier;
     let gs = caps.geometry_shader;
     let fragment_atomics = caps.fragment_stores_and_atomics;
@@ -262,6 +268,9 @@ pub struct PrimitiveMapInputs<'a> {
     pub depth: &'a Image,
     /// Camera-facing geometric normal, w = 0 on background (`ShaderResource` state).
     pub normal: &'a Image,
+    /// Whether the occupancy pass draws the N×N occupancy view, besides the statistics it always
+    /// gathers.
+    pub occupancy_view: bool,
 }
 
 /// The binning pipelines of the path in use.
@@ -305,8 +314,9 @@ pub struct PrimitiveMap {
     pub offsets: Buffer,
     /// The lists' triangle indices (capacity `u32`, plus the guard words in guard mode).
     pub entries: Buffer,
-    /// N×N `RGBA8` occupancy view.
-    pub occupancy: Image,
+    /// `RGBA8` occupancy view: N×N, or 1×1 and never written without `occupancy_view`.
+    occupancy: Image,
+    occupancy_view: bool,
 }
 
 impl PrimitiveMap {
@@ -358,11 +368,12 @@ impl PrimitiveMap {
         let offsets = storage("primitive map list offsets", (n2 + 1) * 4, copy)?;
         let capacity = config.starting_entries(caps, inputs.triangles);
         let entries = Self::create_entries(device, &config, capacity)?;
+        let view_size = if inputs.occupancy_view { n } else { 1 };
         let occupancy = device.create_image(&ImageDesc {
             name: "primitive map occupancy",
             format: Format::Rgba8Unorm,
-            width: n,
-            height: n,
+            width: view_size,
+            height: view_size,
             layers: 1,
             usage: ImageUsage::STORAGE | ImageUsage::COPY_SRC,
         })?;
@@ -412,7 +423,7 @@ impl PrimitiveMap {
                 BindingKind::StorageImage,
                 BindingKind::StorageBuffer,
             ],
-            std::mem::size_of::<u32>() as u32,
+            std::mem::size_of::<[u32; 2]>() as u32,
         )?;
         let fit_group = device.create_bind_group(fit.layout(), &[Resource::Buffer(&state)])?;
         let receivers_group = device.create_bind_group(
@@ -454,8 +465,14 @@ impl PrimitiveMap {
                 Resource::Buffer(&state),
             ],
         )?;
-        let tile_scan = PrefixScan::new(device, &scan, &tile_offsets, inputs.triangles + 1)?;
-        let offset_scan = PrefixScan::new(device, &scan, &offsets, (n2 + 1) as u32)?;
+        let tile_scan = PrefixScan::new(
+            device,
+            &scan,
+            &tile_offsets,
+            &tile_offsets,
+            inputs.triangles + 1,
+        )?;
+        let offset_scan = PrefixScan::new(device, &scan, &counts, &offsets, (n2 + 1) as u32)?;
         Ok(Self {
             config,
             path,
@@ -485,6 +502,7 @@ impl PrimitiveMap {
             offsets,
             entries,
             occupancy,
+            occupancy_view: inputs.occupancy_view,
         })
     }
 
@@ -588,7 +606,17 @@ impl PrimitiveMap {
         .iter()
         .map(|b| b.size())
         .sum::<u64>()
-            + self.occupancy.byte_size()
+            + self.occupancy_view().map_or(0, Image::byte_size)
+    }
+
+    /// The occupancy view, when the map draws one.
+    pub fn occupancy_view(&self) -> Option<&Image> {
+        self.occupancy_view.then_some(&self.occupancy)
+    }
+
+    /// The occupancy pass's image (1×1 and never written without the view), for its barriers.
+    pub fn occupancy_target(&self) -> &Image {
+        &self.occupancy
     }
 
     /// Grows the entry capacity to hold `needed` entries (with a quarter to spare, within the budget), when a
@@ -634,9 +662,10 @@ impl PrimitiveMap {
             ..*push
         };
         let with_mode = |mode| MapPush { mode, ..push };
-        let pixels = [self.screen.0.div_ceil(8), self.screen.1.div_ceil(8), 1];
+        // Each invocation of the receiver pass places a 2x2 quad; a workgroup covers 16x16 pixels.
+        let pixels = [self.screen.0.div_ceil(16), self.screen.1.div_ceil(16), 1];
 
-        enc.begin_pass("primitive map: receivers");
+        enc.begin_pass("primitive map: fit");
         enc.fill_buffer(&self.receivers, 0);
         enc.fill_buffer(&self.counts, 0);
         if self.config.guard {
@@ -667,6 +696,9 @@ impl PrimitiveMap {
             [1, 1, 1],
         )?;
         enc.barriers(&[Barrier::Uav]);
+        enc.end_pass();
+
+        enc.begin_pass("primitive map: receivers");
         enc.dispatch(
             &self.receivers_pipeline,
             &self.receivers_group,
@@ -693,15 +725,6 @@ impl PrimitiveMap {
         enc.end_pass();
 
         enc.begin_pass("primitive map: scan");
-        enc.barriers(&[Barrier::Global {
-            before: S::UnorderedAccess,
-            after: S::CopySource,
-        }]);
-        enc.copy_buffer(&self.counts, &self.offsets)?;
-        enc.barriers(&[Barrier::Global {
-            before: S::CopyDest,
-            after: S::UnorderedAccess,
-        }]);
         self.offset_scan.record(enc, &self.scan)?;
         enc.end_pass();
 
@@ -736,15 +759,18 @@ impl PrimitiveMap {
         Ok(())
     }
 
-    /// Writes the occupancy view and the map statistics into the state.
+    /// Writes the map statistics into the state, and the occupancy view when the map draws one.
     pub fn record_occupancy(&self, enc: &mut Encoder<'_>) -> Result<(), PassError> {
         enc.begin_pass("occupancy");
         let n = self.config.size;
+        let push = [n, u32::from(self.occupancy_view)];
+        // Each invocation tallies a 2x2 quad of texels.
+        let groups = n.div_ceil(16);
         enc.dispatch(
             &self.occupancy_pipeline,
             &self.occupancy_group,
-            bytemuck::bytes_of(&n),
-            [n.div_ceil(8), n.div_ceil(8), 1],
+            bytemuck::cast_slice(&push),
+            [groups, groups, 1],
         )?;
         enc.end_pass();
         Ok(())
@@ -777,6 +803,27 @@ mod tests {
             max_image_dimension_2d: 16384,
             max_image_array_layers: 2048,
             max_compute_work_group_count: [65535; 3],
+            compute_subgroup_arithmetic: true,
+        }
+    }
+
+    #[test]
+    fn every_path_needs_subgroup_arithmetic() {
+        let none = Capabilities {
+            compute_subgroup_arithmetic: false,
+            ..caps(ConservativeRasterTier::Tier3, true)
+        };
+        for request in [
+            BinningRequest::Auto,
+            BinningRequest::Compute,
+            BinningRequest::Hardware,
+            BinningRequest::Software,
+            BinningRequest::EmulateTier1,
+        ] {
+            assert!(matches!(
+                choose_binning_path(&none, request),
+                Err(PassError::Unsupported(what)) if what.contains("subgroup")
+            ));
         }
     }
 

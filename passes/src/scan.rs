@@ -29,14 +29,18 @@ impl ScanPipeline {
         Ok(Self(device.create_compute_pipeline(
             "prefix scan",
             &shader("scan.comp")?,
-            &[BindingKind::StorageBuffer, BindingKind::StorageBuffer],
+            &[
+                BindingKind::StorageBuffer,
+                BindingKind::StorageBuffer,
+                BindingKind::StorageBuffer,
+            ],
             std::mem::size_of::<ScanPush>() as u32,
         )?))
     }
 }
 
-/// An exclusive scan of the first `n` elements of one buffer: after it, element i holds the sum of the
-/// elements before i.
+/// An exclusive scan of the first `n` elements of an input buffer into an output buffer (the same
+/// buffer for a scan in place): after it, output element i holds the sum of the input elements before i.
 pub struct PrefixScan {
     /// (bind group of level data + its block totals, elements of the level), from the data upwards.
     levels: Vec<(BindGroup, u32)>,
@@ -44,10 +48,12 @@ pub struct PrefixScan {
 }
 
 impl PrefixScan {
-    /// Prepares the scan of the first `n` `u32` of `data` (a storage buffer).
+    /// Prepares the scan of the first `n` `u32` of `input` into `data` (storage buffers; they may be
+    /// the same buffer).
     pub fn new(
         device: &Device,
         pipeline: &ScanPipeline,
+        input: &Buffer,
         data: &Buffer,
         n: u32,
     ) -> Result<Self, PassError> {
@@ -70,10 +76,18 @@ impl PrefixScan {
         }
         let mut levels = Vec::with_capacity(counts.len());
         for (level, &count) in counts.iter().enumerate() {
-            let input = if level == 0 { data } else { &sums[level - 1] };
+            let (read, write) = if level == 0 {
+                (input, data)
+            } else {
+                (&sums[level - 1], &sums[level - 1])
+            };
             let group = device.create_bind_group(
                 pipeline.0.layout(),
-                &[Resource::Buffer(input), Resource::Buffer(&sums[level])],
+                &[
+                    Resource::Buffer(read),
+                    Resource::Buffer(write),
+                    Resource::Buffer(&sums[level]),
+                ],
             )?;
             levels.push((group, count));
         }
@@ -87,18 +101,11 @@ impl PrefixScan {
     /// values are visible to later storage accesses after the UAV barrier this records last.
     pub fn record(&self, enc: &mut Encoder<'_>, pipeline: &ScanPipeline) -> Result<(), PassError> {
         let blocks = |n: u32| u64::from(n).div_ceil(BLOCK).max(1) as u32;
-        for (group, n) in &self.levels {
-            let push = ScanPush { n: *n, mode: 0 };
-            enc.dispatch(
-                &pipeline.0,
-                group,
-                bytemuck::bytes_of(&push),
-                [blocks(*n), 1, 1],
-            )?;
-            enc.barriers(&[Barrier::Uav]);
-        }
-        for (group, n) in self.levels.iter().rev().skip(1) {
-            let push = ScanPush { n: *n, mode: 1 };
+        // Up the levels scanning each block (mode 0), then down adding the block totals (mode 1).
+        let up = self.levels.iter().map(|level| (level, 0));
+        let down = self.levels.iter().rev().skip(1).map(|level| (level, 1));
+        for ((group, n), mode) in up.chain(down) {
+            let push = ScanPush { n: *n, mode };
             enc.dispatch(
                 &pipeline.0,
                 group,

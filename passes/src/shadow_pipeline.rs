@@ -275,6 +275,7 @@ impl ShadowPipeline {
                 triangles: geometry.triangle_count(),
                 depth: inputs.depth,
                 normal: inputs.normal,
+                occupancy_view: plan.resources().contains(ResourceId::Occupancy),
             };
             Some(PrimitiveMap::new(device, &map_inputs, config.map)?)
         } else {
@@ -433,7 +434,7 @@ impl ShadowPipeline {
         use ResourceId as R;
         match resource {
             R::ShadowMap => self.shadow_map.as_ref().map(|s| &s.depth),
-            R::Occupancy => self.map.as_ref().map(|m| &m.occupancy),
+            R::Occupancy => self.map.as_ref().and_then(PrimitiveMap::occupancy_view),
             R::RtVisibility => self.ray.as_ref().map(|r| &r.visibility),
             R::BlockerDistance => self.ray.as_ref().map(|r| &r.blocker_distance),
             R::ShadowMapVisibility => self.shadow_map_test.as_ref().map(|p| &p.output),
@@ -466,11 +467,9 @@ impl ShadowPipeline {
     /// Bytes of `resource` if the pipeline allocated it.
     fn resource_bytes(&self, resource: ResourceId) -> Option<u64> {
         match resource {
-            ResourceId::PrimListOffsets => self
-                .map
-                .as_ref()
-                .map(|m| m.bytes() - m.entries.size() - m.occupancy.byte_size()),
-            ResourceId::Occupancy => self.map.as_ref().map(|m| m.occupancy.byte_size()),
+            ResourceId::PrimListOffsets => self.map.as_ref().map(|m| {
+                m.bytes() - m.entries.size() - m.occupancy_view().map_or(0, Image::byte_size)
+            }),
             r => self
                 .buffer(r)
                 .map(Buffer::size)
@@ -771,7 +770,7 @@ impl ShadowPipeline {
             PassId::Occupancy => {
                 if let Some(map) = &self.map {
                     enc.barriers(&[Barrier::Image {
-                        image: &map.occupancy,
+                        image: map.occupancy_target(),
                         before: S::Undefined,
                         after: S::UnorderedAccess,
                     }]);

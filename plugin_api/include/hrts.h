@@ -399,7 +399,8 @@ typedef struct HrtsConfig {
   uint32_t mode;
   // FXAA over the ray-traced shadow (default true).
   bool antialiasing;
-  // The light does not move between frames: the shadow and primitive maps are kept (default false).
+  // The light does not move between frames: the shadow map is kept (default false). The primitive map
+  // follows the camera and is rebuilt every frame.
   bool static_light;
   // Primitive map N: texels per side of the light-space grid fitted to the receivers each frame,
   // 1..=max_map_size (default 1024). It moves cost, never exactness.

@@ -299,7 +299,8 @@ pub struct HrtsConfig {
     pub mode: u32,
     /// FXAA over the ray-traced shadow (default true).
     pub antialiasing: bool,
-    /// The light does not move between frames: the shadow and primitive maps are kept (default false).
+    /// The light does not move between frames: the shadow map is kept (default false). The primitive map
+    /// follows the camera and is rebuilt every frame.
     pub static_light: bool,
     /// Primitive map N: texels per side of the light-space grid fitted to the receivers each frame,
     /// 1..=max_map_size (default 1024). It moves cost, never exactness.

@@ -47,6 +47,8 @@ pub struct Capabilities {
     pub max_image_array_layers: u32,
     /// `maxComputeWorkGroupCount[0..2]`.
     pub max_compute_work_group_count: [u32; 3],
+    /// Subgroup arithmetic (`subgroupAdd`, `subgroupInclusiveAdd`, min/max) in compute shaders.
+    pub compute_subgroup_arithmetic: bool,
 }
 
 impl Capabilities {
@@ -86,7 +88,10 @@ pub(crate) fn read_capabilities(
     let has = |n: &CStr| has_extension(enabled_extensions, n);
     let mut cr = vk::PhysicalDeviceConservativeRasterizationPropertiesEXT::default();
     let mut driver = vk::PhysicalDeviceDriverProperties::default();
-    let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+    let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
+    let mut props2 = vk::PhysicalDeviceProperties2::default()
+        .push_next(&mut driver)
+        .push_next(&mut subgroup);
     let has_cr = has(ash::ext::conservative_rasterization::NAME);
     if has_cr {
         props2 = props2.push_next(&mut cr);
@@ -134,6 +139,12 @@ pub(crate) fn read_capabilities(
         max_image_dimension_2d: p.limits.max_image_dimension2_d,
         max_image_array_layers: p.limits.max_image_array_layers,
         max_compute_work_group_count: p.limits.max_compute_work_group_count,
+        compute_subgroup_arithmetic: subgroup
+            .supported_stages
+            .contains(vk::ShaderStageFlags::COMPUTE)
+            && subgroup
+                .supported_operations
+                .contains(vk::SubgroupFeatureFlags::BASIC | vk::SubgroupFeatureFlags::ARITHMETIC),
     }
 }
 

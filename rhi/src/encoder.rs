@@ -3,7 +3,7 @@
 use crate::conv::{state_scope, uav_barrier, ResourceState};
 use crate::device::Device;
 use crate::error::{Result, RhiError, VkResultExt};
-use crate::pipeline::{BindGroup, ComputePipeline, GraphicsPipeline};
+use crate::pipeline::{BindGroup, ComputePipeline, GraphicsPipeline, PipelineLayout};
 use crate::resources::{subresource_range, Buffer, Image};
 use ash::vk;
 use std::sync::{Arc, Mutex};
@@ -361,6 +361,30 @@ impl<'a> Encoder<'a> {
         };
     }
 
+    /// Binds a pipeline, its bind group (set 0) and its push constants.
+    ///
+    /// # Safety
+    /// `pipeline` was created with `layout`, `group` for that layout, and `push` fits its push range;
+    /// all are live until the command buffer completes.
+    pub(crate) unsafe fn bind(
+        &self,
+        point: vk::PipelineBindPoint,
+        pipeline: vk::Pipeline,
+        layout: &PipelineLayout,
+        group: &BindGroup,
+        push: &[u8],
+    ) {
+        let d = self.d();
+        // SAFETY: guaranteed by the caller.
+        unsafe {
+            d.cmd_bind_pipeline(self.cmd, point, pipeline);
+            d.cmd_bind_descriptor_sets(self.cmd, point, layout.raw, 0, &[group.set], &[]);
+            if !push.is_empty() {
+                d.cmd_push_constants(self.cmd, layout.raw, vk::ShaderStageFlags::ALL, 0, push);
+            }
+        }
+    }
+
     /// Binds a compute pipeline and its resources and dispatches `groups` workgroups.
     pub fn dispatch(
         &mut self,
@@ -381,24 +405,13 @@ impl<'a> Encoder<'a> {
         let d = self.d();
         // SAFETY: live pipeline and set created for its layout; push size and group counts checked.
         unsafe {
-            d.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::COMPUTE, pipeline.raw);
-            d.cmd_bind_descriptor_sets(
-                self.cmd,
+            self.bind(
                 vk::PipelineBindPoint::COMPUTE,
-                pipeline.layout.raw,
-                0,
-                &[group.set],
-                &[],
+                pipeline.raw,
+                &pipeline.layout,
+                group,
+                push,
             );
-            if !push.is_empty() {
-                d.cmd_push_constants(
-                    self.cmd,
-                    pipeline.layout.raw,
-                    vk::ShaderStageFlags::ALL,
-                    0,
-                    push,
-                );
-            }
             d.cmd_dispatch(self.cmd, groups[0], groups[1], groups[2]);
         }
         Ok(())
@@ -489,24 +502,13 @@ impl<'a> Encoder<'a> {
         };
         // SAFETY: inside begin_rendering; pipeline and set are live and match; push size checked.
         unsafe {
-            d.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.raw);
-            d.cmd_bind_descriptor_sets(
-                self.cmd,
+            self.bind(
                 vk::PipelineBindPoint::GRAPHICS,
-                pipeline.layout.raw,
-                0,
-                &[group.set],
-                &[],
+                pipeline.raw,
+                &pipeline.layout,
+                group,
+                push,
             );
-            if !push.is_empty() {
-                d.cmd_push_constants(
-                    self.cmd,
-                    pipeline.layout.raw,
-                    vk::ShaderStageFlags::ALL,
-                    0,
-                    push,
-                );
-            }
             d.cmd_set_viewport(self.cmd, 0, &[viewport]);
             d.cmd_set_scissor(self.cmd, 0, &[scissor]);
             d.cmd_draw(self.cmd, vertex_count, 1, 0, 0);

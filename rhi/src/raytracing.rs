@@ -712,33 +712,17 @@ impl Encoder<'_> {
                 limit: rt.limits.max_invocations.into(),
             });
         }
-        let d = &self.device.shared.device;
         let [raygen, miss, hit] = &pipeline.regions;
         // SAFETY: live pipeline and set created for its layout; push size and dispatch size checked; the
         // binding table regions were filled at creation.
         unsafe {
-            d.cmd_bind_pipeline(
-                self.cmd,
+            self.bind(
                 vk::PipelineBindPoint::RAY_TRACING_KHR,
                 pipeline.raw,
+                &pipeline.layout,
+                group,
+                push,
             );
-            d.cmd_bind_descriptor_sets(
-                self.cmd,
-                vk::PipelineBindPoint::RAY_TRACING_KHR,
-                pipeline.layout.raw,
-                0,
-                &[group.set],
-                &[],
-            );
-            if !push.is_empty() {
-                d.cmd_push_constants(
-                    self.cmd,
-                    pipeline.layout.raw,
-                    vk::ShaderStageFlags::ALL,
-                    0,
-                    push,
-                );
-            }
             rt.pipeline.cmd_trace_rays(
                 self.cmd,
                 raygen,

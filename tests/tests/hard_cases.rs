@@ -161,7 +161,11 @@ fn non_finite_input_is_rejected_at_load() {
 #[test]
 fn overflow_keeps_the_guard_layer_and_exact_visibility() {
     for o in check_family(Family::Overflow) {
-        assert!(o.overflowed_texels > 0, "{}: no overflow", o.name);
+        assert!(
+            o.texels_past_capacity > 0,
+            "{}: no texel past the entry capacity",
+            o.name
+        );
         assert_eq!(o.guard_written, Some(0), "{}", o.name);
     }
 }

@@ -8,7 +8,8 @@ mod common;
 use common::*;
 use host_demo::View;
 use passes::{
-    FrameInputs, PrimitiveMapConfig, ShadowRenderer, GUARD_VALUE, GUARD_WORDS, MIN_ENTRY_BUDGET,
+    FrameInputs, PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig, ShadowRenderer,
+    GUARD_VALUE, GUARD_WORDS, MIN_ENTRY_BUDGET,
 };
 use reference::RefScene;
 
@@ -19,6 +20,8 @@ fn frames(
     count: usize,
 ) -> Vec<(passes::FrameReport, passes::FrameImages)> {
     let geometry = view.upload(device).expect("upload");
+    let mut config = ShadowConfig::from(config);
+    config.extra_outputs = ResourceSet::of(&[ResourceId::Occupancy]);
     let mut r =
         ShadowRenderer::new(device, geometry, view.width, view.height, config).expect("renderer");
     let inputs: FrameInputs = view.frame_inputs();

@@ -194,6 +194,7 @@ fn hybrid_with_comparison_outputs_matches_bit_for_bit() {
             ResourceId::ShadowMapVisibility,
             ResourceId::RtVisibility,
             ResourceId::LerpFactor,
+            ResourceId::Occupancy,
         ]),
         ..ShadowConfig::default()
     };
@@ -206,11 +207,12 @@ fn hard_shadows_of_a_real_mesh_match_bit_for_bit_with_the_lists() {
     let bunny = scene::load_obj(&model("02_stanford_bunny_69k.obj")).expect("bunny loads");
     let view = View::framed(bunny.with_ground_plane(), 160, 120);
     // A budget the lists pass: the exhaustive fallback runs on both paths.
-    let config = ShadowConfig::from(PrimitiveMapConfig {
+    let mut config = ShadowConfig::from(PrimitiveMapConfig {
         size: 256,
         entry_budget: 64 << 10,
         ..PrimitiveMapConfig::default()
     });
+    config.extra_outputs = ResourceSet::of(&[ResourceId::Occupancy]);
     check(
         "hard, bunny past the entry capacity",
         &view,

@@ -1,5 +1,6 @@
 //! The GPU prefix scan behind the primitive map's list offsets equals the CPU's exclusive prefix sum, at
-//! sizes of one, two and three levels of 1024-element blocks, on random data.
+//! sizes of one, two and three levels of 1024-element blocks, on random data, in place and from one
+//! buffer into another.
 
 mod common;
 
@@ -12,7 +13,11 @@ fn gpu_scan_equals_the_cpu_prefix_sum() {
     let device = device();
     let pipeline = ScanPipeline::new(&device).expect("scan pipeline");
     let mut state = 0x2545_f491_4f6c_dd1d_u64;
-    for n in [1u32, 1000, 1024, 1025, 300_000, 1_100_000] {
+    for (case, n) in [1u32, 1000, 1024, 1025, 300_000, 1_100_000]
+        .into_iter()
+        .enumerate()
+    {
+        let in_place = case % 2 == 0;
         let data: Vec<u32> = (0..n)
             .map(|_| {
                 state ^= state << 13;
@@ -28,7 +33,16 @@ fn gpu_scan_equals_the_cpu_prefix_sum() {
                 BufferUsage::STORAGE | BufferUsage::COPY_SRC,
             )
             .expect("data");
-        let scan = PrefixScan::new(&device, &pipeline, &buffer, n).expect("scan");
+        let output = device
+            .create_buffer(
+                "scan output",
+                u64::from(n) * 4,
+                BufferUsage::STORAGE | BufferUsage::COPY_SRC,
+                MemoryLocation::GpuOnly,
+            )
+            .expect("output");
+        let target = if in_place { &buffer } else { &output };
+        let scan = PrefixScan::new(&device, &pipeline, &buffer, target, n).expect("scan");
         let readback = device
             .create_buffer(
                 "scan read-back",
@@ -44,7 +58,7 @@ fn gpu_scan_equals_the_cpu_prefix_sum() {
                     before: S::UnorderedAccess,
                     after: S::CopySource,
                 }]);
-                enc.copy_buffer(&buffer, &readback)?;
+                enc.copy_buffer(target, &readback)?;
                 enc.barriers(&[Barrier::Global {
                     before: S::CopyDest,
                     after: S::HostRead,
@@ -65,7 +79,7 @@ fn gpu_scan_equals_the_cpu_prefix_sum() {
         let wrong = gpu.iter().zip(&cpu).filter(|(a, b)| a != b).count();
         assert_eq!(
             wrong, 0,
-            "{n} elements: {wrong} differ from the CPU prefix sum"
+            "{n} elements (in place: {in_place}): {wrong} differ from the CPU prefix sum"
         );
     }
     assert_no_validation_errors(&device);

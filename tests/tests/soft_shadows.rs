@@ -521,6 +521,7 @@ fn render_and_compare_write_the_soft_shadow_outputs() {
             shadow_map_size: 512,
             ..Default::default()
         },
+        occupancy_view: true,
     };
     let render_dir = dir.join("render");
     host_demo::render::render_to_folder(&device, &view, &options, &render_dir).expect("render");
