@@ -154,19 +154,12 @@ pub fn absolute_tolerance(view: &View) -> f64 {
     64.0 * f64::from(f32::EPSILON) * magnitude
 }
 
-/// Compares GPU visibility and blocker distance with the exact reference.
-pub fn compare_visibility(
-    rs: &RefScene,
-    view: &View,
-    images: &FrameImages,
-) -> VisibilityComparison {
+/// The exact reference's view of `view`: the camera matrices composed in f64 as the passes do (relative to
+/// the camera, the rays starting at the view matrix's own eye), the light, and the tolerances.
+pub fn visibility_params(view: &View) -> VisibilityParams {
     let inputs = view.frame_inputs();
-    let tolerance = absolute_tolerance(view);
-    let per_distance = tolerance_per_distance(view);
-    // The passes compose the camera matrices in f64 relative to the camera; so does the reference, with the
-    // rays starting at the view matrix's own eye.
     let view_matrix = inputs.view.as_dmat4();
-    let params = VisibilityParams {
+    VisibilityParams {
         width: view.width,
         height: view.height,
         view_proj: inputs.proj.as_dmat4() * view_matrix,
@@ -174,10 +167,20 @@ pub fn compare_visibility(
         light: Light::Directional {
             direction: inputs.light.direction().as_dvec3(),
         },
-        tolerance,
-        tolerance_per_distance: per_distance,
+        tolerance: absolute_tolerance(view),
+        tolerance_per_distance: tolerance_per_distance(view),
         pixel_tolerance: 1.0 / 128.0,
-    };
+    }
+}
+
+/// Compares GPU visibility and blocker distance with the exact reference.
+pub fn compare_visibility(
+    rs: &RefScene,
+    view: &View,
+    images: &FrameImages,
+) -> VisibilityComparison {
+    let params = visibility_params(view);
+    let (tolerance, per_distance) = (params.tolerance, params.tolerance_per_distance);
     let r = reference_visibility(rs, &params);
     let mut c = VisibilityComparison {
         near_edge_mask: vec![false; r.class.len()],

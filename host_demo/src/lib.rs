@@ -13,6 +13,7 @@ pub mod ray_dump;
 pub mod render;
 pub mod report;
 pub mod tiers;
+pub mod tradeoff;
 
 use glam::{DVec3, Mat4, Vec3};
 use passes::{Draw, FrameInputs, Geometry, Light, PassError};

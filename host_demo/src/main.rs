@@ -48,6 +48,9 @@ enum Command {
     /// What accuracy costs in time: shadow maps and primitive maps of growing size against the exact
     /// reference, with GPU times and memory (Markdown).
     Accuracy(host_demo::report::AccuracyArgs),
+    /// What accuracy costs in time for soft shadows: every method and setting against a ground-truth soft
+    /// shadow, with GPU time and memory; CSV, JSON, a Pareto plot and error maps.
+    Tradeoff(host_demo::tradeoff::TradeoffArgs),
     /// The conservative-raster tier matrix: every raster path of the device against exact binning (Markdown).
     Tiers {
         /// Folder with the test models (default: `HRTS_MODELS`, else `../shared/models` beside the
@@ -191,6 +194,9 @@ fn main() -> ExitCode {
         }
         Command::Bench { args, out } => {
             device(&cli).and_then(|d| host_demo::bench::run_cli(&d, args, out.as_deref()))
+        }
+        Command::Tradeoff(args) => {
+            device(&cli).and_then(|d| host_demo::tradeoff::run_cli(&d, args))
         }
         Command::Accuracy(args) => device(&cli).and_then(|d| {
             println!("{}", host_demo::report::run_report(&d, args)?);

@@ -51,24 +51,36 @@ fn render(
     std::collections::BTreeMap<String, f64>,
     u64,
 )> {
+    let (images, reports) = render_frames(device, view, config, frames)?;
+    let memory = reports.last().map_or(0, map_bytes);
+    Ok((images, median_timings(&reports), memory))
+}
+
+/// Renders `frames` frames (at least 2) of `view` through the C ABI and reads the last one back.
+pub fn render_frames(
+    device: &Device,
+    view: &View,
+    config: ShadowConfig,
+    frames: u32,
+) -> Result<(passes::FrameImages, Vec<passes::FrameReport>)> {
     let mut r = PluginRenderer::new(device, view, config)?;
     let inputs = view.frame_inputs();
     let mut reports = Vec::new();
     for _ in 0..frames.max(2) {
         reports.push(r.render(device, &inputs)?);
     }
-    let memory = reports.last().map_or(0, map_bytes);
-    Ok((
-        r.read_back(device, false)?,
-        median_timings(&reports),
-        memory,
-    ))
+    Ok((r.read_back(device, false)?, reports))
 }
 
-/// Builds the report as Markdown.
-pub fn run_report(device: &Device, args: &AccuracyArgs) -> Result<String> {
-    let obj = match &args.obj {
-        Some(path) => path.clone(),
+/// The view of an OBJ model on a ground plane, framed automatically, and its file name; the Stanford bunny
+/// of the models folder without `obj`.
+pub fn model_view(
+    obj: Option<&std::path::Path>,
+    width: u32,
+    height: u32,
+) -> Result<(View, String)> {
+    let obj = match obj {
+        Some(path) => path.to_path_buf(),
         None => scene::models_dir()
             .map_err(anyhow::Error::msg)?
             .join("02_stanford_bunny_69k.obj"),
@@ -76,7 +88,15 @@ pub fn run_report(device: &Device, args: &AccuracyArgs) -> Result<String> {
     let scene = scene::load_obj(&obj)
         .with_context(|| format!("loading {}", obj.display()))?
         .with_ground_plane();
-    let view = View::framed(scene, args.width, args.height);
+    let label = obj
+        .file_name()
+        .map_or_else(|| "scene".into(), |n| n.to_string_lossy().into_owned());
+    Ok((View::framed(scene, width, height), label))
+}
+
+/// Builds the report as Markdown.
+pub fn run_report(device: &Device, args: &AccuracyArgs) -> Result<String> {
+    let (view, label) = model_view(args.obj.as_deref(), args.width, args.height)?;
     let rs = RefScene::new(&view.scene);
     let sum = |t: &std::collections::BTreeMap<String, f64>, names: &[&str]| {
         median_of(t, names).unwrap_or(f64::NAN)
@@ -130,7 +150,7 @@ pub fn run_report(device: &Device, args: &AccuracyArgs) -> Result<String> {
     let caps = device.capabilities();
     let mut s = format!(
         "{} ({} triangles with the ground plane), {}×{} px on {}; wrong = pixels whose lit/shadowed value differs from the exact f64 reference outside near-edge pixels; GPU ms are medians over {} frames.\n\n| method | memory | GPU ms | wrong pixels | near-edge (not compared) |\n|---|---:|---:|---:|---:|\n",
-        obj.file_name().and_then(|n| n.to_str()).unwrap_or("model"),
+        label,
         view.scene.triangle_count(),
         args.width,
         args.height,

@@ -9,9 +9,12 @@
 //!   triangle edge or plane classified [`PixelClass::Ambiguous`];
 //! - [`conservative_texel_sets`]: the exact conservative set of triangles per texel
 //!   of a light-space grid (the "deep primitive map" of Jon Story's GDC 2015 talk on
-//!   hybrid ray-traced shadows).
+//!   hybrid ray-traced shadows);
+//! - [`soft_visibility`]: soft-shadow ground truth, the visible fraction of an
+//!   [`AreaLight`] per pixel by stratified Monte Carlo with a stated error bound,
+//!   exact where the light's cone is provably clear.
 //!
-//! Both are built on [`intersect_watertight`] (Woop, Benthin and Wald's watertight
+//! All are built on [`intersect_watertight`] (Woop, Benthin and Wald's watertight
 //! ray/triangle test), exact orientation predicates, and a BVH over the scene
 //! ([`RefScene`]).
 //!
@@ -24,6 +27,7 @@
 mod exact;
 mod geometry;
 mod ref_scene;
+mod soft;
 mod texels;
 mod visibility;
 
@@ -32,6 +36,7 @@ mod tests;
 
 pub use geometry::{intersect_watertight, line_segment_distance};
 pub use ref_scene::RefScene;
+pub use soft::{soft_visibility, AreaLight, SoftParams, SoftReference, RELATIVE_RAY_OFFSET};
 pub use texels::{conservative_texel_sets, overlaps_texel_with_margin, FaceSelection, TexelSets};
 pub use visibility::{
     reference_visibility, Light, PixelClass, VisibilityParams, VisibilityReference,

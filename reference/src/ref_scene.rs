@@ -234,6 +234,43 @@ impl RefScene {
         self.order = order;
     }
 
+    /// Whether some usable triangle satisfies `triangle_may_meet`, descending only
+    /// into nodes whose bounds `node_may_meet(min, max)` accepts (a node that it
+    /// rejects must contain no triangle that `triangle_may_meet` would accept, so a
+    /// caller's region test only ever prunes, never decides).
+    ///
+    /// Stops at the first triangle accepted. `min` and `max` are the exact bounds of
+    /// the node's triangles' vertices (no padding: they are minima and maxima of the
+    /// promoted coordinates, not rounded results).
+    pub(crate) fn any_triangle(
+        &self,
+        mut node_may_meet: impl FnMut(DVec3, DVec3) -> bool,
+        mut triangle_may_meet: impl FnMut(usize) -> bool,
+    ) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let mut stack: Vec<usize> = Vec::with_capacity(64);
+        stack.push(0);
+        while let Some(index) = stack.pop() {
+            let node = self.nodes[index];
+            if !node_may_meet(node.bounds.min, node.bounds.max) {
+                continue;
+            }
+            let first = node.first as usize;
+            if node.count > 0 {
+                let leaf = &self.order[first..first + node.count as usize];
+                if leaf.iter().any(|&tri| triangle_may_meet(tri as usize)) {
+                    return true;
+                }
+            } else {
+                stack.push(first + 1);
+                stack.push(first);
+            }
+        }
+        false
+    }
+
     /// Visits every usable triangle whose bounding box, grown by `expand`, the ray
     /// `origin + t * dir` reaches for `t` in `[t_min, t_max]`, nearest boxes first.
     ///

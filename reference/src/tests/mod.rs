@@ -1,6 +1,7 @@
 //! Unit tests and the helpers they share.
 
 mod perf;
+mod soft;
 mod texels;
 mod visibility;
 mod watertight;
