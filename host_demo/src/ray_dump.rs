@@ -297,22 +297,8 @@ mod tests {
 
     /// A unit cube floating above the ground, a tilted quad beside it, and the demo's ground plane.
     fn small_scene(offset: Vec3) -> Scene {
-        let mut positions = Vec::new();
-        let mut indices = Vec::new();
-        for i in 0..8u32 {
-            let bit = |b: u32| if i & (1 << b) != 0 { 1.0 } else { 0.0 };
-            positions.push(Vec3::new(bit(0), 0.5 + bit(1), bit(2)));
-        }
-        for [a, b, c, d] in [
-            [0, 1, 3, 2],
-            [4, 6, 7, 5],
-            [0, 4, 5, 1],
-            [2, 3, 7, 6],
-            [0, 2, 6, 4],
-            [1, 5, 7, 3],
-        ] {
-            indices.extend([a, b, c, a, c, d]);
-        }
+        let cube = Scene::axis_box("cube", Vec3::new(0.0, 0.5, 0.0), Vec3::new(1.0, 1.5, 1.0));
+        let (mut positions, mut indices) = (cube.positions, cube.indices);
         let base = positions.len() as u32;
         positions.extend([
             Vec3::new(1.5, 0.2, 0.0),

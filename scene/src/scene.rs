@@ -49,6 +49,34 @@ impl Scene {
         }
     }
 
+    /// An axis-aligned box from `min` to `max` as one object named `name`: 8 vertices, 12 triangles
+    /// counter-clockwise seen from outside.
+    pub fn axis_box(name: &str, min: Vec3, max: Vec3) -> Scene {
+        let positions = (0..8u32)
+            .map(|i| {
+                Vec3::new(
+                    if i & 1 != 0 { max.x } else { min.x },
+                    if i & 2 != 0 { max.y } else { min.y },
+                    if i & 4 != 0 { max.z } else { min.z },
+                )
+            })
+            .collect();
+        // Faces as corner quads (a, b, c, d) counter-clockwise from outside: -x, +x, -y, +y, -z, +z.
+        let faces: [[u32; 4]; 6] = [
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+        ];
+        let indices = faces
+            .iter()
+            .flat_map(|&[a, b, c, d]| [a, b, c, a, c, d])
+            .collect();
+        Scene::single_object(positions, indices, name)
+    }
+
     /// Number of complete triangles (`indices.len() / 3`).
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
@@ -317,6 +345,16 @@ mod tests {
             Scene::default().validate(),
             Err(SceneError::Empty { .. })
         ));
+    }
+
+    #[test]
+    fn axis_box_is_closed_and_faces_outwards() {
+        let b = Scene::axis_box("box", Vec3::new(-1.0, 0.0, 2.0), Vec3::new(1.0, 3.0, 5.0));
+        assert_eq!(b.triangle_count(), 12);
+        assert_eq!(b.objects.len(), 1);
+        b.validate().expect("valid");
+        // Outward counter-clockwise faces enclose a positive volume: 2 * 3 * 3.
+        assert!((signed_volume(&b) - 18.0).abs() < 1e-4);
     }
 
     #[test]

@@ -74,24 +74,7 @@ fn check(view: &View, max_near_edge_fraction: f64) {
         peer.trace_ms,
         device.capabilities().driver
     );
-    assert_eq!(c.non_finite, 0);
-    assert_eq!(
-        c.mismatches, 0,
-        "mismatching pixels (x, y, exact, peer): {:?}",
-        c.examples
-    );
-    assert!(
-        c.shadowed > c.pixels / 50,
-        "the view should contain shadows: {} of {} pixels",
-        c.shadowed,
-        c.pixels
-    );
-    let fraction = c.near_edge as f64 / c.pixels as f64;
-    assert!(
-        fraction <= max_near_edge_fraction,
-        "near-edge pixels {:.3}% exceed the bound",
-        fraction * 100.0
-    );
+    assert_exact_visibility(&c, max_near_edge_fraction);
     assert!(peer.build_ms.is_finite() && peer.trace_ms.is_finite());
     assert_no_validation_errors(&device);
 }

@@ -9,7 +9,7 @@ pub use host_demo::accuracy::*;
 use host_demo::View;
 use passes::{FrameImages, FrameReport, PrimitiveMapConfig, ShadowRenderer};
 use rhi::{Device, DeviceDesc};
-use scene::{Camera, DirectionalLight, Object, Scene};
+use scene::{Camera, DirectionalLight, Scene};
 use std::path::PathBuf;
 
 /// The models folder (`HRTS_MODELS`, else `../shared/models` beside the checkout); fails the test with
@@ -60,59 +60,24 @@ pub fn render(
     (report, images)
 }
 
-/// Appends an axis-aligned box (12 triangles, counter-clockwise seen from outside) as object `name`.
-pub fn add_box(scene: &mut Scene, name: &str, min: Vec3, max: Vec3) {
-    let base = scene.positions.len() as u32;
-    let first_triangle = scene.triangle_count() as u32;
-    for i in 0..8u32 {
-        scene.positions.push(Vec3::new(
-            if i & 1 != 0 { max.x } else { min.x },
-            if i & 2 != 0 { max.y } else { min.y },
-            if i & 4 != 0 { max.z } else { min.z },
-        ));
-    }
-    // Faces as corner quads (a, b, c, d) counter-clockwise from outside.
-    let faces = [
-        [0, 4, 6, 2], // -x
-        [1, 3, 7, 5], // +x
-        [0, 1, 5, 4], // -y
-        [2, 6, 7, 3], // +y
-        [0, 2, 3, 1], // -z
-        [4, 5, 7, 6], // +z
-    ];
-    for [a, b, c, d] in faces {
-        scene
-            .indices
-            .extend([a, b, c, a, c, d].map(|k: u32| base + k));
-    }
-    scene.objects.push(Object {
-        name: name.into(),
-        first_triangle,
-        triangle_count: 12,
-    });
-}
-
 /// A ground plane, a thin horizontal plate 1.5 m above it and a box standing on it.
 pub fn plate_and_box() -> Scene {
     let mut s = Scene::default();
-    add_box(
-        &mut s,
-        "ground",
-        Vec3::new(-3.0, -0.05, -3.0),
-        Vec3::new(3.0, 0.0, 3.0),
-    );
-    add_box(
-        &mut s,
-        "plate",
-        Vec3::new(-2.0, 1.5, -0.6),
-        Vec3::new(-0.8, 1.52, 0.6),
-    );
-    add_box(
-        &mut s,
-        "box",
-        Vec3::new(0.8, 0.0, -0.3),
-        Vec3::new(1.4, 0.8, 0.3),
-    );
+    for (name, min, max) in [
+        (
+            "ground",
+            Vec3::new(-3.0, -0.05, -3.0),
+            Vec3::new(3.0, 0.0, 3.0),
+        ),
+        (
+            "plate",
+            Vec3::new(-2.0, 1.5, -0.6),
+            Vec3::new(-0.8, 1.52, 0.6),
+        ),
+        ("box", Vec3::new(0.8, 0.0, -0.3), Vec3::new(1.4, 0.8, 0.3)),
+    ] {
+        s.append(&Scene::axis_box(name, min, max));
+    }
     s.validate().expect("valid test scene");
     s
 }
@@ -128,4 +93,28 @@ pub fn plate_and_box_view(width: u32, height: u32) -> View {
     };
     view.light = DirectionalLight::new(Vec3::new(0.35, -1.0, 0.6)).expect("light");
     view
+}
+
+/// Asserts a visibility comparison with the exact reference: no NaN/Inf, 0 mismatches outside near-edge
+/// pixels, a view with shadows in it (more than 2% of its pixels), and at most `max_near_edge_fraction`
+/// of the pixels near an edge.
+pub fn assert_exact_visibility(c: &VisibilityComparison, max_near_edge_fraction: f64) {
+    assert_eq!(c.non_finite, 0, "NaN/Inf pixels: {c:?}");
+    assert_eq!(
+        c.mismatches, 0,
+        "mismatching pixels (x, y, exact, gpu): {:?}",
+        c.examples
+    );
+    assert!(
+        c.shadowed > c.pixels / 50,
+        "the view should contain shadows: {} of {} pixels",
+        c.shadowed,
+        c.pixels
+    );
+    let fraction = c.near_edge as f64 / c.pixels as f64;
+    assert!(
+        fraction <= max_near_edge_fraction,
+        "near-edge pixels {:.3}% exceed the bound",
+        fraction * 100.0
+    );
 }
