@@ -27,7 +27,7 @@ cargo="${CARGO:-cargo}"
 # C++ code and needs no -lstdc++.
 static_libs=(dl gcc_s util rt pthread m dl c)
 
-"$cargo" build --profile "$profile" -p plugin_api
+"$cargo" build --profile "$profile" -p hrts
 metadata="$("$cargo" metadata --no-deps --format-version 1)"
 version="$(sed -n 's/.*"name":"plugin_api","version":"\([^"]*\)".*/\1/p' <<<"$metadata")"
 target_dir="$(sed -n 's/.*"target_directory":"\([^"]*\)".*/\1/p' <<<"$metadata")"

@@ -9,7 +9,7 @@
 use crate::View;
 use anyhow::{bail, Context as _, Result};
 use glam::Mat4;
-use hrts::*;
+use hrts_plugin::*;
 use passes::gbuffer::{GBufferPass, GBufferTargets};
 use passes::gpu_types::GBufferPush;
 use passes::prim_buffer::PrimBufferPass;
@@ -119,6 +119,7 @@ impl PluginRenderer {
             normal_usage: t.normal.raw_usage(),
             output_image: output.raw_handle(),
             output_usage: output.raw_usage(),
+            output_layers: 1,
         };
         // SAFETY: live context; the images live as long as the renderer, which destroys the context first.
         context.check("hrts_set_targets", unsafe {
@@ -167,6 +168,7 @@ impl PluginRenderer {
         };
         let tris = self.geometry.triangle_count();
         let rebuild_prims = self.frames == 0 || self.dynamic_geometry;
+        let light = c_light(&inputs.light);
         let t = &self.targets;
         device.submit_and_wait(|enc| {
             if rebuild_prims {
@@ -176,7 +178,7 @@ impl PluginRenderer {
                 enc.barriers(&[Barrier::Uav]);
             }
             enc.attach_timer(&self.timer);
-            let frame = c_frame(enc.raw_handle(), inputs);
+            let frame = c_frame(enc.raw_handle(), self.frames, inputs, &light);
             self.record_passes(&frame, HRTS_PASS_MASK_LIGHT_SPACE)?;
             let undefined_to = |image, after| Barrier::Image {
                 image,
@@ -207,12 +209,12 @@ impl PluginRenderer {
         })?;
         let start = std::time::Instant::now();
         device.submit_and_wait(|enc| {
-            let frame = c_frame(enc.raw_handle(), inputs);
+            let frame = c_frame(enc.raw_handle(), self.frames, inputs, &light);
             self.record_passes(&frame, HRTS_PASS_MASK_SCREEN_SPACE)
         })?;
         let wall = start.elapsed().as_secs_f64() * 1e3;
+        let mut report = self.report(self.frames)?;
         self.frames += 1;
-        let mut report = self.report()?;
         report.timings.extend(self.timer.resolve()?);
         report.timings.push(PassTiming {
             name: SCREEN_SPACE_WALL.into(),
@@ -229,14 +231,14 @@ impl PluginRenderer {
             .map_err(recording_error)
     }
 
-    /// The plugin's report of the last frame, as the Rust [`FrameReport`].
-    fn report(&self) -> Result<FrameReport> {
+    /// The plugin's report of frame `frame` (completed), as the Rust [`FrameReport`].
+    fn report(&self, frame: u64) -> Result<FrameReport> {
         // SAFETY: plain-old-data C struct; every field is valid zeroed.
         let mut r: HrtsFrameReport = unsafe { std::mem::zeroed() };
         r.struct_size = size_of::<HrtsFrameReport>() as u32;
         // SAFETY: live context, valid out pointer.
         self.context.check("hrts_get_frame_report", unsafe {
-            hrts_get_frame_report(self.context.0, &mut r)
+            hrts_get_frame_report(self.context.0, frame, 0, &mut r)
         })?;
         let timings = r.passes[..r.pass_count as usize]
             .iter()
@@ -341,7 +343,7 @@ impl PluginRenderer {
             info.struct_size = size_of::<HrtsResourceInfo>() as u32;
             // SAFETY: live context, valid out pointer.
             self.context.check("hrts_get_resource_info", unsafe {
-                hrts_get_resource_info(self.context.0, resource, &mut info)
+                hrts_get_resource_info(self.context.0, 0, resource, &mut info)
             })?;
             if info.allocated {
                 let buffer = device.create_buffer(
@@ -359,6 +361,7 @@ impl PluginRenderer {
                     struct_size: size_of::<HrtsResourceReadback>() as u32,
                     command_buffer: enc.raw_handle(),
                     resource: *resource,
+                    light: 0,
                     buffer: buffer.raw_handle(),
                     buffer_size: buffer.size(),
                     offset: 0,
@@ -434,6 +437,7 @@ fn create_context(device: &Device) -> Result<Context> {
         vulkan: &vulkan,
         device_name_filter: std::ptr::null(),
         enable_validation: false,
+        frames_in_flight: 0,
     };
     let mut context = std::ptr::null_mut();
     // SAFETY: valid structs; the names outlive the call; the device outlives the context (the renderer
@@ -494,10 +498,9 @@ fn set_geometry(context: &Context, geometry: &Geometry, view: &View) -> Result<(
     })
 }
 
-/// The C frame of `inputs`, recorded into `command_buffer`; depth and normal are sampled
-/// (`SHADER_READ_ONLY_OPTIMAL`) and the visibility image is left ready for sampling.
-fn c_frame(command_buffer: u64, inputs: &FrameInputs) -> HrtsFrame {
-    let (light_type, position, direction, view_proj) = match inputs.light {
+/// The C light of `light`.
+fn c_light(light: &Light) -> HrtsLight {
+    let (light_type, position, direction, view_proj) = match *light {
         Light::Directional {
             direction,
             view_proj,
@@ -513,17 +516,32 @@ fn c_frame(command_buffer: u64, inputs: &FrameInputs) -> HrtsFrame {
             view_proj,
         ),
     };
+    HrtsLight {
+        light_type: light_type as u32,
+        position,
+        direction: direction.to_array(),
+        view_proj: view_proj.to_cols_array(),
+    }
+}
+
+/// The C frame `frame_index` of `inputs` with its one light `light`, recorded into `command_buffer`; depth
+/// and normal are sampled (`SHADER_READ_ONLY_OPTIMAL`) and the visibility image is left ready for sampling.
+fn c_frame(
+    command_buffer: u64,
+    frame_index: u64,
+    inputs: &FrameInputs,
+    light: &HrtsLight,
+) -> HrtsFrame {
     let sampled = S::ShaderResource.raw_layout();
     HrtsFrame {
         struct_size: size_of::<HrtsFrame>() as u32,
         command_buffer,
+        frame_index,
         view: inputs.view.to_cols_array(),
         proj: inputs.proj.to_cols_array(),
         camera_position: inputs.camera_position.to_array(),
-        light_type: light_type as u32,
-        light_position: position,
-        light_direction: direction.to_array(),
-        light_view_proj: view_proj.to_cols_array(),
+        lights: light,
+        light_count: 1,
         depth_layout: sampled,
         normal_layout: sampled,
         output_layout_before: S::Undefined.raw_layout(),

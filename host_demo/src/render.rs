@@ -110,6 +110,7 @@ impl RenderOptions {
                 hard_shadow_percentage: s.phs,
             },
             extra_outputs: demo_outputs(s.mode, self.occupancy_view),
+            ..ShadowConfig::default()
         }
     }
 }

@@ -441,6 +441,8 @@ pub enum SkipReason {
     /// Everything it reads is unchanged since it last ran (static geometry; a static light whose
     /// parameters did not change), so its outputs from an earlier frame are reused.
     UpToDate,
+    /// Shared with other lights' pipelines (the prim buffer), and built this frame by another of them.
+    Shared,
 }
 
 impl SkipReason {
@@ -449,6 +451,7 @@ impl SkipReason {
         match self {
             Self::NotRequested => "culled: no requested output depends on it",
             Self::UpToDate => "inputs unchanged since it last ran: earlier output reused",
+            Self::Shared => "shared by the lights: built this frame by another light's passes",
         }
     }
 }

@@ -262,3 +262,17 @@ const _: () = {
     assert!(std::mem::size_of::<FxaaPush>() == 32);
     assert!(std::mem::size_of::<HybridPush>() == 16);
 };
+
+/// A uniform buffer for one `T`, in GPU memory, written by [`rhi::Encoder::update_buffer`] when a pass is
+/// recorded (so that each frame in flight reads its own constants).
+pub(crate) fn constant_buffer<T: bytemuck::Pod>(
+    device: &rhi::Device,
+    name: &str,
+) -> Result<rhi::Buffer, crate::PassError> {
+    Ok(device.create_buffer(
+        name,
+        std::mem::size_of::<T>() as u64,
+        rhi::BufferUsage::UNIFORM | rhi::BufferUsage::COPY_DST,
+        rhi::MemoryLocation::GpuOnly,
+    )?)
+}

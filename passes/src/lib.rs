@@ -1,6 +1,8 @@
 //! The render passes of hybrid ray-traced shadows (deep primitive map, after Jon Story, GDC 2015), each a
 //! short unit that declares what it reads and writes, and the demo frame that strings them together.
 
+#![forbid(unsafe_code)]
+
 mod error;
 pub mod frame_plan;
 pub mod fxaa;
@@ -13,6 +15,7 @@ pub mod prim_buffer;
 pub mod primitive_map;
 pub mod ray_trace;
 pub mod renderer;
+pub mod retire;
 pub mod rt_peer;
 pub mod scan;
 mod screen_pass;
@@ -28,7 +31,7 @@ pub use gpu_types::MapStats;
 pub use hybrid::HybridConfig;
 pub use light::Light;
 pub use pcss::PcssConfig;
-pub use prim_buffer::{Draw, Geometry, IndexFormat, IndexLayout, VertexLayout};
+pub use prim_buffer::{Draw, Geometry, IndexFormat, IndexLayout, SharedGeometry, VertexLayout};
 pub use primitive_map::{
     choose_binning_path, BinningPath, BinningRequest, FaceMode, PrimitiveMapConfig,
     DEFAULT_ENTRY_BUDGET, GUARD_VALUE, GUARD_WORDS, MIN_ENTRY_BUDGET,
@@ -37,7 +40,7 @@ pub use renderer::{read_images, FrameImages, FrameOutput, ShadowRenderer};
 pub use shadow_map::ShadowMapConfig;
 pub use shadow_pipeline::{
     camera_in_frame, FrameInputs, FrameReport, ResourceReport, ShadowConfig, ShadowInputs,
-    ShadowPipeline,
+    ShadowPipeline, MAX_FRAMES_IN_FLIGHT,
 };
 
 mod shaders {

@@ -9,8 +9,9 @@ use crate::frame_plan::{HardEdge, PenumbraFilter};
 use crate::gpu_types::PcssConstants;
 use crate::screen_pass::{visibility_image, ScreenPass};
 use crate::PassError;
-use bytemuck::Zeroable;
-use rhi::{BindingKind, Buffer, BufferUsage, Device, Encoder, Image, Resource};
+
+use crate::gpu_types::constant_buffer;
+use rhi::{BindingKind, Buffer, Device, Encoder, Image, Resource};
 
 /// PCSS settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -144,11 +145,7 @@ impl PcssPass {
             ),
         };
         let output = visibility_image(device, image_name, width, height)?;
-        let constants = device.create_buffer_init(
-            image_name,
-            bytemuck::bytes_of(&PcssConstants::zeroed()),
-            BufferUsage::UNIFORM,
-        )?;
+        let constants = constant_buffer::<PcssConstants>(device, image_name)?;
         let mut bindings = vec![
             BindingKind::UniformBuffer,
             BindingKind::SampledImage,
@@ -186,7 +183,7 @@ impl PcssPass {
         })
     }
 
-    /// Updates the constants (host-visible; call while no submitted frame uses them) and records the pass.
+    /// Records the constants' update (into the command buffer) and the pass.
     pub(crate) fn record(
         &mut self,
         enc: &mut Encoder<'_>,
@@ -194,7 +191,7 @@ impl PcssPass {
     ) -> Result<(), PassError> {
         let mut c = *constants;
         c.dims.w = self.mode;
-        self.constants.write(0, bytemuck::bytes_of(&c))?;
+        enc.update_buffer(&self.constants, 0, bytemuck::bytes_of(&c))?;
         self.step.record(enc, &[], c.dims.x, c.dims.y)
     }
 }

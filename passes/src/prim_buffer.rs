@@ -10,6 +10,7 @@ use rhi::{
     BindGroup, BindingKind, Buffer, BufferUsage, ComputePipeline, Device, Encoder, MemoryLocation,
     Resource,
 };
+use std::sync::{Arc, Mutex};
 
 /// One draw call of the engine's geometry.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -306,5 +307,99 @@ impl PrimBufferPass {
         }
         enc.end_pass();
         Ok(())
+    }
+}
+
+/// Who records the shared prim buffer in a frame (see [`SharedGeometry`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum PrimBufferClaim {
+    /// The caller records the build this frame.
+    Record,
+    /// Another light's pipeline records it this frame, before the caller's passes.
+    RebuiltByAnother,
+    /// It is up to date (static geometry, built by an earlier frame).
+    UpToDate,
+}
+
+/// The scene's geometry and its prim buffer, shared by the pipelines of several lights (one context): in
+/// each frame the first light that needs the prim buffer records its build and the others read it.
+pub struct SharedGeometry {
+    geometry: Geometry,
+    pass: PrimBufferPass,
+    state: Mutex<PrimBufferState>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct PrimBufferState {
+    dynamic: bool,
+    built: bool,
+    claimed: Option<u64>,
+}
+
+impl SharedGeometry {
+    /// Creates the prim buffer of `geometry`. `dynamic`: the vertex or index buffers change between frames,
+    /// so the prim buffer is rebuilt every frame (else once).
+    pub fn new(device: &Device, geometry: Geometry, dynamic: bool) -> Result<Arc<Self>, PassError> {
+        let pass = PrimBufferPass::new(device, &geometry)?;
+        Ok(Arc::new(Self {
+            geometry,
+            pass,
+            state: Mutex::new(PrimBufferState {
+                dynamic,
+                built: false,
+                claimed: None,
+            }),
+        }))
+    }
+
+    /// The geometry.
+    pub fn geometry(&self) -> &Geometry {
+        &self.geometry
+    }
+
+    /// The prim buffer (triangles in frame coordinates).
+    pub fn prims(&self) -> &Buffer {
+        self.pass.prims()
+    }
+
+    /// Whether the prim buffer is rebuilt every frame.
+    pub fn is_dynamic(&self) -> bool {
+        self.lock().dynamic
+    }
+
+    /// Makes the geometry dynamic (rebuilt every frame) or static (kept once built).
+    pub fn set_dynamic(&self, dynamic: bool) {
+        self.lock().dynamic = dynamic;
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, PrimBufferState> {
+        self.state
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    /// Decides, for a pipeline beginning `frame`, who records the prim buffer this frame.
+    pub(crate) fn claim(&self, frame: u64) -> PrimBufferClaim {
+        let mut s = self.lock();
+        if s.claimed == Some(frame) {
+            PrimBufferClaim::RebuiltByAnother
+        } else if !s.built || s.dynamic {
+            s.claimed = Some(frame);
+            PrimBufferClaim::Record
+        } else {
+            PrimBufferClaim::UpToDate
+        }
+    }
+
+    /// Records the build of the prim buffer (by the pipeline whose claim was [`PrimBufferClaim::Record`]).
+    pub(crate) fn record(&self, enc: &mut Encoder<'_>) -> Result<(), PassError> {
+        self.pass.record(enc, &self.geometry)?;
+        self.lock().built = true;
+        Ok(())
+    }
+
+    /// Whether the prim buffer was built (or its build recorded) by some frame.
+    pub(crate) fn is_built(&self) -> bool {
+        self.lock().built
     }
 }

@@ -20,10 +20,9 @@
 //! Reads: prim buffer, depth, normal. Writes: receiver map, per-pixel texels, list offsets, list entries,
 //! map state (fit, statistics); occupancy image (occupancy pass).
 
-use crate::gpu_types::{MapPush, MapState, RayTraceConstants};
+use crate::gpu_types::{constant_buffer, MapPush, MapState, RayTraceConstants};
 use crate::scan::{PrefixScan, ScanPipeline};
 use crate::{shader, PassError};
-use bytemuck::Zeroable;
 use rhi::{
     Barrier, BindGroup, BindingKind, Buffer, BufferUsage, Capabilities, ComputePipeline,
     ConservativeRasterTier, Device, Encoder, Format, GraphicsPipeline, GraphicsPipelineDesc, Image,
@@ -342,11 +341,7 @@ impl PrimitiveMap {
         };
         let copy = BufferUsage::COPY_DST | BufferUsage::COPY_SRC;
         let tris = u64::from(inputs.triangles);
-        let constants = device.create_buffer_init(
-            "primitive map constants",
-            bytemuck::bytes_of(&RayTraceConstants::zeroed()),
-            BufferUsage::UNIFORM,
-        )?;
+        let constants = constant_buffer::<RayTraceConstants>(device, "primitive map constants")?;
         let state = storage(
             "primitive map state",
             std::mem::size_of::<MapState>() as u64,
@@ -620,26 +615,30 @@ impl PrimitiveMap {
     }
 
     /// Grows the entry capacity to hold `needed` entries (with a quarter to spare, within the budget), when a
-    /// frame needed more than it had. Returns whether the entries were reallocated: then whatever else
-    /// reads [`PrimitiveMap::entries`] must be rebound.
-    ///
-    /// # Safety
-    /// No submitted frame that uses the map may still be pending on the GPU.
-    pub unsafe fn grow(&mut self, device: &Device, needed: u32) -> Result<bool, PassError> {
+    /// frame needed more than it had. When the entries were reallocated it returns the buffer and bind group
+    /// they replaced (frames in flight may still use them: drop them once those completed), and whatever
+    /// else reads [`PrimitiveMap::entries`] must be rebound.
+    pub fn grow(
+        &mut self,
+        device: &Device,
+        needed: u32,
+    ) -> Result<Option<(Buffer, BindGroup)>, PassError> {
         let max = self.config.max_entries(device.capabilities());
         if needed <= self.capacity || self.capacity >= max {
-            return Ok(false);
+            return Ok(None);
         }
         let capacity = (u64::from(needed) * 5 / 4).min(u64::from(max)) as u32;
-        self.entries = Self::create_entries(device, &self.config, capacity)?;
-        self.capacity = capacity;
-        let binding = match self.binner {
-            Binner::Compute(_) => 5,
-            Binner::Raster(_) => 4,
+        let entries = Self::create_entries(device, &self.config, capacity)?;
+        let (layout, binding) = match &self.binner {
+            Binner::Compute(p) => (p.layout(), 5),
+            Binner::Raster(p) => (p.layout(), 4),
         };
-        // SAFETY: the caller guarantees that no pending frame uses the group.
-        unsafe { device.rebind_buffer(&mut self.bin_group, binding, &self.entries)? };
-        Ok(true)
+        let group = device.rebound(layout, &self.bin_group, binding, &entries)?;
+        self.capacity = capacity;
+        Ok(Some((
+            std::mem::replace(&mut self.entries, entries),
+            std::mem::replace(&mut self.bin_group, group),
+        )))
     }
 
     /// Records the build of the lists for this frame's receivers. Depth and normal must be in
@@ -650,7 +649,7 @@ impl PrimitiveMap {
         constants: &RayTraceConstants,
         push: &MapPush,
     ) -> Result<(), PassError> {
-        self.constants.write(0, bytemuck::bytes_of(constants))?;
+        enc.update_buffer(&self.constants, 0, bytemuck::bytes_of(constants))?;
         let n = self.config.size;
         let push = MapPush {
             size: n,
@@ -666,6 +665,10 @@ impl PrimitiveMap {
         let pixels = [self.screen.0.div_ceil(16), self.screen.1.div_ceil(16), 1];
 
         enc.begin_pass("primitive map: fit");
+        enc.barriers(&[Barrier::Global {
+            before: S::UnorderedAccess,
+            after: S::CopyDest,
+        }]);
         enc.fill_buffer(&self.receivers, 0);
         enc.fill_buffer(&self.counts, 0);
         if self.config.guard {
@@ -759,9 +762,19 @@ impl PrimitiveMap {
         Ok(())
     }
 
-    /// Writes the map statistics into the state, and the occupancy view when the map draws one.
-    pub fn record_occupancy(&self, enc: &mut Encoder<'_>) -> Result<(), PassError> {
+    /// Writes the map statistics into the state, and the occupancy view when the map draws one, and copies
+    /// the state into `state_readback` (host-readable once the frame completed).
+    pub fn record_occupancy(
+        &self,
+        enc: &mut Encoder<'_>,
+        state_readback: &Buffer,
+    ) -> Result<(), PassError> {
         enc.begin_pass("occupancy");
+        enc.barriers(&[Barrier::Image {
+            image: &self.occupancy,
+            before: S::Undefined,
+            after: S::UnorderedAccess,
+        }]);
         let n = self.config.size;
         let push = [n, u32::from(self.occupancy_view)];
         // Each invocation tallies a 2x2 quad of texels.
@@ -772,6 +785,15 @@ impl PrimitiveMap {
             bytemuck::cast_slice(&push),
             [groups, groups, 1],
         )?;
+        enc.barriers(&[Barrier::Global {
+            before: S::UnorderedAccess,
+            after: S::CopySource,
+        }]);
+        enc.copy_buffer(&self.state, state_readback)?;
+        enc.barriers(&[Barrier::Global {
+            before: S::CopyDest,
+            after: S::HostRead,
+        }]);
         enc.end_pass();
         Ok(())
     }

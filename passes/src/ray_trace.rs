@@ -3,13 +3,12 @@
 //! Reads: depth, normal, the primitive map (state, per-pixel texels, list offsets and entries), prim buffer,
 //! constants. Writes: visibility, blocker distance.
 
-use crate::gpu_types::RayTraceConstants;
+use crate::gpu_types::{constant_buffer, RayTraceConstants};
 use crate::primitive_map::PrimitiveMap;
 use crate::{shader, PassError};
-use bytemuck::Zeroable;
 use rhi::{
-    BindGroup, BindingKind, Buffer, BufferUsage, ComputePipeline, Device, Encoder, Format, Image,
-    ImageDesc, ImageUsage, Resource,
+    BindGroup, BindingKind, Buffer, ComputePipeline, Device, Encoder, Format, Image, ImageDesc,
+    ImageUsage, Resource,
 };
 
 /// Ray-origin offset along the receiver's normal, in pixels of footprint at the receiver's distance.
@@ -66,11 +65,7 @@ impl RayTracePass {
         };
         let visibility = device.create_image(&out("rt visibility"))?;
         let blocker_distance = device.create_image(&out("rt blocker distance"))?;
-        let constants = device.create_buffer_init(
-            "ray trace constants",
-            bytemuck::bytes_of(&RayTraceConstants::zeroed()),
-            BufferUsage::UNIFORM,
-        )?;
+        let constants = constant_buffer::<RayTraceConstants>(device, "ray trace constants")?;
         let pipeline = device.create_compute_pipeline(
             "ray trace",
             &shader("ray_trace.comp")?,
@@ -114,26 +109,28 @@ impl RayTracePass {
     }
 
     /// Points the ray trace at the primitive map's entries after [`PrimitiveMap::grow`] reallocated them.
-    ///
-    /// # Safety
-    /// No submitted frame that uses this pass may still be pending on the GPU.
-    pub unsafe fn rebind_entries(
+    /// Returns the bind group it used before: frames in flight may still use it.
+    pub fn rebind_entries(
         &mut self,
         device: &Device,
         map: &PrimitiveMap,
-    ) -> Result<(), PassError> {
-        // SAFETY: the caller guarantees no pending use of the group.
-        unsafe { device.rebind_buffer(&mut self.group, ENTRIES_BINDING, &map.entries)? };
-        Ok(())
+    ) -> Result<BindGroup, PassError> {
+        let group = device.rebound(
+            self.pipeline.layout(),
+            &self.group,
+            ENTRIES_BINDING,
+            &map.entries,
+        )?;
+        Ok(std::mem::replace(&mut self.group, group))
     }
 
-    /// Updates the constants (host-visible; call while no submitted frame uses them) and records the pass.
+    /// Records the constants' update (into the command buffer) and the pass.
     pub fn record(
         &mut self,
         enc: &mut Encoder<'_>,
         constants: &RayTraceConstants,
     ) -> Result<(), PassError> {
-        self.constants.write(0, bytemuck::bytes_of(constants))?;
+        enc.update_buffer(&self.constants, 0, bytemuck::bytes_of(constants))?;
         enc.begin_pass("ray trace");
         let groups = [
             constants.dims.x.div_ceil(8),

@@ -6,8 +6,9 @@
 use crate::gpu_types::ShadowMapPush;
 use crate::{shader, PassError};
 use rhi::{
-    BindGroup, BindingKind, Buffer, Capabilities, DepthState, DepthTarget, Device, Encoder, Format,
-    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, ImageUsage, Resource,
+    Barrier, BindGroup, BindingKind, Buffer, Capabilities, DepthState, DepthTarget, Device,
+    Encoder, Format, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, ImageUsage,
+    Resource, ResourceState as S,
 };
 
 /// Size of the shadow map and the bias of the classic single-tap test.
@@ -102,7 +103,7 @@ impl ShadowMapPass {
         })
     }
 
-    /// Records the pass; the depth image must be in `DepthWrite` state.
+    /// Records the pass: discards the depth image, renders it and leaves it in `ShaderResource` state.
     pub fn record(
         &self,
         enc: &mut Encoder<'_>,
@@ -114,6 +115,11 @@ impl ShadowMapPass {
             .checked_mul(3)
             .ok_or_else(|| PassError::InvalidGeometry("too many triangles to draw".into()))?;
         enc.begin_pass("shadow map");
+        enc.barriers(&[Barrier::Image {
+            image: &self.depth,
+            before: S::Undefined,
+            after: S::DepthWrite,
+        }]);
         enc.begin_rendering(
             (size, size),
             &[],
@@ -129,6 +135,11 @@ impl ShadowMapPass {
             vertices,
         );
         enc.end_rendering();
+        enc.barriers(&[Barrier::Image {
+            image: &self.depth,
+            before: S::DepthWrite,
+            after: S::ShaderResource,
+        }]);
         enc.end_pass();
         drawn?;
         Ok(())

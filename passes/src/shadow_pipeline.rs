@@ -9,7 +9,7 @@
 
 use crate::frame_plan::{
     FramePlan, HardEdge, PassId, PassStatus, PenumbraFilter, PlanRequest, ResourceId, ResourceSet,
-    ShadowMode,
+    ShadowMode, SkipReason,
 };
 use crate::fxaa::FxaaPass;
 use crate::gpu_types::{
@@ -18,21 +18,23 @@ use crate::gpu_types::{
 use crate::hybrid::{BlendPass, HybridConfig, LerpFactorPass};
 use crate::light::{rebased, Light, LightFrame};
 use crate::pcss::{PcssConfig, PcssInputs, PcssKind, PcssPass};
-use crate::prim_buffer::{Geometry, PrimBufferPass};
+use crate::prim_buffer::{Geometry, PrimBufferClaim, SharedGeometry};
 use crate::primitive_map::{
     choose_binning_path, BinningPath, FaceMode, PrimitiveMap, PrimitiveMapConfig,
     PrimitiveMapInputs,
 };
 use crate::ray_trace::{RayTraceInputs, RayTracePass, RAY_OFFSET_FLOAT_BOUND, RAY_OFFSET_PIXELS};
+use crate::retire::{completed_before, RetireQueue};
 use crate::screen_pass::visibility_image;
 use crate::shadow_map::{ShadowMapConfig, ShadowMapPass};
 use crate::PassError;
 use bytemuck::Zeroable;
 use glam::{DMat4, DVec3, Mat4, UVec4, Vec3, Vec4};
 use rhi::{
-    Barrier, Buffer, BufferUsage, Device, Encoder, GpuTimer, Image, MemoryLocation, PassTiming,
-    ResourceState as S,
+    Barrier, BindGroup, Buffer, BufferUsage, Device, Encoder, GpuTimer, Image, MemoryLocation,
+    PassTiming, ResourceState as S,
 };
+use std::sync::Arc;
 
 /// Camera and light of one frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -72,7 +74,14 @@ pub struct ShadowConfig {
     /// Resources to produce besides the final output (comparison views, debug images, a host G-buffer
     /// drawing the prim buffer). Empty by default.
     pub extra_outputs: ResourceSet,
+    /// The most frames recorded and not yet completed on the GPU (1..=[`MAX_FRAMES_IN_FLIGHT`], default 3):
+    /// when frame `f` is begun, every frame up to `f - frames_in_flight` has completed. Per-frame
+    /// read-backs and timers are ring-buffered this deep, and replaced GPU objects are held as long.
+    pub frames_in_flight: u32,
 }
+
+/// The most frames in flight a pipeline supports.
+pub const MAX_FRAMES_IN_FLIGHT: u32 = 8;
 
 impl Default for ShadowConfig {
     /// The talk's full technique: hybrid with FXAA, 1K×1K×32 primitive map, 3K shadow map, shrinking PCSS.
@@ -87,6 +96,7 @@ impl Default for ShadowConfig {
             pcss: PcssConfig::default(),
             hybrid: HybridConfig::default(),
             extra_outputs: ResourceSet::EMPTY,
+            frames_in_flight: 3,
         }
     }
 }
@@ -186,18 +196,42 @@ struct FrameConstants {
 struct FrameState {
     constants: FrameConstants,
     light: Light,
+    /// The frame's index and its slot in the ring.
+    index: u64,
+    slot: usize,
+    /// Whether this pipeline records the shared prim buffer's build this frame.
+    records_prims: bool,
     /// Index in the linear order of the first pass neither recorded nor passed over yet.
     next: usize,
     /// Whether a recording of this frame has reset and attached the GPU timer.
     timer_started: bool,
 }
 
+/// What the ring keeps of one frame in flight: its GPU timer, the map state read back, and its schedule.
+struct FrameSlot {
+    /// The frame whose recording last used this slot.
+    frame: Option<u64>,
+    timer: GpuTimer,
+    stats_readback: Buffer,
+    /// Whether the frame recorded the copy of the map state into `stats_readback`.
+    map_state_recorded: bool,
+    statuses: Vec<(PassId, PassStatus)>,
+    /// Written by the GPU when the frame's last pass has run: the frame's index plus one.
+    completion: Buffer,
+}
+
+/// What growing the primitive map replaced, held while frames in flight may still use it.
+struct RetiredMapEntries {
+    _entries: Buffer,
+    _bin_group: BindGroup,
+    _ray_group: Option<BindGroup>,
+}
+
 /// The passes of one view of one light, and the resources the plan allocates for them.
 pub struct ShadowPipeline {
     config: ShadowConfig,
     plan: FramePlan,
-    geometry: Geometry,
-    prim_buffer: Option<PrimBufferPass>,
+    shared: Arc<SharedGeometry>,
     shadow_map: Option<ShadowMapPass>,
     map: Option<PrimitiveMap>,
     ray: Option<RayTracePass>,
@@ -207,19 +241,22 @@ pub struct ShadowPipeline {
     lerp: Option<LerpFactorPass>,
     blend: Option<BlendPass>,
     lit: Option<Image>,
-    timer: GpuTimer,
-    stats_readback: Buffer,
+    slots: Vec<FrameSlot>,
     binning_path: BinningPath,
     /// Resources whose contents are valid from an earlier recording.
     valid: ResourceSet,
     /// The light of the last recording that rendered the light-space maps.
     maps_light: Option<Light>,
-    /// Whether `stats_readback` holds the state of a recorded map build (it is uninitialised before).
-    map_state_recorded: bool,
-    /// The frame of the last `begin_frame`.
+    /// The frame being recorded (from `begin_frame` to the end of its linear order).
     frame: Option<FrameState>,
-    /// Storage writes recorded and not yet followed by a UAV barrier.
-    pending_uav: bool,
+    /// The index of the last frame begun.
+    last_frame: Option<u64>,
+    /// List entries the newest completed map build needed (grows the map before the next build).
+    needed_entries: u32,
+    retired: RetireQueue<RetiredMapEntries>,
+    /// Whether storage writes were recorded and not yet followed by a UAV barrier, and the plan's
+    /// resources among what they wrote.
+    pending_uav: Option<ResourceSet>,
     /// The schedule of the last frame begun, in linear order.
     statuses: Vec<(PassId, PassStatus)>,
     width: u32,
@@ -237,6 +274,28 @@ impl ShadowPipeline {
         config: impl Into<ShadowConfig>,
     ) -> Result<Self, PassError> {
         let config = config.into();
+        let shared = SharedGeometry::new(device, geometry, !config.static_geometry)?;
+        Self::with_shared_geometry(device, shared, inputs, config)
+    }
+
+    /// Creates the passes of one light over geometry that other lights' pipelines share: the prim buffer is
+    /// built by the first pipeline that begins a frame needing it, and `shared`'s dynamic flag (not
+    /// `config.static_geometry`) decides whether it is rebuilt every frame. Begin and record the lights'
+    /// frames in the same order, frame after frame.
+    pub fn with_shared_geometry(
+        device: &Device,
+        shared: Arc<SharedGeometry>,
+        inputs: &ShadowInputs<'_>,
+        config: impl Into<ShadowConfig>,
+    ) -> Result<Self, PassError> {
+        let config = config.into();
+        if !(1..=MAX_FRAMES_IN_FLIGHT).contains(&config.frames_in_flight) {
+            return Err(PassError::InvalidConfig(format!(
+                "frames_in_flight {} must be within 1..={MAX_FRAMES_IN_FLIGHT}",
+                config.frames_in_flight
+            )));
+        }
+        let geometry = shared.geometry();
         let (width, height) = (inputs.depth.width(), inputs.depth.height());
         if (inputs.normal.width(), inputs.normal.height()) != (width, height) {
             return Err(PassError::InvalidConfig(
@@ -251,12 +310,7 @@ impl ShadowPipeline {
         let plan = FramePlan::derive(config.plan_request());
         let runs = |p| plan.runs(p);
 
-        let prim_buffer = if runs(PassId::PrimBuffer) {
-            Some(PrimBufferPass::new(device, &geometry)?)
-        } else {
-            None
-        };
-        let prims = prim_buffer.as_ref().map(PrimBufferPass::prims);
+        let prims = runs(PassId::PrimBuffer).then(|| shared.prims());
         let need_prims = || {
             prims.ok_or_else(|| PassError::InvalidConfig("the plan lacks the prim buffer".into()))
         };
@@ -361,18 +415,36 @@ impl ShadowPipeline {
         } else {
             None
         };
-        let timer = device.create_timer(48)?;
-        let stats_readback = device.create_buffer(
-            "map state read-back",
-            std::mem::size_of::<MapState>() as u64,
-            BufferUsage::COPY_DST,
-            MemoryLocation::GpuToCpu,
-        )?;
+        let slots = (0..config.frames_in_flight)
+            .map(|_| {
+                Ok(FrameSlot {
+                    frame: None,
+                    timer: device.create_timer(48)?,
+                    stats_readback: device.create_buffer(
+                        "map state read-back",
+                        std::mem::size_of::<MapState>() as u64,
+                        BufferUsage::COPY_DST,
+                        MemoryLocation::GpuToCpu,
+                    )?,
+                    map_state_recorded: false,
+                    statuses: Vec::new(),
+                    completion: {
+                        let mut b = device.create_buffer(
+                            "frame completion",
+                            8,
+                            BufferUsage::COPY_DST,
+                            MemoryLocation::GpuToCpu,
+                        )?;
+                        b.write(0, &0u64.to_le_bytes())?;
+                        b
+                    },
+                })
+            })
+            .collect::<Result<Vec<_>, PassError>>()?;
         let pipeline = Self {
             config,
             plan,
-            geometry,
-            prim_buffer,
+            shared,
             shadow_map,
             map,
             ray,
@@ -382,14 +454,15 @@ impl ShadowPipeline {
             lerp,
             blend,
             lit,
-            timer,
-            stats_readback,
+            slots,
             binning_path,
-            map_state_recorded: false,
             valid: ResourceSet::EMPTY,
             maps_light: None,
             frame: None,
-            pending_uav: false,
+            last_frame: None,
+            needed_entries: 0,
+            retired: RetireQueue::default(),
+            pending_uav: None,
             statuses: Vec::new(),
             width,
             height,
@@ -479,12 +552,24 @@ impl ShadowPipeline {
 
     /// The prim buffer (triangles in frame coordinates), if the plan has it.
     pub fn prims(&self) -> Option<&Buffer> {
-        self.prim_buffer.as_ref().map(PrimBufferPass::prims)
+        self.plan
+            .runs(PassId::PrimBuffer)
+            .then(|| self.shared.prims())
     }
 
     /// The geometry.
     pub fn geometry(&self) -> &Geometry {
-        &self.geometry
+        self.shared.geometry()
+    }
+
+    /// The geometry and prim buffer this pipeline shares with other lights' pipelines.
+    pub fn shared_geometry(&self) -> &Arc<SharedGeometry> {
+        &self.shared
+    }
+
+    /// GPU objects replaced (by the map's growth) and held until the frames that used them completed.
+    pub fn retired_objects(&self) -> usize {
+        self.retired.len()
     }
 
     /// The primitive map, if the plan has it.
@@ -500,11 +585,11 @@ impl ShadowPipeline {
     /// Camera-relative view-projection and the camera in frame coordinates (for a host G-buffer that
     /// rasterizes the prim buffer).
     pub fn camera_in_frame(&self, inputs: &FrameInputs) -> Result<(Mat4, Vec3), PassError> {
-        camera_in_frame(inputs, self.geometry.origin())
+        camera_in_frame(inputs, self.geometry().origin())
     }
 
     fn constants(&self, inputs: &FrameInputs) -> Result<FrameConstants, PassError> {
-        let origin = self.geometry.origin();
+        let origin = self.geometry().origin();
         let (_, camera_frame) = camera_in_frame(inputs, origin)?;
         let inv_view_proj_rel = camera_relative(inputs).inverse().as_mat4();
         let light = LightFrame::new(&inputs.light, origin)?;
@@ -546,7 +631,7 @@ impl ShadowPipeline {
                     RAY_OFFSET_FLOAT_BOUND,
                     0.0,
                 ),
-                misc: UVec4::new(front_only, self.geometry.triangle_count(), 0, 0),
+                misc: UVec4::new(front_only, self.geometry().triangle_count(), 0, 0),
                 light_pos: light.position.map_or(Vec4::ZERO, |p| p.extend(1.0)),
             },
             pcss: PcssConstants {
@@ -571,11 +656,32 @@ impl ShadowPipeline {
         })
     }
 
-    /// Plans a frame (no commands): computes its constants and decides which passes run and which are
-    /// skipped as up to date. Then [`ShadowPipeline::record_passes`] records them, in one call or several,
-    /// in linear order. A frame begun before this one and not recorded to its end is abandoned: the outputs
-    /// of its unrecorded passes count as stale.
+    /// Plans the next frame (its index one past the last begun, 0 at first): see
+    /// [`ShadowPipeline::begin_frame_at`].
     pub fn begin_frame(&mut self, inputs: &FrameInputs) -> Result<(), PassError> {
+        let index = self.last_frame.map_or(0, |f| f + 1);
+        self.begin_frame_at(inputs, index)
+    }
+
+    /// Plans frame `index` (no commands): computes its constants and decides which passes run and which are
+    /// skipped as up to date. Then [`ShadowPipeline::record_passes`] records them, in one call or several,
+    /// in linear order.
+    ///
+    /// Frames in flight: indices increase from frame to frame (gaps are allowed), and beginning frame
+    /// `index` states that the recordings of every frame up to `index - frames_in_flight` have completed on
+    /// the GPU. Beginning the frame being recorded again (the same index) abandons it, as does beginning a
+    /// later one before it was recorded to its end: the outputs of its unrecorded passes count as stale.
+    pub fn begin_frame_at(&mut self, inputs: &FrameInputs, index: u64) -> Result<(), PassError> {
+        let open = self.frame.as_ref().map(|f| (f.index, f.records_prims));
+        let reopening = open.is_some_and(|(i, _)| i == index);
+        if let Some(last) = self
+            .last_frame
+            .filter(|&last| index < last || (index == last && !reopening))
+        {
+            return Err(PassError::InvalidConfig(format!(
+                "frame index {index} does not follow the last frame begun ({last}): frame indices must increase"
+            )));
+        }
         let constants = self.constants(inputs)?;
         if let Some(open) = self.frame.take() {
             for &(pass, status) in &self.statuses[open.next..] {
@@ -584,17 +690,51 @@ impl ShadowPipeline {
                 }
             }
         }
+        let frames = self.config.frames_in_flight;
+        self.retired
+            .release_completed(completed_before(index, frames));
+        let slot = (index % u64::from(frames)) as usize;
+        if !reopening {
+            // The newest completed frame's map state says how many list entries the map needed, which the
+            // next build grows to: the frame that used this slot before has completed (the contract), and
+            // a later one may have too (its completion marker says so).
+            if let Some(state) = self.newest_completed_map_state(completed_before(index, frames))? {
+                self.needed_entries = state.totals.y;
+            }
+        }
+        let claim = match (self.plan.runs(PassId::PrimBuffer), open) {
+            (false, _) => PrimBufferClaim::UpToDate,
+            (true, Some((_, true))) if reopening => PrimBufferClaim::Record,
+            (true, _) => self.shared.claim(index),
+        };
         let mut changed = ResourceSet::of(&[ResourceId::Depth, ResourceId::Normal]);
-        if !self.config.static_geometry {
+        if claim != PrimBufferClaim::UpToDate {
             changed = changed.with(ResourceId::SceneGeometry);
         }
         if !self.config.static_light || self.maps_light != Some(inputs.light) {
             changed = changed.with(ResourceId::Light);
         }
+        let prims = ResourceSet::of(&[ResourceId::PrimBuffer]);
+        self.valid = if self.shared.is_built() {
+            self.valid.union(prims)
+        } else {
+            self.valid.difference(prims)
+        };
         self.statuses = self.plan.schedule(changed, self.valid);
+        if claim == PrimBufferClaim::RebuiltByAnother {
+            self.statuses[PassId::PrimBuffer as usize].1 = PassStatus::Skipped(SkipReason::Shared);
+        }
+        let s = &mut self.slots[slot];
+        s.frame = Some(index);
+        s.map_state_recorded = false;
+        s.statuses = self.statuses.clone();
+        self.last_frame = Some(index);
         self.frame = Some(FrameState {
             constants,
             light: inputs.light,
+            index,
+            slot,
+            records_prims: claim == PrimBufferClaim::Record,
             next: 0,
             timer_started: false,
         });
@@ -653,15 +793,7 @@ impl ShadowPipeline {
         frame: &mut FrameState,
         passes: &[PassId],
     ) -> Result<(), PassError> {
-        if frame.timer_started {
-            enc.continue_timer(&self.timer);
-        } else {
-            enc.attach_timer(&self.timer);
-            frame.timer_started = true;
-        }
-        let Some(&last) = passes.iter().max() else {
-            return Ok(());
-        };
+        let last = passes.iter().max().copied();
         if let Some(&first) = passes.iter().min().filter(|&&p| (p as usize) < frame.next) {
             return Err(PassError::InvalidConfig(format!(
                 "pass '{}' comes before a pass already recorded this frame: record passes in linear order",
@@ -670,19 +802,35 @@ impl ShadowPipeline {
         }
         let statuses = self.statuses.clone();
         let runs = |p: PassId| statuses[p as usize].1 == PassStatus::Ran;
-        if let Some(&missing) = PassId::ALL[frame.next..=last as usize]
-            .iter()
-            .find(|&&p| runs(p) && !passes.contains(&p))
-        {
+        if let Some((&missing, last)) = last.and_then(|last| {
+            PassId::ALL[frame.next..=last as usize]
+                .iter()
+                .find(|&&p| runs(p) && !passes.contains(&p))
+                .map(|m| (m, last))
+        }) {
             return Err(PassError::InvalidConfig(format!(
                 "pass '{}' runs this frame: record it (it comes before '{}')",
                 missing.name(),
                 last.name()
             )));
         }
+        // Checked: from here on the call records.
+        let timer = &self.slots[frame.slot].timer;
+        if frame.timer_started {
+            enc.continue_timer(timer);
+        } else {
+            // The frame's first recording: separate it from the earlier frames in flight that used the same
+            // resources (write-after-read and write-after-write across frames).
+            enc.barriers(&[Barrier::Full]);
+            enc.attach_timer(timer);
+            frame.timer_started = true;
+        }
+        let Some(last) = last else {
+            return Ok(());
+        };
         for &pass in &PassId::ALL[frame.next..=last as usize] {
             if runs(pass) {
-                self.record_pass(enc, pass, &frame.constants)?;
+                self.record_pass(enc, pass, frame)?;
                 self.valid = self.valid.union(self.plan.writes(pass));
                 if matches!(pass, PassId::ShadowMap | PassId::PrimitiveMap) {
                     self.maps_light = Some(frame.light);
@@ -691,12 +839,22 @@ impl ShadowPipeline {
             frame.next = pass as usize + 1;
         }
         self.flush_uav(enc);
+        if frame.next == PassId::ALL.len() {
+            // The frame's end: the GPU marks the slot with the frame, so a report can tell whether the
+            // frame has completed without a fence.
+            let marker = (frame.index + 1).to_le_bytes();
+            enc.update_buffer(&self.slots[frame.slot].completion, 0, &marker)?;
+            enc.barriers(&[Barrier::Global {
+                before: S::CopyDest,
+                after: S::HostRead,
+            }]);
+        }
         Ok(())
     }
 
     /// Makes the storage writes of the passes recorded since the last UAV barrier visible.
     fn flush_uav(&mut self, enc: &mut Encoder<'_>) {
-        if std::mem::take(&mut self.pending_uav) {
+        if self.pending_uav.take().is_some() {
             enc.barriers(&[Barrier::Uav]);
         }
     }
@@ -717,74 +875,52 @@ impl ShadowPipeline {
         enc.barriers(&to_uav);
     }
 
-    /// Records one pass with the barriers around it. The screen-space passes that do not read each
-    /// other's outputs (shadow-map test, PCSS, FXAA, lerp factor) share one UAV barrier after them.
+    /// Records one pass with the barriers around it. A UAV barrier precedes a pass that reads what
+    /// earlier passes wrote since the last one; the screen-space passes that do not read each other's
+    /// outputs (shadow-map test, PCSS, FXAA, lerp factor) share one after them.
     fn record_pass(
         &mut self,
         enc: &mut Encoder<'_>,
         pass: PassId,
-        c: &FrameConstants,
+        frame: &FrameState,
     ) -> Result<(), PassError> {
+        let c = &frame.constants;
         let independent = matches!(
             pass,
             PassId::ShadowMapTest | PassId::Pcss | PassId::Fxaa | PassId::LerpFactor
         );
-        if !independent {
+        let reads_pending = self
+            .pending_uav
+            .is_some_and(|written| self.plan.reads(pass).intersects(written));
+        if !independent || reads_pending {
             self.flush_uav(enc);
         }
-        let tris = self.geometry.triangle_count();
+        let tris = self.geometry().triangle_count();
         match pass {
             PassId::PrimBuffer => {
-                if let Some(p) = &self.prim_buffer {
-                    p.record(enc, &self.geometry)?;
+                if frame.records_prims {
+                    self.shared.record(enc)?;
                 }
             }
             PassId::ShadowMap => {
                 if let Some(sm) = &self.shadow_map {
-                    enc.barriers(&[Barrier::Image {
-                        image: &sm.depth,
-                        before: S::Undefined,
-                        after: S::DepthWrite,
-                    }]);
                     let push = ShadowMapPush {
                         light_view_proj: c.light.view_proj,
                     };
                     sm.record(enc, &push, tris)?;
-                    enc.barriers(&[Barrier::Image {
-                        image: &sm.depth,
-                        before: S::DepthWrite,
-                        after: S::ShaderResource,
-                    }]);
                 }
             }
             PassId::PrimitiveMap => {
-                self.grow_map(enc.device())?;
+                self.grow_map(enc.device(), frame.index)?;
                 if let Some(map) = self.map.as_mut() {
-                    enc.barriers(&[Barrier::Global {
-                        before: S::UnorderedAccess,
-                        after: S::CopyDest,
-                    }]);
                     map.record(enc, &c.ray, &c.map)?;
                 }
             }
             PassId::Occupancy => {
                 if let Some(map) = &self.map {
-                    enc.barriers(&[Barrier::Image {
-                        image: map.occupancy_target(),
-                        before: S::Undefined,
-                        after: S::UnorderedAccess,
-                    }]);
-                    map.record_occupancy(enc)?;
-                    enc.barriers(&[Barrier::Global {
-                        before: S::UnorderedAccess,
-                        after: S::CopySource,
-                    }]);
-                    enc.copy_buffer(&map.state, &self.stats_readback)?;
-                    self.map_state_recorded = true;
-                    enc.barriers(&[Barrier::Global {
-                        before: S::CopyDest,
-                        after: S::HostRead,
-                    }]);
+                    let slot = &mut self.slots[frame.slot];
+                    map.record_occupancy(enc, &slot.stats_readback)?;
+                    slot.map_state_recorded = true;
                 }
             }
             PassId::RayTrace => {
@@ -825,68 +961,116 @@ impl ShadowPipeline {
             }
             PassId::FillLit => {
                 if let Some(lit) = &self.lit {
-                    enc.begin_pass(PassId::FillLit.name());
-                    enc.barriers(&[Barrier::Image {
-                        image: lit,
-                        before: S::Undefined,
-                        after: S::CopyDest,
-                    }]);
-                    enc.clear_uint(lit, 1.0f32.to_bits());
-                    enc.barriers(&[Barrier::Image {
-                        image: lit,
-                        before: S::CopyDest,
-                        after: S::UnorderedAccess,
-                    }]);
-                    enc.end_pass();
+                    record_fill_lit(enc, lit);
                 }
             }
         }
-        self.pending_uav = true;
+        self.pending_uav = Some(
+            self.pending_uav
+                .unwrap_or(ResourceSet::EMPTY)
+                .union(self.plan.writes(pass)),
+        );
         Ok(())
     }
 
-    /// Timings and statistics of the last recorded frame, waiting for its GPU timestamps; call after its
+    /// Timings and statistics of the last frame begun, waiting for its GPU timestamps; call after its
     /// submission was made.
     pub fn report(&self) -> Result<FrameReport, PassError> {
-        let timings = self.timer.resolve()?;
-        self.report_with(timings)
+        let slot = self.slot_of(self.last_frame)?;
+        let timings = slot.timer.resolve()?;
+        self.report_with(slot, timings)
     }
 
     /// [`ShadowPipeline::report`] without waiting: `None` while the GPU has not finished the frame.
     pub fn try_report(&self) -> Result<Option<FrameReport>, PassError> {
-        match self.timer.try_resolve()? {
-            Some(timings) => self.report_with(timings).map(Some),
+        self.try_report_frame(self.last_frame.unwrap_or(u64::MAX))
+    }
+
+    /// The report of frame `index` if the GPU has finished it (`None` while not), from the ring of the last
+    /// `frames_in_flight` frames begun; an error for a frame no longer (or never) in the ring.
+    pub fn try_report_frame(&self, index: u64) -> Result<Option<FrameReport>, PassError> {
+        let slot = self.slot_of(Some(index))?;
+        if !slot_completed(slot, index)? {
+            return Ok(None);
+        }
+        match slot.timer.try_resolve()? {
+            Some(timings) => self.report_with(slot, timings).map(Some),
             None => Ok(None),
         }
     }
 
-    /// The map state of the last frame that built the primitive map (zero before the first).
-    fn last_map_state(&self) -> Result<MapState, PassError> {
-        if !self.map_state_recorded {
-            return Ok(MapState::zeroed());
-        }
-        Ok(bytemuck::pod_read_unaligned(self.stats_readback.read()?))
+    fn slot_of(&self, index: Option<u64>) -> Result<&FrameSlot, PassError> {
+        let frames = u64::from(self.config.frames_in_flight);
+        index
+            .and_then(|i| {
+                self.slots
+                    .get((i % frames) as usize)
+                    .filter(|s| s.frame == Some(i))
+            })
+            .ok_or_else(|| {
+                PassError::InvalidConfig(match (index, self.last_frame) {
+                    (Some(i), Some(last)) => format!(
+                        "frame {i} is not among the last {frames} frames begun (the last is {last})"
+                    ),
+                    _ => "no frame has been begun".into(),
+                })
+            })
     }
 
-    /// Grows the primitive map's entries when the last frame needed more than they hold, and rebinds the
-    /// ray trace to them. Under the recording contract that frame has completed.
-    fn grow_map(&mut self, device: &Device) -> Result<(), PassError> {
-        let needed = self.last_map_state()?.totals.y;
+    /// The map state a slot's frame read back, once that frame has completed (the caller's contract).
+    /// The map state of the newest frame in the ring that built the map and has completed: by the caller's
+    /// contract (up to `completed`), or by its completion marker.
+    fn newest_completed_map_state(
+        &self,
+        completed: Option<u64>,
+    ) -> Result<Option<MapState>, PassError> {
+        let mut newest: Option<(u64, &FrameSlot)> = None;
+        for s in &self.slots {
+            let Some(frame) = s.frame.filter(|_| s.map_state_recorded) else {
+                continue;
+            };
+            let done = completed.is_some_and(|c| frame <= c) || slot_completed(s, frame)?;
+            if done && newest.is_none_or(|(f, _)| frame > f) {
+                newest = Some((frame, s));
+            }
+        }
+        newest
+            .map(|(_, s)| Ok(bytemuck::pod_read_unaligned(s.stats_readback.read()?)))
+            .transpose()
+    }
+
+    /// Grows the primitive map's entries to what the newest completed build needed, and rebinds the ray
+    /// trace to them; the replaced objects are held until the frames before `frame` completed.
+    fn grow_map(&mut self, device: &Device, frame: u64) -> Result<(), PassError> {
         let Some(map) = self.map.as_mut() else {
             return Ok(());
         };
-        // SAFETY: the recording contract: the frames that used the map have completed.
-        if unsafe { map.grow(device, needed)? } {
-            if let Some(ray) = self.ray.as_mut() {
-                // SAFETY: as above.
-                unsafe { ray.rebind_entries(device, map)? };
+        if let Some((entries, bin_group)) = map.grow(device, self.needed_entries)? {
+            let ray_group = match self.ray.as_mut() {
+                Some(ray) => Some(ray.rebind_entries(device, map)?),
+                None => None,
+            };
+            let retired = RetiredMapEntries {
+                _entries: entries,
+                _bin_group: bin_group,
+                _ray_group: ray_group,
+            };
+            if let Some(last_user) = frame.checked_sub(1) {
+                self.retired.retire(last_user, retired);
             }
         }
         Ok(())
     }
 
-    fn report_with(&self, timings: Vec<PassTiming>) -> Result<FrameReport, PassError> {
-        let state = self.last_map_state()?;
+    fn report_with(
+        &self,
+        slot: &FrameSlot,
+        timings: Vec<PassTiming>,
+    ) -> Result<FrameReport, PassError> {
+        let state = match slot.map_state_recorded {
+            true => bytemuck::pod_read_unaligned(slot.stats_readback.read()?),
+            false => MapState::zeroed(),
+        };
         let resources = self
             .plan
             .resources()
@@ -901,7 +1085,7 @@ impl ShadowPipeline {
             binning_path: self.binning_path,
             stats: MapStats::from_state(&state),
             map_to_texels: state.to_texels,
-            passes: self.statuses.clone(),
+            passes: slot.statuses.clone(),
             resources,
             output: self.plan.final_output(),
         })
@@ -925,6 +1109,31 @@ pub fn camera_in_frame(inputs: &FrameInputs, origin: DVec3) -> Result<(Mat4, Vec
 /// The view-projection of coordinates relative to the camera, in f64.
 fn camera_relative(inputs: &FrameInputs) -> DMat4 {
     inputs.proj.as_dmat4() * rebased(inputs.view, inputs.camera_position.as_dvec3())
+}
+
+/// Whether the GPU has run frame `frame`'s recording in `slot` to its end (its completion marker).
+fn slot_completed(slot: &FrameSlot, frame: u64) -> Result<bool, PassError> {
+    let marker: [u8; 8] = slot.completion.read()?[..8]
+        .try_into()
+        .map_err(|_| PassError::InvalidConfig("frame completion marker".into()))?;
+    Ok(u64::from_le_bytes(marker) == frame + 1)
+}
+
+/// Fills the lit image (mode none) with 1 and leaves it in `UnorderedAccess` state.
+fn record_fill_lit(enc: &mut Encoder<'_>, lit: &Image) {
+    enc.begin_pass(PassId::FillLit.name());
+    enc.barriers(&[Barrier::Image {
+        image: lit,
+        before: S::Undefined,
+        after: S::CopyDest,
+    }]);
+    enc.clear_uint(lit, 1.0f32.to_bits());
+    enc.barriers(&[Barrier::Image {
+        image: lit,
+        before: S::CopyDest,
+        after: S::UnorderedAccess,
+    }]);
+    enc.end_pass();
 }
 
 /// PCSS receiver-plane tolerance, in texels of the receiver plane's depth slope: covers the rasterizer's

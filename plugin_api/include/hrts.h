@@ -9,7 +9,13 @@
 
 // Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 // version differs.
-#define HRTS_API_VERSION (2 << 22)
+#define HRTS_API_VERSION (3 << 22)
+
+// The most lights one context shades (`hrts_configure_lights`).
+#define HRTS_MAX_LIGHTS 16
+
+// The most frames in flight a context supports (`HrtsContextCreateInfo::frames_in_flight`).
+#define HRTS_MAX_FRAMES_IN_FLIGHT 8
 
 // Number of `HrtsPass` values.
 #define HRTS_PASS_COUNT 12
@@ -59,6 +65,8 @@ typedef enum HrtsResult {
   HRTS_RESULT_ERROR_IMAGE_USAGE = 11,
   // A bug inside the plugin was caught at the boundary; the context may be unusable.
   HRTS_RESULT_ERROR_INTERNAL = 12,
+  // The frame asked about has not completed on the GPU yet (not an error of the caller: ask again).
+  HRTS_RESULT_NOT_READY = 13,
 } HrtsResult;
 
 // Conservative-rasterization path (input field values and report values).
@@ -148,15 +156,15 @@ typedef uint32_t HrtsShadowMode;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
-// Light type of a frame.
+// Light type.
 enum HrtsLightType
 #if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
   : uint32_t
 #endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
  {
-  // Parallel light along `light_direction`, orthographic `light_view_proj`.
+  // Parallel light along `direction`, orthographic `view_proj`.
   HRTS_LIGHT_TYPE_DIRECTIONAL = 0,
-  // Spot light at `light_position` pointing along `light_direction`, perspective `light_view_proj`.
+  // Spot light at `position` pointing along `direction`, perspective `view_proj`.
   HRTS_LIGHT_TYPE_SPOT = 1,
 };
 #ifndef __cplusplus
@@ -238,6 +246,8 @@ enum HrtsPassStatus
   HRTS_PASS_STATUS_RAN = 1,
   // Skipped: its inputs did not change since it last ran (static geometry, static light).
   HRTS_PASS_STATUS_UP_TO_DATE = 2,
+  // Shared by the context's lights (the prim buffer) and recorded this frame by an earlier light.
+  HRTS_PASS_STATUS_SHARED = 3,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -288,7 +298,9 @@ typedef uint32_t HrtsResource;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
-// Opaque plugin context.
+// Opaque plugin context. A handle is never a valid address: it names a registry slot and the
+// generation of the context in it, so a handle of a destroyed context stays invalid even after another
+// context reuses the slot.
 typedef struct HrtsContext HrtsContext;
 
 // The engine's host allocator. The plugin's host memory (not Vulkan's) goes through it for the whole
@@ -308,8 +320,11 @@ typedef struct HrtsAllocationCallbacks {
 typedef struct HrtsMemoryStats {
   // `sizeof(HrtsMemoryStats)`, set by the caller.
   uint32_t struct_size;
-  // Host bytes allocated by the plugin and not freed.
+  // Host bytes allocated by the plugin and not freed (0 unless `host_bytes_counted`).
   uint64_t host_bytes;
+  // Whether the plugin counts its host memory: true in its shared and static libraries, whose global
+  // allocator counts it; false when a Rust program links the plugin's rlib and keeps its own allocator.
+  bool host_bytes_counted;
   // GPU bytes allocated by the plugin and not freed (excludes what the Vulkan driver keeps internally).
   uint64_t gpu_bytes;
 } HrtsMemoryStats;
@@ -360,6 +375,10 @@ typedef struct HrtsContextCreateInfo {
   const char *device_name_filter;
   // Own device only: enable the Khronos validation layer.
   bool enable_validation;
+  // The most frames the engine records before waiting for the oldest to complete, 1..=
+  // `HRTS_MAX_FRAMES_IN_FLIGHT` (0: 3). Recording frame `frame_index` states that every frame up to
+  // `frame_index - frames_in_flight` has completed on the GPU.
+  uint32_t frames_in_flight;
 } HrtsContextCreateInfo;
 
 // What the device can do.
@@ -539,10 +558,26 @@ typedef struct HrtsTargets {
   // Usage flags of the normal image.
   uint32_t normal_usage;
   // Visibility `VkImage` the plugin writes (`VK_FORMAT_R32_SFLOAT`, usage includes TRANSFER_DST): 1 = lit.
+  // Light `i`'s visibility goes to array layer `i`.
   uint64_t output_image;
   // Usage flags of the output image.
   uint32_t output_usage;
+  // Array layers of the output image: at least the number of lights when a frame is recorded.
+  uint32_t output_layers;
 } HrtsTargets;
+
+// One light of a frame.
+typedef struct HrtsLight {
+  // `HrtsLightType`.
+  uint32_t light_type;
+  // Spot light: emitter position in world space (ignored for directional lights).
+  float position[3];
+  // Direction the light travels, or the spot light's axis (need not be normalised; non-zero).
+  float direction[3];
+  // The light's view-projection enclosing shadow casters and receivers (column-major): orthographic
+  // for a directional light, perspective with its eye at `position` for a spot light.
+  float view_proj[16];
+} HrtsLight;
 
 // One frame to record into the engine's command buffer.
 typedef struct HrtsFrame {
@@ -550,21 +585,20 @@ typedef struct HrtsFrame {
   uint32_t struct_size;
   // `VkCommandBuffer` in the recording state, outside a render pass, from `queue_family_index`.
   uint64_t command_buffer;
+  // The engine's frame counter: it increases from frame to frame (gaps allowed) and stays the same
+  // across the calls that record one frame pass by pass. Recording frame `f` states that every frame
+  // up to `f - frames_in_flight` has completed on the GPU.
+  uint64_t frame_index;
   // World-to-view matrix, column-major.
   float view[16];
   // View-to-clip matrix, column-major, reversed Z, Vulkan clip conventions.
   float proj[16];
   // Camera position in world space.
   float camera_position[3];
-  // `HrtsLightType`.
-  uint32_t light_type;
-  // Spot light: emitter position in world space (ignored for directional lights).
-  float light_position[3];
-  // Direction the light travels, or the spot light's axis (need not be normalised; non-zero).
-  float light_direction[3];
-  // The light's view-projection enclosing shadow casters and receivers (column-major): orthographic
-  // for a directional light, perspective with its eye at `light_position` for a spot light.
-  float light_view_proj[16];
+  // The lights, one per configured light, in the order of `hrts_configure_lights`.
+  const struct HrtsLight *lights;
+  // Number of entries in `lights`: the number of configured lights.
+  uint32_t light_count;
   // `VkImageLayout` of the depth image when the commands run; it is restored afterwards.
   int32_t depth_layout;
   // `VkImageLayout` of the normal image when the commands run; restored afterwards.
@@ -601,6 +635,8 @@ typedef struct HrtsResourceReadback {
   uint64_t command_buffer;
   // `HrtsResource` to copy (allocated by the configuration: see `HrtsConfig::extra_outputs`).
   uint32_t resource;
+  // The light whose resource to copy.
+  uint32_t light;
   // Destination `VkBuffer` (usage includes TRANSFER_DST).
   uint64_t buffer;
   // Size of the destination buffer in bytes.
@@ -617,7 +653,7 @@ typedef struct HrtsPassTiming {
   double milliseconds;
 } HrtsPassTiming;
 
-// What the last completed frame did. Read it after the engine's submission has completed.
+// What one light's passes did in one frame (`hrts_get_frame_report`).
 typedef struct HrtsFrameReport {
   // `sizeof(HrtsFrameReport)`, set by the caller.
   uint32_t struct_size;
@@ -658,6 +694,9 @@ typedef struct HrtsFrameReport {
   float map_to_texels[16];
 } HrtsFrameReport;
 
+// Every result, in value order.
+#define HrtsResult_ALL { HrtsResult_Ok, HrtsResult_ErrorNullPointer, HrtsResult_ErrorStructSize, HrtsResult_ErrorVersion, HrtsResult_ErrorInvalidEnum, HrtsResult_ErrorInvalidArgument, HrtsResult_ErrorInvalidContext, HrtsResult_ErrorInvalidState, HrtsResult_ErrorUnsupported, HrtsResult_ErrorVulkan, HrtsResult_ErrorOutOfMemory, HrtsResult_ErrorImageUsage, HrtsResult_ErrorInternal, HrtsResult_NotReady, }
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -666,8 +705,8 @@ extern "C" {
 uint32_t hrts_get_api_version(void);
 
 // Routes the plugin's host memory through the engine's allocator, for the whole process. It must be the
-// first call into the plugin: once the plugin has allocated anything (or callbacks are installed) it
-// returns `HRTS_RESULT_ERROR_INVALID_STATE`. Vulkan objects keep the driver's allocator.
+// first call into the plugin: once the plugin holds any memory (or callbacks are installed) it returns
+// `HRTS_RESULT_ERROR_INVALID_STATE`. Vulkan objects keep the driver's allocator.
 //
 // # Safety
 // `callbacks` is NULL or valid; its functions are thread-safe and outlive every use of the plugin.
@@ -679,17 +718,19 @@ enum HrtsResult hrts_set_allocation_callbacks(const struct HrtsAllocationCallbac
 // `out` is NULL or valid.
 enum HrtsResult hrts_get_memory_stats(struct HrtsMemoryStats *out);
 
-// A static name for a result code (also for values this library does not know).
+// A static name for a result code (also for values this library does not know: `HRTS_RESULT_UNKNOWN`).
 const char *hrts_result_name(int32_t result);
 
 // The message of the last failed call on `context`, or, if `context` is NULL or not live, of the last
-// failed call on this thread. Empty if none. Valid until the next failing call on the same context/thread.
+// failed call on this thread. Empty if none. A successful call does not clear it. Valid until the next
+// failing call on the same context (or thread), and for a context until it is destroyed.
 //
 // # Safety
-// `context` is NULL or a pointer returned by `hrts_context_create`.
+// `context` is NULL or a handle returned by `hrts_context_create`.
 const char *hrts_last_error(const struct HrtsContext *context);
 
-// Creates a context. On success `*out_context` receives it; on failure it is set to NULL.
+// Creates a context. On success `*out_context` receives its handle; on failure it is set to NULL.
+// Handles are never reused: a destroyed context's handle stays invalid (`HRTS_RESULT_ERROR_INVALID_CONTEXT`).
 //
 // # Safety
 // `info` and `out_context` point at valid objects; the Vulkan objects in `info->vulkan` outlive the context.
@@ -697,10 +738,10 @@ enum HrtsResult hrts_context_create(const struct HrtsContextCreateInfo *info,
                                     struct HrtsContext **out_context);
 
 // Destroys a context and everything it created (not the engine's objects). The engine must have waited
-// for GPU work recorded by the context.
+// for every frame the context recorded (all frames in flight) to complete.
 //
 // # Safety
-// `context` is NULL or a pointer returned by `hrts_context_create`.
+// `context` is NULL or a handle returned by `hrts_context_create`.
 enum HrtsResult hrts_context_destroy(struct HrtsContext *context);
 
 // Fills `out` (with `out->struct_size` set) with the device's capabilities.
@@ -716,13 +757,27 @@ enum HrtsResult hrts_get_capabilities(struct HrtsContext *context, struct HrtsCa
 // `out` is NULL or valid.
 enum HrtsResult hrts_config_defaults(struct HrtsConfig *out);
 
-// Sets the configuration (validated against the device).
+// Sets one light's configuration: `hrts_configure_lights` with one light.
 //
 // # Safety
 // As for `hrts_get_capabilities`.
 enum HrtsResult hrts_configure(struct HrtsContext *context, const struct HrtsConfig *config);
 
-// Sets the shadow-casting geometry from CPU arrays (copied).
+// Sets the lights: `light_count` configurations (1..=`HRTS_MAX_LIGHTS`, each validated against the
+// device), one per light, each with its own mode and settings. The lights share the prim buffer; each
+// has its own passes and writes its visibility to its layer of the output image. A light whose
+// configuration is unchanged keeps its passes (and what they cached); a changed light's passes are
+// rebuilt; another light count rebuilds all. What is replaced is destroyed once the frames recorded so
+// far completed (`frames_in_flight` frames later), so the engine need not wait before calling this.
+//
+// # Safety
+// As for `hrts_get_capabilities`; `configs` points at `light_count` configurations.
+enum HrtsResult hrts_configure_lights(struct HrtsContext *context,
+                                      uint32_t light_count,
+                                      const struct HrtsConfig *configs);
+
+// Sets the shadow-casting geometry from CPU arrays (copied). The passes built on the old geometry are
+// destroyed once the frames recorded so far completed.
 //
 // # Safety
 // As for `hrts_get_capabilities`; the arrays hold the counts stated.
@@ -737,11 +792,14 @@ enum HrtsResult hrts_set_geometry_cpu(struct HrtsContext *context,
 enum HrtsResult hrts_set_geometry_vulkan(struct HrtsContext *context,
                                          const struct HrtsVulkanGeometry *geometry);
 
-// Sets the engine images read (depth, normal) and written (visibility).
+// Sets the engine images read (depth, normal) and written (visibility, one layer per light). The passes
+// bound to the old images are destroyed once the frames recorded so far completed; the old images must
+// live until then.
 //
 // # Safety
 // As for `hrts_get_capabilities`; the images are live `VkImage`s of the adopted device.
-enum HrtsResult hrts_set_targets(struct HrtsContext *context, const struct HrtsTargets *targets);
+enum HrtsResult hrts_set_targets(struct HrtsContext *context,
+                                 const struct HrtsTargets *targets);
 
 // Records every pass of one frame into `frame->command_buffer`: `hrts_record_passes` with
 // `HRTS_PASS_MASK_ALL`.
@@ -772,12 +830,13 @@ enum HrtsResult hrts_record_passes(struct HrtsContext *context,
                                    const struct HrtsFrame *frame,
                                    uint32_t pass_mask);
 
-// Fills `out` (with `out->struct_size` set) with the shape of `resource` (`HrtsResource`) under the
-// current configuration, geometry and targets (building the passes if needed).
+// Fills `out` (with `out->struct_size` set) with the shape of `light`'s `resource` (`HrtsResource`) under
+// the current configuration, geometry and targets (building the passes if needed).
 //
 // # Safety
 // As for `hrts_get_capabilities`.
 enum HrtsResult hrts_get_resource_info(struct HrtsContext *context,
+                                       uint32_t light,
                                        uint32_t resource,
                                        struct HrtsResourceInfo *out);
 
@@ -791,12 +850,16 @@ enum HrtsResult hrts_get_resource_info(struct HrtsContext *context,
 enum HrtsResult hrts_record_resource_readback(struct HrtsContext *context,
                                               const struct HrtsResourceReadback *readback);
 
-// Fills `out` (with `out->struct_size` set) with the last frame's report. Call only after the engine's
-// submission of that frame has completed (its fence signalled).
+// Fills `out` (with `out->struct_size` set) with what `light`'s passes did in frame `frame_index`: one
+// of the last `frames_in_flight` frames recorded. Returns `HRTS_RESULT_NOT_READY` while the GPU has not
+// finished that frame (ask after its fence signalled), `HRTS_RESULT_ERROR_INVALID_ARGUMENT` for a frame
+// no longer kept.
 //
 // # Safety
 // As for `hrts_get_capabilities`.
 enum HrtsResult hrts_get_frame_report(struct HrtsContext *context,
+                                      uint64_t frame_index,
+                                      uint32_t light,
                                       struct HrtsFrameReport *out);
 
 #ifdef __cplusplus

@@ -9,41 +9,38 @@
 //! and returns an `HrtsResult`; `hrts_last_error` gives the message of the last failure. A context must
 //! not be used from two threads at once.
 
+mod adopt;
 mod context;
+mod convert;
+mod error;
+mod geometry;
+mod handles;
 mod memory;
+mod record;
 mod types;
 
-#[global_allocator]
-static ALLOCATOR: memory::CountingAllocator = memory::CountingAllocator;
-
-use context::{ApiError, ApiResult, Context};
+use context::Context;
+use error::{ApiError, ApiResult};
+pub use memory::CountingAllocator;
 use std::cell::RefCell;
-use std::collections::HashSet;
 use std::ffi::{c_char, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::Mutex;
 pub use types::*;
 
-/// Addresses of live contexts: calls with any other pointer fail with `HRTS_RESULT_ERROR_INVALID_CONTEXT`.
-static LIVE: Mutex<Option<HashSet<usize>>> = Mutex::new(None);
-
 thread_local! {
-    static LAST_ERROR: RefCell<CString> = RefCell::new(CString::default());
+    /// The message of the thread's last call if it failed (clearing it allocates nothing, so the first call
+    /// can still install allocation callbacks).
+    static LAST_ERROR: RefCell<Option<CString>> = const { RefCell::new(None) };
 }
 
-fn live(ctx: *const HrtsContext) -> bool {
-    LIVE.lock()
-        .map(|set| set.as_ref().is_some_and(|s| s.contains(&(ctx as usize))))
-        .unwrap_or(false)
+fn c_message(message: &str) -> CString {
+    CString::new(message.replace('\0', " ")).unwrap_or_default()
 }
 
-fn set_thread_error(message: &str) {
-    let c = CString::new(message.replace('\0', " ")).unwrap_or_default();
-    LAST_ERROR.with(|e| *e.borrow_mut() = c);
-}
-
-/// Runs `f` behind the panic boundary and turns its outcome into a result code and error message.
-fn boundary(ctx: Option<*mut HrtsContext>, f: impl FnOnce() -> ApiResult<()>) -> HrtsResult {
+/// Runs `f` behind the panic boundary and turns its outcome into a result code and error message (kept
+/// for the thread, and for the context `ctx` if it names a live one; a success clears both).
+fn boundary(ctx: Option<*const HrtsContext>, f: impl FnOnce() -> ApiResult<()>) -> HrtsResult {
+    LAST_ERROR.with(|last| *last.borrow_mut() = None);
     let outcome = catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|panic| {
         let what = panic
             .downcast_ref::<&str>()
@@ -58,13 +55,10 @@ fn boundary(ctx: Option<*mut HrtsContext>, f: impl FnOnce() -> ApiResult<()>) ->
     match outcome {
         Ok(()) => HrtsResult::Ok,
         Err(e) => {
-            set_thread_error(&e.message);
-            if let Some(c) = ctx.filter(|&c| live(c)) {
-                // SAFETY: `c` is live (registered and not destroyed); callers do not share it across threads.
-                unsafe {
-                    (*c).inner.last_error =
-                        CString::new(e.message.replace('\0', " ")).unwrap_or_default()
-                };
+            let context = ctx.and_then(handles::lookup);
+            LAST_ERROR.with(|last| *last.borrow_mut() = Some(c_message(&e.message)));
+            if let Some(Ok(mut c)) = context.as_ref().map(|c| c.try_lock()) {
+                c.last_error = Some(c_message(&e.message));
             }
             e.code
         }
@@ -83,14 +77,29 @@ fn with_context(
                 "context is NULL",
             ));
         }
-        if !live(ctx) {
-            return Err(ApiError::new(
+        let context = handles::lookup(ctx).ok_or_else(|| {
+            ApiError::new(
                 HrtsResult::ErrorInvalidContext,
                 "context is not live (destroyed or never created)",
-            ));
-        }
-        // SAFETY: `ctx` is live; the caller does not use it from another thread during the call.
-        f(unsafe { &mut (*ctx).inner })
+            )
+        })?;
+        let mut guard = match context.try_lock() {
+            Ok(guard) => guard,
+            Err(std::sync::TryLockError::WouldBlock) => {
+                return Err(ApiError::new(
+                    HrtsResult::ErrorInvalidState,
+                    "the context is in use by another thread: a context must not be used from two threads at once",
+                ))
+            }
+            Err(std::sync::TryLockError::Poisoned(_)) => {
+                return Err(ApiError::new(
+                    HrtsResult::ErrorInternal,
+                    "the context is unusable after an internal error: destroy it",
+                ))
+            }
+        };
+        guard.last_error = None;
+        f(&mut guard)
     })
 }
 
@@ -108,18 +117,18 @@ fn deref_mut<'a, T>(p: *mut T, name: &str) -> ApiResult<&'a mut T> {
 
 /// For Rust hosts linking the rlib: the pipeline resource an `HrtsResource` value names.
 pub fn resource_from_c(value: u32) -> Option<passes::ResourceId> {
-    context::resource_id(value).ok()
+    convert::resource_id(value).ok()
 }
 
 /// For Rust hosts linking the rlib: the `HrtsResource` value of a pipeline resource, if it has one.
 pub fn resource_to_c(id: passes::ResourceId) -> Option<u32> {
-    context::resource_index(id).ok()
+    convert::resource_index(id).ok()
 }
 
 /// For Rust hosts linking the rlib: the C configuration of a Rust one (the inverse of what
 /// `hrts_configure` reads), or why it has none.
 pub fn config_to_c(config: &passes::ShadowConfig) -> Result<HrtsConfig, String> {
-    context::config_to_c(config).map_err(|e| e.message)
+    convert::config_to_c(config).map_err(|e| e.message)
 }
 
 /// The library's `HRTS_API_VERSION`.
@@ -129,8 +138,8 @@ pub extern "C" fn hrts_get_api_version() -> u32 {
 }
 
 /// Routes the plugin's host memory through the engine's allocator, for the whole process. It must be the
-/// first call into the plugin: once the plugin has allocated anything (or callbacks are installed) it
-/// returns `HRTS_RESULT_ERROR_INVALID_STATE`. Vulkan objects keep the driver's allocator.
+/// first call into the plugin: once the plugin holds any memory (or callbacks are installed) it returns
+/// `HRTS_RESULT_ERROR_INVALID_STATE`. Vulkan objects keep the driver's allocator.
 ///
 /// # Safety
 /// `callbacks` is NULL or valid; its functions are thread-safe and outlive every use of the plugin.
@@ -140,13 +149,20 @@ pub unsafe extern "C" fn hrts_set_allocation_callbacks(
 ) -> HrtsResult {
     boundary(None, || {
         let c = deref(callbacks, "callbacks")?;
-        context::check_size::<HrtsAllocationCallbacks>(c.struct_size, "HrtsAllocationCallbacks")?;
+        error::check_size::<HrtsAllocationCallbacks>(c.struct_size, "HrtsAllocationCallbacks")?;
         let (Some(allocate), Some(free)) = (c.allocate, c.free) else {
             return Err(ApiError::new(
                 HrtsResult::ErrorNullPointer,
                 "allocate and free must be non-NULL",
             ));
         };
+        if !memory::is_global_allocator() {
+            return Err(ApiError::new(
+                HrtsResult::ErrorUnsupported,
+                "host allocation callbacks need the plugin's shared or static library: a program linking \
+                 the Rust rlib keeps its own global allocator",
+            ));
+        }
         let installed = memory::install(memory::Callbacks {
             user_data: c.user_data as usize,
             allocate,
@@ -171,50 +187,53 @@ pub unsafe extern "C" fn hrts_set_allocation_callbacks(
 pub unsafe extern "C" fn hrts_get_memory_stats(out: *mut HrtsMemoryStats) -> HrtsResult {
     boundary(None, || {
         let out = deref_mut(out, "out")?;
-        context::check_size::<HrtsMemoryStats>(out.struct_size, "HrtsMemoryStats")?;
-        out.host_bytes = memory::live_host_bytes();
+        error::check_size::<HrtsMemoryStats>(out.struct_size, "HrtsMemoryStats")?;
+        out.host_bytes_counted = memory::is_global_allocator();
+        out.host_bytes = if out.host_bytes_counted {
+            memory::live_host_bytes()
+        } else {
+            0
+        };
         out.gpu_bytes = rhi::live_gpu_allocation_bytes();
         Ok(())
     })
 }
 
-/// A static name for a result code (also for values this library does not know).
+/// A static name for a result code (also for values this library does not know: `HRTS_RESULT_UNKNOWN`).
 #[no_mangle]
 pub extern "C" fn hrts_result_name(result: i32) -> *const c_char {
-    let name: &'static std::ffi::CStr = match result {
-        0 => c"HRTS_RESULT_OK",
-        1 => c"HRTS_RESULT_ERROR_NULL_POINTER",
-        2 => c"HRTS_RESULT_ERROR_STRUCT_SIZE",
-        3 => c"HRTS_RESULT_ERROR_VERSION",
-        4 => c"HRTS_RESULT_ERROR_INVALID_ENUM",
-        5 => c"HRTS_RESULT_ERROR_INVALID_ARGUMENT",
-        6 => c"HRTS_RESULT_ERROR_INVALID_CONTEXT",
-        7 => c"HRTS_RESULT_ERROR_INVALID_STATE",
-        8 => c"HRTS_RESULT_ERROR_UNSUPPORTED",
-        9 => c"HRTS_RESULT_ERROR_VULKAN",
-        10 => c"HRTS_RESULT_ERROR_OUT_OF_MEMORY",
-        11 => c"HRTS_RESULT_ERROR_IMAGE_USAGE",
-        12 => c"HRTS_RESULT_ERROR_INTERNAL",
-        _ => c"HRTS_RESULT_UNKNOWN",
-    };
-    name.as_ptr()
+    static NAMES: std::sync::OnceLock<Vec<CString>> = std::sync::OnceLock::new();
+    let names = NAMES.get_or_init(|| {
+        HrtsResult::ALL
+            .iter()
+            .map(|r| c_message(&r.c_name()))
+            .collect()
+    });
+    match HrtsResult::from_c(result) {
+        Some(r) => names[r as usize].as_ptr(),
+        None => c"HRTS_RESULT_UNKNOWN".as_ptr(),
+    }
 }
 
-/// The message of the last failed call on `context`, or, if `context` is NULL or not live, of the last
-/// failed call on this thread. Empty if none. Valid until the next failing call on the same context/thread.
+/// The message of the last call on `context` if it failed, or, if `context` is NULL or not live, of the
+/// last call on this thread if it failed; empty after a successful call. Valid until the next call on the
+/// same context (or thread).
 ///
 /// # Safety
-/// `context` is NULL or a pointer returned by `hrts_context_create`.
+/// `context` is NULL or a handle returned by `hrts_context_create`.
 #[no_mangle]
 pub unsafe extern "C" fn hrts_last_error(context: *const HrtsContext) -> *const c_char {
-    if !context.is_null() && live(context) {
-        // SAFETY: live context, not shared across threads during the call.
-        return unsafe { (*context).inner.last_error.as_ptr() };
+    if let Some(c) = handles::lookup(context) {
+        if let Ok(c) = c.try_lock() {
+            // The message lives in the context, which the registry keeps alive until it is destroyed.
+            return c.last_error.as_ref().map_or(c"".as_ptr(), |m| m.as_ptr());
+        }
     }
-    LAST_ERROR.with(|e| e.borrow().as_ptr())
+    LAST_ERROR.with(|e| e.borrow().as_ref().map_or(c"".as_ptr(), |m| m.as_ptr()))
 }
 
-/// Creates a context. On success `*out_context` receives it; on failure it is set to NULL.
+/// Creates a context. On success `*out_context` receives its handle; on failure it is set to NULL.
+/// Handles are never reused: a destroyed context's handle stays invalid (`HRTS_RESULT_ERROR_INVALID_CONTEXT`).
 ///
 /// # Safety
 /// `info` and `out_context` point at valid objects; the Vulkan objects in `info->vulkan` outlive the context.
@@ -227,24 +246,17 @@ pub unsafe extern "C" fn hrts_context_create(
         let out = deref_mut(out_context, "out_context")?;
         *out = std::ptr::null_mut();
         let info = deref(info, "info")?;
-        context::check_size::<HrtsContextCreateInfo>(info.struct_size, "HrtsContextCreateInfo")?;
-        let ctx = Box::into_raw(Box::new(HrtsContext {
-            inner: Context::new(info)?,
-        }));
-        LIVE.lock()
-            .map_err(|_| ApiError::new(HrtsResult::ErrorInternal, "context registry poisoned"))?
-            .get_or_insert_with(HashSet::new)
-            .insert(ctx as usize);
-        *out = ctx;
+        error::check_size::<HrtsContextCreateInfo>(info.struct_size, "HrtsContextCreateInfo")?;
+        *out = handles::register(Context::new(info)?);
         Ok(())
     })
 }
 
 /// Destroys a context and everything it created (not the engine's objects). The engine must have waited
-/// for GPU work recorded by the context.
+/// for every frame the context recorded (all frames in flight) to complete.
 ///
 /// # Safety
-/// `context` is NULL or a pointer returned by `hrts_context_create`.
+/// `context` is NULL or a handle returned by `hrts_context_create`.
 #[no_mangle]
 pub unsafe extern "C" fn hrts_context_destroy(context: *mut HrtsContext) -> HrtsResult {
     boundary(None, || {
@@ -254,19 +266,13 @@ pub unsafe extern "C" fn hrts_context_destroy(context: *mut HrtsContext) -> Hrts
                 "context is NULL",
             ));
         }
-        let removed = LIVE
-            .lock()
-            .map_err(|_| ApiError::new(HrtsResult::ErrorInternal, "context registry poisoned"))?
-            .as_mut()
-            .is_some_and(|s| s.remove(&(context as usize)));
-        if !removed {
-            return Err(ApiError::new(
+        let removed = handles::unregister(context).ok_or_else(|| {
+            ApiError::new(
                 HrtsResult::ErrorInvalidContext,
                 "context is not live (destroyed or never created)",
-            ));
-        }
-        // SAFETY: the pointer came from Box::into_raw in hrts_context_create and was live until now.
-        drop(unsafe { Box::from_raw(context) });
+            )
+        })?;
+        drop(removed);
         Ok(())
     })
 }
@@ -290,10 +296,10 @@ pub unsafe extern "C" fn hrts_get_capabilities(
 /// `out` is NULL or valid.
 #[no_mangle]
 pub unsafe extern "C" fn hrts_config_defaults(out: *mut HrtsConfig) -> HrtsResult {
-    boundary(None, || context::config_defaults(deref_mut(out, "out")?))
+    boundary(None, || convert::config_defaults(deref_mut(out, "out")?))
 }
 
-/// Sets the configuration (validated against the device).
+/// Sets one light's configuration: `hrts_configure_lights` with one light.
 ///
 /// # Safety
 /// As for `hrts_get_capabilities`.
@@ -302,10 +308,41 @@ pub unsafe extern "C" fn hrts_configure(
     context: *mut HrtsContext,
     config: *const HrtsConfig,
 ) -> HrtsResult {
-    with_context(context, |c| c.configure(deref(config, "config")?))
+    with_context(context, |c| {
+        c.configure_lights(std::slice::from_ref(deref(config, "config")?))
+    })
 }
 
-/// Sets the shadow-casting geometry from CPU arrays (copied).
+/// Sets the lights: `light_count` configurations (1..=`HRTS_MAX_LIGHTS`, each validated against the
+/// device), one per light, each with its own mode and settings. The lights share the prim buffer; each
+/// has its own passes and writes its visibility to its layer of the output image. A light whose
+/// configuration is unchanged keeps its passes (and what they cached); a changed light's passes are
+/// rebuilt; another light count rebuilds all. What is replaced is destroyed once the frames recorded so
+/// far completed (`frames_in_flight` frames later), so the engine need not wait before calling this.
+///
+/// # Safety
+/// As for `hrts_get_capabilities`; `configs` points at `light_count` configurations.
+#[no_mangle]
+pub unsafe extern "C" fn hrts_configure_lights(
+    context: *mut HrtsContext,
+    light_count: u32,
+    configs: *const HrtsConfig,
+) -> HrtsResult {
+    with_context(context, |c| {
+        let first = deref(configs, "configs")?;
+        if light_count == 0 || light_count > HRTS_MAX_LIGHTS {
+            return Err(error::invalid(format!(
+                "light_count {light_count} must be within 1..={HRTS_MAX_LIGHTS}"
+            )));
+        }
+        // SAFETY: non-NULL; the caller guarantees `light_count` configurations.
+        let all = unsafe { std::slice::from_raw_parts(first, light_count as usize) };
+        c.configure_lights(all)
+    })
+}
+
+/// Sets the shadow-casting geometry from CPU arrays (copied). The passes built on the old geometry are
+/// destroyed once the frames recorded so far completed.
 ///
 /// # Safety
 /// As for `hrts_get_capabilities`; the arrays hold the counts stated.
@@ -334,7 +371,9 @@ pub unsafe extern "C" fn hrts_set_geometry_vulkan(
     })
 }
 
-/// Sets the engine images read (depth, normal) and written (visibility).
+/// Sets the engine images read (depth, normal) and written (visibility, one layer per light). The passes
+/// bound to the old images are destroyed once the frames recorded so far completed; the old images must
+/// live until then.
 ///
 /// # Safety
 /// As for `hrts_get_capabilities`; the images are live `VkImage`s of the adopted device.
@@ -366,14 +405,21 @@ pub unsafe extern "C" fn hrts_record_frame(
 /// `HRTS_PASS_MASK_SCREEN_SPACE` after its G-buffer, in the same or a later command buffer of the same
 /// queue, submitted in recording order.
 ///
-/// A call whose lowest pass comes after the last pass recorded in the current frame continues that frame
-/// (its camera and light must be the same); any other call begins a new frame. Passes the frame does not
-/// run (not needed by the configuration, or up to date) record nothing. Within a frame, every pass that
-/// runs must be recorded, in order: a call that leaves out such a pass before its last requested one fails
-/// with `HRTS_RESULT_ERROR_INVALID_STATE`. `HRTS_PASS_OUTPUT_COPY` ends the frame.
+/// Every light's passes of the mask are recorded, light after light. A call with the `frame_index` of the
+/// frame being recorded and whose lowest pass comes after the last pass recorded continues that frame (its
+/// camera and lights must be the same); a call with a greater `frame_index` begins a new frame (abandoning
+/// an unfinished one); any other call fails. Passes the frame does not run (not needed by the
+/// configuration, up to date, or shared) record nothing. Within a frame, every pass that runs must be
+/// recorded, in order: a call that leaves out such a pass before its last requested one fails with
+/// `HRTS_RESULT_ERROR_INVALID_STATE` and records nothing. `HRTS_PASS_OUTPUT_COPY` ends the frame.
 ///
-/// Layouts: a call with a ray-trace, shadow-map-test or PCSS pass transitions depth and normal from
-/// `depth_layout` and `normal_layout` and back; the output copy takes the output image from
+/// Frames in flight: recording frame `f` states that every frame up to `f - frames_in_flight` has
+/// completed on the GPU; the plugin's per-frame data is ring-buffered that deep, and its constants go
+/// into the command buffer itself, so the engine never waits for the plugin. Each call's commands are
+/// ordered after everything earlier on the queue that used the same plugin resources.
+///
+/// Layouts: a call with a primitive-map, ray-trace, shadow-map-test or PCSS pass transitions depth and
+/// normal from `depth_layout` and `normal_layout` and back; the output copy takes the output image from
 /// `output_layout_before` to `output_layout_after`. Other calls leave the engine's images alone. The
 /// plugin binds its own pipelines and descriptor sets and sets viewport and scissor: re-bind yours after.
 ///
@@ -390,19 +436,20 @@ pub unsafe extern "C" fn hrts_record_passes(
     })
 }
 
-/// Fills `out` (with `out->struct_size` set) with the shape of `resource` (`HrtsResource`) under the
-/// current configuration, geometry and targets (building the passes if needed).
+/// Fills `out` (with `out->struct_size` set) with the shape of `light`'s `resource` (`HrtsResource`) under
+/// the current configuration, geometry and targets (building the passes if needed).
 ///
 /// # Safety
 /// As for `hrts_get_capabilities`.
 #[no_mangle]
 pub unsafe extern "C" fn hrts_get_resource_info(
     context: *mut HrtsContext,
+    light: u32,
     resource: u32,
     out: *mut HrtsResourceInfo,
 ) -> HrtsResult {
     with_context(context, |c| {
-        c.resource_info(resource, deref_mut(out, "out")?)
+        c.resource_info(light, resource, deref_mut(out, "out")?)
     })
 }
 
@@ -421,15 +468,21 @@ pub unsafe extern "C" fn hrts_record_resource_readback(
     with_context(context, |c| c.record_readback(deref(readback, "readback")?))
 }
 
-/// Fills `out` (with `out->struct_size` set) with the last frame's report. Call only after the engine's
-/// submission of that frame has completed (its fence signalled).
+/// Fills `out` (with `out->struct_size` set) with what `light`'s passes did in frame `frame_index`: one
+/// of the last `frames_in_flight` frames recorded. Returns `HRTS_RESULT_NOT_READY` while the GPU has not
+/// finished that frame (ask after its fence signalled), `HRTS_RESULT_ERROR_INVALID_ARGUMENT` for a frame
+/// no longer kept.
 ///
 /// # Safety
 /// As for `hrts_get_capabilities`.
 #[no_mangle]
 pub unsafe extern "C" fn hrts_get_frame_report(
     context: *mut HrtsContext,
+    frame_index: u64,
+    light: u32,
     out: *mut HrtsFrameReport,
 ) -> HrtsResult {
-    with_context(context, |c| c.report(deref_mut(out, "out")?))
+    with_context(context, |c| {
+        c.report(frame_index, light, deref_mut(out, "out")?)
+    })
 }

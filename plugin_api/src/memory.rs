@@ -1,14 +1,16 @@
-//! Host memory of the plugin: the library's global allocator counts the bytes the plugin holds, so an
-//! engine (and the C host test) can see exactly what the plugin owns apart from what the Vulkan driver
-//! keeps; and it forwards to the engine's allocation callbacks when they were installed first.
+//! Host memory of the plugin: [`CountingAllocator`], the global allocator of the plugin's shared and static
+//! libraries (the `hrts` package installs it; this rlib does not, so a Rust program linking it keeps its
+//! own allocator), counts the bytes the plugin holds, so an engine (and the C host test) can see exactly
+//! what the plugin owns apart from what the Vulkan driver keeps; and it forwards to the engine's
+//! allocation callbacks when they were installed first.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::ffi::c_void;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::OnceLock;
 
-/// `System`, or the engine's callbacks, with a count of live bytes.
-pub(crate) struct CountingAllocator;
+/// `System`, or the engine's callbacks, with a count of live bytes and allocations.
+pub struct CountingAllocator;
 
 /// The engine's host allocation functions.
 #[derive(Clone, Copy)]
@@ -19,19 +21,28 @@ pub(crate) struct Callbacks {
 }
 
 static LIVE_HOST_BYTES: AtomicU64 = AtomicU64::new(0);
-static EVER_ALLOCATED: AtomicBool = AtomicBool::new(false);
+static LIVE_ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
+static TOTAL_ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
 static CALLBACKS: OnceLock<Callbacks> = OnceLock::new();
 
-/// Installs the engine's callbacks; false if the plugin already allocated (or callbacks are installed).
+/// Whether [`CountingAllocator`] is the process's global allocator (the plugin's shared or static
+/// library), rather than this crate being linked as an rlib into a program with its own.
+pub(crate) fn is_global_allocator() -> bool {
+    let before = TOTAL_ALLOCATIONS.load(Ordering::SeqCst);
+    drop(std::hint::black_box(Box::new(0u8)));
+    TOTAL_ALLOCATIONS.load(Ordering::SeqCst) > before
+}
+
+/// Installs the engine's callbacks; false if the plugin holds memory (or callbacks are installed).
 pub(crate) fn install(callbacks: Callbacks) -> bool {
-    !EVER_ALLOCATED.load(Ordering::SeqCst) && CALLBACKS.set(callbacks).is_ok()
+    LIVE_ALLOCATIONS.load(Ordering::SeqCst) == 0 && CALLBACKS.set(callbacks).is_ok()
 }
 
 // SAFETY: every method returns memory from one allocator for the whole process (callbacks can only be
 // installed before the first allocation) with the requested layout, and frees it with the same one.
 unsafe impl GlobalAlloc for CountingAllocator {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        EVER_ALLOCATED.store(true, Ordering::Relaxed);
+        TOTAL_ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
         let p = match CALLBACKS.get() {
             // SAFETY: the engine's allocate returns `size` bytes aligned to `align`, or NULL.
             Some(c) => unsafe {
@@ -42,6 +53,7 @@ unsafe impl GlobalAlloc for CountingAllocator {
         };
         if !p.is_null() {
             LIVE_HOST_BYTES.fetch_add(layout.size() as u64, Ordering::Relaxed);
+            LIVE_ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
         }
         p
     }
@@ -61,6 +73,7 @@ unsafe impl GlobalAlloc for CountingAllocator {
             None => unsafe { System.dealloc(ptr, layout) },
         }
         LIVE_HOST_BYTES.fetch_sub(layout.size() as u64, Ordering::Relaxed);
+        LIVE_ALLOCATIONS.fetch_sub(1, Ordering::SeqCst);
     }
 }
 

@@ -6,7 +6,14 @@ use std::ffi::c_char;
 
 /// Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 /// version differs.
-pub const HRTS_API_VERSION: u32 = 2 << 22;
+pub const HRTS_API_VERSION: u32 = 3 << 22;
+
+/// The most lights one context shades (`hrts_configure_lights`).
+pub const HRTS_MAX_LIGHTS: u32 = 16;
+
+/// The most frames in flight a context supports (`HrtsContextCreateInfo::frames_in_flight`).
+pub const HRTS_MAX_FRAMES_IN_FLIGHT: u32 = 8;
+const _: () = assert!(HRTS_MAX_FRAMES_IN_FLIGHT == passes::MAX_FRAMES_IN_FLIGHT);
 
 /// Result of every call. Append-only: values never change meaning.
 #[repr(C)]
@@ -38,6 +45,45 @@ pub enum HrtsResult {
     ErrorImageUsage = 11,
     /// A bug inside the plugin was caught at the boundary; the context may be unusable.
     ErrorInternal = 12,
+    /// The frame asked about has not completed on the GPU yet (not an error of the caller: ask again).
+    NotReady = 13,
+}
+
+impl HrtsResult {
+    /// Every result, in value order.
+    pub const ALL: [Self; 14] = [
+        Self::Ok,
+        Self::ErrorNullPointer,
+        Self::ErrorStructSize,
+        Self::ErrorVersion,
+        Self::ErrorInvalidEnum,
+        Self::ErrorInvalidArgument,
+        Self::ErrorInvalidContext,
+        Self::ErrorInvalidState,
+        Self::ErrorUnsupported,
+        Self::ErrorVulkan,
+        Self::ErrorOutOfMemory,
+        Self::ErrorImageUsage,
+        Self::ErrorInternal,
+        Self::NotReady,
+    ];
+
+    /// The result of a C value, if it names one.
+    pub fn from_c(value: i32) -> Option<Self> {
+        Self::ALL.get(usize::try_from(value).ok()?).copied()
+    }
+
+    /// The C name of the result (`HRTS_RESULT_` and the variant's name in upper snake case).
+    pub fn c_name(self) -> String {
+        let mut name = String::from("HRTS_RESULT");
+        for c in format!("{self:?}").chars() {
+            if c.is_ascii_uppercase() {
+                name.push('_');
+            }
+            name.push(c.to_ascii_uppercase());
+        }
+        name
+    }
 }
 
 /// Conservative-rasterization path (input field values and report values).
@@ -119,6 +165,8 @@ pub enum HrtsPassStatus {
     Ran = 1,
     /// Skipped: its inputs did not change since it last ran (static geometry, static light).
     UpToDate = 2,
+    /// Shared by the context's lights (the prim buffer) and recorded this frame by an earlier light.
+    Shared = 3,
 }
 
 /// A resource the plugin allocates (for the report, `hrts_get_resource_info` and
@@ -180,13 +228,13 @@ pub enum HrtsShadowMode {
     Hybrid = 3,
 }
 
-/// Light type of a frame.
+/// Light type.
 #[repr(u32)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum HrtsLightType {
-    /// Parallel light along `light_direction`, orthographic `light_view_proj`.
+    /// Parallel light along `direction`, orthographic `view_proj`.
     Directional = 0,
-    /// Spot light at `light_position` pointing along `light_direction`, perspective `light_view_proj`.
+    /// Spot light at `position` pointing along `direction`, perspective `view_proj`.
     Spot = 1,
 }
 
@@ -208,9 +256,11 @@ pub type HrtsGetInstanceProcAddr = Option<
     ) -> Option<unsafe extern "C" fn()>,
 >;
 
-/// Opaque plugin context.
+/// Opaque plugin context. A handle is never a valid address: it names a registry slot and the
+/// generation of the context in it, so a handle of a destroyed context stays invalid even after another
+/// context reuses the slot.
 pub struct HrtsContext {
-    pub(crate) inner: crate::context::Context,
+    _opaque: (),
 }
 
 /// The engine's Vulkan objects, adopted (never destroyed) by the plugin.
@@ -258,6 +308,10 @@ pub struct HrtsContextCreateInfo {
     pub device_name_filter: *const c_char,
     /// Own device only: enable the Khronos validation layer.
     pub enable_validation: bool,
+    /// The most frames the engine records before waiting for the oldest to complete, 1..=
+    /// `HRTS_MAX_FRAMES_IN_FLIGHT` (0: 3). Recording frame `frame_index` states that every frame up to
+    /// `frame_index - frames_in_flight` has completed on the GPU.
+    pub frames_in_flight: u32,
 }
 
 /// What the device can do.
@@ -444,9 +498,27 @@ pub struct HrtsTargets {
     /// Usage flags of the normal image.
     pub normal_usage: u32,
     /// Visibility `VkImage` the plugin writes (`VK_FORMAT_R32_SFLOAT`, usage includes TRANSFER_DST): 1 = lit.
+    /// Light `i`'s visibility goes to array layer `i`.
     pub output_image: u64,
     /// Usage flags of the output image.
     pub output_usage: u32,
+    /// Array layers of the output image: at least the number of lights when a frame is recorded.
+    pub output_layers: u32,
+}
+
+/// One light of a frame.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct HrtsLight {
+    /// `HrtsLightType`.
+    pub light_type: u32,
+    /// Spot light: emitter position in world space (ignored for directional lights).
+    pub position: [f32; 3],
+    /// Direction the light travels, or the spot light's axis (need not be normalised; non-zero).
+    pub direction: [f32; 3],
+    /// The light's view-projection enclosing shadow casters and receivers (column-major): orthographic
+    /// for a directional light, perspective with its eye at `position` for a spot light.
+    pub view_proj: [f32; 16],
 }
 
 /// One frame to record into the engine's command buffer.
@@ -456,21 +528,20 @@ pub struct HrtsFrame {
     pub struct_size: u32,
     /// `VkCommandBuffer` in the recording state, outside a render pass, from `queue_family_index`.
     pub command_buffer: u64,
+    /// The engine's frame counter: it increases from frame to frame (gaps allowed) and stays the same
+    /// across the calls that record one frame pass by pass. Recording frame `f` states that every frame
+    /// up to `f - frames_in_flight` has completed on the GPU.
+    pub frame_index: u64,
     /// World-to-view matrix, column-major.
     pub view: [f32; 16],
     /// View-to-clip matrix, column-major, reversed Z, Vulkan clip conventions.
     pub proj: [f32; 16],
     /// Camera position in world space.
     pub camera_position: [f32; 3],
-    /// `HrtsLightType`.
-    pub light_type: u32,
-    /// Spot light: emitter position in world space (ignored for directional lights).
-    pub light_position: [f32; 3],
-    /// Direction the light travels, or the spot light's axis (need not be normalised; non-zero).
-    pub light_direction: [f32; 3],
-    /// The light's view-projection enclosing shadow casters and receivers (column-major): orthographic
-    /// for a directional light, perspective with its eye at `light_position` for a spot light.
-    pub light_view_proj: [f32; 16],
+    /// The lights, one per configured light, in the order of `hrts_configure_lights`.
+    pub lights: *const HrtsLight,
+    /// Number of entries in `lights`: the number of configured lights.
+    pub light_count: u32,
     /// `VkImageLayout` of the depth image when the commands run; it is restored afterwards.
     pub depth_layout: i32,
     /// `VkImageLayout` of the normal image when the commands run; restored afterwards.
@@ -513,8 +584,11 @@ pub struct HrtsAllocationCallbacks {
 pub struct HrtsMemoryStats {
     /// `sizeof(HrtsMemoryStats)`, set by the caller.
     pub struct_size: u32,
-    /// Host bytes allocated by the plugin and not freed.
+    /// Host bytes allocated by the plugin and not freed (0 unless `host_bytes_counted`).
     pub host_bytes: u64,
+    /// Whether the plugin counts its host memory: true in its shared and static libraries, whose global
+    /// allocator counts it; false when a Rust program links the plugin's rlib and keeps its own allocator.
+    pub host_bytes_counted: bool,
     /// GPU bytes allocated by the plugin and not freed (excludes what the Vulkan driver keeps internally).
     pub gpu_bytes: u64,
 }
@@ -532,7 +606,7 @@ pub struct HrtsPassTiming {
 /// Maximum passes in a report.
 pub const HRTS_MAX_REPORTED_PASSES: usize = 32;
 
-/// What the last completed frame did. Read it after the engine's submission has completed.
+/// What one light's passes did in one frame (`hrts_get_frame_report`).
 #[repr(C)]
 pub struct HrtsFrameReport {
     /// `sizeof(HrtsFrameReport)`, set by the caller.
@@ -583,6 +657,8 @@ pub struct HrtsResourceReadback {
     pub command_buffer: u64,
     /// `HrtsResource` to copy (allocated by the configuration: see `HrtsConfig::extra_outputs`).
     pub resource: u32,
+    /// The light whose resource to copy.
+    pub light: u32,
     /// Destination `VkBuffer` (usage includes TRANSFER_DST).
     pub buffer: u64,
     /// Size of the destination buffer in bytes.
@@ -608,4 +684,25 @@ pub struct HrtsResourceInfo {
     pub format: i32,
     /// Bytes of a tightly packed read-back of all layers (layer-major, rows top to bottom).
     pub bytes: u64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn results_are_listed_in_value_order_with_their_c_names() {
+        for (i, r) in HrtsResult::ALL.iter().enumerate() {
+            assert_eq!(*r as usize, i);
+            assert_eq!(HrtsResult::from_c(i as i32), Some(*r));
+        }
+        assert_eq!(HrtsResult::from_c(-1), None);
+        assert_eq!(HrtsResult::from_c(HrtsResult::ALL.len() as i32), None);
+        assert_eq!(HrtsResult::Ok.c_name(), "HRTS_RESULT_OK");
+        assert_eq!(
+            HrtsResult::ErrorInvalidArgument.c_name(),
+            "HRTS_RESULT_ERROR_INVALID_ARGUMENT"
+        );
+        assert_eq!(HrtsResult::NotReady.c_name(), "HRTS_RESULT_NOT_READY");
+    }
 }

@@ -53,7 +53,8 @@ pub fn conservative_raster_tier(
 /// D3D12-style resource state, used on both sides of a transition.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum ResourceState {
-    /// Contents may be discarded.
+    /// Contents may be discarded. As the state before a transition it waits for every earlier command
+    /// (so that discarding an image that an earlier frame still reads is not a write-after-read hazard).
     Undefined,
     /// UAV: read/write storage access from any shader stage.
     UnorderedAccess,
@@ -99,7 +100,7 @@ pub fn state_scope(
 ) -> (vk::ImageLayout, vk::PipelineStageFlags2, vk::AccessFlags2) {
     use vk::{AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
     match state {
-        ResourceState::Undefined => (L::UNDEFINED, S::TOP_OF_PIPE, A::NONE),
+        ResourceState::Undefined => (L::UNDEFINED, S::ALL_COMMANDS, A::NONE),
         ResourceState::UnorderedAccess => (
             L::GENERAL,
             SHADER_STAGES,

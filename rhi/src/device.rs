@@ -122,9 +122,12 @@ pub(crate) struct Shared {
 
 impl Drop for Shared {
     fn drop(&mut self) {
-        // SAFETY: every resource holds an Arc<Shared>, so none is alive now; the device is idle after the wait.
+        // SAFETY: every resource holds an Arc<Shared>, so none is alive now; the device is idle after the wait
+        // (an adopted device's engine has finished the plugin's work: its contract).
         unsafe {
-            let _ = self.device.device_wait_idle();
+            if self.owned {
+                let _ = self.device.device_wait_idle();
+            }
             self.device.destroy_sampler(self.nearest_sampler, None);
             ManuallyDrop::drop(&mut self.allocator);
             if self.owned {
@@ -141,7 +144,9 @@ impl Drop for Shared {
 /// A Vulkan device with a graphics+compute queue, a memory allocator and its capabilities.
 pub struct Device {
     pub(crate) shared: Arc<Shared>,
-    command_pool: vk::CommandPool,
+    /// The pool of `submit_and_wait`'s command buffers; its lock also serialises this device's own queue
+    /// submissions, so `Device` may be shared between threads.
+    command_pool: Mutex<vk::CommandPool>,
 }
 
 /// `vkGetInstanceProcAddr` as a plain C function pointer (`VkInstance` is a pointer-sized handle).
@@ -394,9 +399,20 @@ impl Device {
         let entry = unsafe { ash::Entry::from_static_fn(static_fn.clone()) };
         // SAFETY: as above.
         let instance = unsafe { ash::Instance::load(&static_fn, instance) };
+        let problems = adoption_problems(
+            &instance,
+            vk::PhysicalDevice::from_raw(desc.physical_device),
+            &desc,
+        );
+        if !problems.is_empty() {
+            return Err(RhiError::MissingFeature(format!(
+                "the adopted device cannot run the plugin: {}",
+                problems.join("; ")
+            )));
+        }
         // SAFETY: as above.
         let device = unsafe { ash::Device::load(instance.fp_v1_0(), device) };
-        // SAFETY: the caller guarantees the queue exists.
+        // SAFETY: the caller guarantees the queue exists (checked against the family's queue count above).
         let queue = unsafe { device.get_device_queue(desc.queue_family_index, desc.queue_index) };
         let f = desc.enabled_features;
         let features = vk::PhysicalDeviceFeatures::default()
@@ -501,7 +517,7 @@ impl Device {
         });
         Ok(Self {
             shared,
-            command_pool,
+            command_pool: Mutex::new(command_pool),
         })
     }
 
@@ -537,18 +553,24 @@ impl Device {
         &self.shared.validation
     }
 
-    /// Records commands with `record`, submits them and waits for completion.
+    /// Records commands with `record`, submits them and waits for completion. Only on a device of the RHI's
+    /// own: an adopted device's queue belongs to the engine, which synchronises its use.
     pub fn submit_and_wait<R>(
         &self,
         record: impl FnOnce(&mut crate::Encoder<'_>) -> Result<R>,
     ) -> Result<R> {
+        self.require_owned("submit_and_wait")?;
+        let pool = self
+            .command_pool
+            .lock()
+            .map_err(|_| RhiError::InvalidArgument("command pool lock poisoned".into()))?;
         let d = &self.shared.device;
         let alloc = vk::CommandBufferAllocateInfo::default()
-            .command_pool(self.command_pool)
+            .command_pool(*pool)
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(1);
-        // SAFETY: the pool belongs to this device and is only used from `&self` calls that finish before
-        // returning; the command buffer is freed below on every path.
+        // SAFETY: the pool and the queue are used only under the pool's lock, held until this returns; the
+        // command buffer is freed below on every path.
         unsafe {
             let cmd = d
                 .allocate_command_buffers(&alloc)
@@ -578,26 +600,52 @@ impl Device {
                 d.destroy_fence(fence, None);
                 waited.map(|_| r)
             })();
-            d.free_command_buffers(self.command_pool, &[cmd]);
+            d.free_command_buffers(*pool, &[cmd]);
             result
         }
     }
 
-    /// Waits until the GPU is idle.
+    /// Waits until the GPU is idle. Only on a device of the RHI's own (see [`Device::submit_and_wait`]).
     pub fn wait_idle(&self) -> Result<()> {
-        // SAFETY: valid device.
+        self.require_owned("wait_idle")?;
+        let _queue = self
+            .command_pool
+            .lock()
+            .map_err(|_| RhiError::InvalidArgument("command pool lock poisoned".into()))?;
+        // SAFETY: valid device; its only queue is used under the lock held here.
         unsafe { self.shared.device.device_wait_idle() }.call("vkDeviceWaitIdle")
+    }
+
+    /// Whether this device was created by the RHI (rather than adopted from an engine).
+    pub fn is_owned(&self) -> bool {
+        self.shared.owned
+    }
+
+    fn require_owned(&self, what: &str) -> Result<()> {
+        if self.shared.owned {
+            Ok(())
+        } else {
+            Err(RhiError::InvalidArgument(format!(
+                "{what} needs a device of the RHI's own: an adopted device's queues belong to the engine"
+            )))
+        }
     }
 }
 
 impl Drop for Device {
     fn drop(&mut self) {
-        // SAFETY: command buffers from this pool are freed after each submission; the device is idle.
+        let pool = match self.command_pool.get_mut() {
+            Ok(pool) => *pool,
+            Err(poisoned) => *poisoned.into_inner(),
+        };
+        // SAFETY: command buffers from this pool are freed after each submission. A device of our own is
+        // waited idle; an adopted one's engine has finished the work that used the plugin (its contract), and
+        // its queues are the engine's to synchronise, so it is not waited on here.
         unsafe {
-            let _ = self.shared.device.device_wait_idle();
-            self.shared
-                .device
-                .destroy_command_pool(self.command_pool, None);
+            if self.shared.owned {
+                let _ = self.shared.device.device_wait_idle();
+            }
+            self.shared.device.destroy_command_pool(pool, None);
         }
     }
 }
@@ -644,6 +692,87 @@ fn ray_tracing_features(
         acceleration_structure: accel.acceleration_structure == vk::TRUE,
         ray_tracing_pipeline: pipeline.ray_tracing_pipeline == vk::TRUE,
     }
+}
+
+/// What the engine's physical device lacks, or what the engine claims it enabled that the device does not
+/// support, for the plugin to adopt it (empty: nothing).
+fn adoption_problems(
+    instance: &ash::Instance,
+    pd: vk::PhysicalDevice,
+    desc: &AdoptDesc,
+) -> Vec<String> {
+    let mut problems = Vec::new();
+    // SAFETY: the caller of `adopt` guarantees `pd` belongs to `instance`.
+    let props = unsafe { instance.get_physical_device_properties(pd) };
+    if props.api_version < REQUIRED_API {
+        problems.push(format!(
+            "Vulkan {}.{} (1.3 needed)",
+            vk::api_version_major(props.api_version),
+            vk::api_version_minor(props.api_version)
+        ));
+        return problems;
+    }
+    let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
+    // SAFETY: as above; the chain outlives the call.
+    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+    let core = f2.features;
+    for (supported, name) in [
+        (f13.dynamic_rendering, "dynamicRendering (required)"),
+        (f13.synchronization2, "synchronization2 (required)"),
+    ] {
+        if supported == vk::FALSE {
+            problems.push(format!("no {name}"));
+        }
+    }
+    let f = desc.enabled_features;
+    for (claimed, supported, name) in [
+        (f.geometry_shader, core.geometry_shader, "geometryShader"),
+        (
+            f.fragment_stores_and_atomics,
+            core.fragment_stores_and_atomics,
+            "fragmentStoresAndAtomics",
+        ),
+        (f.depth_clamp, core.depth_clamp, "depthClamp"),
+        (f.shader_float64, core.shader_float64, "shaderFloat64"),
+    ] {
+        if claimed && supported == vk::FALSE {
+            problems.push(format!("{name} is claimed enabled but not supported"));
+        }
+    }
+    // SAFETY: as above.
+    let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
+    match families.get(desc.queue_family_index as usize) {
+        None => problems.push(format!(
+            "queue family {} does not exist ({} families)",
+            desc.queue_family_index,
+            families.len()
+        )),
+        Some(family) => {
+            let needed = vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE;
+            if !family.queue_flags.contains(needed) {
+                problems.push(format!(
+                    "queue family {} lacks graphics and compute",
+                    desc.queue_family_index
+                ));
+            }
+            if desc.queue_index >= family.queue_count {
+                problems.push(format!(
+                    "queue {} does not exist in family {} ({} queues)",
+                    desc.queue_index, desc.queue_family_index, family.queue_count
+                ));
+            }
+        }
+    }
+    let supported = device_extensions(instance, pd);
+    for ext in &desc.enabled_extensions {
+        if !supported.iter().any(|s| s == ext) {
+            problems.push(format!(
+                "extension {ext} is claimed enabled but not supported"
+            ));
+        }
+    }
+    problems
 }
 
 /// Why a physical device cannot run the plugin, or None if it can.

@@ -30,6 +30,9 @@ pub enum Barrier<'a> {
         /// State after.
         after: ResourceState,
     },
+    /// Orders every earlier command and its memory writes before every later command: what separates the
+    /// work of one frame from the frames before it that reuse the same resources.
+    Full,
     /// Global memory dependency for buffers between two states.
     Global {
         /// State before.
@@ -287,6 +290,15 @@ impl<'a> Encoder<'a> {
         for b in barriers {
             match b {
                 Barrier::Uav => memory.push(uav_barrier()),
+                Barrier::Full => memory.push(
+                    vk::MemoryBarrier2::default()
+                        .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                        .src_access_mask(vk::AccessFlags2::MEMORY_WRITE)
+                        .dst_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                        .dst_access_mask(
+                            vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE,
+                        ),
+                ),
                 Barrier::Global { before, after } => {
                     let (_, ss, sa) = state_scope(*before);
                     let (_, ds, da) = state_scope(*after);
@@ -359,6 +371,68 @@ impl<'a> Encoder<'a> {
             self.d()
                 .cmd_fill_buffer(self.cmd, buffer.raw, 0, vk::WHOLE_SIZE, value)
         };
+    }
+
+    /// Writes `data` into `buffer` at `offset` from the command buffer (`vkCmdUpdateBuffer`): the data is
+    /// copied into the recording, so frames in flight each see their own. The update waits for earlier
+    /// shader reads of the buffer and is visible to later uniform and storage reads. `data` is at most
+    /// 65,536 bytes, a multiple of 4, and the buffer has `COPY_DST` usage.
+    pub fn update_buffer(&mut self, buffer: &Buffer, offset: u64, data: &[u8]) -> Result<()> {
+        let end = offset.checked_add(data.len() as u64);
+        if data.is_empty()
+            || data.len() > 65_536
+            || !data.len().is_multiple_of(4)
+            || !offset.is_multiple_of(4)
+            || end.is_none_or(|e| e > buffer.size())
+        {
+            return Err(RhiError::InvalidArgument(format!(
+                "buffer update of {} bytes at offset {offset} into {} bytes: needs 4..=65536 bytes, \
+                 multiples of 4, within the buffer",
+                data.len(),
+                buffer.size()
+            )));
+        }
+        let (_, reader_stages, reader_access) = state_scope(ResourceState::ShaderResource);
+        let (_, copy_stages, copy_access) = state_scope(ResourceState::CopyDest);
+        let barrier = |src, src_access, dst, dst_access| {
+            vk::BufferMemoryBarrier2::default()
+                .src_stage_mask(src)
+                .src_access_mask(src_access)
+                .dst_stage_mask(dst)
+                .dst_access_mask(dst_access)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .buffer(buffer.raw)
+                .offset(offset)
+                .size(data.len() as u64)
+        };
+        let before = [barrier(
+            reader_stages,
+            vk::AccessFlags2::NONE,
+            copy_stages,
+            copy_access,
+        )];
+        let after = [barrier(
+            copy_stages,
+            copy_access,
+            reader_stages,
+            reader_access,
+        )];
+        let d = self.d();
+        // SAFETY: recording command buffer outside a render pass; a live buffer; size, offset and alignment
+        // checked above; the barriers only name that buffer.
+        unsafe {
+            d.cmd_pipeline_barrier2(
+                self.cmd,
+                &vk::DependencyInfo::default().buffer_memory_barriers(&before),
+            );
+            d.cmd_update_buffer(self.cmd, buffer.raw, offset, data);
+            d.cmd_pipeline_barrier2(
+                self.cmd,
+                &vk::DependencyInfo::default().buffer_memory_barriers(&after),
+            );
+        }
+        Ok(())
     }
 
     /// Binds a pipeline, its bind group (set 0) and its push constants.
@@ -588,6 +662,46 @@ impl<'a> Encoder<'a> {
                 depth: 1,
             });
         // SAFETY: sizes and formats checked; the images are in the stated layouts by contract.
+        unsafe {
+            self.d().cmd_copy_image(
+                self.cmd,
+                src.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                dst.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[region],
+            )
+        };
+        Ok(())
+    }
+
+    /// Copies the single-layer image `src` into array layer `layer` of `dst` (same size and format).
+    pub fn copy_image_into_layer(&mut self, src: &Image, dst: &Image, layer: u32) -> Result<()> {
+        if (src.width(), src.height(), src.format()) != (dst.width(), dst.height(), dst.format())
+            || src.layers() != 1
+            || layer >= dst.layers()
+        {
+            return Err(RhiError::InvalidArgument(format!(
+                "image copy into layer {layer} of {} needs one source layer of the same size and format",
+                dst.layers()
+            )));
+        }
+        let subresource = |base| {
+            vk::ImageSubresourceLayers::default()
+                .aspect_mask(src.format().aspect())
+                .mip_level(0)
+                .base_array_layer(base)
+                .layer_count(1)
+        };
+        let region = vk::ImageCopy::default()
+            .src_subresource(subresource(0))
+            .dst_subresource(subresource(layer))
+            .extent(vk::Extent3D {
+                width: src.width(),
+                height: src.height(),
+                depth: 1,
+            });
+        // SAFETY: sizes, formats and the layer checked; the images are in the stated layouts by contract.
         unsafe {
             self.d().cmd_copy_image(
                 self.cmd,

@@ -361,39 +361,8 @@ impl Device {
             )));
         }
         let d = &self.shared.device;
-        let mut sizes: Vec<vk::DescriptorPoolSize> = Vec::new();
-        for &k in &layout.kinds {
-            let ty = descriptor_type(k);
-            match sizes.iter_mut().find(|s| s.ty == ty) {
-                Some(s) => s.descriptor_count += 1,
-                None => sizes.push(vk::DescriptorPoolSize {
-                    ty,
-                    descriptor_count: 1,
-                }),
-            }
-        }
-        let pool_info = vk::DescriptorPoolCreateInfo::default()
-            .max_sets(1)
-            .pool_sizes(&sizes);
-        // SAFETY: valid device; the pool is destroyed with the BindGroup.
-        let pool =
-            unsafe { d.create_descriptor_pool(&pool_info, None) }.call("vkCreateDescriptorPool")?;
-        let mut group = BindGroup {
-            shared: self.shared.clone(),
-            pool,
-            set: vk::DescriptorSet::null(),
-            kinds: layout.kinds.clone(),
-        };
-        let layouts = [layout.set_layout];
-        // SAFETY: the pool has room for exactly this set.
-        let set = unsafe {
-            d.allocate_descriptor_sets(
-                &vk::DescriptorSetAllocateInfo::default()
-                    .descriptor_pool(pool)
-                    .set_layouts(&layouts),
-            )
-        }
-        .call("vkAllocateDescriptorSets")?[0];
+        let group = self.allocate_group(layout)?;
+        let set = group.set;
         let mut buffer_infos = Vec::new();
         let mut image_infos = Vec::new();
         let mut structures = Vec::new();
@@ -477,43 +446,93 @@ impl Device {
         }
         // SAFETY: all handles are live; the infos outlive the call.
         unsafe { d.update_descriptor_sets(&writes, &[]) };
-        group.set = set;
         Ok(group)
     }
 
-    /// Points buffer binding `binding` of `group` at `buffer` (a buffer that replaced the one bound, e.g.
-    /// after growing it).
-    ///
-    /// # Safety
-    /// No command buffer that uses `group` may be pending or recording (the descriptor set is updated in
-    /// place, without update-after-bind).
-    pub unsafe fn rebind_buffer(
+    /// A bind group of `layout` with an allocated, unwritten descriptor set.
+    fn allocate_group(&self, layout: &PipelineLayout) -> Result<BindGroup> {
+        let d = &self.shared.device;
+        let mut sizes: Vec<vk::DescriptorPoolSize> = Vec::new();
+        for &k in &layout.kinds {
+            let ty = descriptor_type(k);
+            match sizes.iter_mut().find(|s| s.ty == ty) {
+                Some(s) => s.descriptor_count += 1,
+                None => sizes.push(vk::DescriptorPoolSize {
+                    ty,
+                    descriptor_count: 1,
+                }),
+            }
+        }
+        let pool_info = vk::DescriptorPoolCreateInfo::default()
+            .max_sets(1)
+            .pool_sizes(&sizes);
+        // SAFETY: valid device; the pool is destroyed with the BindGroup.
+        let pool =
+            unsafe { d.create_descriptor_pool(&pool_info, None) }.call("vkCreateDescriptorPool")?;
+        let mut group = BindGroup {
+            shared: self.shared.clone(),
+            pool,
+            set: vk::DescriptorSet::null(),
+            kinds: layout.kinds.clone(),
+        };
+        let layouts = [layout.set_layout];
+        // SAFETY: the pool has room for exactly this set.
+        group.set = unsafe {
+            d.allocate_descriptor_sets(
+                &vk::DescriptorSetAllocateInfo::default()
+                    .descriptor_pool(pool)
+                    .set_layouts(&layouts),
+            )
+        }
+        .call("vkAllocateDescriptorSets")?[0];
+        Ok(group)
+    }
+
+    /// A new bind group of the same layout as `group` whose buffer binding `binding` is `buffer` (a buffer
+    /// that replaced the one bound, e.g. after growing it) and whose other bindings are `group`'s. `group`
+    /// is left as it was, so frames in flight that use it stay valid; drop it once they completed.
+    pub fn rebound(
         &self,
-        group: &mut BindGroup,
+        layout: &PipelineLayout,
+        group: &BindGroup,
         binding: u32,
         buffer: &Buffer,
-    ) -> Result<()> {
+    ) -> Result<BindGroup> {
         let kind = group.kinds.get(binding as usize).copied();
-        if !matches!(
-            kind,
-            Some(BindingKind::StorageBuffer | BindingKind::UniformBuffer)
-        ) {
+        let Some(kind @ (BindingKind::StorageBuffer | BindingKind::UniformBuffer)) = kind else {
             return Err(RhiError::InvalidArgument(format!(
                 "binding {binding} of the group is not a buffer binding"
             )));
+        };
+        if layout.kinds != group.kinds {
+            return Err(RhiError::InvalidArgument(
+                "the layout is not the bind group's".into(),
+            ));
         }
+        let fresh = self.allocate_group(layout)?;
+        let copies: Vec<vk::CopyDescriptorSet<'_>> = (0..group.kinds.len() as u32)
+            .filter(|&i| i != binding)
+            .map(|i| {
+                vk::CopyDescriptorSet::default()
+                    .src_set(group.set)
+                    .src_binding(i)
+                    .dst_set(fresh.set)
+                    .dst_binding(i)
+                    .descriptor_count(1)
+            })
+            .collect();
         let info = [vk::DescriptorBufferInfo::default()
             .buffer(buffer.raw)
             .range(vk::WHOLE_SIZE)];
         let write = vk::WriteDescriptorSet::default()
-            .dst_set(group.set)
+            .dst_set(fresh.set)
             .dst_binding(binding)
-            .descriptor_type(descriptor_type(kind.unwrap_or(BindingKind::StorageBuffer)))
+            .descriptor_type(descriptor_type(kind))
             .buffer_info(&info);
-        // SAFETY: live set and buffer of a matching binding kind; the caller guarantees the set is not in
-        // use by the GPU or a recording.
-        unsafe { self.shared.device.update_descriptor_sets(&[write], &[]) };
-        Ok(())
+        // SAFETY: `fresh` is new and unused; `group` is only read (copying from a set in use is allowed);
+        // both have the same layout; the buffer is live and of the binding's kind.
+        unsafe { self.shared.device.update_descriptor_sets(&[write], &copies) };
+        Ok(fresh)
     }
 }
 

@@ -1,0 +1,487 @@
+//! Conversion between the C types and the Rust ones, checking every value.
+
+use crate::error::{check_size, invalid, ApiError, ApiResult};
+use crate::types::*;
+use glam::{Mat4, Vec3};
+use passes::{
+    BinningPath, BinningRequest, FaceMode, FrameInputs, Light, PassId, PenumbraFilter,
+    PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig, ShadowMode,
+};
+use rhi::ImageUsage;
+
+pub(crate) fn finite(values: &[f32], what: &str) -> ApiResult<()> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(invalid(format!("{what} contains NaN or infinity")))
+    }
+}
+
+/// The plugin's resources by their C value (`HrtsResource`), in that order.
+pub(crate) const RESOURCES: [ResourceId; HRTS_RESOURCE_COUNT] = [
+    ResourceId::ShadowMap,
+    ResourceId::PrimListOffsets,
+    ResourceId::PrimListEntries,
+    ResourceId::Occupancy,
+    ResourceId::RtVisibility,
+    ResourceId::BlockerDistance,
+    ResourceId::ShadowMapVisibility,
+    ResourceId::Pcss,
+    ResourceId::RtAntialiased,
+    ResourceId::LerpFactor,
+    ResourceId::Hybrid,
+    ResourceId::Lit,
+];
+
+/// The pipeline's passes by their C value (`HrtsPass`); `HRTS_PASS_OUTPUT_COPY` is the context's own.
+pub(crate) fn pass_from_index(index: u32) -> Option<PassId> {
+    PassId::ALL.get(index as usize).copied()
+}
+
+fn image_usage(vk_usage: u32) -> ImageUsage {
+    const TRANSFER_SRC: u32 = 0x1;
+    const TRANSFER_DST: u32 = 0x2;
+    const SAMPLED: u32 = 0x4;
+    const STORAGE: u32 = 0x8;
+    const COLOR: u32 = 0x10;
+    const DEPTH: u32 = 0x20;
+    let mut u = ImageUsage::default();
+    for (bit, ours) in [
+        (TRANSFER_SRC, ImageUsage::COPY_SRC),
+        (TRANSFER_DST, ImageUsage::COPY_DST),
+        (SAMPLED, ImageUsage::SAMPLED),
+        (STORAGE, ImageUsage::STORAGE),
+        (COLOR, ImageUsage::COLOR_TARGET),
+        (DEPTH, ImageUsage::DEPTH_TARGET),
+    ] {
+        if vk_usage & bit != 0 {
+            u = u | ours;
+        }
+    }
+    u
+}
+
+pub(crate) fn require_usage(
+    vk_usage: u32,
+    needed: ImageUsage,
+    what: &str,
+    needed_name: &str,
+) -> ApiResult<ImageUsage> {
+    let usage = image_usage(vk_usage);
+    if !usage.contains(needed) {
+        return Err(ApiError::new(
+            HrtsResult::ErrorImageUsage,
+            format!("{what} was not created with {needed_name} usage (usage flags 0x{vk_usage:x})"),
+        ));
+    }
+    Ok(usage)
+}
+
+pub(crate) fn mat4(m: &[f32; 16]) -> Mat4 {
+    Mat4::from_cols_array(m)
+}
+
+pub(crate) fn resource_id(value: u32) -> ApiResult<ResourceId> {
+    RESOURCES.get(value as usize).copied().ok_or_else(|| {
+        ApiError::new(
+            HrtsResult::ErrorInvalidEnum,
+            format!("resource {value} is not a HrtsResource value"),
+        )
+    })
+}
+
+pub(crate) fn resource_index(id: ResourceId) -> ApiResult<u32> {
+    RESOURCES
+        .iter()
+        .position(|&r| r == id)
+        .map(|i| i as u32)
+        .ok_or_else(|| {
+            ApiError::new(
+                HrtsResult::ErrorInternal,
+                format!("{} has no HrtsResource value", id.name()),
+            )
+        })
+}
+
+/// The camera and each light of a frame (every field checked): one `FrameInputs` per light.
+pub(crate) fn frame_inputs(f: &HrtsFrame) -> ApiResult<Vec<FrameInputs>> {
+    finite(&f.view, "view")?;
+    finite(&f.proj, "proj")?;
+    finite(&f.camera_position, "camera_position")?;
+    if f.light_count == 0 || f.light_count > HRTS_MAX_LIGHTS {
+        return Err(invalid(format!(
+            "light_count {} must be within 1..={HRTS_MAX_LIGHTS}",
+            f.light_count
+        )));
+    }
+    if f.lights.is_null() {
+        return Err(ApiError::new(
+            HrtsResult::ErrorNullPointer,
+            "lights is NULL",
+        ));
+    }
+    // SAFETY: the caller guarantees `lights` points at `light_count` lights (documented contract).
+    let lights = unsafe { std::slice::from_raw_parts(f.lights, f.light_count as usize) };
+    lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            Ok(FrameInputs {
+                view: mat4(&f.view),
+                proj: mat4(&f.proj),
+                camera_position: Vec3::from_array(f.camera_position),
+                light: light_from_c(l, i)?,
+            })
+        })
+        .collect()
+}
+
+/// The light of `lights[index]` (every field checked).
+fn light_from_c(l: &HrtsLight, index: usize) -> ApiResult<Light> {
+    let field = |name: &str| format!("lights[{index}].{name}");
+    finite(&l.direction, &field("direction"))?;
+    finite(&l.view_proj, &field("view_proj"))?;
+    finite(&l.position, &field("position"))?;
+    let direction = Vec3::from_array(l.direction);
+    if direction.length_squared() == 0.0 {
+        return Err(invalid(format!("{} is zero", field("direction"))));
+    }
+    let view_proj = mat4(&l.view_proj);
+    let spot = enum_value(
+        l.light_type,
+        &[
+            (HrtsLightType::Directional as u32, false),
+            (HrtsLightType::Spot as u32, true),
+        ],
+        &field("light_type"),
+        "HrtsLightType",
+    )?;
+    // Passed on as given: the passes normalise in f64 (normalising here in f32 would round twice).
+    Ok(if spot {
+        Light::Spot {
+            position: Vec3::from_array(l.position),
+            direction,
+            view_proj,
+        }
+    } else {
+        Light::Directional {
+            direction,
+            view_proj,
+        }
+    })
+}
+
+pub(crate) fn enum_value<T>(
+    value: u32,
+    variants: &[(u32, T)],
+    field: &str,
+    type_name: &str,
+) -> ApiResult<T>
+where
+    T: Copy,
+{
+    variants
+        .iter()
+        .find(|(v, _)| *v == value)
+        .map(|(_, t)| *t)
+        .ok_or_else(|| {
+            ApiError::new(
+                HrtsResult::ErrorInvalidEnum,
+                format!("{field} {value} is not a {type_name} value"),
+            )
+        })
+}
+
+fn positive(value: f32, field: &str) -> ApiResult<f32> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(invalid(format!(
+            "{field} must be a positive finite number, got {value}"
+        )))
+    }
+}
+
+fn non_negative(value: f32, field: &str) -> ApiResult<f32> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(invalid(format!(
+            "{field} must be a non-negative finite number, got {value}"
+        )))
+    }
+}
+
+fn taps(value: u32, field: &str) -> ApiResult<u32> {
+    if (1..=256).contains(&value) {
+        Ok(value)
+    } else {
+        Err(invalid(format!(
+            "{field} must be within 1..=256, got {value}"
+        )))
+    }
+}
+
+/// `HrtsShadowMode` values and the modes they name (both directions use this one table).
+const MODES: [(u32, ShadowMode); 4] = [
+    (HrtsShadowMode::None as u32, ShadowMode::None),
+    (HrtsShadowMode::Hard as u32, ShadowMode::Hard),
+    (HrtsShadowMode::Soft as u32, ShadowMode::Soft),
+    (HrtsShadowMode::Hybrid as u32, ShadowMode::Hybrid),
+];
+
+/// `HrtsFaces` values.
+const FACES: [(u32, FaceMode); 2] = [
+    (HrtsFaces::Both as u32, FaceMode::Both),
+    (HrtsFaces::FrontOnly as u32, FaceMode::FrontOnly),
+];
+
+/// The C value of a binning path in use.
+pub(crate) fn binning_path_to_c(path: BinningPath) -> HrtsBinningPath {
+    match path {
+        BinningPath::Compute => HrtsBinningPath::Compute,
+        BinningPath::Hardware(_) => HrtsBinningPath::Hardware,
+        BinningPath::Software => HrtsBinningPath::Software,
+        BinningPath::EmulatedTier1 { .. } => HrtsBinningPath::EmulatedTier1,
+    }
+}
+
+/// `HrtsBinningPath` values as requests.
+const BINNING_REQUESTS: [(u32, BinningRequest); 5] = [
+    (HrtsBinningPath::Auto as u32, BinningRequest::Auto),
+    (HrtsBinningPath::Compute as u32, BinningRequest::Compute),
+    (HrtsBinningPath::Hardware as u32, BinningRequest::Hardware),
+    (HrtsBinningPath::Software as u32, BinningRequest::Software),
+    (
+        HrtsBinningPath::EmulatedTier1 as u32,
+        BinningRequest::EmulateTier1,
+    ),
+];
+
+/// `HrtsPenumbraFilter` values.
+const FILTERS: [(u32, PenumbraFilter); 2] = [
+    (
+        HrtsPenumbraFilter::Shrinking as u32,
+        PenumbraFilter::Shrinking,
+    ),
+    (
+        HrtsPenumbraFilter::Standard as u32,
+        PenumbraFilter::Standard,
+    ),
+];
+
+/// The C value of `value` in `table` (every table covers its whole Rust enum).
+fn c_value<T: PartialEq>(value: T, table: &[(u32, T)]) -> u32 {
+    table
+        .iter()
+        .find(|(_, t)| *t == value)
+        .map_or(u32::MAX, |&(c, _)| c)
+}
+
+/// The plugin's configuration from the C one (every field checked).
+pub(crate) fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
+    check_size::<HrtsConfig>(c.struct_size, "HrtsConfig")?;
+    let mode = enum_value(c.mode, &MODES, "mode", "HrtsShadowMode")?;
+    let faces = enum_value(c.faces, &FACES, "faces", "HrtsFaces")?;
+    let binning = enum_value(
+        c.binning_path,
+        &BINNING_REQUESTS,
+        "binning_path",
+        "HrtsBinningPath",
+    )?;
+    if u64::from(c.map_entry_budget_kib) << 10 < passes::MIN_ENTRY_BUDGET {
+        return Err(invalid(format!(
+            "map_entry_budget_kib {} is below the minimum of {}",
+            c.map_entry_budget_kib,
+            passes::MIN_ENTRY_BUDGET >> 10
+        )));
+    }
+    let filter = enum_value(c.pcss_filter, &FILTERS, "pcss_filter", "HrtsPenumbraFilter")?;
+    if c.extra_outputs >> HRTS_RESOURCE_COUNT != 0 {
+        return Err(ApiError::new(
+            HrtsResult::ErrorInvalidEnum,
+            format!(
+                "extra_outputs 0x{:x} has bits of no HrtsResource",
+                c.extra_outputs
+            ),
+        ));
+    }
+    let extra_outputs = RESOURCES
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| c.extra_outputs & 1 << i != 0)
+        .fold(ResourceSet::EMPTY, |set, (_, &r)| set.with(r));
+    let mut config = ShadowConfig {
+        mode,
+        antialiasing: c.antialiasing,
+        static_light: c.static_light,
+        static_geometry: !c.dynamic_geometry,
+        extra_outputs,
+        map: PrimitiveMapConfig {
+            size: c.map_size,
+            faces,
+            binning,
+            entry_budget: u64::from(c.map_entry_budget_kib) << 10,
+            guard: c.guard_entries,
+            receiver_culling: !c.debug_bin_all_texels,
+            initial_entries: c.map_initial_entries,
+        },
+        ..ShadowConfig::default()
+    };
+    config.shadow_map.size = c.shadow_map_size;
+    config.shadow_map.constant_bias =
+        non_negative(c.shadow_map_constant_bias, "shadow_map_constant_bias")?;
+    config.shadow_map.slope_bias = non_negative(c.shadow_map_slope_bias, "shadow_map_slope_bias")?;
+    config.pcss.filter = filter;
+    config.pcss.max_search_radius = positive(c.pcss_max_search_radius, "pcss_max_search_radius")?;
+    config.pcss.min_filter_radius =
+        non_negative(c.pcss_min_filter_radius, "pcss_min_filter_radius")?;
+    config.pcss.max_filter_radius = positive(c.pcss_max_filter_radius, "pcss_max_filter_radius")?;
+    config.pcss.angular_radius = positive(c.pcss_angular_radius, "pcss_angular_radius")?;
+    config.pcss.spot_radius = positive(c.pcss_spot_radius, "pcss_spot_radius")?;
+    config.pcss.blocker_search_taps = taps(c.pcss_blocker_search_taps, "pcss_blocker_search_taps")?;
+    config.pcss.pcf_taps = taps(c.pcss_pcf_taps, "pcss_pcf_taps")?;
+    config.hybrid.world_space_scale =
+        positive(c.hybrid_world_space_scale, "hybrid_world_space_scale")?;
+    config.hybrid.hard_shadow_percentage = positive(
+        c.hybrid_hard_shadow_percentage,
+        "hybrid_hard_shadow_percentage",
+    )?;
+    config.pcss.validate()?;
+    Ok(config)
+}
+
+/// The C configuration of `config`, the inverse of [`shadow_config`]. Fails if an extra output has no
+/// `HrtsResource` value.
+pub(crate) fn config_to_c(config: &ShadowConfig) -> ApiResult<HrtsConfig> {
+    let extra_outputs = config.extra_outputs.iter().try_fold(0u32, |bits, r| {
+        resource_index(r).map(|i| bits | 1 << i).map_err(|_| {
+            invalid(format!(
+                "{} cannot be requested through the C ABI",
+                r.name()
+            ))
+        })
+    })?;
+    Ok(HrtsConfig {
+        struct_size: std::mem::size_of::<HrtsConfig>() as u32,
+        mode: c_value(config.mode, &MODES),
+        antialiasing: config.antialiasing,
+        static_light: config.static_light,
+        map_size: config.map.size,
+        map_entry_budget_kib: (config.map.entry_budget >> 10).min(u64::from(u32::MAX)) as u32,
+        faces: c_value(config.map.faces, &FACES),
+        binning_path: c_value(config.map.binning, &BINNING_REQUESTS),
+        shadow_map_size: config.shadow_map.size,
+        pcss_angular_radius: config.pcss.angular_radius,
+        pcss_spot_radius: config.pcss.spot_radius,
+        pcss_blocker_search_taps: config.pcss.blocker_search_taps,
+        pcss_pcf_taps: config.pcss.pcf_taps,
+        hybrid_world_space_scale: config.hybrid.world_space_scale,
+        hybrid_hard_shadow_percentage: config.hybrid.hard_shadow_percentage,
+        pcss_filter: c_value(config.pcss.filter, &FILTERS),
+        pcss_max_search_radius: config.pcss.max_search_radius,
+        pcss_min_filter_radius: config.pcss.min_filter_radius,
+        pcss_max_filter_radius: config.pcss.max_filter_radius,
+        shadow_map_constant_bias: config.shadow_map.constant_bias,
+        shadow_map_slope_bias: config.shadow_map.slope_bias,
+        dynamic_geometry: !config.static_geometry,
+        extra_outputs,
+        guard_entries: config.map.guard,
+        debug_bin_all_texels: !config.map.receiver_culling,
+        map_initial_entries: config.map.initial_entries,
+    })
+}
+
+/// Fills `out` with the defaults of [`ShadowConfig::default`].
+pub(crate) fn config_defaults(out: &mut HrtsConfig) -> ApiResult<()> {
+    check_size::<HrtsConfig>(out.struct_size, "HrtsConfig")?;
+    *out = config_to_c(&ShadowConfig::default())?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::record::DEPTH_NORMAL_READERS;
+
+    #[test]
+    fn c_pass_values_are_the_pipeline_order() {
+        let pairs = [
+            (HrtsPass::PrimBuffer, PassId::PrimBuffer),
+            (HrtsPass::ShadowMap, PassId::ShadowMap),
+            (HrtsPass::PrimitiveMap, PassId::PrimitiveMap),
+            (HrtsPass::Occupancy, PassId::Occupancy),
+            (HrtsPass::RayTrace, PassId::RayTrace),
+            (HrtsPass::ShadowMapTest, PassId::ShadowMapTest),
+            (HrtsPass::Pcss, PassId::Pcss),
+            (HrtsPass::Fxaa, PassId::Fxaa),
+            (HrtsPass::LerpFactor, PassId::LerpFactor),
+            (HrtsPass::Blend, PassId::Blend),
+            (HrtsPass::FillLit, PassId::FillLit),
+        ];
+        assert_eq!(pairs.len(), PassId::ALL.len());
+        for (c, rust) in pairs {
+            assert_eq!(pass_from_index(c as u32), Some(rust));
+        }
+        assert_eq!(pass_from_index(HrtsPass::OutputCopy as u32), None);
+        assert_eq!(HrtsPass::OutputCopy as usize + 1, HRTS_PASS_COUNT);
+        assert_eq!(HRTS_PASS_MASK_ALL, (1 << HRTS_PASS_COUNT) - 1);
+        assert_eq!(
+            HRTS_PASS_MASK_LIGHT_SPACE | HRTS_PASS_MASK_SCREEN_SPACE,
+            HRTS_PASS_MASK_ALL
+        );
+        assert_eq!(HRTS_PASS_MASK_LIGHT_SPACE & HRTS_PASS_MASK_SCREEN_SPACE, 0);
+        assert_eq!(HRTS_PASS_MASK_LIGHT_SPACE & DEPTH_NORMAL_READERS, 0);
+    }
+
+    #[test]
+    fn c_resource_values_name_the_pipeline_resources() {
+        let pairs = [
+            (HrtsResource::ShadowMap, ResourceId::ShadowMap),
+            (HrtsResource::PrimListOffsets, ResourceId::PrimListOffsets),
+            (HrtsResource::PrimListEntries, ResourceId::PrimListEntries),
+            (HrtsResource::Occupancy, ResourceId::Occupancy),
+            (HrtsResource::RtVisibility, ResourceId::RtVisibility),
+            (HrtsResource::BlockerDistance, ResourceId::BlockerDistance),
+            (
+                HrtsResource::ShadowMapVisibility,
+                ResourceId::ShadowMapVisibility,
+            ),
+            (HrtsResource::Pcss, ResourceId::Pcss),
+            (HrtsResource::RtAntialiased, ResourceId::RtAntialiased),
+            (HrtsResource::LerpFactor, ResourceId::LerpFactor),
+            (HrtsResource::Hybrid, ResourceId::Hybrid),
+            (HrtsResource::Lit, ResourceId::Lit),
+        ];
+        assert_eq!(pairs.len(), HRTS_RESOURCE_COUNT);
+        for (c, rust) in pairs {
+            assert_eq!(resource_id(c as u32).ok(), Some(rust));
+            assert_eq!(resource_index(rust).ok(), Some(c as u32));
+        }
+        assert!(resource_id(HRTS_RESOURCE_COUNT as u32).is_err());
+    }
+
+    #[test]
+    fn configurations_round_trip_through_c() {
+        let mut c = config_to_c(&ShadowConfig::default()).expect("defaults");
+        config_defaults(&mut c).expect("defaults");
+        assert_eq!(shadow_config(&c).expect("valid"), ShadowConfig::default());
+        let mut other = ShadowConfig {
+            mode: ShadowMode::Soft,
+            antialiasing: false,
+            static_geometry: false,
+            static_light: true,
+            extra_outputs: ResourceSet::of(&[ResourceId::RtVisibility, ResourceId::Lit]),
+            ..ShadowConfig::default()
+        };
+        other.map.faces = FaceMode::FrontOnly;
+        other.map.binning = BinningRequest::EmulateTier1;
+        other.map.guard = true;
+        other.pcss.filter = PenumbraFilter::Standard;
+        other.shadow_map.slope_bias = 2.5;
+        let c = config_to_c(&other).expect("representable");
+        assert_eq!(shadow_config(&c).expect("valid"), other);
+        other.extra_outputs = ResourceSet::of(&[ResourceId::PrimBuffer]);
+        assert!(config_to_c(&other).is_err());
+    }
+}

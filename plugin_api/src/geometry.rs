@@ -1,0 +1,204 @@
+//! Geometry intake: the engine's CPU arrays or Vulkan buffers, checked and kept to rebuild the passes.
+
+use crate::convert::{enum_value, finite, mat4};
+use crate::error::{check_size, invalid, ApiError, ApiResult};
+use crate::types::*;
+use glam::{DVec3, Vec3};
+use passes::{Draw, Geometry, IndexFormat, IndexLayout, VertexLayout};
+use rhi::{BufferUsage, Device};
+
+/// The frame origin of geometry within `lo..hi`: the centre, rounded to f32. Then the frame coordinates
+/// of f32 world positions near it (vertex minus origin) are differences of numbers on the same f32 grid,
+/// and computing them loses nothing.
+fn frame_origin(lo: DVec3, hi: DVec3) -> DVec3 {
+    ((lo + hi) * 0.5).as_vec3().as_dvec3()
+}
+
+/// Geometry as the engine described it, kept to rebuild the passes after a configuration change.
+pub(crate) enum GeometrySource {
+    Cpu {
+        positions: Vec<f32>,
+        indices: Vec<u32>,
+        draws: Vec<Draw>,
+        origin: DVec3,
+    },
+    Vulkan {
+        vertices: (u64, u64),
+        vertex: VertexLayout,
+        indices: (u64, u64),
+        index: IndexLayout,
+        draws: Vec<Draw>,
+        origin: DVec3,
+    },
+}
+
+fn draws_from(ptr: *const HrtsDraw, count: u32) -> ApiResult<Vec<Draw>> {
+    if count == 0 {
+        return Err(invalid("draw_count is 0"));
+    }
+    if ptr.is_null() {
+        return Err(ApiError::new(HrtsResult::ErrorNullPointer, "draws is NULL"));
+    }
+    // SAFETY: the caller guarantees `ptr` points at `count` draws (documented contract).
+    let draws = unsafe { std::slice::from_raw_parts(ptr, count as usize) };
+    draws
+        .iter()
+        .enumerate()
+        .map(|(i, d)| {
+            finite(&d.transform, &format!("draws[{i}].transform"))?;
+            Ok(Draw {
+                first_index: d.first_index,
+                index_count: d.index_count,
+                model: mat4(&d.transform),
+            })
+        })
+        .collect()
+}
+
+/// The geometry of `hrts_set_geometry_cpu`, copied and checked.
+pub(crate) fn cpu_geometry(g: &HrtsCpuGeometry) -> ApiResult<GeometrySource> {
+    check_size::<HrtsCpuGeometry>(g.struct_size, "HrtsCpuGeometry")?;
+    if g.positions.is_null() || g.indices.is_null() {
+        return Err(ApiError::new(
+            HrtsResult::ErrorNullPointer,
+            "positions and indices must be non-NULL",
+        ));
+    }
+    if g.vertex_count == 0 || g.index_count == 0 {
+        return Err(invalid("vertex_count and index_count must be positive"));
+    }
+    if g.vertex_stride < 12 || !g.vertex_stride.is_multiple_of(4) {
+        return Err(invalid(format!(
+            "vertex_stride {} must be a multiple of 4 and at least 12",
+            g.vertex_stride
+        )));
+    }
+    let floats = (g.vertex_count as usize - 1) * (g.vertex_stride as usize / 4) + 3;
+    // SAFETY: the caller guarantees the arrays hold `vertex_count` strided positions and `index_count`
+    // indices (documented contract); they are copied before returning.
+    let raw = unsafe { std::slice::from_raw_parts(g.positions, floats) };
+    let step = g.vertex_stride as usize / 4;
+    let positions: Vec<f32> = (0..g.vertex_count as usize)
+        .flat_map(|i| raw[i * step..i * step + 3].to_vec())
+        .collect();
+    finite(&positions, "positions")?;
+    // SAFETY: as above.
+    let indices = unsafe { std::slice::from_raw_parts(g.indices, g.index_count as usize) }.to_vec();
+    let draws = draws_from(g.draws, g.draw_count)?;
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for d in &draws {
+        let model = d.model.as_dmat4();
+        for &i in indices
+            .iter()
+            .skip(d.first_index as usize)
+            .take(d.index_count as usize)
+        {
+            let Some(p) = positions.get(i as usize * 3..i as usize * 3 + 3) else {
+                return Err(invalid(format!(
+                    "index {i} is out of range ({} vertices)",
+                    g.vertex_count
+                )));
+            };
+            let w = model.transform_point3(Vec3::from_slice(p).as_dvec3());
+            lo = lo.min(w);
+            hi = hi.max(w);
+        }
+    }
+    if !lo.is_finite() || !hi.is_finite() {
+        return Err(invalid("the draws reference no vertices"));
+    }
+    for (n, d) in draws.iter().enumerate() {
+        if !d.index_count.is_multiple_of(3)
+            || u64::from(d.first_index) + u64::from(d.index_count) > indices.len() as u64
+        {
+            return Err(invalid(format!(
+                "draw {n} does not cover whole triangles of the index array"
+            )));
+        }
+    }
+    Ok(GeometrySource::Cpu {
+        positions,
+        indices,
+        draws,
+        origin: frame_origin(lo, hi),
+    })
+}
+
+/// The geometry of `hrts_set_geometry_vulkan`, checked (its buffers are wrapped once to check them).
+pub(crate) fn vulkan_geometry(
+    device: &Device,
+    g: &HrtsVulkanGeometry,
+) -> ApiResult<GeometrySource> {
+    check_size::<HrtsVulkanGeometry>(g.struct_size, "HrtsVulkanGeometry")?;
+    if g.vertex_buffer == 0 || g.index_buffer == 0 {
+        return Err(ApiError::new(
+            HrtsResult::ErrorNullPointer,
+            "vertex_buffer and index_buffer must be non-NULL",
+        ));
+    }
+    let format = enum_value(
+        g.index_type,
+        &[
+            (HrtsIndexType::Uint16 as u32, IndexFormat::U16),
+            (HrtsIndexType::Uint32 as u32, IndexFormat::U32),
+        ],
+        "index_type",
+        "HrtsIndexType",
+    )?;
+    finite(&g.bounds, "bounds")?;
+    let lo = Vec3::from_slice(&g.bounds[..3]).as_dvec3();
+    let hi = Vec3::from_slice(&g.bounds[3..]).as_dvec3();
+    if lo.cmpgt(hi).any() {
+        return Err(invalid("bounds min exceeds max"));
+    }
+    let draws = draws_from(g.draws, g.draw_count)?;
+    let vertex = VertexLayout {
+        offset: g.vertex_offset,
+        stride: g.vertex_stride,
+        count: g.vertex_count,
+    };
+    let index = IndexLayout {
+        offset: g.index_offset,
+        format,
+        count: g.index_count,
+    };
+    let source = GeometrySource::Vulkan {
+        vertices: (g.vertex_buffer, g.vertex_buffer_size),
+        vertex,
+        indices: (g.index_buffer, g.index_buffer_size),
+        index,
+        draws,
+        origin: frame_origin(lo, hi),
+    };
+    geometry_from(device, &source)?;
+    Ok(source)
+}
+
+pub(crate) fn geometry_from(device: &Device, source: &GeometrySource) -> ApiResult<Geometry> {
+    Ok(match source {
+        GeometrySource::Cpu {
+            positions,
+            indices,
+            draws,
+            origin,
+        } => Geometry::upload(device, positions, indices, draws, *origin)?,
+        GeometrySource::Vulkan {
+            vertices,
+            vertex,
+            indices,
+            index,
+            draws,
+            origin,
+        } => {
+            // SAFETY: the engine guarantees its buffers are live and of the stated sizes (contract).
+            let (vb, ib) = unsafe {
+                (
+                    device.external_buffer(vertices.0, vertices.1, BufferUsage::STORAGE)?,
+                    device.external_buffer(indices.0, indices.1, BufferUsage::STORAGE)?,
+                )
+            };
+            Geometry::from_buffers(vb, *vertex, ib, *index, draws, *origin)?
+        }
+    })
+}

@@ -1,0 +1,89 @@
+//! The registry of live contexts. A handle names a slot and the generation of the context created in it,
+//! so the handle of a destroyed context never matches a later context that reuses the slot (an address
+//! could be reused by the allocator and pass as live).
+
+use crate::context::Context;
+use crate::types::HrtsContext;
+use std::sync::{Arc, Mutex};
+
+/// One slot: its current generation and the context created with it, if live.
+struct Slot {
+    generation: u32,
+    context: Option<Arc<Mutex<Context>>>,
+}
+
+static SLOTS: Mutex<Vec<Slot>> = Mutex::new(Vec::new());
+
+/// The handle of slot `index` at `generation`: `generation << 32 | (index + 1)`, never NULL and never
+/// dereferenced.
+fn handle(index: usize, generation: u32) -> *mut HrtsContext {
+    ((u64::from(generation) << 32) | (index as u64 + 1)) as usize as *mut HrtsContext
+}
+
+/// The slot index and generation a handle names.
+fn parts(handle: *const HrtsContext) -> Option<(usize, u32)> {
+    let raw = handle as usize as u64;
+    let index = (raw & 0xFFFF_FFFF).checked_sub(1)?;
+    Some((index as usize, (raw >> 32) as u32))
+}
+
+fn slots() -> std::sync::MutexGuard<'static, Vec<Slot>> {
+    SLOTS
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// Registers a new context and returns its handle.
+pub(crate) fn register(context: Context) -> *mut HrtsContext {
+    let mut slots = slots();
+    let context = Some(Arc::new(Mutex::new(context)));
+    match slots.iter().position(|s| s.context.is_none()) {
+        Some(i) => {
+            let slot = &mut slots[i];
+            slot.generation = slot.generation.wrapping_add(1);
+            slot.context = context;
+            handle(i, slot.generation)
+        }
+        None => {
+            slots.push(Slot {
+                generation: 0,
+                context,
+            });
+            handle(slots.len() - 1, 0)
+        }
+    }
+}
+
+/// The live context a handle names.
+pub(crate) fn lookup(handle: *const HrtsContext) -> Option<Arc<Mutex<Context>>> {
+    let (index, generation) = parts(handle)?;
+    let slots = slots();
+    let slot = slots.get(index).filter(|s| s.generation == generation)?;
+    slot.context.clone()
+}
+
+/// Unregisters the context a handle names; returns it if it was live.
+pub(crate) fn unregister(handle: *const HrtsContext) -> Option<Arc<Mutex<Context>>> {
+    let (index, generation) = parts(handle)?;
+    let mut slots = slots();
+    let slot = slots
+        .get_mut(index)
+        .filter(|s| s.generation == generation)?;
+    slot.context.take()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn handles_name_slot_and_generation() {
+        for (index, generation) in [(0, 0), (5, 1), (70_000, u32::MAX)] {
+            let h = handle(index, generation);
+            assert!(!h.is_null());
+            assert_eq!(parts(h), Some((index, generation)));
+        }
+        assert_eq!(parts(std::ptr::null()), None);
+        assert_eq!(parts(0x1_0000_0000usize as *const HrtsContext), None);
+    }
+}

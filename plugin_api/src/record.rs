@@ -1,0 +1,302 @@
+//! Recording into the engine's command buffers: every light's passes of a frame (whole or pass by pass),
+//! the copy of each light's visibility into the engine's output, and resource read-backs.
+
+use crate::context::{Built, Context, FrameProgress, OpenFrame};
+use crate::convert::{frame_inputs, pass_from_index, resource_id};
+use crate::error::{check_size, invalid, ApiError, ApiResult};
+use crate::types::*;
+use passes::{PassError, PassId, ResourceId};
+use rhi::{Barrier, BufferUsage, Encoder, ResourceState as S};
+
+/// Pass-mask bits of the passes that read the engine's depth and normal images (the primitive map fits
+/// itself to the receivers).
+pub(crate) const DEPTH_NORMAL_READERS: u32 = 1 << HrtsPass::PrimitiveMap as u32
+    | 1 << HrtsPass::RayTrace as u32
+    | 1 << HrtsPass::ShadowMapTest as u32
+    | 1 << HrtsPass::Pcss as u32;
+
+impl Context {
+    pub(crate) fn record_passes(&mut self, f: &HrtsFrame, mask: u32) -> ApiResult<()> {
+        check_size::<HrtsFrame>(f.struct_size, "HrtsFrame")?;
+        if f.command_buffer == 0 {
+            return Err(ApiError::new(
+                HrtsResult::ErrorNullPointer,
+                "command_buffer is NULL",
+            ));
+        }
+        if mask == 0 || mask & !HRTS_PASS_MASK_ALL != 0 {
+            return Err(invalid(format!(
+                "pass mask 0x{mask:x} must be a non-empty set of HRTS_PASS_MASK_ALL (0x{HRTS_PASS_MASK_ALL:x}) bits"
+            )));
+        }
+        let inputs = frame_inputs(f)?;
+        if inputs.len() != self.lights.len() {
+            return Err(invalid(format!(
+                "light_count {} differs from the {} lights configured",
+                inputs.len(),
+                self.lights.len()
+            )));
+        }
+        let mut used_layouts = Vec::new();
+        if mask & DEPTH_NORMAL_READERS != 0 {
+            used_layouts.extend([
+                ("depth_layout", f.depth_layout),
+                ("normal_layout", f.normal_layout),
+            ]);
+        }
+        let copy_output = mask & 1 << HrtsPass::OutputCopy as u32 != 0;
+        if copy_output {
+            used_layouts.push(("output_layout_after", f.output_layout_after));
+        }
+        for (what, layout) in used_layouts {
+            if layout <= 0 {
+                return Err(invalid(format!(
+                    "{what} {layout} is not a usable VkImageLayout"
+                )));
+            }
+        }
+        if let Some(t) = self
+            .targets
+            .filter(|t| t.output_layers < self.lights.len() as u32)
+        {
+            return Err(invalid(format!(
+                "the output image has {} layers for {} lights",
+                t.output_layers,
+                self.lights.len()
+            )));
+        }
+        let lowest = mask.trailing_zeros();
+        let highest = 31 - mask.leading_zeros();
+        let continues = match &self.progress.open {
+            Some(open) if open.index == f.frame_index && lowest > open.last_pass => {
+                if open.inputs != inputs {
+                    return Err(invalid(
+                        "the camera and lights must stay the same across the calls of one frame",
+                    ));
+                }
+                true
+            }
+            Some(open) if open.index == f.frame_index => {
+                return Err(invalid(format!(
+                    "frame {} is being recorded up to pass {}: a call of the same frame must go on after it",
+                    open.index, open.last_pass
+                )))
+            }
+            _ => false,
+        };
+        if !continues {
+            self.begin_frame(f.frame_index)?;
+        }
+        self.ensure_built()?;
+        let frame_index = f.frame_index;
+        let (device, built) = match self.built.as_mut() {
+            Some(b) => (&self.device, b),
+            None => return Err(ApiError::new(HrtsResult::ErrorInternal, "passes not built")),
+        };
+        if !continues {
+            self.progress.open = None;
+            self.last_frame = Some(frame_index);
+            for (pipeline, light_inputs) in built.lights.iter_mut().flatten().zip(&inputs) {
+                pipeline.begin_frame_at(light_inputs, frame_index)?;
+            }
+        }
+        let passes: Vec<PassId> = (0..HRTS_PASS_COUNT as u32)
+            .filter(|i| mask & 1 << i != 0)
+            .filter_map(pass_from_index)
+            .collect();
+        if copy_output {
+            for (i, pipeline) in built.lights.iter().flatten().enumerate() {
+                if let Some(missing) = pipeline
+                    .passes_to_record()
+                    .into_iter()
+                    .find(|p| !passes.contains(p))
+                {
+                    return Err(ApiError::new(
+                        HrtsResult::ErrorInvalidState,
+                        format!(
+                            "pass '{}' of light {i} runs this frame and has not been recorded: record it before (or with) the output copy",
+                            missing.name()
+                        ),
+                    ));
+                }
+            }
+        }
+        // SAFETY: the engine guarantees the command buffer is recording, outside a render pass, on this
+        // device and used by no other thread during the call (documented contract).
+        let mut enc = unsafe { Encoder::from_raw_handle(device, f.command_buffer) };
+        let reads_depth = mask & DEPTH_NORMAL_READERS != 0;
+        if reads_depth {
+            engine_inputs(&mut enc, built, f, true);
+        }
+        let mut recorded = Ok(());
+        for pipeline in built.lights.iter_mut().flatten() {
+            recorded = pipeline.record_passes(&mut enc, &passes);
+            if recorded.is_err() {
+                break;
+            }
+        }
+        if reads_depth {
+            engine_inputs(&mut enc, built, f, false);
+        }
+        recorded.map_err(|e| match e {
+            PassError::InvalidConfig(m) => ApiError::new(HrtsResult::ErrorInvalidState, m),
+            other => other.into(),
+        })?;
+        if copy_output {
+            record_output_copy(&mut enc, built, f)?;
+            self.progress = FrameProgress {
+                open: None,
+                completed: Some(frame_index),
+            };
+        } else {
+            self.progress.open = Some(OpenFrame {
+                index: frame_index,
+                inputs,
+                last_pass: highest,
+            });
+        }
+        Ok(())
+    }
+
+    pub(crate) fn record_readback(&self, r: &HrtsResourceReadback) -> ApiResult<()> {
+        check_size::<HrtsResourceReadback>(r.struct_size, "HrtsResourceReadback")?;
+        if r.command_buffer == 0 || r.buffer == 0 {
+            return Err(ApiError::new(
+                HrtsResult::ErrorNullPointer,
+                "command_buffer and buffer must be non-NULL",
+            ));
+        }
+        let id = resource_id(r.resource)?;
+        let pipeline = self.finished_frame()?.light(r.light)?;
+        let (image, list) = (pipeline.image(id), pipeline.buffer(id));
+        let bytes = match (image, list) {
+            (Some(image), _) => image.byte_size(),
+            (None, Some(list)) => list.size(),
+            (None, None) => {
+                return Err(ApiError::new(
+                    HrtsResult::ErrorInvalidState,
+                    format!(
+                        "{} is not allocated by light {}'s configuration: add it to extra_outputs",
+                        id.name(),
+                        r.light
+                    ),
+                ))
+            }
+        };
+        let fits = r
+            .offset
+            .checked_add(bytes)
+            .is_some_and(|end| end <= r.buffer_size);
+        if !fits || !r.offset.is_multiple_of(4) {
+            return Err(invalid(format!(
+                "{} needs {} bytes at a multiple-of-4 offset: offset {} in a buffer of {} bytes does not do",
+                id.name(),
+                bytes,
+                r.offset,
+                r.buffer_size
+            )));
+        }
+        // SAFETY: the engine guarantees a live buffer of `buffer_size` bytes with TRANSFER_DST usage.
+        let buffer = unsafe {
+            self.device
+                .external_buffer(r.buffer, r.buffer_size, BufferUsage::COPY_DST)?
+        };
+        let state = if id == ResourceId::ShadowMap {
+            S::ShaderResource
+        } else {
+            S::UnorderedAccess
+        };
+        // SAFETY: as for `record_passes`.
+        let mut enc = unsafe { Encoder::from_raw_handle(&self.device, r.command_buffer) };
+        match (image, list) {
+            (Some(image), _) => {
+                enc.barriers(&[Barrier::Image {
+                    image,
+                    before: state,
+                    after: S::CopySource,
+                }]);
+                enc.copy_image_to_buffer_at(image, &buffer, r.offset)?;
+                enc.barriers(&[Barrier::Image {
+                    image,
+                    before: S::CopySource,
+                    after: state,
+                }]);
+            }
+            (None, Some(list)) => {
+                enc.barriers(&[Barrier::Global {
+                    before: S::UnorderedAccess,
+                    after: S::CopySource,
+                }]);
+                enc.copy_buffer_at(list, &buffer, r.offset)?;
+            }
+            (None, None) => {}
+        }
+        enc.barriers(&[
+            Barrier::Global {
+                before: S::CopyDest,
+                after: S::Engine(0),
+            },
+            Barrier::Global {
+                before: S::CopyDest,
+                after: S::HostRead,
+            },
+        ]);
+        Ok(())
+    }
+}
+
+/// Transitions the engine's depth and normal images from their layouts to `ShaderResource` (`to_shader`)
+/// or back.
+fn engine_inputs(enc: &mut Encoder<'_>, b: &Built, f: &HrtsFrame, to_shader: bool) {
+    let transition = |image, layout| {
+        let (before, after) = if to_shader {
+            (S::Engine(layout), S::ShaderResource)
+        } else {
+            (S::ShaderResource, S::Engine(layout))
+        };
+        Barrier::Image {
+            image,
+            before,
+            after,
+        }
+    };
+    enc.barriers(&[
+        transition(&b.depth, f.depth_layout),
+        transition(&b.normal, f.normal_layout),
+    ]);
+}
+
+/// Copies each light's final visibility into its layer of the engine's output image.
+fn record_output_copy(enc: &mut Encoder<'_>, b: &Built, f: &HrtsFrame) -> ApiResult<()> {
+    let outputs: Vec<_> = b.lights.iter().flatten().map(|p| p.output()).collect();
+    let each = |before, after| -> Vec<Barrier<'_>> {
+        outputs
+            .iter()
+            .map(|&image| Barrier::Image {
+                image,
+                before,
+                after,
+            })
+            .collect()
+    };
+    enc.begin_pass("output copy");
+    let mut to_copy = each(S::UnorderedAccess, S::CopySource);
+    to_copy.push(Barrier::Image {
+        image: &b.output,
+        before: S::Engine(f.output_layout_before),
+        after: S::CopyDest,
+    });
+    enc.barriers(&to_copy);
+    for (layer, vis) in outputs.iter().enumerate() {
+        enc.copy_image_into_layer(vis, &b.output, layer as u32)?;
+    }
+    let mut back = each(S::CopySource, S::UnorderedAccess);
+    back.push(Barrier::Image {
+        image: &b.output,
+        before: S::CopyDest,
+        after: S::Engine(f.output_layout_after),
+    });
+    enc.barriers(&back);
+    enc.end_pass();
+    Ok(())
+}
