@@ -58,4 +58,14 @@ pub enum SceneError {
         /// The file.
         path: PathBuf,
     },
+    /// A light has invalid parameters (spot cone angles, negative size, range, colour, ...).
+    #[error("{path}: {light}: {message}")]
+    InvalidLight {
+        /// The file (`<memory>` for [`SceneLight::validate`](crate::SceneLight::validate)).
+        path: PathBuf,
+        /// Which light (and, for glTF, which node).
+        light: String,
+        /// What is wrong.
+        message: String,
+    },
 }

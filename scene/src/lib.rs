@@ -23,6 +23,7 @@ mod models;
 mod obj;
 mod procedural;
 mod scene;
+mod scene_light;
 
 pub use aabb::Aabb;
 pub use camera::Camera;
@@ -33,3 +34,4 @@ pub use models::{models_dir, MODELS_ENV};
 pub use obj::load_obj;
 pub use procedural::procedural_default;
 pub use scene::{Object, Scene};
+pub use scene_light::{LightKind, LightSize, SceneLight};
