@@ -1,4 +1,4 @@
-//! The error type shared by OBJ loading and scene validation.
+//! The error type shared by OBJ and glTF loading and scene validation.
 
 use std::path::PathBuf;
 
@@ -57,5 +57,84 @@ pub enum SceneError {
     Empty {
         /// The file.
         path: PathBuf,
+    },
+    /// The file is not a usable glTF 2.0 asset: not glTF at all, a truncated or malformed GLB,
+    /// invalid JSON or glTF schema, a bad accessor, a node hierarchy that is not a tree, a
+    /// non-finite transform, an invalid camera. `message` says what is wrong and where.
+    #[error("{path}: not a valid glTF 2.0 asset: {message}")]
+    Gltf {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// A glTF buffer cannot be loaded (missing or unreadable file, bad `data:` URI, missing GLB
+    /// binary chunk) or holds fewer bytes than its `byteLength`.
+    #[error("{path}: buffer {buffer}: {message}")]
+    GltfBuffer {
+        /// The glTF file.
+        path: PathBuf,
+        /// Index of the buffer.
+        buffer: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A vertex of a glTF mesh primitive has a NaN or infinite coordinate, in the file or after
+    /// the node transform.
+    #[error("{path}: {primitive}: vertex {vertex} has a non-finite coordinate ({value}); NaN/Inf geometry is rejected")]
+    GltfNonFinite {
+        /// The file.
+        path: PathBuf,
+        /// Which primitive of which mesh of which node.
+        primitive: String,
+        /// Zero-based index of the vertex in the primitive's `POSITION` accessor.
+        vertex: usize,
+        /// The offending coordinate.
+        value: f32,
+    },
+    /// A triangle of a glTF mesh primitive references a vertex that does not exist.
+    #[error("{path}: {primitive}: triangle {triangle} references vertex {index}, but there are only {count} vertices")]
+    GltfIndexOutOfRange {
+        /// The file.
+        path: PathBuf,
+        /// Which primitive of which mesh of which node.
+        primitive: String,
+        /// Zero-based index of the triangle in the primitive (after strip/fan triangulation).
+        triangle: usize,
+        /// The missing vertex.
+        index: u32,
+        /// Number of vertices in the primitive's `POSITION` accessor.
+        count: usize,
+    },
+    /// A light has invalid parameters (spot cone angles, negative size, range, colour, ...).
+    #[error("{path}: {light}: {message}")]
+    InvalidLight {
+        /// The file (`<memory>` for [`SceneLight::validate`](crate::SceneLight::validate)).
+        path: PathBuf,
+        /// Which light (and, for glTF, which node).
+        light: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// An `extras.hrts` object of a glTF node or light holds a key the loader does not know.
+    #[error("{path}: {owner}: unknown key \"{key}\" in extras.hrts (known keys: static, casts_shadows, radius, angular_radius)")]
+    UnknownExtrasKey {
+        /// The file.
+        path: PathBuf,
+        /// The node or light whose extras hold the key.
+        owner: String,
+        /// The unknown key.
+        key: String,
+    },
+    /// An `extras.hrts` value of a glTF node or light has the wrong type or does not apply to
+    /// its owner (a light size on a node without a light, a radius on a directional light, ...).
+    #[error("{path}: {owner}: extras.hrts: {message}")]
+    InvalidExtras {
+        /// The file.
+        path: PathBuf,
+        /// The node or light whose extras are wrong.
+        owner: String,
+        /// What is wrong.
+        message: String,
     },
 }

@@ -4,6 +4,8 @@
 //!   ([`Object`]s), validated by [`Scene::validate`];
 //! - [`load_obj`]: Wavefront OBJ loading that rejects malformed, non-finite and out-of-range
 //!   content with a [`SceneError`] naming the file, and never panics;
+//! - [`load_gltf`]: glTF 2.0 loading ([`gltf_scene`]): geometry, [`SceneLight`]s with sizes and
+//!   static/shadow flags, static objects and the camera, as a [`SceneFile`];
 //! - [`procedural_default`]: the built-in demo scene of shadow-mapping trouble makers;
 //! - [`Camera`] and [`DirectionalLight`]: view and projection matrices that frame a scene;
 //! - [`hard_cases`]: the deterministic hard numerical cases ([`HardCase`]) of the shadow renderer.
@@ -17,19 +19,23 @@ pub use glam;
 mod aabb;
 mod camera;
 mod error;
+pub mod gltf_scene;
 pub mod hard_cases;
 mod light;
 mod models;
 mod obj;
 mod procedural;
 mod scene;
+mod scene_light;
 
 pub use aabb::Aabb;
 pub use camera::Camera;
 pub use error::SceneError;
+pub use gltf_scene::{load_gltf, SceneFile};
 pub use hard_cases::HardCase;
 pub use light::DirectionalLight;
 pub use models::{models_dir, MODELS_ENV};
 pub use obj::load_obj;
 pub use procedural::procedural_default;
 pub use scene::{Object, Scene};
+pub use scene_light::{LightKind, LightSize, SceneLight};

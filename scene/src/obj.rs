@@ -312,6 +312,7 @@ mod tests {
             Err(SceneError::NonFinite { .. }) => "non-finite",
             Err(SceneError::IndexOutOfRange { .. }) => "out-of-range",
             Err(SceneError::Empty { .. }) => "empty",
+            Err(_) => "other",
         }
     }
 
