@@ -35,9 +35,10 @@ use std::path::Path;
 use glam::{DMat4, DQuat, DVec3, Mat4, Vec3};
 
 use crate::obj::parse_obj;
-use crate::procedural::Rng;
 use crate::scene::ground_square;
-use crate::{load_obj, procedural_default, Aabb, Camera, DirectionalLight, Scene, SceneError};
+use crate::{
+    load_obj, procedural_default, Aabb, Camera, DirectionalLight, Scene, SceneError, SplitMix64,
+};
 
 /// A group of related cases (one integration test each).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -872,20 +873,20 @@ fn small_triangles() -> Vec<HardCase> {
         48,
     );
 
-    let mut rng = Rng(0xd057);
+    let mut rng = SplitMix64::new(0xd057);
     let mut dust = Mesh::default();
     for _ in 0..1500 {
         let c = DVec3::new(
-            f64::from(rng.signed()) * 0.5,
-            0.3 + f64::from(rng.unit()) * 0.5,
-            f64::from(rng.signed()) * 0.5,
+            f64::from(rng.uniform_f32(-1.0, 1.0)) * 0.5,
+            0.3 + f64::from(rng.next_f32()) * 0.5,
+            f64::from(rng.uniform_f32(-1.0, 1.0)) * 0.5,
         );
-        let size = texel * (0.1 + 0.3 * f64::from(rng.unit()));
+        let size = texel * (0.1 + 0.3 * f64::from(rng.next_f32()));
         let mut corner = || {
             DVec3::new(
-                f64::from(rng.signed()),
-                f64::from(rng.signed()),
-                f64::from(rng.signed()),
+                f64::from(rng.uniform_f32(-1.0, 1.0)),
+                f64::from(rng.uniform_f32(-1.0, 1.0)),
+                f64::from(rng.uniform_f32(-1.0, 1.0)),
             ) * size
         };
         let tri = [c + corner(), c + corner(), c + corner()];
@@ -940,9 +941,9 @@ fn small_triangles() -> Vec<HardCase> {
     }
     for k in 0..100 {
         let p = DVec3::new(
-            f64::from(rng.signed()),
-            0.2 + f64::from(rng.unit()),
-            f64::from(rng.signed()),
+            f64::from(rng.uniform_f32(-1.0, 1.0)),
+            0.2 + f64::from(rng.next_f32()),
+            f64::from(rng.uniform_f32(-1.0, 1.0)),
         );
         if k % 2 == 0 {
             degenerate.triangle([p, p, p]);
@@ -1246,7 +1247,7 @@ fn thin_geometry() -> Vec<HardCase> {
         )));
     }
 
-    let mut rng = Rng(0xf011a6e);
+    let mut rng = SplitMix64::new(0xf011a6e);
     let mut cards = Mesh::default();
     let mut card_checks = Vec::new();
     for k in 0..5 {
@@ -1255,7 +1256,7 @@ fn thin_geometry() -> Vec<HardCase> {
             0.0,
             -0.6 + 0.3 * f64::from(k % 2),
         );
-        let yaw = f64::from(rng.unit()) * std::f64::consts::PI;
+        let yaw = f64::from(rng.next_f32()) * std::f64::consts::PI;
         for turn in [0.0, std::f64::consts::FRAC_PI_2] {
             let across = DQuat::from_rotation_y(yaw + turn) * DVec3::X * 0.3;
             let corners = [
@@ -1279,15 +1280,15 @@ fn thin_geometry() -> Vec<HardCase> {
     for _ in 0..300 {
         let c = DVec3::new(0.9, 0.6, 0.7)
             + DVec3::new(
-                f64::from(rng.signed()),
-                f64::from(rng.signed()),
-                f64::from(rng.signed()),
+                f64::from(rng.uniform_f32(-1.0, 1.0)),
+                f64::from(rng.uniform_f32(-1.0, 1.0)),
+                f64::from(rng.uniform_f32(-1.0, 1.0)),
             ) * 0.3;
         let q = DQuat::from_euler(
             glam::EulerRot::YXZ,
-            f64::from(rng.unit()) * TAU,
-            f64::from(rng.signed()),
-            f64::from(rng.signed()) * 3.0,
+            f64::from(rng.next_f32()) * TAU,
+            f64::from(rng.uniform_f32(-1.0, 1.0)),
+            f64::from(rng.uniform_f32(-1.0, 1.0)) * 3.0,
         );
         cards.triangle([
             c,
@@ -1447,14 +1448,14 @@ fn far_slivers() -> (Scene, Aabb) {
         16,
         16,
     );
-    let mut rng = Rng(0x511_4e25);
+    let mut rng = SplitMix64::new(0x511_4e25);
     let mut slivers = Mesh::default();
     for k in 0..1000 {
         let (c, s) = circle(k, 1000);
         let radial = DVec3::new(c, 0.0, s);
         let across = DVec3::new(-s, 0.0, c);
-        let r = 60.0 + 40.0 * f64::from(rng.unit());
-        let p = radial * r + DVec3::Y * (0.05 + 0.5 * f64::from(rng.unit()));
+        let r = 60.0 + 40.0 * f64::from(rng.next_f32());
+        let p = radial * r + DVec3::Y * (0.05 + 0.5 * f64::from(rng.next_f32()));
         slivers.triangle([
             p,
             p + radial * 0.02 + DVec3::Y * 0.01,

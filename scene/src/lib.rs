@@ -6,6 +6,8 @@
 //!   content with a [`SceneError`] naming the file, and never panics;
 //! - [`procedural_default`]: the built-in demo scene of shadow-mapping trouble makers;
 //! - [`Camera`] and [`DirectionalLight`]: view and projection matrices that frame a scene;
+//! - [`SplitMix64`]: the small deterministic pseudo-random generator used wherever the workspace
+//!   needs reproducible random numbers;
 //! - [`hard_cases`]: the deterministic hard numerical cases ([`HardCase`]) of the shadow renderer.
 //!
 //! Conventions: right-handed world in metres with +Y up; triangles wind counter-clockwise seen
@@ -22,6 +24,7 @@ mod light;
 mod models;
 mod obj;
 mod procedural;
+mod random;
 mod scene;
 
 pub use aabb::Aabb;
@@ -32,4 +35,5 @@ pub use light::DirectionalLight;
 pub use models::{models_dir, MODELS_ENV};
 pub use obj::load_obj;
 pub use procedural::procedural_default;
+pub use random::SplitMix64;
 pub use scene::{Object, Scene};

@@ -5,7 +5,7 @@ use std::f32::consts::{FRAC_PI_2, PI, TAU};
 use glam::{Affine3A, EulerRot, Quat, Vec2, Vec3};
 
 use crate::scene::ground_square;
-use crate::Scene;
+use crate::{Scene, SplitMix64};
 
 /// The demo's built-in scene: a collection of shadow-mapping trouble makers on a ground plane.
 ///
@@ -99,23 +99,27 @@ fn fence() -> MeshBuilder {
 fn foliage() -> MeshBuilder {
     const LEAVES: usize = 560;
     const TUFTS: usize = 10;
-    let mut rng = Rng(0x5eed_1eaf);
+    let mut rng = SplitMix64::new(0x5eed_1eaf);
     let mut mesh = MeshBuilder::new(Affine3A::from_translation(Vec3::new(-1.5, 0.0, 0.9)));
     for _ in 0..LEAVES {
         let offset = loop {
-            let p = Vec3::new(rng.signed(), rng.signed(), rng.signed());
+            let p = Vec3::new(
+                rng.uniform_f32(-1.0, 1.0),
+                rng.uniform_f32(-1.0, 1.0),
+                rng.uniform_f32(-1.0, 1.0),
+            );
             if p.length_squared() <= 1.0 {
                 break p * Vec3::new(0.55, 0.45, 0.55);
             }
         };
         let orientation = Quat::from_euler(
             EulerRot::YXZ,
-            rng.unit() * TAU,
-            rng.signed() * 1.2,
-            rng.signed() * PI,
+            rng.next_f32() * TAU,
+            rng.uniform_f32(-1.0, 1.0) * 1.2,
+            rng.uniform_f32(-1.0, 1.0) * PI,
         );
-        let length = 0.1 + 0.08 * rng.unit();
-        let width = length * (0.4 + 0.1 * rng.unit());
+        let length = 0.1 + 0.08 * rng.next_f32();
+        let width = length * (0.4 + 0.1 * rng.next_f32());
         let outline = [
             Vec2::new(0.0, 0.0),
             Vec2::new(0.3, -0.5),
@@ -133,9 +137,9 @@ fn foliage() -> MeshBuilder {
     }
     for i in 0..TUFTS {
         let angle = i as f32 / TUFTS as f32 * TAU;
-        let base = Vec3::new(angle.cos(), 0.0, angle.sin()) * (0.7 + 0.15 * rng.unit());
-        let yaw = rng.unit() * PI;
-        let (half_width, height) = (0.15 + 0.05 * rng.unit(), 0.4 + 0.2 * rng.unit());
+        let base = Vec3::new(angle.cos(), 0.0, angle.sin()) * (0.7 + 0.15 * rng.next_f32());
+        let yaw = rng.next_f32() * PI;
+        let (half_width, height) = (0.15 + 0.05 * rng.next_f32(), 0.4 + 0.2 * rng.next_f32());
         for card in 0..3 {
             let across = Quat::from_rotation_y(yaw + card as f32 * PI / 3.0) * Vec3::X * half_width;
             let up = Vec3::Y * height;
@@ -299,29 +303,6 @@ impl MeshBuilder {
             self.indices
                 .extend([top_pole, last_ring + j, last_ring + k]);
         }
-    }
-}
-
-/// Small deterministic pseudo-random generator (SplitMix64).
-pub(crate) struct Rng(pub(crate) u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[0, 1)`.
-    pub(crate) fn unit(&mut self) -> f32 {
-        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    /// Uniform in `[-1, 1)`.
-    pub(crate) fn signed(&mut self) -> f32 {
-        self.unit() * 2.0 - 1.0
     }
 }
 
@@ -520,14 +501,5 @@ mod tests {
         assert!(normals.iter().filter(|n| n.y.abs() < 0.3).count() > 100);
         let cards = object_bounds(&scene, "foliage");
         assert!(cards.size().min_element() > 0.5);
-    }
-
-    #[test]
-    fn random_numbers_are_uniform_enough() {
-        let mut rng = Rng(1);
-        let samples = (0..10_000).map(|_| rng.unit()).collect::<Vec<_>>();
-        assert!(samples.iter().all(|x| (0.0..1.0).contains(x)));
-        let mean = samples.iter().sum::<f32>() / samples.len() as f32;
-        assert!((mean - 0.5).abs() < 0.02);
     }
 }

@@ -7,50 +7,24 @@ mod visibility;
 mod watertight;
 
 use glam::{DVec3, Vec3};
+use scene::SplitMix64;
 
-/// Small deterministic generator (SplitMix64).
-pub(crate) struct Rng(u64);
+/// Uniform in the cube `[-half, half)^3`.
+pub(crate) fn in_cube(rng: &mut SplitMix64, half: f64) -> DVec3 {
+    DVec3::new(
+        rng.uniform_f64(-half, half),
+        rng.uniform_f64(-half, half),
+        rng.uniform_f64(-half, half),
+    )
+}
 
-impl Rng {
-    pub(crate) fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[0, 1)`.
-    pub(crate) fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform in `[lo, hi)`.
-    pub(crate) fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.unit()
-    }
-
-    /// Uniform in the cube `[-half, half)^3`.
-    pub(crate) fn in_cube(&mut self, half: f64) -> DVec3 {
-        DVec3::new(
-            self.range(-half, half),
-            self.range(-half, half),
-            self.range(-half, half),
-        )
-    }
-
-    /// Uniformly distributed unit vector.
-    pub(crate) fn direction(&mut self) -> DVec3 {
-        loop {
-            let v = self.in_cube(1.0);
-            let len = v.length();
-            if len > 0.1 && len <= 1.0 {
-                return v / len;
-            }
+/// Uniformly distributed unit vector (rejection sampling in the unit ball).
+pub(crate) fn random_direction(rng: &mut SplitMix64) -> DVec3 {
+    loop {
+        let v = in_cube(rng, 1.0);
+        let len = v.length();
+        if len > 0.1 && len <= 1.0 {
+            return v / len;
         }
     }
 }

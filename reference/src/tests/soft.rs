@@ -9,8 +9,9 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use std::time::Instant;
 
 use glam::{DVec3, Mat4, Vec3};
+use scene::SplitMix64;
 
-use super::{MeshBuilder, Rng};
+use super::{in_cube, random_direction, MeshBuilder};
 use crate::soft::{cone_may_meet_triangle, soft_visibility_with, ExactShortcuts};
 use crate::{
     reference_visibility, soft_visibility, AreaLight, Light, RefScene, SoftParams, SoftReference,
@@ -466,13 +467,13 @@ fn cone_triangle_test_is_conservative_and_tight() {
     // Against the smallest angle from the axis over a dense barycentric grid of the
     // triangle (an upper bound of the true smallest angle).
     const GRID: usize = 64;
-    let mut rng = Rng::new(3);
+    let mut rng = SplitMix64::new(3);
     let (mut meets, mut clear, mut loose) = (0, 0, 0);
     for case in 0..2000 {
-        let apex = rng.in_cube(1.0);
-        let axis = rng.direction();
-        let half_angle = rng.range(0.01, 1.2);
-        let tri = [0; 3].map(|_| apex + rng.in_cube(2.0));
+        let apex = in_cube(&mut rng, 1.0);
+        let axis = random_direction(&mut rng);
+        let half_angle = rng.uniform_f64(0.01, 1.2);
+        let tri = [0; 3].map(|_| apex + in_cube(&mut rng, 2.0));
         let mut smallest = f64::INFINITY;
         for i in 0..=GRID {
             for j in 0..=GRID - i {

@@ -1,8 +1,9 @@
 //! Watertightness and robustness of the ray/triangle and line/segment primitives.
 
 use glam::{DVec3, Vec3};
+use scene::SplitMix64;
 
-use super::{MeshBuilder, Rng};
+use super::{in_cube, random_direction, MeshBuilder};
 use crate::{intersect_watertight, line_segment_distance, RefScene};
 
 /// Every hit parameter of the line `origin + t * dir` against all triangles.
@@ -80,7 +81,7 @@ fn edge_and_vertex_targets(scene: &RefScene) -> Vec<DVec3> {
 
 #[test]
 fn rays_at_shared_fan_edges_and_vertex_always_hit() {
-    let mut rng = Rng::new(1);
+    let mut rng = SplitMix64::new(1);
     for k in [3, 5, 8, 13] {
         let scene = RefScene::new(&fan(Vec3::new(0.0, 0.3, 0.0), k).scene());
         let center = scene.triangle(0)[0];
@@ -94,8 +95,9 @@ fn rays_at_shared_fan_edges_and_vertex_always_hit() {
         for target in targets {
             for _ in 0..200 {
                 // Within 25 degrees of vertical, so that no spoke is a silhouette.
-                let side = if rng.unit() < 0.5 { 3.0 } else { -3.0 };
-                let origin = target + DVec3::new(rng.range(-1.0, 1.0), side, rng.range(-1.0, 1.0));
+                let side = if rng.next_f64() < 0.5 { 3.0 } else { -3.0 };
+                let origin = target
+                    + DVec3::new(rng.uniform_f64(-1.0, 1.0), side, rng.uniform_f64(-1.0, 1.0));
                 let dir = target - origin;
                 assert!(
                     !hits(&scene, origin, dir).is_empty(),
@@ -108,7 +110,7 @@ fn rays_at_shared_fan_edges_and_vertex_always_hit() {
 
 #[test]
 fn rays_at_shared_grid_edges_and_vertices_always_hit() {
-    let mut rng = Rng::new(2);
+    let mut rng = SplitMix64::new(2);
     for offset in [0.0f32, 1e5] {
         let mut mesh = MeshBuilder::default();
         mesh.add_grid((offset - 2.0, -2.0), (offset + 2.0, 2.0), 8, |x, z| {
@@ -123,8 +125,9 @@ fn rays_at_shared_grid_edges_and_vertices_always_hit() {
         assert!(targets.len() > 200);
         for target in targets {
             for _ in 0..20 {
-                let side = if rng.unit() < 0.5 { 5.0 } else { -5.0 };
-                let origin = target + DVec3::new(rng.range(-2.0, 2.0), side, rng.range(-2.0, 2.0));
+                let side = if rng.next_f64() < 0.5 { 5.0 } else { -5.0 };
+                let origin = target
+                    + DVec3::new(rng.uniform_f64(-2.0, 2.0), side, rng.uniform_f64(-2.0, 2.0));
                 let dir = target - origin;
                 assert!(
                     !hits(&scene, origin, dir).is_empty(),
@@ -137,15 +140,15 @@ fn rays_at_shared_grid_edges_and_vertices_always_hit() {
 
 #[test]
 fn lines_through_closed_meshes_hit_on_both_sides() {
-    let mut rng = Rng::new(3);
+    let mut rng = SplitMix64::new(3);
     let mut sphere = MeshBuilder::default();
     sphere.add_sphere(Vec3::ZERO, 1.0, 12, 16);
     for mesh in [sphere, cube(4)] {
         let scene = RefScene::new(&mesh.scene());
         // Random lines through interior points.
         for _ in 0..3000 {
-            let inside = rng.in_cube(0.5);
-            let dir = rng.direction();
+            let inside = in_cube(&mut rng, 0.5);
+            let dir = random_direction(&mut rng);
             let ts = hits(&scene, inside, dir);
             assert!(ts.len() >= 2, "line through {inside} along {dir}: {ts:?}");
             assert!(ts.iter().any(|t| *t > 0.0) && ts.iter().any(|t| *t < 0.0));
@@ -153,7 +156,7 @@ fn lines_through_closed_meshes_hit_on_both_sides() {
         // Rays from interior points aimed exactly at vertices and edge midpoints.
         for target in edge_and_vertex_targets(&scene) {
             for _ in 0..3 {
-                let inside = rng.in_cube(0.5);
+                let inside = in_cube(&mut rng, 0.5);
                 let ts = hits(&scene, inside, target - inside);
                 assert!(ts.iter().any(|t| *t > 0.0), "ray {inside} -> {target}");
                 assert!(ts.iter().any(|t| *t < 0.0), "ray {inside} <- {target}");
@@ -178,7 +181,7 @@ fn cube_corners_and_seams_are_watertight_along_axes_and_diagonals() {
 
 #[test]
 fn degenerate_triangles_give_none_and_never_nan() {
-    let mut rng = Rng::new(4);
+    let mut rng = SplitMix64::new(4);
     let collinear = [
         DVec3::ZERO,
         DVec3::new(1.0, 1.0, 1.0),
@@ -188,10 +191,13 @@ fn degenerate_triangles_give_none_and_never_nan() {
     let repeated = [DVec3::ZERO, DVec3::ZERO, DVec3::X];
     for tri in [collinear, point, repeated] {
         for _ in 0..2000 {
-            let origin = rng.in_cube(3.0);
-            let target = tri[0] + (tri[2] - tri[0]) * rng.unit();
+            let origin = in_cube(&mut rng, 3.0);
+            let target = tri[0] + (tri[2] - tri[0]) * rng.next_f64();
             assert_eq!(intersect_watertight(origin, target - origin, &tri), None);
-            assert_eq!(intersect_watertight(origin, rng.direction(), &tri), None);
+            assert_eq!(
+                intersect_watertight(origin, random_direction(&mut rng), &tri),
+                None
+            );
         }
     }
     let tri = [DVec3::ZERO, DVec3::X, DVec3::Y];
@@ -258,16 +264,16 @@ fn huge_coordinates_stay_exact() {
     assert_eq!(t, 1.0);
     assert_eq!(bary, [0.5, 0.25, 0.25]);
     // Oblique rays: the hit point reproduces the target to near f64 precision.
-    let mut rng = Rng::new(5);
+    let mut rng = SplitMix64::new(5);
     for _ in 0..1000 {
-        let (u, v) = (rng.unit(), rng.unit());
+        let (u, v) = (rng.next_f64(), rng.next_f64());
         let (u, v) = if u + v > 1.0 {
             (1.0 - u, 1.0 - v)
         } else {
             (u, v)
         };
         let target = tri[0] + (tri[1] - tri[0]) * u + (tri[2] - tri[0]) * v;
-        let origin = target + rng.direction() * 3.0;
+        let origin = target + random_direction(&mut rng) * 3.0;
         let dir = target - origin;
         let Some((t, [w0, w1, w2])) = intersect_watertight(origin, dir, &tri) else {
             // Only rays grazing the plane may legitimately miss after rounding.
@@ -350,13 +356,13 @@ fn line_segment_distances() {
         5.0
     );
     // Agrees with brute-force sampling.
-    let mut rng = Rng::new(6);
+    let mut rng = SplitMix64::new(6);
     for _ in 0..500 {
         let (o, dir, a, b) = (
-            rng.in_cube(2.0),
-            rng.direction(),
-            rng.in_cube(2.0),
-            rng.in_cube(2.0),
+            in_cube(&mut rng, 2.0),
+            random_direction(&mut rng),
+            in_cube(&mut rng, 2.0),
+            in_cube(&mut rng, 2.0),
         );
         let exact = d(o, dir, a, b);
         let sampled = (0..=2000)
