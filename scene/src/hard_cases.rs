@@ -37,7 +37,8 @@ use glam::{DMat4, DQuat, DVec3, Mat4, Vec3};
 use crate::obj::parse_obj;
 use crate::scene::ground_square;
 use crate::{
-    load_obj, procedural_default, Aabb, Camera, DirectionalLight, Scene, SceneError, SplitMix64,
+    load_obj, procedural_default, Aabb, Camera, DirectionalLight, MeshBuilder, Scene, SceneError,
+    SplitMix64,
 };
 
 /// A group of related cases (one integration test each).
@@ -369,166 +370,143 @@ fn circle(num: i64, den: i64) -> (f64, f64) {
     (cos_sign * c, sin_sign * s)
 }
 
-/// Triangles of one object under construction.
-#[derive(Default)]
-struct Mesh {
-    positions: Vec<Vec3>,
-    indices: Vec<u32>,
+/// `points` rounded to f32.
+fn rounded<const N: usize>(points: [DVec3; N]) -> [Vec3; N] {
+    points.map(|p| p.as_vec3())
 }
 
-impl Mesh {
-    fn vertex(&mut self, p: DVec3) -> u32 {
-        self.positions.push(p.as_vec3());
-        (self.positions.len() - 1) as u32
-    }
+/// Adds the vertex `p` rounded to f32.
+fn add_vertex(mesh: &mut MeshBuilder, p: DVec3) -> u32 {
+    mesh.vertex(p.as_vec3())
+}
 
-    /// A triangle with vertices of its own, wound as given.
-    fn triangle(&mut self, corners: [DVec3; 3]) {
-        for p in corners {
-            let i = self.vertex(p);
-            self.indices.push(i);
+/// Adds a grid of `nu` x `nv` quads over the parallelogram spanned from `corner` by `u` and `v`, facing
+/// `u × v`, with shared vertices (computed in f64).
+fn add_grid(mesh: &mut MeshBuilder, corner: DVec3, u: DVec3, v: DVec3, nu: u32, nv: u32) {
+    let first = mesh.positions().len() as u32;
+    for j in 0..=nv {
+        for i in 0..=nu {
+            add_vertex(
+                mesh,
+                corner + u * (f64::from(i) / f64::from(nu)) + v * (f64::from(j) / f64::from(nv)),
+            );
         }
     }
-
-    /// A planar convex quad `a b c d` as the triangles `a b c` and `a c d`.
-    fn quad(&mut self, [a, b, c, d]: [DVec3; 4]) {
-        self.triangle([a, b, c]);
-        self.triangle([a, c, d]);
+    let at = |i: u32, j: u32| first + j * (nu + 1) + i;
+    for j in 0..nv {
+        for i in 0..nu {
+            mesh.connect_quad([at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
     }
+}
 
-    /// A grid of `nu` x `nv` quads over the parallelogram spanned from `corner` by `u` and `v`, facing
-    /// `u × v`, with shared vertices.
-    fn grid(&mut self, corner: DVec3, u: DVec3, v: DVec3, nu: u32, nv: u32) {
-        let first = self.positions.len() as u32;
+/// Adds a closed box whose faces are grids of `n[axis]` cells per axis, wound outwards. Every vertex is
+/// taken from one lattice of coordinates, so vertices on shared edges are bit-identical.
+fn add_lattice_box(mesh: &mut MeshBuilder, min: DVec3, max: DVec3, n: [u32; 3]) {
+    let coordinate = |axis: usize, i: u32| -> f64 {
+        if i == n[axis] {
+            max[axis]
+        } else {
+            min[axis] + (max[axis] - min[axis]) * f64::from(i) / f64::from(n[axis])
+        }
+    };
+    let [nx, ny, nz] = n;
+    type Face = (u32, u32, fn(u32, u32, [u32; 3]) -> [u32; 3]);
+    let faces: [Face; 6] = [
+        (nz, ny, |i, j, [nx, _, nz]| [nx, j, nz - i]),
+        (nz, ny, |i, j, _| [0, j, i]),
+        (nx, nz, |i, j, [_, ny, nz]| [i, ny, nz - j]),
+        (nx, nz, |i, j, _| [i, 0, j]),
+        (nx, ny, |i, j, [_, _, nz]| [i, j, nz]),
+        (nx, ny, |i, j, [nx, _, _]| [nx - i, j, 0]),
+    ];
+    for (nu, nv, lattice) in faces {
+        let first = mesh.positions().len() as u32;
         for j in 0..=nv {
             for i in 0..=nu {
-                self.vertex(
-                    corner
-                        + u * (f64::from(i) / f64::from(nu))
-                        + v * (f64::from(j) / f64::from(nv)),
+                let [x, y, z] = lattice(i, j, n);
+                add_vertex(
+                    mesh,
+                    DVec3::new(coordinate(0, x), coordinate(1, y), coordinate(2, z)),
                 );
             }
         }
         let at = |i: u32, j: u32| first + j * (nu + 1) + i;
         for j in 0..nv {
             for i in 0..nu {
-                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
-                self.indices.extend([a, b, c, a, c, d]);
+                mesh.connect_quad([at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
             }
         }
     }
+}
 
-    /// A closed box whose faces are grids of `n[axis]` cells per axis, wound outwards. Every vertex is
-    /// taken from one lattice of coordinates, so vertices on shared edges are bit-identical.
-    fn lattice_box(&mut self, min: DVec3, max: DVec3, n: [u32; 3]) {
-        let coordinate = |axis: usize, i: u32| -> f64 {
-            if i == n[axis] {
-                max[axis]
-            } else {
-                min[axis] + (max[axis] - min[axis]) * f64::from(i) / f64::from(n[axis])
+/// Adds a closed sphere of `rings` latitude bands and `segments` meridians, poles on the vertical axis,
+/// meridian 0 towards +x, wound outwards. Unlike [`MeshBuilder::add_sphere`], its vertices come from
+/// [`circle`], so that vertices related by the sphere's symmetries are bit-identical mirror images.
+fn add_uv_sphere(mesh: &mut MeshBuilder, center: DVec3, radius: f64, rings: u32, segments: u32) {
+    let bottom = add_vertex(mesh, center - DVec3::Y * radius);
+    let ring_starts: Vec<u32> = (1..rings)
+        .map(|k| {
+            let (c, s) = circle(i64::from(k), 2 * i64::from(rings));
+            let (y, rho) = (center.y - radius * c, radius * s);
+            let start = mesh.positions().len() as u32;
+            for j in 0..segments {
+                let (cj, sj) = circle(i64::from(j), i64::from(segments));
+                add_vertex(
+                    mesh,
+                    DVec3::new(center.x + rho * cj, y, center.z - rho * sj),
+                );
             }
-        };
-        let [nx, ny, nz] = n;
-        type Face = (u32, u32, fn(u32, u32, [u32; 3]) -> [u32; 3]);
-        let faces: [Face; 6] = [
-            (nz, ny, |i, j, [nx, _, nz]| [nx, j, nz - i]),
-            (nz, ny, |i, j, _| [0, j, i]),
-            (nx, nz, |i, j, [_, ny, nz]| [i, ny, nz - j]),
-            (nx, nz, |i, j, _| [i, 0, j]),
-            (nx, ny, |i, j, [_, _, nz]| [i, j, nz]),
-            (nx, ny, |i, j, [nx, _, _]| [nx - i, j, 0]),
-        ];
-        for (nu, nv, lattice) in faces {
-            let first = self.positions.len() as u32;
-            for j in 0..=nv {
-                for i in 0..=nu {
-                    let [x, y, z] = lattice(i, j, n);
-                    self.vertex(DVec3::new(
-                        coordinate(0, x),
-                        coordinate(1, y),
-                        coordinate(2, z),
-                    ));
-                }
-            }
-            let at = |i: u32, j: u32| first + j * (nu + 1) + i;
-            for j in 0..nv {
-                for i in 0..nu {
-                    let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
-                    self.indices.extend([a, b, c, a, c, d]);
-                }
-            }
+            start
+        })
+        .collect();
+    let top = add_vertex(mesh, center + DVec3::Y * radius);
+    let (first, last) = (ring_starts[0], ring_starts[ring_starts.len() - 1]);
+    for j in 0..segments {
+        let k = (j + 1) % segments;
+        mesh.connect_triangle([bottom, first + k, first + j]);
+        for pair in ring_starts.windows(2) {
+            let (lo, up) = (pair[0], pair[1]);
+            mesh.connect_quad([lo + j, lo + k, up + k, up + j]);
         }
+        mesh.connect_triangle([top, last + j, last + k]);
     }
+}
 
-    /// A closed sphere of `rings` latitude bands and `segments` meridians, poles on the vertical axis,
-    /// meridian 0 towards +x, wound outwards.
-    fn uv_sphere(&mut self, center: DVec3, radius: f64, rings: u32, segments: u32) {
-        let bottom = self.vertex(center - DVec3::Y * radius);
-        let ring_starts: Vec<u32> = (1..rings)
-            .map(|k| {
-                let (c, s) = circle(i64::from(k), 2 * i64::from(rings));
-                let (y, rho) = (center.y - radius * c, radius * s);
-                let start = self.positions.len() as u32;
-                for j in 0..segments {
-                    let (cj, sj) = circle(i64::from(j), i64::from(segments));
-                    self.vertex(DVec3::new(center.x + rho * cj, y, center.z - rho * sj));
-                }
-                start
-            })
-            .collect();
-        let top = self.vertex(center + DVec3::Y * radius);
-        let (first, last) = (ring_starts[0], ring_starts[ring_starts.len() - 1]);
-        for j in 0..segments {
-            let k = (j + 1) % segments;
-            self.indices.extend([bottom, first + k, first + j]);
-            for pair in ring_starts.windows(2) {
-                let (lo, up) = (pair[0], pair[1]);
-                self.indices
-                    .extend([lo + j, lo + k, up + k, lo + j, up + k, up + j]);
-            }
-            self.indices.extend([top, last + j, last + k]);
+/// Adds an open tube along z (no caps), `segments` facets wound outwards; one facet faces exactly +y.
+fn add_tube(mesh: &mut MeshBuilder, center: DVec3, radius: f64, half_length: f64, segments: u32) {
+    let n = i64::from(segments);
+    let first = mesh.positions().len() as u32;
+    for j in 0..n {
+        // Vertex j at π/2 + (2j + 1)π/n: the facet between the last and the first vertex is centred on +y.
+        let (c, s) = circle(n + 4 * j + 2, 4 * n);
+        for z in [-half_length, half_length] {
+            add_vertex(mesh, center + DVec3::new(radius * c, radius * s, z));
         }
     }
+    for j in 0..segments {
+        let k = (j + 1) % segments;
+        let (a, d) = (first + 2 * j, first + 2 * j + 1);
+        let (b, c) = (first + 2 * k, first + 2 * k + 1);
+        mesh.connect_quad([a, b, c, d]);
+    }
+}
 
-    /// An open tube along z (no caps), `segments` facets wound outwards; one facet faces exactly +y.
-    fn tube(&mut self, center: DVec3, radius: f64, half_length: f64, segments: u32) {
-        let n = i64::from(segments);
-        let first = self.positions.len() as u32;
-        for j in 0..n {
-            // Vertex j at π/2 + (2j + 1)π/n: the facet between the last and the first vertex is centred on +y.
-            let (c, s) = circle(n + 4 * j + 2, 4 * n);
-            for z in [-half_length, half_length] {
-                self.vertex(center + DVec3::new(radius * c, radius * s, z));
-            }
-        }
-        for j in 0..segments {
-            let k = (j + 1) % segments;
-            let (a, d) = (first + 2 * j, first + 2 * j + 1);
-            let (b, c) = (first + 2 * k, first + 2 * k + 1);
-            self.indices.extend([a, b, c, a, c, d]);
-        }
+/// Adds a horizontal disc of `n` fan triangles sharing the centre vertex, facing +y; rim vertex 0 towards
+/// +x. Returns the rim polygon.
+fn add_fan_disc(mesh: &mut MeshBuilder, center: DVec3, radius: f64, n: u32) -> Vec<Vec3> {
+    let hub = add_vertex(mesh, center);
+    let rim: Vec<u32> = (0..n)
+        .map(|k| {
+            let (c, s) = circle(i64::from(k), i64::from(n));
+            add_vertex(mesh, center + DVec3::new(radius * c, 0.0, radius * s))
+        })
+        .collect();
+    for k in 0..n as usize {
+        let next = rim[(k + 1) % rim.len()];
+        mesh.connect_triangle([hub, next, rim[k]]);
     }
-
-    /// A horizontal disc of `n` fan triangles sharing the centre vertex, facing +y; rim vertex 0 towards +x.
-    /// Returns the rim polygon.
-    fn fan_disc(&mut self, center: DVec3, radius: f64, n: u32) -> Vec<Vec3> {
-        let hub = self.vertex(center);
-        let rim: Vec<u32> = (0..n)
-            .map(|k| {
-                let (c, s) = circle(i64::from(k), i64::from(n));
-                self.vertex(center + DVec3::new(radius * c, 0.0, radius * s))
-            })
-            .collect();
-        for k in 0..n as usize {
-            let next = rim[(k + 1) % rim.len()];
-            self.indices.extend([hub, next, rim[k]]);
-        }
-        rim.iter().map(|&i| self.positions[i as usize]).collect()
-    }
-
-    fn object(self, name: &str) -> Scene {
-        Scene::single_object(self.positions, self.indices, name)
-    }
+    rim.iter().map(|&i| mesh.positions()[i as usize]).collect()
 }
 
 /// Radius of the largest ball around `center` inside the convex closed mesh `scene`: the smallest distance
@@ -553,21 +531,21 @@ fn rectangle(x: [f64; 2], y: f64, z: [f64; 2]) -> Vec<Vec3> {
 
 /// A horizontal quad facing +y over the rectangle `x` × `z` at height `y`.
 fn plate(name: &str, x: [f64; 2], y: f64, z: [f64; 2]) -> Scene {
-    let mut m = Mesh::default();
-    m.quad([
+    let mut m = MeshBuilder::new();
+    m.add_quad(rounded([
         DVec3::new(x[0], y, z[1]),
         DVec3::new(x[1], y, z[1]),
         DVec3::new(x[1], y, z[0]),
         DVec3::new(x[0], y, z[0]),
-    ]);
-    m.object(name)
+    ]));
+    m.into_scene(name)
 }
 
 /// A closed box of 12 triangles.
 fn solid_box(name: &str, min: [f64; 3], max: [f64; 3]) -> Scene {
-    let mut m = Mesh::default();
-    m.lattice_box(DVec3::from(min), DVec3::from(max), [1, 1, 1]);
-    m.object(name)
+    let mut m = MeshBuilder::new();
+    add_lattice_box(&mut m, DVec3::from(min), DVec3::from(max), [1, 1, 1]);
+    m.into_scene(name)
 }
 
 fn shared_edges() -> Vec<HardCase> {
@@ -578,23 +556,29 @@ fn shared_edges() -> Vec<HardCase> {
         ..MapSpec::new(256)
     };
 
-    let mut fan = Mesh::default();
-    let rim = fan.fan_disc(DVec3::new(0.0, 1.0, 0.0), 1.0, 96);
-    let mut plate_grid = Mesh::default();
-    plate_grid.grid(
+    let mut fan = MeshBuilder::new();
+    let rim = add_fan_disc(&mut fan, DVec3::new(0.0, 1.0, 0.0), 1.0, 96);
+    let mut plate_grid = MeshBuilder::new();
+    add_grid(
+        &mut plate_grid,
         DVec3::new(-1.0, 1.0, 1.0),
         DVec3::new(2.0, 0.0, 0.0),
         DVec3::new(0.0, 0.0, -2.0),
         32,
         32,
     );
-    let mut grid_box = Mesh::default();
+    let mut grid_box = MeshBuilder::new();
     let (box_min, box_max) = ([-0.75, 0.75, -0.75], [0.75, 1.5, 0.75]);
-    grid_box.lattice_box(DVec3::from(box_min), DVec3::from(box_max), [8, 4, 8]);
-    let mut sphere = Mesh::default();
+    add_lattice_box(
+        &mut grid_box,
+        DVec3::from(box_min),
+        DVec3::from(box_max),
+        [8, 4, 8],
+    );
+    let mut sphere = MeshBuilder::new();
     let center = Vec3::new(0.0, 1.2, 0.0);
-    sphere.uv_sphere(center.as_dvec3(), 0.8, 24, 48);
-    let sphere = sphere.object("sphere");
+    add_uv_sphere(&mut sphere, center.as_dvec3(), 0.8, 24, 48);
+    let sphere = sphere.into_scene("sphere");
     let radius = inscribed_radius(&sphere, center);
 
     vec![
@@ -605,7 +589,7 @@ fn shared_edges() -> Vec<HardCase> {
              down: the receiver under the centre sends its ray through the vertex shared by all \
              96, the centre pixel column through the edges on x = 0 and the centre row through \
              the edges on z = 0.",
-            with(ground(4.0), [fan.object("fan")]),
+            with(ground(4.0), [fan.into_scene("fan")]),
             down,
             camera,
             MapSpec::new(256),
@@ -616,7 +600,7 @@ fn shared_edges() -> Vec<HardCase> {
             Family::SharedEdges,
             "A 2 m plate of 2,048 triangles 1 m above the ground, light straight down: the centre \
              column and row of receivers lie exactly under grid edges and vertices.",
-            with(ground(4.0), [plate_grid.object("plate")]),
+            with(ground(4.0), [plate_grid.into_scene("plate")]),
             down,
             camera,
             MapSpec::new(256),
@@ -632,7 +616,7 @@ fn shared_edges() -> Vec<HardCase> {
             "A floating closed box whose faces are 8x4x8 grids, bit-identical vertices on every \
              seam; only light-facing triangles are stored, so a single layer of shared edges must \
              stop every ray.",
-            with(ground(4.0), [grid_box.object("box")]),
+            with(ground(4.0), [grid_box.into_scene("box")]),
             down,
             camera,
             closed,
@@ -669,23 +653,24 @@ fn grazing() -> Vec<HardCase> {
         rotation * DVec3::X,
         rotation * DVec3::Z,
     );
-    let mut plane = Mesh::default();
-    plane.grid(
+    let mut plane = MeshBuilder::new();
+    add_grid(
+        &mut plane,
         center + rotation * DVec3::new(-2.0, 0.0, 2.0),
         rotation * DVec3::new(4.0, 0.0, 0.0),
         rotation * DVec3::new(0.0, 0.0, -4.0),
         12,
         12,
     );
-    let plane = plane.object("tilted plane");
+    let plane = plane.into_scene("tilted plane");
     let mut plane_bounds = plane.bounds();
     plane_bounds.min -= Vec3::splat(1e-3);
     plane_bounds.max += Vec3::splat(1e-3);
 
     let radius = 20.0;
-    let mut tube = Mesh::default();
-    tube.tube(DVec3::ZERO, radius, 20.0, 512);
-    let tube = tube.object("tube");
+    let mut tube = MeshBuilder::new();
+    add_tube(&mut tube, DVec3::ZERO, radius, 20.0, 512);
+    let tube = tube.into_scene("tube");
     let mut tube_bounds = tube.bounds();
     tube_bounds.min -= Vec3::splat(1e-2);
     tube_bounds.max += Vec3::splat(1e-2);
@@ -864,8 +849,9 @@ fn small_triangles() -> Vec<HardCase> {
     // Ground of 4 m on a 128 map: texels of 1/32 m.
     let texel = 4.0 / 128.0;
 
-    let mut fine = Mesh::default();
-    fine.grid(
+    let mut fine = MeshBuilder::new();
+    add_grid(
+        &mut fine,
         DVec3::new(-0.25, 0.6, 0.25),
         DVec3::new(0.5, 0.0, 0.0),
         DVec3::new(0.0, 0.0, -0.5),
@@ -874,7 +860,7 @@ fn small_triangles() -> Vec<HardCase> {
     );
 
     let mut rng = SplitMix64::new(0xd057);
-    let mut dust = Mesh::default();
+    let mut dust = MeshBuilder::new();
     for _ in 0..1500 {
         let c = DVec3::new(
             f64::from(rng.uniform_f32(-1.0, 1.0)) * 0.5,
@@ -890,40 +876,45 @@ fn small_triangles() -> Vec<HardCase> {
             ) * size
         };
         let tri = [c + corner(), c + corner(), c + corner()];
-        dust.triangle(tri);
+        dust.add_triangle(rounded(tri));
     }
 
     // Needles: a star of 64 isolated needles 1 m long and 10 µm wide, and a plate cut into 1,000 slivers
     // fanning out from one corner.
-    let mut needles = Mesh::default();
+    let mut needles = MeshBuilder::new();
     for k in 0..64 {
         let (c, s) = circle(k, 64);
         let dir = DVec3::new(c, 0.0, s);
         let side = DVec3::new(-s, 0.0, c) * 5e-6;
         let hub = DVec3::new(0.0, 0.4, 0.0) + dir * 0.02;
-        needles.triangle([hub - side, hub + dir * 0.5 + side * 0.5, hub + side]);
+        needles.add_triangle(rounded([
+            hub - side,
+            hub + dir * 0.5 + side * 0.5,
+            hub + side,
+        ]));
     }
-    let mut slivers = Mesh::default();
+    let mut slivers = MeshBuilder::new();
     let apex = DVec3::new(-0.5, 0.7, -0.5);
     let rim: Vec<DVec3> = (0..=500)
         .map(|i| DVec3::new(0.5, 0.7, -0.5 + f64::from(i) / 500.0))
         .chain((1..=500).map(|i| DVec3::new(0.5 - f64::from(i) / 500.0, 0.7, 0.5)))
         .collect();
     for pair in rim.windows(2) {
-        slivers.triangle([apex, pair[1], pair[0]]);
+        slivers.add_triangle(rounded([apex, pair[1], pair[0]]));
     }
 
     // Zero-area triangles inside and next to a plate: collinear ones along its interior edges, ones with
     // repeated vertices, and points.
-    let mut zero = Mesh::default();
-    zero.grid(
+    let mut zero = MeshBuilder::new();
+    add_grid(
+        &mut zero,
         DVec3::new(-0.5, 0.6, 0.5),
         DVec3::new(1.0, 0.0, 0.0),
         DVec3::new(0.0, 0.0, -1.0),
         8,
         8,
     );
-    let mut degenerate = Mesh::default();
+    let mut degenerate = MeshBuilder::new();
     for i in 0..=8 {
         for j in 0..8 {
             let (u, v0, v1) = (
@@ -932,11 +923,11 @@ fn small_triangles() -> Vec<HardCase> {
                 -0.5 + f64::from(j + 1) / 8.0,
             );
             let (a, b) = (DVec3::new(u, 0.6, v0), DVec3::new(u, 0.6, v1));
-            degenerate.triangle([a, b, (a + b) * 0.5]);
-            degenerate.triangle([a, a, b]);
+            degenerate.add_triangle(rounded([a, b, (a + b) * 0.5]));
+            degenerate.add_triangle(rounded([a, a, b]));
             let (c, d) = (DVec3::new(v0, 0.6, u), DVec3::new(v1, 0.6, u));
-            degenerate.triangle([c, (c + d) * 0.5, d]);
-            degenerate.triangle([c, c, c]);
+            degenerate.add_triangle(rounded([c, (c + d) * 0.5, d]));
+            degenerate.add_triangle(rounded([c, c, c]));
         }
     }
     for k in 0..100 {
@@ -946,9 +937,9 @@ fn small_triangles() -> Vec<HardCase> {
             f64::from(rng.uniform_f32(-1.0, 1.0)),
         );
         if k % 2 == 0 {
-            degenerate.triangle([p, p, p]);
+            degenerate.add_triangle(rounded([p, p, p]));
         } else {
-            degenerate.triangle([p, p + DVec3::X * 0.1, p + DVec3::X * 0.3]);
+            degenerate.add_triangle(rounded([p, p + DVec3::X * 0.1, p + DVec3::X * 0.3]));
         }
     }
 
@@ -958,7 +949,7 @@ fn small_triangles() -> Vec<HardCase> {
             Family::SmallTriangles,
             "A 0.5 m plate of cells a third of a texel wide: no triangle covers a texel centre, \
              so only conservative rasterization finds them.",
-            with(ground(4.0), [fine.object("fine plate")]),
+            with(ground(4.0), [fine.into_scene("fine plate")]),
             light,
             camera,
             MapSpec::new(128),
@@ -972,7 +963,7 @@ fn small_triangles() -> Vec<HardCase> {
             "sub-texel dust (1,500 triangles)",
             Family::SmallTriangles,
             "1,500 randomly oriented triangles 0.1 to 0.4 texels across, scattered in a 1 m box.",
-            with(ground(4.0), [dust.object("dust")]),
+            with(ground(4.0), [dust.into_scene("dust")]),
             light,
             camera,
             MapSpec::new(128),
@@ -984,7 +975,7 @@ fn small_triangles() -> Vec<HardCase> {
              out from one corner (aspect up to 1,400).",
             with(
                 ground(4.0),
-                [needles.object("needles"), slivers.object("slivers")],
+                [needles.into_scene("needles"), slivers.into_scene("slivers")],
             ),
             light,
             camera,
@@ -1003,7 +994,10 @@ fn small_triangles() -> Vec<HardCase> {
              blocker.",
             with(
                 ground(4.0),
-                [zero.object("plate"), degenerate.object("degenerate")],
+                [
+                    zero.into_scene("plate"),
+                    degenerate.into_scene("degenerate"),
+                ],
             ),
             light,
             camera,
@@ -1039,26 +1033,31 @@ fn texel_blockers(light: DirectionalLight) -> (Scene, Vec<Vec3>) {
     let n = TEXEL_MAP;
     let c = i64::from(n / 2);
     let p = |i: i64, j: i64| texel_corner(inverse, n, c + i, c + j, TEXEL_BLOCKER_HEIGHT);
-    let mut m = Mesh::default();
+    let mut m = MeshBuilder::new();
     // A plate of 32x32 texel-sized cells.
     for j in -16..16 {
         for i in -16..16 {
-            m.quad([p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1)]);
+            m.add_quad(rounded([
+                p(i, j),
+                p(i + 1, j),
+                p(i + 1, j + 1),
+                p(i, j + 1),
+            ]));
         }
     }
     let outline = [p(-16, -16), p(16, -16), p(16, 16), p(-16, 16)]
         .map(|p| p.as_vec3())
         .to_vec();
     // A square of 8x8 texels cut along its diagonal through texel corners.
-    m.triangle([p(20, -4), p(28, -4), p(20, 4)]);
-    m.triangle([p(28, -4), p(28, 4), p(20, 4)]);
+    m.add_triangle(rounded([p(20, -4), p(28, -4), p(20, 4)]));
+    m.add_triangle(rounded([p(28, -4), p(28, 4), p(20, 4)]));
     // A strip exactly one texel wide.
-    m.quad([p(-28, -16), p(-27, -16), p(-27, 16), p(-28, 16)]);
+    m.add_quad(rounded([p(-28, -16), p(-27, -16), p(-27, 16), p(-28, 16)]));
     // Half a texel.
-    m.triangle([p(-22, 20), p(-21, 20), p(-22, 21)]);
+    m.add_triangle(rounded([p(-22, 20), p(-21, 20), p(-22, 21)]));
     // A triangle touching its neighbour texel at a single corner.
-    m.triangle([p(20, 20), p(22, 21), p(21, 22)]);
-    (with(ground(4.0), [m.object("texel-aligned")]), outline)
+    m.add_triangle(rounded([p(20, 20), p(22, 21), p(21, 22)]));
+    (with(ground(4.0), [m.into_scene("texel-aligned")]), outline)
 }
 
 fn texel_boundaries() -> Vec<HardCase> {
@@ -1099,28 +1098,28 @@ fn texel_boundaries() -> Vec<HardCase> {
 
 fn frustum_border() -> Vec<HardCase> {
     let light = DirectionalLight::slanted();
-    let mut tilted = Mesh::default();
+    let mut tilted = MeshBuilder::new();
     let tilted_corners = [
         DVec3::new(-0.8, 0.3, 0.5),
         DVec3::new(0.8, 0.3, 0.5),
         DVec3::new(0.0, 5.0, 0.9),
     ];
-    tilted.triangle(tilted_corners);
-    let mut card = Mesh::default();
+    tilted.add_triangle(rounded(tilted_corners));
+    let mut card = MeshBuilder::new();
     let card_corners = [
         DVec3::new(-0.5, -3.0, 0.0),
         DVec3::new(-0.5, -3.0, 0.4),
         DVec3::new(-0.5, 0.8, 0.4),
         DVec3::new(-0.5, 0.8, 0.0),
     ];
-    card.quad(card_corners);
+    card.add_quad(rounded(card_corners));
     let scene = with(
         ground(2.0),
         [
             plate("strip along x", [-10.0, 10.0], 0.6, [-0.6, -0.1]),
             plate("strip along z", [0.2, 0.7], 0.9, [-10.0, 10.0]),
-            tilted.object("tilted"),
-            card.object("card"),
+            tilted.into_scene("tilted"),
+            card.into_scene("card"),
         ],
     );
     let map_box = aabb([-1.0, 0.0, -1.0], [1.0, 1.0, 1.0]);
@@ -1150,19 +1149,19 @@ fn frustum_border() -> Vec<HardCase> {
 
 fn coplanar() -> Vec<HardCase> {
     let light = DirectionalLight::slanted().direction;
-    let mut second = Mesh::default();
+    let mut second = MeshBuilder::new();
     // Same plane as the first plate, the other diagonal.
-    second.quad([
+    second.add_quad(rounded([
         DVec3::new(0.6, 0.5, 0.5),
         DVec3::new(0.6, 0.5, -0.3),
         DVec3::new(-0.2, 0.5, -0.3),
         DVec3::new(-0.2, 0.5, 0.5),
-    ]);
+    ]));
     let overlapping = with(
         ground(4.0),
         [
             plate("plate", [-0.6, 0.2], 0.5, [-0.5, 0.3]),
-            second.object("overlapping plate"),
+            second.into_scene("overlapping plate"),
             plate("decal", [0.8, 1.4], 0.0, [-1.4, -0.8]),
         ],
     );
@@ -1216,10 +1215,11 @@ fn coplanar() -> Vec<HardCase> {
 
 fn thin_geometry() -> Vec<HardCase> {
     let light = DirectionalLight::slanted().direction;
-    let mut slats = Mesh::default();
+    let mut slats = MeshBuilder::new();
     for k in 0..6 {
         let x = 0.7 + 0.1 * f64::from(k);
-        slats.lattice_box(
+        add_lattice_box(
+            &mut slats,
             DVec3::new(x, 0.0, -0.4),
             DVec3::new(x + 0.002, 0.8, 0.4),
             [1, 1, 1],
@@ -1229,7 +1229,7 @@ fn thin_geometry() -> Vec<HardCase> {
         ground(4.0),
         [
             solid_box("floating plate", [-0.5, 0.6, -0.5], [0.5, 0.6001, 0.5]),
-            slats.object("slats"),
+            slats.into_scene("slats"),
             solid_box("plate on the ground", [-1.2, 0.0, 0.6], [-0.6, 5e-4, 1.2]),
         ],
     );
@@ -1248,7 +1248,7 @@ fn thin_geometry() -> Vec<HardCase> {
     }
 
     let mut rng = SplitMix64::new(0xf011a6e);
-    let mut cards = Mesh::default();
+    let mut cards = MeshBuilder::new();
     let mut card_checks = Vec::new();
     for k in 0..5 {
         let base = DVec3::new(
@@ -1265,7 +1265,7 @@ fn thin_geometry() -> Vec<HardCase> {
                 base + across + DVec3::Y * 0.85,
                 base - across + DVec3::Y * 0.85,
             ];
-            cards.quad(corners);
+            cards.add_quad(rounded(corners));
             // Cards seen nearly edge-on by the light cast slivers of shadow: too thin to judge.
             let normal = (corners[1] - corners[0])
                 .cross(corners[3] - corners[0])
@@ -1290,13 +1290,13 @@ fn thin_geometry() -> Vec<HardCase> {
             f64::from(rng.uniform_f32(-1.0, 1.0)),
             f64::from(rng.uniform_f32(-1.0, 1.0)) * 3.0,
         );
-        cards.triangle([
+        cards.add_triangle(rounded([
             c,
             c + q * DVec3::new(0.12, 0.0, 0.03),
             c + q * DVec3::new(0.05, 0.0, 0.06),
-        ]);
+        ]));
     }
-    let foliage = with(ground(4.0), [cards.object("cards and leaves")]);
+    let foliage = with(ground(4.0), [cards.into_scene("cards and leaves")]);
     vec![
         case(
             "thin closed plates",
@@ -1440,8 +1440,9 @@ fn non_finite() -> Vec<HardCase> {
 /// functions round to zero. The exhaustive fallback of overflowed texels tests the shadow ray against all
 /// of them.
 fn far_slivers() -> (Scene, Aabb) {
-    let mut buried = Mesh::default();
-    buried.grid(
+    let mut buried = MeshBuilder::new();
+    add_grid(
+        &mut buried,
         DVec3::new(-0.5, -0.05, 0.5),
         DVec3::new(1.0, 0.0, 0.0),
         DVec3::new(0.0, 0.0, -1.0),
@@ -1449,22 +1450,25 @@ fn far_slivers() -> (Scene, Aabb) {
         16,
     );
     let mut rng = SplitMix64::new(0x511_4e25);
-    let mut slivers = Mesh::default();
+    let mut slivers = MeshBuilder::new();
     for k in 0..1000 {
         let (c, s) = circle(k, 1000);
         let radial = DVec3::new(c, 0.0, s);
         let across = DVec3::new(-s, 0.0, c);
         let r = 60.0 + 40.0 * f64::from(rng.next_f32());
         let p = radial * r + DVec3::Y * (0.05 + 0.5 * f64::from(rng.next_f32()));
-        slivers.triangle([
+        slivers.add_triangle(rounded([
             p,
             p + radial * 0.02 + DVec3::Y * 0.01,
             p + radial * 0.04 + across * 1e-5,
-        ]);
+        ]));
     }
     let scene = with(
         ground(4.0),
-        [buried.object("buried grid"), slivers.object("far slivers")],
+        [
+            buried.into_scene("buried grid"),
+            slivers.into_scene("far slivers"),
+        ],
     );
     (scene, aabb([-0.5, -1e-3, -0.5], [0.5, 1e-3, 0.5]))
 }
@@ -1647,9 +1651,9 @@ mod tests {
 
     #[test]
     fn tube_has_a_facet_facing_up() {
-        let mut m = Mesh::default();
-        m.tube(DVec3::ZERO, 20.0, 20.0, 512);
-        let s = m.object("tube");
+        let mut m = MeshBuilder::new();
+        add_tube(&mut m, DVec3::ZERO, 20.0, 20.0, 512);
+        let s = m.into_scene("tube");
         let up = (0..s.triangle_count()).filter(|&t| {
             let [a, b, c] = s.triangle(t);
             (b - a).cross(c - a).normalize() == Vec3::Y

@@ -6,6 +6,8 @@
 //!   content with a [`SceneError`] naming the file, and never panics;
 //! - [`procedural_default`]: the built-in demo scene of shadow-mapping trouble makers;
 //! - [`Camera`] and [`DirectionalLight`]: view and projection matrices that frame a scene;
+//! - [`MeshBuilder`]: the builder of boxes, quads, triangles, spheres and lathes that every
+//!   generated mesh is made with;
 //! - [`SplitMix64`]: the small deterministic pseudo-random generator used wherever the workspace
 //!   needs reproducible random numbers;
 //! - [`hard_cases`]: the deterministic hard numerical cases ([`HardCase`]) of the shadow renderer.
@@ -21,6 +23,7 @@ mod camera;
 mod error;
 pub mod hard_cases;
 mod light;
+mod mesh_builder;
 mod models;
 mod obj;
 mod procedural;
@@ -32,6 +35,7 @@ pub use camera::Camera;
 pub use error::SceneError;
 pub use hard_cases::HardCase;
 pub use light::DirectionalLight;
+pub use mesh_builder::MeshBuilder;
 pub use models::{models_dir, MODELS_ENV};
 pub use obj::load_obj;
 pub use procedural::procedural_default;

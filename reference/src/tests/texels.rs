@@ -1,9 +1,9 @@
 //! Conservative texel sets against hand-checked cases and a brute-force oracle.
 
 use glam::{DVec2, Mat4, Vec3, Vec4};
-use scene::SplitMix64;
+use scene::{MeshBuilder, SplitMix64};
 
-use super::{in_cube, MeshBuilder};
+use super::in_cube;
 use crate::{
     conservative_texel_sets, overlaps_texel_with_margin, FaceSelection, RefScene, TexelSets,
 };
@@ -27,11 +27,11 @@ fn flat(points: [(f32, f32); 3]) -> [Vec3; 3] {
 }
 
 fn scene_of(triangles: &[[Vec3; 3]]) -> RefScene {
-    let mut mesh = MeshBuilder::default();
+    let mut mesh = MeshBuilder::new();
     for [a, b, c] in triangles {
-        mesh.add_triangle(*a, *b, *c);
+        mesh.add_triangle([*a, *b, *c]);
     }
-    RefScene::new(&mesh.scene())
+    RefScene::new(&mesh.into_scene("mesh"))
 }
 
 /// Texels `(x, y)` containing triangle `tri`.

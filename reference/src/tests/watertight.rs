@@ -1,9 +1,9 @@
 //! Watertightness and robustness of the ray/triangle and line/segment primitives.
 
 use glam::{DVec3, Vec3};
-use scene::SplitMix64;
+use scene::{MeshBuilder, SplitMix64};
 
-use super::{in_cube, random_direction, MeshBuilder};
+use super::{add_heightfield, in_cube, random_direction};
 use crate::{intersect_watertight, line_segment_distance, RefScene};
 
 /// Every hit parameter of the line `origin + t * dir` against all triangles.
@@ -19,7 +19,7 @@ fn hits(scene: &RefScene, origin: DVec3, dir: DVec3) -> Vec<f64> {
 
 /// Closed fan around `center` (the shared vertex) with `k` triangles.
 fn fan(center: Vec3, k: u32) -> MeshBuilder {
-    let mut mesh = MeshBuilder::default();
+    let mut mesh = MeshBuilder::new();
     let c = mesh.vertex(center);
     let first = c + 1;
     for i in 0..k {
@@ -32,7 +32,7 @@ fn fan(center: Vec3, k: u32) -> MeshBuilder {
         ));
     }
     for i in 0..k {
-        mesh.triangle(c, first + i, first + (i + 1) % k);
+        mesh.connect_triangle([c, first + i, first + (i + 1) % k]);
     }
     mesh
 }
@@ -40,12 +40,12 @@ fn fan(center: Vec3, k: u32) -> MeshBuilder {
 /// Tessellated closed cube `[-1, 1]^3`; seam vertices of neighbouring faces are
 /// bit-identical.
 fn cube(cells: u32) -> MeshBuilder {
-    let mut mesh = MeshBuilder::default();
+    let mut mesh = MeshBuilder::new();
     let coord = |i: u32| -1.0 + 2.0 * i as f32 / cells as f32;
     for axis in 0..3 {
         for side in [-1.0f32, 1.0] {
             let (u_axis, v_axis) = ((axis + 1) % 3, (axis + 2) % 3);
-            let first = mesh.positions.len() as u32;
+            let first = mesh.positions().len() as u32;
             for j in 0..=cells {
                 for i in 0..=cells {
                     let mut p = Vec3::ZERO;
@@ -59,8 +59,8 @@ fn cube(cells: u32) -> MeshBuilder {
             for j in 0..cells {
                 for i in 0..cells {
                     let v = |di: u32, dj: u32| first + (j + dj) * row + i + di;
-                    mesh.triangle(v(0, 0), v(1, 0), v(1, 1));
-                    mesh.triangle(v(0, 0), v(1, 1), v(0, 1));
+                    mesh.connect_triangle([v(0, 0), v(1, 0), v(1, 1)]);
+                    mesh.connect_triangle([v(0, 0), v(1, 1), v(0, 1)]);
                 }
             }
         }
@@ -83,7 +83,7 @@ fn edge_and_vertex_targets(scene: &RefScene) -> Vec<DVec3> {
 fn rays_at_shared_fan_edges_and_vertex_always_hit() {
     let mut rng = SplitMix64::new(1);
     for k in [3, 5, 8, 13] {
-        let scene = RefScene::new(&fan(Vec3::new(0.0, 0.3, 0.0), k).scene());
+        let scene = RefScene::new(&fan(Vec3::new(0.0, 0.3, 0.0), k).into_scene("mesh"));
         let center = scene.triangle(0)[0];
         let mut targets = vec![center];
         for i in 0..scene.triangle_count() {
@@ -112,11 +112,15 @@ fn rays_at_shared_fan_edges_and_vertex_always_hit() {
 fn rays_at_shared_grid_edges_and_vertices_always_hit() {
     let mut rng = SplitMix64::new(2);
     for offset in [0.0f32, 1e5] {
-        let mut mesh = MeshBuilder::default();
-        mesh.add_grid((offset - 2.0, -2.0), (offset + 2.0, 2.0), 8, |x, z| {
-            0.37 * (x - offset) + 0.61 * z + 0.1 + 0.05 * ((x - offset) * 3.0).sin()
-        });
-        let scene = RefScene::new(&mesh.scene());
+        let mut mesh = MeshBuilder::new();
+        add_heightfield(
+            &mut mesh,
+            (offset - 2.0, -2.0),
+            (offset + 2.0, 2.0),
+            8,
+            |x, z| 0.37 * (x - offset) + 0.61 * z + 0.1 + 0.05 * ((x - offset) * 3.0).sin(),
+        );
+        let scene = RefScene::new(&mesh.into_scene("mesh"));
         let interior = |p: DVec3| (p.x - f64::from(offset)).abs() < 1.99 && p.z.abs() < 1.99;
         let targets: Vec<DVec3> = edge_and_vertex_targets(&scene)
             .into_iter()
@@ -141,10 +145,10 @@ fn rays_at_shared_grid_edges_and_vertices_always_hit() {
 #[test]
 fn lines_through_closed_meshes_hit_on_both_sides() {
     let mut rng = SplitMix64::new(3);
-    let mut sphere = MeshBuilder::default();
+    let mut sphere = MeshBuilder::new();
     sphere.add_sphere(Vec3::ZERO, 1.0, 12, 16);
     for mesh in [sphere, cube(4)] {
-        let scene = RefScene::new(&mesh.scene());
+        let scene = RefScene::new(&mesh.into_scene("mesh"));
         // Random lines through interior points.
         for _ in 0..3000 {
             let inside = in_cube(&mut rng, 0.5);
@@ -167,7 +171,7 @@ fn lines_through_closed_meshes_hit_on_both_sides() {
 
 #[test]
 fn cube_corners_and_seams_are_watertight_along_axes_and_diagonals() {
-    let scene = RefScene::new(&cube(3).scene());
+    let scene = RefScene::new(&cube(3).into_scene("mesh"));
     // Rays from the centre straight at corners and along seams.
     for target in edge_and_vertex_targets(&scene) {
         let ts = hits(&scene, DVec3::ZERO, target);
@@ -221,10 +225,10 @@ fn degenerate_triangles_give_none_and_never_nan() {
         None
     );
     // Degenerate triangles are never usable as blockers or receivers.
-    let mut mesh = MeshBuilder::default();
-    mesh.add_triangle(Vec3::ZERO, Vec3::ONE, Vec3::splat(2.0));
-    mesh.add_triangle(Vec3::ZERO, Vec3::X, Vec3::Y);
-    let scene = RefScene::new(&mesh.scene());
+    let mut mesh = MeshBuilder::new();
+    mesh.add_triangle([Vec3::ZERO, Vec3::ONE, Vec3::splat(2.0)]);
+    mesh.add_triangle([Vec3::ZERO, Vec3::X, Vec3::Y]);
+    let scene = RefScene::new(&mesh.into_scene("mesh"));
     assert!(!scene.is_usable(0));
     assert!(scene.is_usable(1));
 }
