@@ -24,6 +24,8 @@
 //! camera projection is reversed-Z with an infinite far plane. A light direction is
 //! the direction the light travels. Visibility 1 means lit.
 
+#![forbid(unsafe_code)]
+
 mod exact;
 mod geometry;
 mod ref_scene;

@@ -16,6 +16,8 @@
 //! from their front side; a light direction is the unit vector along which the light travels;
 //! projections follow Vulkan (depth range `[0, 1]`, no y flip in the matrices).
 
+#![forbid(unsafe_code)]
+
 pub use glam;
 
 mod aabb;
