@@ -19,12 +19,12 @@
 use crate::accuracy::{absolute_tolerance, compare_map, compare_visibility, fitted_light_matrix};
 use crate::output::write_png;
 use crate::plugin::PluginRenderer;
-use crate::View;
+use crate::{FrameImages, View};
 use anyhow::{anyhow, bail, Context, Result};
 use glam::{DMat4, DVec2, DVec3, Mat4};
 use passes::{
-    BinningRequest, FaceMode, FrameImages, FrameInputs, Light, PrimitiveMapConfig,
-    DEFAULT_ENTRY_BUDGET, GUARD_VALUE, GUARD_WORDS,
+    BinningRequest, FaceMode, FrameInputs, Light, PrimitiveMapConfig, DEFAULT_ENTRY_BUDGET,
+    GUARD_VALUE, GUARD_WORDS,
 };
 use reference::{certainly_blocked, contact_shadow_start, FaceSelection, RefScene};
 use rhi::Device;
