@@ -1,9 +1,10 @@
 //! Accuracy of a rendered frame against the exact CPU reference, as counts: primitive-map texel lists
 //! against exact conservative binning, and ray-traced visibility against exact visibility.
 
+use crate::FrameImages;
 use crate::View;
 use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
-use passes::{FrameImages, PrimitiveMapConfig, GUARD_WORDS};
+use passes::{PrimitiveMapConfig, GUARD_WORDS};
 use reference::{
     conservative_texel_sets, overlaps_texel_with_margin, reference_visibility, FaceSelection,
     Light, PixelClass, RefScene, VisibilityParams,

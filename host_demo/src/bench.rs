@@ -225,7 +225,7 @@ fn measure(device: &Device, model: &Model, models: &Path, args: &BenchArgs) -> R
         let run = run_peer(device, &renderer, &inputs, args.frames)?;
         let wrong = match &reference {
             Some(rs) => {
-                let images = passes::FrameImages {
+                let images = crate::FrameImages {
                     visibility: run.visibility,
                     ..renderer.read_back(device, false)?
                 };

@@ -6,12 +6,13 @@ use crate::images::{lerp_factor_preview, write_png_compact, Canvas};
 use crate::output::{shade_preview, write_png};
 use crate::plugin::PluginRenderer;
 use crate::render::{default_world_space_scale, median_timings};
+use crate::FrameImages;
 use crate::{parse_vec3, View};
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
 use passes::{
-    FrameImages, HybridConfig, PcssConfig, PenumbraFilter, PrimitiveMapConfig, ResourceId,
-    ResourceSet, ShadowConfig, ShadowMapConfig, ShadowMode,
+    HybridConfig, PcssConfig, PenumbraFilter, PrimitiveMapConfig, ResourceId, ResourceSet,
+    ShadowConfig, ShadowMapConfig, ShadowMode,
 };
 use rhi::Device;
 use scene::Camera;

@@ -19,14 +19,14 @@
 use crate::accuracy::{absolute_tolerance, compare_map, compare_visibility, fitted_light_matrix};
 use crate::output::write_png;
 use crate::plugin::PluginRenderer;
-use crate::View;
+use crate::{FrameImages, View};
 use anyhow::{anyhow, bail, Context, Result};
 use glam::{DMat4, DVec2, DVec3, Mat4};
 use passes::{
-    BinningRequest, FaceMode, FrameImages, FrameInputs, Light, PrimitiveMapConfig,
-    DEFAULT_ENTRY_BUDGET, GUARD_VALUE, GUARD_WORDS,
+    BinningRequest, FaceMode, FrameInputs, Light, PrimitiveMapConfig, DEFAULT_ENTRY_BUDGET,
+    GUARD_VALUE, GUARD_WORDS,
 };
-use reference::{FaceSelection, RefScene};
+use reference::{certainly_blocked, contact_shadow_start, FaceSelection, RefScene};
 use rhi::Device;
 use scene::hard_cases::{Check, Expectation, Family, HardCase, Overflow, Solid};
 use scene::{Aabb, DirectionalLight, Scene};
@@ -602,45 +602,21 @@ impl<'a> Probe<'a> {
     /// largest screen distance (pixels) between a lit one and the footprint edge its shadow ray enters
     /// through.
     fn contact_gap(&self, b: &Aabb, flagged: &mut [bool]) -> (usize, f64) {
-        let (min, max) = (b.min.as_dvec3(), b.max.as_dvec3());
-        let l = self.to_light;
-        let horizontal = DVec2::new(l.x, l.z);
-        if l.y <= 0.0 || horizontal == DVec2::ZERO {
-            return (0, 0.0);
-        }
+        let min_y = f64::from(b.min.y);
         let (mut judged, mut gap) = (0, 0.0f64);
         for r in self.receivers() {
             let p = r.position;
-            let on_base = (p.y - min.y).abs() <= 1e-3 * r.margin + 1e-6 * (1.0 + min.y.abs());
+            let on_base = (p.y - min_y).abs() <= 1e-3 * r.margin + 1e-6 * (1.0 + min_y.abs());
             if !on_base || r.normal.y < 0.999 {
                 continue;
             }
-            let m = r.margin;
-            let start = DVec2::new(p.x, p.z);
-            let inner = slab_2d(
-                start,
-                horizontal,
-                DVec2::new(min.x + m, min.z + m),
-                DVec2::new(max.x - m, max.z - m),
-            );
-            let Some((enter, _)) = inner.filter(|&(enter, _)| enter >= 0.0) else {
+            let Some(contact) = contact_shadow_start(b, p, self.to_light, r.margin) else {
                 continue;
             };
-            if p.y + enter * l.y >= max.y - m {
-                continue;
-            }
             judged += 1;
             if !r.lit {
                 continue;
             }
-            let outer = slab_2d(
-                start,
-                horizontal,
-                DVec2::new(min.x, min.z),
-                DVec2::new(max.x, max.z),
-            );
-            let edge = outer.map_or(enter, |(e, _)| e.max(0.0));
-            let contact = DVec3::new(p.x + edge * l.x, p.y, p.z + edge * l.z);
             let distance = self.screen(p).distance(self.screen(contact));
             flagged[r.index] = true;
             gap = gap.max(distance);
@@ -653,89 +629,6 @@ impl<'a> Probe<'a> {
         let clip = self.view_proj * p.extend(1.0);
         let ndc = clip.truncate().truncate() / clip.w;
         (ndc * 0.5 + 0.5) * DVec2::new(self.width, self.height)
-    }
-}
-
-/// Entry and exit parameters of the 2D ray `start + s * dir` through the box `[lo, hi]`, if it crosses it
-/// (at any `s`, also negative).
-fn slab_2d(start: DVec2, dir: DVec2, lo: DVec2, hi: DVec2) -> Option<(f64, f64)> {
-    let (mut enter, mut exit) = (f64::NEG_INFINITY, f64::INFINITY);
-    for axis in 0..2 {
-        if lo[axis] > hi[axis] {
-            return None;
-        }
-        if dir[axis] == 0.0 {
-            if start[axis] < lo[axis] || start[axis] > hi[axis] {
-                return None;
-            }
-        } else {
-            let a = (lo[axis] - start[axis]) / dir[axis];
-            let b = (hi[axis] - start[axis]) / dir[axis];
-            enter = enter.max(a.min(b));
-            exit = exit.min(a.max(b));
-        }
-    }
-    (enter < exit).then_some((enter, exit))
-}
-
-/// Whether the ray `p + s * l` (`s > 0`, `l` unit) certainly hits `solid`: it passes through the solid
-/// shrunk by `margin`, so that every parallel ray within `margin` of it hits the solid too.
-fn certainly_blocked(solid: &Solid, p: DVec3, l: DVec3, margin: f64) -> bool {
-    match solid {
-        Solid::Ball { center, radius } => {
-            let r = f64::from(*radius) - margin;
-            let oc = center.as_dvec3() - p;
-            let along = oc.dot(l);
-            let d2 = oc.length_squared() - along * along;
-            r > 0.0 && along > 0.0 && d2 < r * r && along - (r * r - d2).sqrt() > 0.0
-        }
-        Solid::Box(b) => {
-            let (lo, hi) = (b.min.as_dvec3() + margin, b.max.as_dvec3() - margin);
-            let (mut enter, mut exit) = (0.0f64, f64::INFINITY);
-            for axis in 0..3 {
-                if lo[axis] > hi[axis] {
-                    return false;
-                }
-                if l[axis] == 0.0 {
-                    if p[axis] < lo[axis] || p[axis] > hi[axis] {
-                        return false;
-                    }
-                } else {
-                    let a = (lo[axis] - p[axis]) / l[axis];
-                    let c = (hi[axis] - p[axis]) / l[axis];
-                    enter = enter.max(a.min(c));
-                    exit = exit.min(a.max(c));
-                }
-            }
-            enter > 0.0 && enter < exit
-        }
-        Solid::Polygon(vertices) => {
-            let v: Vec<DVec3> = vertices.iter().map(|p| p.as_dvec3()).collect();
-            if v.len() < 3 {
-                return false;
-            }
-            // Newell's normal.
-            let normal = v
-                .iter()
-                .zip(v.iter().cycle().skip(1))
-                .fold(DVec3::ZERO, |n, (a, b)| n + a.cross(*b))
-                .normalize_or_zero();
-            let cos = normal.dot(l);
-            if cos.abs() < 0.05 {
-                return false;
-            }
-            let s = normal.dot(v[0] - p) / cos;
-            if s <= margin {
-                return false;
-            }
-            let x = p + l * s;
-            // A parallel ray moved by less than `margin` crosses the plane less than this far from x.
-            let in_plane = margin * (1.0 + 1.0 / cos.abs());
-            v.iter().zip(v.iter().cycle().skip(1)).all(|(a, b)| {
-                let inward = normal.cross(*b - *a).normalize_or_zero();
-                inward != DVec3::ZERO && (x - *a).dot(inward) >= in_plane
-            })
-        }
     }
 }
 
@@ -906,97 +799,6 @@ pub fn table(outcomes: &[Outcome], markdown: bool) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Vec3;
-
-    #[test]
-    fn blocked_rays() {
-        let up = DVec3::Y;
-        let square = Solid::Polygon(vec![
-            Vec3::new(-1.0, 1.0, -1.0),
-            Vec3::new(1.0, 1.0, -1.0),
-            Vec3::new(1.0, 1.0, 1.0),
-            Vec3::new(-1.0, 1.0, 1.0),
-        ]);
-        assert!(certainly_blocked(&square, DVec3::ZERO, up, 0.1));
-        assert!(!certainly_blocked(
-            &square,
-            DVec3::new(0.95, 0.0, 0.0),
-            up,
-            0.1
-        ));
-        assert!(!certainly_blocked(
-            &square,
-            DVec3::new(0.0, 2.0, 0.0),
-            up,
-            0.1
-        ));
-        let ball = Solid::Ball {
-            center: Vec3::new(0.0, 2.0, 0.0),
-            radius: 1.0,
-        };
-        assert!(certainly_blocked(&ball, DVec3::new(0.5, 0.0, 0.0), up, 0.1));
-        assert!(!certainly_blocked(
-            &ball,
-            DVec3::new(0.95, 0.0, 0.0),
-            up,
-            0.1
-        ));
-        assert!(!certainly_blocked(
-            &ball,
-            DVec3::new(0.0, 4.0, 0.0),
-            up,
-            0.1
-        ));
-        let cube = Solid::Box(Aabb {
-            min: Vec3::new(-1.0, 1.0, -1.0),
-            max: Vec3::new(1.0, 2.0, 1.0),
-        });
-        assert!(certainly_blocked(
-            &cube,
-            DVec3::new(0.5, 0.0, -0.5),
-            up,
-            0.1
-        ));
-        assert!(!certainly_blocked(
-            &cube,
-            DVec3::new(0.95, 0.0, 0.0),
-            up,
-            0.1
-        ));
-        let slanted = DVec3::new(1.0, 1.0, 0.0).normalize();
-        assert!(certainly_blocked(
-            &cube,
-            DVec3::new(-1.5, 0.0, 0.0),
-            slanted,
-            0.1
-        ));
-        assert!(!certainly_blocked(
-            &cube,
-            DVec3::new(-0.5, 2.5, 0.0),
-            slanted,
-            0.1
-        ));
-    }
-
-    #[test]
-    fn slabs() {
-        let r = slab_2d(
-            DVec2::ZERO,
-            DVec2::X,
-            DVec2::new(1.0, -1.0),
-            DVec2::new(2.0, 1.0),
-        );
-        assert_eq!(r, Some((1.0, 2.0)));
-        assert_eq!(
-            slab_2d(
-                DVec2::ZERO,
-                DVec2::X,
-                DVec2::new(1.0, 0.5),
-                DVec2::new(2.0, 1.0)
-            ),
-            None
-        );
-    }
 
     #[test]
     fn table_layout() {

@@ -1,9 +1,14 @@
 //! The standalone demo host as a library: scene setup shared by the `host_demo` binary and the
 //! integration tests, so that what the tests check is what the demo shows.
+//!
+//! The demo's own G-buffer ([`gbuffer`], shaders in `host_demo/shaders/` embedded at build time) and
+//! the frame that drives it with a [`passes::ShadowPipeline`] ([`ShadowRenderer`]) live here, not in
+//! the shipped `passes` library: an engine brings its own G-buffer.
 
 pub mod accuracy;
 pub mod bench;
 pub mod compare;
+pub mod gbuffer;
 pub mod hardcases;
 pub mod images;
 pub mod output;
@@ -11,6 +16,7 @@ pub mod peer;
 pub mod plugin;
 pub mod ray_dump;
 pub mod render;
+pub mod renderer;
 pub mod report;
 pub mod tiers;
 pub mod tradeoff;
@@ -19,6 +25,22 @@ use glam::{DVec3, Mat4, Vec3};
 use passes::{Draw, FrameInputs, Geometry, Light, PassError};
 use rhi::Device;
 use scene::{Aabb, Camera, DirectionalLight, Scene};
+
+pub use renderer::{read_images, FrameImages, FrameOutput, ShadowRenderer};
+
+mod shaders {
+    include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
+}
+
+/// SPIR-V words of the demo's embedded shader `name` (file name in `host_demo/shaders/`).
+pub fn shader(name: &str) -> Result<Vec<u32>, PassError> {
+    let bytes = shaders::ALL
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, b)| *b)
+        .ok_or_else(|| PassError::InvalidConfig(format!("no embedded demo shader named {name}")))?;
+    Ok(bytemuck::pod_collect_to_vec(bytes))
+}
 
 /// A scene with its camera and light, ready to render.
 #[derive(Debug, Clone)]
@@ -175,5 +197,17 @@ mod tests {
         assert!(parse_vec3("1,2").is_err());
         assert!(parse_vec3("1,nan,2").is_err());
         assert!(parse_vec3("a,b,c").is_err());
+    }
+
+    #[test]
+    fn every_demo_shader_is_embedded_spirv() {
+        let names: Vec<&str> = shaders::ALL.iter().map(|(n, _)| *n).collect();
+        assert_eq!(names, ["gbuffer.frag", "gbuffer.vert"]);
+        for n in names {
+            let words = shader(n).unwrap();
+            assert!(words.len() > 5, "{n} is too short for a SPIR-V module");
+            assert_eq!(words[0], 0x0723_0203, "{n} lacks the SPIR-V magic number");
+        }
+        assert!(shader("gbuffer.comp").is_err());
     }
 }

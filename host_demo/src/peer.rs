@@ -3,9 +3,10 @@
 //! demo's prim buffer ([`passes::rt_peer::RtPeerPass`]). What a user would pick instead of our technique.
 
 use crate::plugin::PluginRenderer;
+use crate::{read_images, FrameImages, FrameOutput};
 use anyhow::Result;
 use passes::rt_peer::{shadow_ray_constants, RtPeerPass};
-use passes::{read_images, FrameImages, FrameInputs, FrameOutput, PassError};
+use passes::{FrameInputs, PassError};
 use rhi::{Device, ResourceState as S};
 
 /// The name of the peer's build pass (bottom and top level).

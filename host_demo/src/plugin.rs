@@ -6,17 +6,16 @@
 //! images come back through `hrts_record_resource_readback`, the report through `hrts_get_frame_report`.
 //! So what the demo shows is what an integrator gets.
 
-use crate::View;
+use crate::gbuffer::{GBufferPass, GBufferPush, GBufferTargets};
+use crate::{read_images, FrameImages, FrameOutput, View};
 use anyhow::{bail, Context as _, Result};
 use glam::Mat4;
 use hrts_plugin::*;
-use passes::gbuffer::{GBufferPass, GBufferTargets};
-use passes::gpu_types::GBufferPush;
 use passes::prim_buffer::PrimBufferPass;
 use passes::MapStats;
 use passes::{
-    camera_in_frame, read_images, BinningPath, FrameImages, FrameInputs, FrameOutput, FrameReport,
-    Geometry, Light, PassId, PassStatus, ResourceId, ResourceReport, ShadowConfig, SkipReason,
+    camera_in_frame, BinningPath, FrameInputs, FrameReport, Geometry, Light, PassId, PassStatus,
+    ResourceId, ResourceReport, ShadowConfig, SkipReason,
 };
 use rhi::{
     Barrier, Buffer, BufferUsage, ConservativeRasterTier, Device, Format, GpuTimer, Image,

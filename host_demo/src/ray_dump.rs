@@ -285,7 +285,7 @@ mod tests {
     use super::*;
     use glam::Vec3;
     use reference::intersect_watertight;
-    use scene::Scene;
+    use scene::{MeshBuilder, Scene};
 
     fn read_f32(path: &Path) -> Vec<f32> {
         std::fs::read(path)
@@ -297,17 +297,16 @@ mod tests {
 
     /// A unit cube floating above the ground, a tilted quad beside it, and the demo's ground plane.
     fn small_scene(offset: Vec3) -> Scene {
-        let cube = Scene::axis_box("cube", Vec3::new(0.0, 0.5, 0.0), Vec3::new(1.0, 1.5, 1.0));
-        let (mut positions, mut indices) = (cube.positions, cube.indices);
-        let base = positions.len() as u32;
-        positions.extend([
+        let mut blocks = MeshBuilder::new();
+        blocks.add_box(Vec3::new(0.0, 0.5, 0.0), Vec3::new(1.0, 1.5, 1.0));
+        blocks.add_quad([
             Vec3::new(1.5, 0.2, 0.0),
             Vec3::new(2.5, 0.6, 0.0),
             Vec3::new(2.5, 0.6, 1.0),
             Vec3::new(1.5, 0.2, 1.0),
         ]);
-        indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
-        Scene::single_object(positions, indices, "blocks")
+        blocks
+            .into_scene("blocks")
             .with_ground_plane()
             .translated(offset)
     }

@@ -47,7 +47,7 @@ fn render(
     config: ShadowConfig,
     frames: u32,
 ) -> Result<(
-    passes::FrameImages,
+    crate::FrameImages,
     std::collections::BTreeMap<String, f64>,
     u64,
 )> {
@@ -62,7 +62,7 @@ pub fn render_frames(
     view: &View,
     config: ShadowConfig,
     frames: u32,
-) -> Result<(passes::FrameImages, Vec<passes::FrameReport>)> {
+) -> Result<(crate::FrameImages, Vec<passes::FrameReport>)> {
     let mut r = PluginRenderer::new(device, view, config)?;
     let inputs = view.frame_inputs();
     let mut reports = Vec::new();

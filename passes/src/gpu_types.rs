@@ -36,16 +36,6 @@ pub struct PrimBufferPush {
     pub pad: u32,
 }
 
-/// Push constants of the G-buffer (`gbuffer_push.glsl`).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-pub struct GBufferPush {
-    /// proj * view with the camera at the origin.
-    pub view_proj_rel: Mat4,
-    /// Camera position in frame coordinates (xyz).
-    pub camera_pos: Vec4,
-}
-
 /// Push constants of the primitive-map passes (`map_push.glsl`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
@@ -245,7 +235,6 @@ const _: () = {
     assert!(std::mem::size_of::<GpuTriangle>() == 48);
     assert!(std::mem::size_of::<PrimBufferPush>() == 96);
     assert!(std::mem::offset_of!(PrimBufferPush, first_index) == 64);
-    assert!(std::mem::size_of::<GBufferPush>() == 80);
     assert!(std::mem::size_of::<MapPush>() == 112);
     assert!(std::mem::offset_of!(MapPush, size) == 80);
     assert!(std::mem::size_of::<RayTraceConstants>() == 224);

@@ -1,12 +1,12 @@
 //! The render passes of hybrid ray-traced shadows (deep primitive map, after Jon Story, GDC 2015), each a
-//! short unit that declares what it reads and writes, and the demo frame that strings them together.
+//! short unit that declares what it reads and writes, and the [`ShadowPipeline`] that strings them
+//! together.
 
 #![forbid(unsafe_code)]
 
 mod error;
 pub mod frame_plan;
 pub mod fxaa;
-pub mod gbuffer;
 pub mod gpu_types;
 pub mod hybrid;
 pub mod light;
@@ -14,7 +14,6 @@ pub mod pcss;
 pub mod prim_buffer;
 pub mod primitive_map;
 pub mod ray_trace;
-pub mod renderer;
 pub mod retire;
 pub mod rt_peer;
 pub mod scan;
@@ -36,7 +35,6 @@ pub use primitive_map::{
     choose_binning_path, BinningPath, BinningRequest, FaceMode, PrimitiveMapConfig,
     DEFAULT_ENTRY_BUDGET, GUARD_VALUE, GUARD_WORDS, MIN_ENTRY_BUDGET,
 };
-pub use renderer::{read_images, FrameImages, FrameOutput, ShadowRenderer};
 pub use shadow_map::ShadowMapConfig;
 pub use shadow_pipeline::{
     camera_in_frame, FrameInputs, FrameReport, ResourceReport, ShadowConfig, ShadowInputs,

@@ -18,14 +18,20 @@
 //! ray/triangle test), exact orientation predicates, and a BVH over the scene
 //! ([`RefScene`]).
 //!
+//! [`certainly_blocked`] and [`contact_shadow_start`] are the conservative predicates of the
+//! hard cases' analytic checks (leaks, contact shadows), decided with a margin.
+//!
 //! Conventions: right-handed world with +Y up; Vulkan clip depth `[0, 1]`;
 //! framebuffer pixel `(x, y)` with `y = 0` the top row has its centre at NDC
 //! `((x + 0.5) / W * 2 - 1, (y + 0.5) / H * 2 - 1)` (NDC y = -1 is the top row). The
 //! camera projection is reversed-Z with an infinite far plane. A light direction is
 //! the direction the light travels. Visibility 1 means lit.
 
+#![forbid(unsafe_code)]
+
 mod exact;
 mod geometry;
+mod predicates;
 mod ref_scene;
 mod soft;
 mod texels;
@@ -35,6 +41,7 @@ mod visibility;
 mod tests;
 
 pub use geometry::{intersect_watertight, line_segment_distance};
+pub use predicates::{certainly_blocked, contact_shadow_start};
 pub use ref_scene::RefScene;
 pub use soft::{soft_visibility, AreaLight, SoftParams, SoftReference, RELATIVE_RAY_OFFSET};
 pub use texels::{conservative_texel_sets, overlaps_texel_with_margin, FaceSelection, TexelSets};

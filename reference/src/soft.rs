@@ -7,6 +7,7 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, TAU};
 
 use glam::DVec3;
 use rayon::prelude::*;
+use scene::SplitMix64;
 
 use crate::{intersect_watertight, RefScene, VisibilityReference};
 
@@ -112,7 +113,7 @@ pub struct SoftReference {
 ///    map: for [`AreaLight::Directional`] `cos θ = 1 - u (1 - cos r)`, `φ = 2π v`
 ///    around `-direction` (uniform in solid angle); for [`AreaLight::Disk`] the
 ///    Shirley–Chiu concentric map onto the disk (uniform in area). The jitter comes
-///    from SplitMix64 seeded with `seed ^ (pixel index × 0x9E3779B97F4A7C15)`.
+///    from [`scene::SplitMix64`] seeded with `seed ^ (pixel index × SplitMix64::GAMMA)`.
 /// 3. **Sample visibility.** With `L` the unit direction from `P` to the sample,
 ///    the sample is blocked if `n · L <= 0`, or if some usable triangle other than
 ///    `R` is hit ([`intersect_watertight`]) by `P + s L` at `s` in `(tol, d)`, where
@@ -535,8 +536,8 @@ impl Receiver {
         let mut visible = 0u32;
         for i in 0..n {
             for j in 0..n {
-                let u = (f64::from(i) + rng.unit()) * cell;
-                let v = (f64::from(j) + rng.unit()) * cell;
+                let u = (f64::from(i) + rng.next_f64()) * cell;
+                let v = (f64::from(j) + rng.next_f64()) * cell;
                 let (dir, distance) = emitter.sample(self.position, u, v);
                 if self.normal.dot(dir) > 0.0 && !self.occluded(scene, dir, distance) {
                     visible += 1;
@@ -696,30 +697,5 @@ fn angle_to_wedge(a: DVec3, p: DVec3, q: DVec3) -> f64 {
         height.abs().atan2(in_plane.length())
     } else {
         angle_between(a, p).min(angle_between(a, q))
-    }
-}
-
-/// Small deterministic generator (SplitMix64, Steele, Lea and Flood 2014).
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    /// The generator's increment (the golden ratio in 64-bit fixed point).
-    const GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
-
-    fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(Self::GAMMA);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[0, 1)`.
-    fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
     }
 }

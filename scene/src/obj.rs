@@ -270,6 +270,7 @@ mod tests {
     use std::sync::atomic::{AtomicUsize, Ordering};
 
     use super::*;
+    use crate::SplitMix64;
 
     /// A file in the system temporary directory, removed on drop.
     struct TempFile(PathBuf);
@@ -518,17 +519,10 @@ mod tests {
         assert!(err.to_string().contains("scene-test-does-not-exist.obj"));
     }
 
-    /// Deterministic byte soup (xorshift64*).
+    /// Deterministic byte soup.
     fn garbage(seed: u64, len: usize) -> Vec<u8> {
-        let mut state = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
-        (0..len)
-            .map(|_| {
-                state ^= state >> 12;
-                state ^= state << 25;
-                state ^= state >> 27;
-                (state.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 56) as u8
-            })
-            .collect()
+        let mut rng = SplitMix64::new(seed);
+        (0..len).map(|_| (rng.next_u64() >> 56) as u8).collect()
     }
 
     #[test]

@@ -5,7 +5,7 @@ use std::f32::consts::{FRAC_PI_2, PI, TAU};
 use glam::{Affine3A, EulerRot, Quat, Vec2, Vec3};
 
 use crate::scene::ground_square;
-use crate::Scene;
+use crate::{MeshBuilder, Scene, SplitMix64};
 
 /// The demo's built-in scene: a collection of shadow-mapping trouble makers on a ground plane.
 ///
@@ -22,29 +22,35 @@ use crate::Scene;
 /// identical on every call.
 pub fn procedural_default() -> Scene {
     let mut scene = ground_square("ground", Vec3::ZERO, 12.0);
-    scene.append(&character().into_object("character"));
-    scene.append(&fence().into_object("fence"));
-    scene.append(&foliage().into_object("foliage"));
-    scene.append(&sphere().into_object("sphere"));
+    scene.append(&character().into_scene("character"));
+    scene.append(&fence().into_scene("fence"));
+    scene.append(&foliage().into_scene("foliage"));
+    scene.append(&sphere().into_scene("sphere"));
     scene
 }
 
 fn character() -> MeshBuilder {
     let root =
         Affine3A::from_rotation_translation(Quat::from_rotation_y(0.35), Vec3::new(0.0, 0.0, 0.4));
-    let mut mesh = MeshBuilder::new(root);
+    let mut mesh = MeshBuilder::placed(root);
     for side in [-1.0, 1.0] {
-        mesh.add_box(
+        add_centered_box(
+            &mut mesh,
             Vec3::new(0.05, 0.035, 0.12),
             Vec3::new(0.1 * side, 0.035, 0.04),
         );
-        mesh.add_capsule(
+        add_capsule(
+            &mut mesh,
             Vec3::new(0.1 * side, 0.12, 0.0),
             Vec3::new(0.1 * side, 0.86, 0.0),
             0.065,
         );
     }
-    mesh.add_box(Vec3::new(0.16, 0.08, 0.1), Vec3::new(0.0, 0.93, 0.0));
+    add_centered_box(
+        &mut mesh,
+        Vec3::new(0.16, 0.08, 0.1),
+        Vec3::new(0.0, 0.93, 0.0),
+    );
     mesh.add_lathe(
         &capsule_profile(0.17, 0.26),
         CAPSULE_SEGMENTS,
@@ -68,7 +74,7 @@ fn character() -> MeshBuilder {
     let shoulders = [Vec3::new(0.22, 1.43, 0.0), Vec3::new(-0.22, 1.43, 0.0)];
     let wrists = [Vec3::new(0.29, 0.92, 0.03), Vec3::new(-0.28, 1.25, 0.5)];
     for (shoulder, wrist) in shoulders.into_iter().zip(wrists) {
-        mesh.add_capsule(shoulder, wrist, 0.045);
+        add_capsule(&mut mesh, shoulder, wrist, 0.045);
         let hand = wrist + (wrist - shoulder).normalize() * 0.06;
         mesh.add_sphere(hand, 0.05, 8, 10);
     }
@@ -80,18 +86,30 @@ fn fence() -> MeshBuilder {
     const SLAT_PITCH: f32 = 0.1;
     let root =
         Affine3A::from_rotation_translation(Quat::from_rotation_y(0.2), Vec3::new(0.3, 0.0, -1.6));
-    let mut mesh = MeshBuilder::new(root);
+    let mut mesh = MeshBuilder::placed(root);
     for i in 0..4 {
         let x = -HALF_LENGTH + i as f32 * (2.0 * HALF_LENGTH / 3.0);
-        mesh.add_box(Vec3::new(0.04, 0.575, 0.04), Vec3::new(x, 0.575, 0.0));
+        add_centered_box(
+            &mut mesh,
+            Vec3::new(0.04, 0.575, 0.04),
+            Vec3::new(x, 0.575, 0.0),
+        );
     }
     for y in [0.25, 0.9] {
-        mesh.add_box(Vec3::new(HALF_LENGTH, 0.02, 0.01), Vec3::new(0.0, y, 0.05));
+        add_centered_box(
+            &mut mesh,
+            Vec3::new(HALF_LENGTH, 0.02, 0.01),
+            Vec3::new(0.0, y, 0.05),
+        );
     }
     let slats = (2.0 * HALF_LENGTH / SLAT_PITCH) as usize;
     for i in 0..slats {
         let x = -HALF_LENGTH + (i as f32 + 0.5) * SLAT_PITCH;
-        mesh.add_box(Vec3::new(0.0125, 0.5, 0.0075), Vec3::new(x, 0.55, 0.0675));
+        add_centered_box(
+            &mut mesh,
+            Vec3::new(0.0125, 0.5, 0.0075),
+            Vec3::new(x, 0.55, 0.0675),
+        );
     }
     mesh
 }
@@ -99,23 +117,27 @@ fn fence() -> MeshBuilder {
 fn foliage() -> MeshBuilder {
     const LEAVES: usize = 560;
     const TUFTS: usize = 10;
-    let mut rng = Rng(0x5eed_1eaf);
-    let mut mesh = MeshBuilder::new(Affine3A::from_translation(Vec3::new(-1.5, 0.0, 0.9)));
+    let mut rng = SplitMix64::new(0x5eed_1eaf);
+    let mut mesh = MeshBuilder::placed(Affine3A::from_translation(Vec3::new(-1.5, 0.0, 0.9)));
     for _ in 0..LEAVES {
         let offset = loop {
-            let p = Vec3::new(rng.signed(), rng.signed(), rng.signed());
+            let p = Vec3::new(
+                rng.uniform_f32(-1.0, 1.0),
+                rng.uniform_f32(-1.0, 1.0),
+                rng.uniform_f32(-1.0, 1.0),
+            );
             if p.length_squared() <= 1.0 {
                 break p * Vec3::new(0.55, 0.45, 0.55);
             }
         };
         let orientation = Quat::from_euler(
             EulerRot::YXZ,
-            rng.unit() * TAU,
-            rng.signed() * 1.2,
-            rng.signed() * PI,
+            rng.next_f32() * TAU,
+            rng.uniform_f32(-1.0, 1.0) * 1.2,
+            rng.uniform_f32(-1.0, 1.0) * PI,
         );
-        let length = 0.1 + 0.08 * rng.unit();
-        let width = length * (0.4 + 0.1 * rng.unit());
+        let length = 0.1 + 0.08 * rng.next_f32();
+        let width = length * (0.4 + 0.1 * rng.next_f32());
         let outline = [
             Vec2::new(0.0, 0.0),
             Vec2::new(0.3, -0.5),
@@ -133,9 +155,9 @@ fn foliage() -> MeshBuilder {
     }
     for i in 0..TUFTS {
         let angle = i as f32 / TUFTS as f32 * TAU;
-        let base = Vec3::new(angle.cos(), 0.0, angle.sin()) * (0.7 + 0.15 * rng.unit());
-        let yaw = rng.unit() * PI;
-        let (half_width, height) = (0.15 + 0.05 * rng.unit(), 0.4 + 0.2 * rng.unit());
+        let base = Vec3::new(angle.cos(), 0.0, angle.sin()) * (0.7 + 0.15 * rng.next_f32());
+        let yaw = rng.next_f32() * PI;
+        let (half_width, height) = (0.15 + 0.05 * rng.next_f32(), 0.4 + 0.2 * rng.next_f32());
         for card in 0..3 {
             let across = Quat::from_rotation_y(yaw + card as f32 * PI / 3.0) * Vec3::X * half_width;
             let up = Vec3::Y * height;
@@ -152,7 +174,7 @@ fn foliage() -> MeshBuilder {
 
 fn sphere() -> MeshBuilder {
     const RADIUS: f32 = 0.45;
-    let mut mesh = MeshBuilder::new(Affine3A::IDENTITY);
+    let mut mesh = MeshBuilder::new();
     mesh.add_sphere(Vec3::new(1.6, RADIUS, 1.1), RADIUS, 24, 36);
     mesh
 }
@@ -174,155 +196,21 @@ fn capsule_profile(radius: f32, length: f32) -> Vec<Vec2> {
     cap(0.0, 0.0).chain(cap(FRAC_PI_2, length)).collect()
 }
 
-/// Triangles of one object under construction; every shape is placed through `root`.
-struct MeshBuilder {
-    root: Affine3A,
-    positions: Vec<Vec3>,
-    indices: Vec<u32>,
+/// Adds a closed box of half extents `half_extents` around `center` (axis-aligned in the builder's
+/// local space).
+fn add_centered_box(mesh: &mut MeshBuilder, half_extents: Vec3, center: Vec3) {
+    mesh.add_box(center - half_extents, center + half_extents);
 }
 
-impl MeshBuilder {
-    fn new(root: Affine3A) -> Self {
-        Self {
-            root,
-            positions: Vec::new(),
-            indices: Vec::new(),
-        }
-    }
-
-    fn into_object(self, name: &str) -> Scene {
-        Scene::single_object(self.positions, self.indices, name)
-    }
-
-    /// Adds a vertex given in the builder's local space.
-    fn vertex(&mut self, local: Vec3) -> u32 {
-        self.positions.push(self.root.transform_point3(local));
-        (self.positions.len() - 1) as u32
-    }
-
-    /// Adds the quad `a b c d` (counter-clockwise seen from the front) as two triangles.
-    fn quad(&mut self, [a, b, c, d]: [u32; 4]) {
-        self.indices.extend([a, b, c, a, c, d]);
-    }
-
-    /// Adds a planar convex polygon, fan-triangulated, wound in the order given.
-    fn add_polygon(&mut self, points: &[Vec3]) {
-        let first = self.positions.len() as u32;
-        for &p in points {
-            self.vertex(p);
-        }
-        for i in 2..points.len() as u32 {
-            self.indices.extend([first, first + i - 1, first + i]);
-        }
-    }
-
-    /// Adds a closed axis-aligned (in local space) box.
-    fn add_box(&mut self, half_extents: Vec3, center: Vec3) {
-        let first = self.positions.len() as u32;
-        for i in 0..8 {
-            let sign = |bit: usize| if i & bit == 0 { -1.0 } else { 1.0 };
-            self.vertex(center + half_extents * Vec3::new(sign(1), sign(2), sign(4)));
-        }
-        for face in [
-            [1, 3, 7, 5],
-            [0, 4, 6, 2],
-            [2, 6, 7, 3],
-            [0, 1, 5, 4],
-            [4, 5, 7, 6],
-            [0, 2, 3, 1],
-        ] {
-            self.quad(face.map(|v| first + v));
-        }
-    }
-
-    /// Adds a closed sphere with `rings` latitude bands and `segments` longitude bands; its
-    /// poles are single vertices on the vertical axis.
-    fn add_sphere(&mut self, center: Vec3, radius: f32, rings: u32, segments: u32) {
-        let profile = (0..=rings)
-            .map(|k| {
-                let phi = PI * k as f32 / rings as f32;
-                Vec2::new(radius * phi.sin(), -radius * phi.cos())
-            })
-            .collect::<Vec<_>>();
-        self.add_lathe(&profile, segments, Affine3A::from_translation(center));
-    }
-
-    /// Adds a closed capsule whose cap centres are `a` and `b`.
-    fn add_capsule(&mut self, a: Vec3, b: Vec3, radius: f32) {
-        let axis = b - a;
-        let rotation = Quat::from_rotation_arc(Vec3::Y, axis.normalize());
-        self.add_lathe(
-            &capsule_profile(radius, axis.length()),
-            CAPSULE_SEGMENTS,
-            Affine3A::from_rotation_translation(rotation, a),
-        );
-    }
-
-    /// Adds the closed surface of revolution of `profile` (radius, height) points around the
-    /// local +Y axis, placed by `transform` (which must preserve orientation). The first and last
-    /// profile points become single pole vertices on the axis; the others become rings of
-    /// `segments` vertices. Triangles wind counter-clockwise seen from outside.
-    fn add_lathe(&mut self, profile: &[Vec2], segments: u32, transform: Affine3A) {
-        let [bottom, rings @ .., top] = profile else {
-            return;
-        };
-        if rings.is_empty() {
-            return;
-        }
-        let mut point = |p: Vec3| self.vertex(transform.transform_point3(p));
-        let bottom_pole = point(Vec3::new(0.0, bottom.y, 0.0));
-        let ring_starts = rings
-            .iter()
-            .map(|ring| {
-                let start = point(Vec3::new(ring.x, ring.y, 0.0));
-                for j in 1..segments {
-                    let theta = TAU * j as f32 / segments as f32;
-                    point(Vec3::new(
-                        ring.x * theta.cos(),
-                        ring.y,
-                        -ring.x * theta.sin(),
-                    ));
-                }
-                start
-            })
-            .collect::<Vec<_>>();
-        let top_pole = point(Vec3::new(0.0, top.y, 0.0));
-        let (first_ring, last_ring) = (ring_starts[0], ring_starts[ring_starts.len() - 1]);
-        for j in 0..segments {
-            let k = (j + 1) % segments;
-            self.indices
-                .extend([bottom_pole, first_ring + k, first_ring + j]);
-            for pair in ring_starts.windows(2) {
-                let (lower, upper) = (pair[0], pair[1]);
-                self.quad([lower + j, lower + k, upper + k, upper + j]);
-            }
-            self.indices
-                .extend([top_pole, last_ring + j, last_ring + k]);
-        }
-    }
-}
-
-/// Small deterministic pseudo-random generator (SplitMix64).
-pub(crate) struct Rng(pub(crate) u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[0, 1)`.
-    pub(crate) fn unit(&mut self) -> f32 {
-        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    /// Uniform in `[-1, 1)`.
-    pub(crate) fn signed(&mut self) -> f32 {
-        self.unit() * 2.0 - 1.0
-    }
+/// Adds a closed capsule whose cap centres are `a` and `b`.
+fn add_capsule(mesh: &mut MeshBuilder, a: Vec3, b: Vec3, radius: f32) {
+    let axis = b - a;
+    let rotation = Quat::from_rotation_arc(Vec3::Y, axis.normalize());
+    mesh.add_lathe(
+        &capsule_profile(radius, axis.length()),
+        CAPSULE_SEGMENTS,
+        Affine3A::from_rotation_translation(rotation, a),
+    );
 }
 
 #[cfg(test)]
@@ -520,14 +408,5 @@ mod tests {
         assert!(normals.iter().filter(|n| n.y.abs() < 0.3).count() > 100);
         let cards = object_bounds(&scene, "foliage");
         assert!(cards.size().min_element() > 0.5);
-    }
-
-    #[test]
-    fn random_numbers_are_uniform_enough() {
-        let mut rng = Rng(1);
-        let samples = (0..10_000).map(|_| rng.unit()).collect::<Vec<_>>();
-        assert!(samples.iter().all(|x| (0.0..1.0).contains(x)));
-        let mean = samples.iter().sum::<f32>() / samples.len() as f32;
-        assert!((mean - 0.5).abs() < 0.02);
     }
 }

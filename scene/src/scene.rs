@@ -4,7 +4,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use crate::{error::MEMORY_PATH, Aabb, SceneError};
+use crate::{error::MEMORY_PATH, Aabb, MeshBuilder, SceneError};
 
 /// A named contiguous range of triangles (one OBJ object/group, or one procedural part).
 /// A draw call.
@@ -50,31 +50,11 @@ impl Scene {
     }
 
     /// An axis-aligned box from `min` to `max` as one object named `name`: 8 vertices, 12 triangles
-    /// counter-clockwise seen from outside.
+    /// counter-clockwise seen from outside (see [`MeshBuilder::add_box`]).
     pub fn axis_box(name: &str, min: Vec3, max: Vec3) -> Scene {
-        let positions = (0..8u32)
-            .map(|i| {
-                Vec3::new(
-                    if i & 1 != 0 { max.x } else { min.x },
-                    if i & 2 != 0 { max.y } else { min.y },
-                    if i & 4 != 0 { max.z } else { min.z },
-                )
-            })
-            .collect();
-        // Faces as corner quads (a, b, c, d) counter-clockwise from outside: -x, +x, -y, +y, -z, +z.
-        let faces: [[u32; 4]; 6] = [
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-        ];
-        let indices = faces
-            .iter()
-            .flat_map(|&[a, b, c, d]| [a, b, c, a, c, d])
-            .collect();
-        Scene::single_object(positions, indices, name)
+        let mut mesh = MeshBuilder::new();
+        mesh.add_box(min, max);
+        mesh.into_scene(name)
     }
 
     /// Number of complete triangles (`indices.len() / 3`).
@@ -235,20 +215,14 @@ impl Scene {
 /// from +Y, centred on `center` (at height `center.y`).
 pub(crate) fn ground_square(name: &str, center: Vec3, side: f32) -> Scene {
     let h = side * 0.5;
-    Scene {
-        positions: vec![
-            center + Vec3::new(-h, 0.0, -h),
-            center + Vec3::new(-h, 0.0, h),
-            center + Vec3::new(h, 0.0, h),
-            center + Vec3::new(h, 0.0, -h),
-        ],
-        indices: vec![0, 1, 2, 0, 2, 3],
-        objects: vec![Object {
-            name: name.to_owned(),
-            first_triangle: 0,
-            triangle_count: 2,
-        }],
-    }
+    let mut mesh = MeshBuilder::new();
+    mesh.add_quad([
+        center + Vec3::new(-h, 0.0, -h),
+        center + Vec3::new(-h, 0.0, h),
+        center + Vec3::new(h, 0.0, h),
+        center + Vec3::new(h, 0.0, -h),
+    ]);
+    mesh.into_scene(name)
 }
 
 #[cfg(test)]

@@ -6,10 +6,10 @@
 mod common;
 
 use common::*;
-use host_demo::View;
+use host_demo::{FrameImages, ShadowRenderer, View};
 use passes::{
-    FrameInputs, PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig, ShadowRenderer,
-    GUARD_VALUE, GUARD_WORDS, MIN_ENTRY_BUDGET,
+    FrameInputs, PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig, GUARD_VALUE,
+    GUARD_WORDS, MIN_ENTRY_BUDGET,
 };
 use reference::RefScene;
 
@@ -18,7 +18,7 @@ fn frames(
     view: &View,
     config: PrimitiveMapConfig,
     count: usize,
-) -> Vec<(passes::FrameReport, passes::FrameImages)> {
+) -> Vec<(passes::FrameReport, FrameImages)> {
     let geometry = view.upload(device).expect("upload");
     let mut config = ShadowConfig::from(config);
     config.extra_outputs = ResourceSet::of(&[ResourceId::Occupancy]);
@@ -37,7 +37,7 @@ fn assert_past_capacity_is_safe_and_exact(
     rs: &RefScene,
     view: &View,
     report: &passes::FrameReport,
-    images: &passes::FrameImages,
+    images: &FrameImages,
 ) {
     let st = report.stats;
     let n = 128usize;

@@ -1,15 +1,15 @@
 //! The demo drives the plugin through its C ABI (`host_demo::plugin::PluginRenderer`). Its frames equal,
-//! bit for bit, the frames of the Rust passes driven directly (`passes::ShadowRenderer`), for every
+//! bit for bit, the frames of the Rust passes driven directly (`host_demo::ShadowRenderer`), for every
 //! output both produce, and its report says the same: what the demo shows is what integrators get.
 
 mod common;
 
 use common::*;
 use host_demo::plugin::PluginRenderer;
-use host_demo::View;
+use host_demo::{FrameImages, ShadowRenderer, View};
 use passes::{
-    BinningRequest, FrameImages, FrameReport, PassId, PassStatus, PrimitiveMapConfig, ResourceId,
-    ResourceSet, ShadowConfig, ShadowMode, ShadowRenderer,
+    BinningRequest, FrameReport, PassId, PassStatus, PrimitiveMapConfig, ResourceId, ResourceSet,
+    ShadowConfig, ShadowMode,
 };
 use rhi::Device;
 

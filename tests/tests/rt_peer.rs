@@ -11,8 +11,8 @@ mod common;
 use common::*;
 use host_demo::peer::run_peer;
 use host_demo::plugin::PluginRenderer;
-use host_demo::View;
-use passes::{FrameImages, PassError, PrimitiveMapConfig};
+use host_demo::{FrameImages, View};
+use passes::{PassError, PrimitiveMapConfig};
 use reference::RefScene;
 use rhi::Device;
 

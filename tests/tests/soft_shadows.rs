@@ -10,12 +10,12 @@ use common::{
     tolerance_per_distance,
 };
 use glam::{Mat4, Vec3};
-use host_demo::View;
+use host_demo::{FrameImages, ShadowRenderer, View};
 use passes::hybrid::{blend, lerp_factor};
 use passes::{
-    BinningRequest, FrameImages, FrameReport, HybridConfig, Light, PassId, PassStatus, PcssConfig,
+    BinningRequest, FrameReport, HybridConfig, Light, PassId, PassStatus, PcssConfig,
     PenumbraFilter, PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig, ShadowMapConfig,
-    ShadowMode, ShadowRenderer, SkipReason,
+    ShadowMode, SkipReason,
 };
 use reference::{reference_visibility, PixelClass, RefScene, VisibilityParams};
 use rhi::Device;

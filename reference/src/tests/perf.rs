@@ -4,8 +4,9 @@
 use std::time::Instant;
 
 use glam::{DVec3, Mat4, Vec3};
+use scene::MeshBuilder;
 
-use super::MeshBuilder;
+use super::add_heightfield;
 use crate::{
     conservative_texel_sets, reference_visibility, FaceSelection, Light, PixelClass, RefScene,
     VisibilityParams,
@@ -13,8 +14,8 @@ use crate::{
 
 /// About 70K triangles: a bumpy terrain, boxes and spheres.
 fn big_scene() -> scene::Scene {
-    let mut mesh = MeshBuilder::default();
-    mesh.add_grid((-20.0, -20.0), (20.0, 20.0), 180, |x, z| {
+    let mut mesh = MeshBuilder::new();
+    add_heightfield(&mut mesh, (-20.0, -20.0), (20.0, 20.0), 180, |x, z| {
         0.3 * (x * 0.7).sin() * (z * 0.5).cos()
     });
     for i in 0..6 {
@@ -25,7 +26,7 @@ fn big_scene() -> scene::Scene {
         );
         mesh.add_sphere(Vec3::new(x + 1.0, 2.5, 5.0), 1.2, 24, 32);
     }
-    mesh.scene()
+    mesh.into_scene("mesh")
 }
 
 #[test]

@@ -9,8 +9,9 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use std::time::Instant;
 
 use glam::{DVec3, Mat4, Vec3};
+use scene::{MeshBuilder, SplitMix64};
 
-use super::{MeshBuilder, Rng};
+use super::{add_heightfield, in_cube, random_direction};
 use crate::soft::{cone_may_meet_triangle, soft_visibility_with, ExactShortcuts};
 use crate::{
     reference_visibility, soft_visibility, AreaLight, Light, RefScene, SoftParams, SoftReference,
@@ -24,12 +25,12 @@ const CAMERA: Vec3 = Vec3::new(0.0, 0.5, 0.0);
 /// Ground `[-50, 50]²` at y = 0 (triangles 0 and 1) and, with `occluder`, the quad
 /// `[-20, 0] x [-20, 20]` at y = `OCCLUDER_HEIGHT` (triangles 2 and 3).
 fn ground_scene(occluder: bool) -> RefScene {
-    let mut mesh = MeshBuilder::default();
+    let mut mesh = MeshBuilder::new();
     let quad = |mesh: &mut MeshBuilder, x: (f32, f32), z: (f32, f32), y: f32| {
         let c = [(x.0, z.0), (x.1, z.0), (x.1, z.1), (x.0, z.1)]
             .map(|(x, z)| mesh.vertex(Vec3::new(x, y, z)));
-        mesh.triangle(c[0], c[3], c[1]);
-        mesh.triangle(c[1], c[3], c[2]);
+        mesh.connect_triangle([c[0], c[3], c[1]]);
+        mesh.connect_triangle([c[1], c[3], c[2]]);
     };
     quad(&mut mesh, (-50.0, 50.0), (-50.0, 50.0), 0.0);
     if occluder {
@@ -40,7 +41,7 @@ fn ground_scene(occluder: bool) -> RefScene {
             OCCLUDER_HEIGHT as f32,
         );
     }
-    RefScene::new(&mesh.scene())
+    RefScene::new(&mesh.into_scene("mesh"))
 }
 
 /// Hard reference from `CAMERA` looking straight down (90° field of view), so the
@@ -324,13 +325,13 @@ fn receiver_facing_away_from_the_light_is_exactly_unlit() {
 
 /// Boxes and a sphere over a bumpy grid, for checking exact pixels against sampling.
 fn cluttered_scene() -> RefScene {
-    let mut mesh = MeshBuilder::default();
-    mesh.add_grid((-2.0, -2.0), (2.0, 2.0), 12, |x, z| {
+    let mut mesh = MeshBuilder::new();
+    add_heightfield(&mut mesh, (-2.0, -2.0), (2.0, 2.0), 12, |x, z| {
         0.05 * (3.0 * x).sin() * z
     });
     mesh.add_box(Vec3::new(-0.3, 0.2, -0.3), Vec3::new(0.0, 0.6, 0.1));
     mesh.add_sphere(Vec3::new(0.25, 0.3, 0.2), 0.12, 8, 12);
-    RefScene::new(&mesh.scene())
+    RefScene::new(&mesh.into_scene("mesh"))
 }
 
 #[test]
@@ -466,13 +467,13 @@ fn cone_triangle_test_is_conservative_and_tight() {
     // Against the smallest angle from the axis over a dense barycentric grid of the
     // triangle (an upper bound of the true smallest angle).
     const GRID: usize = 64;
-    let mut rng = Rng::new(3);
+    let mut rng = SplitMix64::new(3);
     let (mut meets, mut clear, mut loose) = (0, 0, 0);
     for case in 0..2000 {
-        let apex = rng.in_cube(1.0);
-        let axis = rng.direction();
-        let half_angle = rng.range(0.01, 1.2);
-        let tri = [0; 3].map(|_| apex + rng.in_cube(2.0));
+        let apex = in_cube(&mut rng, 1.0);
+        let axis = random_direction(&mut rng);
+        let half_angle = rng.uniform_f64(0.01, 1.2);
+        let tri = [0; 3].map(|_| apex + in_cube(&mut rng, 2.0));
         let mut smallest = f64::INFINITY;
         for i in 0..=GRID {
             for j in 0..=GRID - i {

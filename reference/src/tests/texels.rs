@@ -1,8 +1,9 @@
 //! Conservative texel sets against hand-checked cases and a brute-force oracle.
 
 use glam::{DVec2, Mat4, Vec3, Vec4};
+use scene::{MeshBuilder, SplitMix64};
 
-use super::{MeshBuilder, Rng};
+use super::in_cube;
 use crate::{
     conservative_texel_sets, overlaps_texel_with_margin, FaceSelection, RefScene, TexelSets,
 };
@@ -26,11 +27,11 @@ fn flat(points: [(f32, f32); 3]) -> [Vec3; 3] {
 }
 
 fn scene_of(triangles: &[[Vec3; 3]]) -> RefScene {
-    let mut mesh = MeshBuilder::default();
+    let mut mesh = MeshBuilder::new();
     for [a, b, c] in triangles {
-        mesh.add_triangle(*a, *b, *c);
+        mesh.add_triangle([*a, *b, *c]);
     }
-    RefScene::new(&mesh.scene())
+    RefScene::new(&mesh.into_scene("mesh"))
 }
 
 /// Texels `(x, y)` containing triangle `tri`.
@@ -310,14 +311,14 @@ fn front_only_skips_back_faces_and_3d_degenerates() {
 #[test]
 fn random_triangles_match_brute_force() {
     let n = 16;
-    let mut rng = Rng::new(7);
+    let mut rng = SplitMix64::new(7);
     let mut triangles = Vec::new();
     for k in 0..400 {
-        let center = (rng.range(-4.0, 20.0), rng.range(-4.0, 20.0));
+        let center = (rng.uniform_f64(-4.0, 20.0), rng.uniform_f64(-4.0, 20.0));
         let size = [0.05, 0.5, 3.0, 12.0][k % 4];
         let mut vertex = || {
-            let x = center.0 + rng.range(-size, size);
-            let z = center.1 + rng.range(-size, size);
+            let x = center.0 + rng.uniform_f64(-size, size);
+            let z = center.1 + rng.uniform_f64(-size, size);
             (x as f32, z as f32)
         };
         let (a, b) = (vertex(), vertex());
@@ -338,12 +339,12 @@ fn perspective_light_matches_brute_force() {
     let n = 32;
     let matrix = Mat4::perspective_rh(70f32.to_radians(), 1.0, 0.5, 50.0)
         * Mat4::look_at_rh(Vec3::new(0.5, 10.0, 0.3), Vec3::ZERO, Vec3::Z);
-    let mut rng = Rng::new(8);
+    let mut rng = SplitMix64::new(8);
     let mut triangles = Vec::new();
     for _ in 0..200 {
-        let center = rng.in_cube(8.0).as_vec3() * Vec3::new(1.0, 0.25, 1.0);
-        let size = rng.range(0.05, 3.0) as f32;
-        triangles.push([0, 1, 2].map(|_| center + rng.in_cube(1.0).as_vec3() * size));
+        let center = in_cube(&mut rng, 8.0).as_vec3() * Vec3::new(1.0, 0.25, 1.0);
+        let size = rng.uniform_f64(0.05, 3.0) as f32;
+        triangles.push([0, 1, 2].map(|_| center + in_cube(&mut rng, 1.0).as_vec3() * size));
     }
     let scene = scene_of(&triangles);
     check_against_brute_force(&scene, &triangles, matrix, n);

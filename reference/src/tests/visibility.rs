@@ -1,8 +1,9 @@
 //! Hand-checkable visibility scenes.
 
 use glam::{DVec3, Mat4, Vec3, Vec4Swizzles};
+use scene::MeshBuilder;
 
-use super::MeshBuilder;
+use super::add_heightfield;
 use crate::{
     reference_visibility, Light, PixelClass, RefScene, VisibilityParams, VisibilityReference,
 };
@@ -13,13 +14,13 @@ const HEIGHT: u32 = 120;
 /// Floor `[-10, 10]^2` at y = 0 (triangles 0 and 1, split along x = -z) and the box
 /// `[-1, 1] x [1, 2] x [-1, 1]` floating above it (triangles 2..14).
 fn box_over_plane() -> RefScene {
-    let mut mesh = MeshBuilder::default();
+    let mut mesh = MeshBuilder::new();
     let corners = [(-10.0, -10.0), (10.0, -10.0), (10.0, 10.0), (-10.0, 10.0)]
         .map(|(x, z)| mesh.vertex(Vec3::new(x, 0.0, z)));
-    mesh.triangle(corners[0], corners[3], corners[1]);
-    mesh.triangle(corners[1], corners[3], corners[2]);
+    mesh.connect_triangle([corners[0], corners[3], corners[1]]);
+    mesh.connect_triangle([corners[1], corners[3], corners[2]]);
     mesh.add_box(Vec3::new(-1.0, 1.0, -1.0), Vec3::new(1.0, 2.0, 1.0));
-    RefScene::new(&mesh.scene())
+    RefScene::new(&mesh.into_scene("mesh"))
 }
 
 fn params(camera: Vec3, light: Light) -> VisibilityParams {
@@ -209,24 +210,24 @@ fn point_light_respects_light_distance() {
 
 #[test]
 fn coplanar_duplicate_receivers_are_ambiguous() {
-    let mut mesh = MeshBuilder::default();
-    mesh.add_triangle(
+    let mut mesh = MeshBuilder::new();
+    mesh.add_triangle([
         Vec3::new(-10.0, 0.0, -10.0),
         Vec3::new(-10.0, 0.0, 10.0),
         Vec3::new(10.0, 0.0, 10.0),
-    );
-    mesh.add_triangle(
+    ]);
+    mesh.add_triangle([
         Vec3::new(-10.0, 0.0, -10.0),
         Vec3::new(10.0, 0.0, 10.0),
         Vec3::new(10.0, 0.0, -10.0),
-    );
+    ]);
     // A second copy of a patch of the floor (z-fighting).
-    mesh.add_triangle(
+    mesh.add_triangle([
         Vec3::new(-2.0, 0.0, -2.0),
         Vec3::new(-2.0, 0.0, 2.0),
         Vec3::new(2.0, 0.0, 2.0),
-    );
-    let scene = RefScene::new(&mesh.scene());
+    ]);
+    let scene = RefScene::new(&mesh.into_scene("mesh"));
     let params = params(Vec3::new(0.0, 8.0, 6.0), oblique_light());
     let result = reference_visibility(&scene, &params);
     check_invariants(&result);
@@ -247,10 +248,10 @@ fn coplanar_duplicate_receivers_are_ambiguous() {
 #[test]
 fn receivers_next_to_blocker_edges_are_ambiguous() {
     // A box standing on the floor: floor points along its base touch its edges.
-    let mut mesh = MeshBuilder::default();
-    mesh.add_grid((-10.0, -10.0), (10.0, 10.0), 1, |_, _| 0.0);
+    let mut mesh = MeshBuilder::new();
+    add_heightfield(&mut mesh, (-10.0, -10.0), (10.0, 10.0), 1, |_, _| 0.0);
     mesh.add_box(Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 2.0, 1.0));
-    let scene = RefScene::new(&mesh.scene());
+    let scene = RefScene::new(&mesh.into_scene("mesh"));
     let params = VisibilityParams {
         tolerance: 0.05,
         tolerance_per_distance: 0.0,
@@ -300,13 +301,13 @@ fn camera_rays_through_edges_are_ambiguous_even_when_missing() {
     let p = camera.as_dvec3() + dir * 4.0;
     let across = dir.cross(DVec3::Y).normalize();
     let up = across.cross(dir).normalize();
-    let mut mesh = MeshBuilder::default();
-    mesh.add_triangle(
+    let mut mesh = MeshBuilder::new();
+    mesh.add_triangle([
         (p - across).as_vec3(),
         (p + across).as_vec3(),
         (p + up).as_vec3(),
-    );
-    let scene = RefScene::new(&mesh.scene());
+    ]);
+    let scene = RefScene::new(&mesh.into_scene("mesh"));
     let result = reference_visibility(&scene, &params);
     check_invariants(&result);
     let at = |x: usize, y: usize| result.class[y * WIDTH as usize + x];
@@ -318,17 +319,17 @@ fn camera_rays_through_edges_are_ambiguous_even_when_missing() {
 
 #[test]
 fn uncertain_nearer_events_hide_the_blocker_distance() {
-    let mut mesh = MeshBuilder::default();
-    mesh.add_grid((-10.0, -10.0), (10.0, 10.0), 1, |_, _| 0.0);
+    let mut mesh = MeshBuilder::new();
+    add_heightfield(&mut mesh, (-10.0, -10.0), (10.0, 10.0), 1, |_, _| 0.0);
     // Large roof at y = 2 (triangles 2, 3) and a smaller one at y = 1 (triangle 4)
     // whose edge x = 0.5 runs above the floor point (0.5, 0, 0.3).
-    mesh.add_grid((-3.0, -3.0), (3.0, 3.0), 1, |_, _| 2.0);
-    mesh.add_triangle(
+    add_heightfield(&mut mesh, (-3.0, -3.0), (3.0, 3.0), 1, |_, _| 2.0);
+    mesh.add_triangle([
         Vec3::new(-2.0, 1.0, -1.0),
         Vec3::new(0.5, 1.0, -1.0),
         Vec3::new(0.5, 1.0, 1.5),
-    );
-    let scene = RefScene::new(&mesh.scene());
+    ]);
+    let scene = RefScene::new(&mesh.into_scene("mesh"));
     let camera = Vec3::new(12.0, 1.5, 0.0);
     let params = VisibilityParams {
         tolerance: 0.2,

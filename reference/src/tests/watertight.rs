@@ -1,8 +1,9 @@
 //! Watertightness and robustness of the ray/triangle and line/segment primitives.
 
 use glam::{DVec3, Vec3};
+use scene::{MeshBuilder, SplitMix64};
 
-use super::{MeshBuilder, Rng};
+use super::{add_heightfield, in_cube, random_direction};
 use crate::{intersect_watertight, line_segment_distance, RefScene};
 
 /// Every hit parameter of the line `origin + t * dir` against all triangles.
@@ -18,7 +19,7 @@ fn hits(scene: &RefScene, origin: DVec3, dir: DVec3) -> Vec<f64> {
 
 /// Closed fan around `center` (the shared vertex) with `k` triangles.
 fn fan(center: Vec3, k: u32) -> MeshBuilder {
-    let mut mesh = MeshBuilder::default();
+    let mut mesh = MeshBuilder::new();
     let c = mesh.vertex(center);
     let first = c + 1;
     for i in 0..k {
@@ -31,7 +32,7 @@ fn fan(center: Vec3, k: u32) -> MeshBuilder {
         ));
     }
     for i in 0..k {
-        mesh.triangle(c, first + i, first + (i + 1) % k);
+        mesh.connect_triangle([c, first + i, first + (i + 1) % k]);
     }
     mesh
 }
@@ -39,12 +40,12 @@ fn fan(center: Vec3, k: u32) -> MeshBuilder {
 /// Tessellated closed cube `[-1, 1]^3`; seam vertices of neighbouring faces are
 /// bit-identical.
 fn cube(cells: u32) -> MeshBuilder {
-    let mut mesh = MeshBuilder::default();
+    let mut mesh = MeshBuilder::new();
     let coord = |i: u32| -1.0 + 2.0 * i as f32 / cells as f32;
     for axis in 0..3 {
         for side in [-1.0f32, 1.0] {
             let (u_axis, v_axis) = ((axis + 1) % 3, (axis + 2) % 3);
-            let first = mesh.positions.len() as u32;
+            let first = mesh.positions().len() as u32;
             for j in 0..=cells {
                 for i in 0..=cells {
                     let mut p = Vec3::ZERO;
@@ -58,8 +59,8 @@ fn cube(cells: u32) -> MeshBuilder {
             for j in 0..cells {
                 for i in 0..cells {
                     let v = |di: u32, dj: u32| first + (j + dj) * row + i + di;
-                    mesh.triangle(v(0, 0), v(1, 0), v(1, 1));
-                    mesh.triangle(v(0, 0), v(1, 1), v(0, 1));
+                    mesh.connect_triangle([v(0, 0), v(1, 0), v(1, 1)]);
+                    mesh.connect_triangle([v(0, 0), v(1, 1), v(0, 1)]);
                 }
             }
         }
@@ -80,9 +81,9 @@ fn edge_and_vertex_targets(scene: &RefScene) -> Vec<DVec3> {
 
 #[test]
 fn rays_at_shared_fan_edges_and_vertex_always_hit() {
-    let mut rng = Rng::new(1);
+    let mut rng = SplitMix64::new(1);
     for k in [3, 5, 8, 13] {
-        let scene = RefScene::new(&fan(Vec3::new(0.0, 0.3, 0.0), k).scene());
+        let scene = RefScene::new(&fan(Vec3::new(0.0, 0.3, 0.0), k).into_scene("mesh"));
         let center = scene.triangle(0)[0];
         let mut targets = vec![center];
         for i in 0..scene.triangle_count() {
@@ -94,8 +95,9 @@ fn rays_at_shared_fan_edges_and_vertex_always_hit() {
         for target in targets {
             for _ in 0..200 {
                 // Within 25 degrees of vertical, so that no spoke is a silhouette.
-                let side = if rng.unit() < 0.5 { 3.0 } else { -3.0 };
-                let origin = target + DVec3::new(rng.range(-1.0, 1.0), side, rng.range(-1.0, 1.0));
+                let side = if rng.next_f64() < 0.5 { 3.0 } else { -3.0 };
+                let origin = target
+                    + DVec3::new(rng.uniform_f64(-1.0, 1.0), side, rng.uniform_f64(-1.0, 1.0));
                 let dir = target - origin;
                 assert!(
                     !hits(&scene, origin, dir).is_empty(),
@@ -108,13 +110,17 @@ fn rays_at_shared_fan_edges_and_vertex_always_hit() {
 
 #[test]
 fn rays_at_shared_grid_edges_and_vertices_always_hit() {
-    let mut rng = Rng::new(2);
+    let mut rng = SplitMix64::new(2);
     for offset in [0.0f32, 1e5] {
-        let mut mesh = MeshBuilder::default();
-        mesh.add_grid((offset - 2.0, -2.0), (offset + 2.0, 2.0), 8, |x, z| {
-            0.37 * (x - offset) + 0.61 * z + 0.1 + 0.05 * ((x - offset) * 3.0).sin()
-        });
-        let scene = RefScene::new(&mesh.scene());
+        let mut mesh = MeshBuilder::new();
+        add_heightfield(
+            &mut mesh,
+            (offset - 2.0, -2.0),
+            (offset + 2.0, 2.0),
+            8,
+            |x, z| 0.37 * (x - offset) + 0.61 * z + 0.1 + 0.05 * ((x - offset) * 3.0).sin(),
+        );
+        let scene = RefScene::new(&mesh.into_scene("mesh"));
         let interior = |p: DVec3| (p.x - f64::from(offset)).abs() < 1.99 && p.z.abs() < 1.99;
         let targets: Vec<DVec3> = edge_and_vertex_targets(&scene)
             .into_iter()
@@ -123,8 +129,9 @@ fn rays_at_shared_grid_edges_and_vertices_always_hit() {
         assert!(targets.len() > 200);
         for target in targets {
             for _ in 0..20 {
-                let side = if rng.unit() < 0.5 { 5.0 } else { -5.0 };
-                let origin = target + DVec3::new(rng.range(-2.0, 2.0), side, rng.range(-2.0, 2.0));
+                let side = if rng.next_f64() < 0.5 { 5.0 } else { -5.0 };
+                let origin = target
+                    + DVec3::new(rng.uniform_f64(-2.0, 2.0), side, rng.uniform_f64(-2.0, 2.0));
                 let dir = target - origin;
                 assert!(
                     !hits(&scene, origin, dir).is_empty(),
@@ -137,15 +144,15 @@ fn rays_at_shared_grid_edges_and_vertices_always_hit() {
 
 #[test]
 fn lines_through_closed_meshes_hit_on_both_sides() {
-    let mut rng = Rng::new(3);
-    let mut sphere = MeshBuilder::default();
+    let mut rng = SplitMix64::new(3);
+    let mut sphere = MeshBuilder::new();
     sphere.add_sphere(Vec3::ZERO, 1.0, 12, 16);
     for mesh in [sphere, cube(4)] {
-        let scene = RefScene::new(&mesh.scene());
+        let scene = RefScene::new(&mesh.into_scene("mesh"));
         // Random lines through interior points.
         for _ in 0..3000 {
-            let inside = rng.in_cube(0.5);
-            let dir = rng.direction();
+            let inside = in_cube(&mut rng, 0.5);
+            let dir = random_direction(&mut rng);
             let ts = hits(&scene, inside, dir);
             assert!(ts.len() >= 2, "line through {inside} along {dir}: {ts:?}");
             assert!(ts.iter().any(|t| *t > 0.0) && ts.iter().any(|t| *t < 0.0));
@@ -153,7 +160,7 @@ fn lines_through_closed_meshes_hit_on_both_sides() {
         // Rays from interior points aimed exactly at vertices and edge midpoints.
         for target in edge_and_vertex_targets(&scene) {
             for _ in 0..3 {
-                let inside = rng.in_cube(0.5);
+                let inside = in_cube(&mut rng, 0.5);
                 let ts = hits(&scene, inside, target - inside);
                 assert!(ts.iter().any(|t| *t > 0.0), "ray {inside} -> {target}");
                 assert!(ts.iter().any(|t| *t < 0.0), "ray {inside} <- {target}");
@@ -164,7 +171,7 @@ fn lines_through_closed_meshes_hit_on_both_sides() {
 
 #[test]
 fn cube_corners_and_seams_are_watertight_along_axes_and_diagonals() {
-    let scene = RefScene::new(&cube(3).scene());
+    let scene = RefScene::new(&cube(3).into_scene("mesh"));
     // Rays from the centre straight at corners and along seams.
     for target in edge_and_vertex_targets(&scene) {
         let ts = hits(&scene, DVec3::ZERO, target);
@@ -178,7 +185,7 @@ fn cube_corners_and_seams_are_watertight_along_axes_and_diagonals() {
 
 #[test]
 fn degenerate_triangles_give_none_and_never_nan() {
-    let mut rng = Rng::new(4);
+    let mut rng = SplitMix64::new(4);
     let collinear = [
         DVec3::ZERO,
         DVec3::new(1.0, 1.0, 1.0),
@@ -188,10 +195,13 @@ fn degenerate_triangles_give_none_and_never_nan() {
     let repeated = [DVec3::ZERO, DVec3::ZERO, DVec3::X];
     for tri in [collinear, point, repeated] {
         for _ in 0..2000 {
-            let origin = rng.in_cube(3.0);
-            let target = tri[0] + (tri[2] - tri[0]) * rng.unit();
+            let origin = in_cube(&mut rng, 3.0);
+            let target = tri[0] + (tri[2] - tri[0]) * rng.next_f64();
             assert_eq!(intersect_watertight(origin, target - origin, &tri), None);
-            assert_eq!(intersect_watertight(origin, rng.direction(), &tri), None);
+            assert_eq!(
+                intersect_watertight(origin, random_direction(&mut rng), &tri),
+                None
+            );
         }
     }
     let tri = [DVec3::ZERO, DVec3::X, DVec3::Y];
@@ -215,10 +225,10 @@ fn degenerate_triangles_give_none_and_never_nan() {
         None
     );
     // Degenerate triangles are never usable as blockers or receivers.
-    let mut mesh = MeshBuilder::default();
-    mesh.add_triangle(Vec3::ZERO, Vec3::ONE, Vec3::splat(2.0));
-    mesh.add_triangle(Vec3::ZERO, Vec3::X, Vec3::Y);
-    let scene = RefScene::new(&mesh.scene());
+    let mut mesh = MeshBuilder::new();
+    mesh.add_triangle([Vec3::ZERO, Vec3::ONE, Vec3::splat(2.0)]);
+    mesh.add_triangle([Vec3::ZERO, Vec3::X, Vec3::Y]);
+    let scene = RefScene::new(&mesh.into_scene("mesh"));
     assert!(!scene.is_usable(0));
     assert!(scene.is_usable(1));
 }
@@ -258,16 +268,16 @@ fn huge_coordinates_stay_exact() {
     assert_eq!(t, 1.0);
     assert_eq!(bary, [0.5, 0.25, 0.25]);
     // Oblique rays: the hit point reproduces the target to near f64 precision.
-    let mut rng = Rng::new(5);
+    let mut rng = SplitMix64::new(5);
     for _ in 0..1000 {
-        let (u, v) = (rng.unit(), rng.unit());
+        let (u, v) = (rng.next_f64(), rng.next_f64());
         let (u, v) = if u + v > 1.0 {
             (1.0 - u, 1.0 - v)
         } else {
             (u, v)
         };
         let target = tri[0] + (tri[1] - tri[0]) * u + (tri[2] - tri[0]) * v;
-        let origin = target + rng.direction() * 3.0;
+        let origin = target + random_direction(&mut rng) * 3.0;
         let dir = target - origin;
         let Some((t, [w0, w1, w2])) = intersect_watertight(origin, dir, &tri) else {
             // Only rays grazing the plane may legitimately miss after rounding.
@@ -350,13 +360,13 @@ fn line_segment_distances() {
         5.0
     );
     // Agrees with brute-force sampling.
-    let mut rng = Rng::new(6);
+    let mut rng = SplitMix64::new(6);
     for _ in 0..500 {
         let (o, dir, a, b) = (
-            rng.in_cube(2.0),
-            rng.direction(),
-            rng.in_cube(2.0),
-            rng.in_cube(2.0),
+            in_cube(&mut rng, 2.0),
+            random_direction(&mut rng),
+            in_cube(&mut rng, 2.0),
+            in_cube(&mut rng, 2.0),
         );
         let exact = d(o, dir, a, b);
         let sampled = (0..=2000)

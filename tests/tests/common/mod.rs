@@ -6,8 +6,8 @@
 
 use glam::Vec3;
 pub use host_demo::accuracy::*;
-use host_demo::View;
-use passes::{FrameImages, FrameReport, PrimitiveMapConfig, ShadowRenderer};
+use host_demo::{FrameImages, ShadowRenderer, View};
+use passes::{FrameReport, PrimitiveMapConfig};
 use rhi::{Device, DeviceDesc};
 use scene::{Camera, DirectionalLight, Scene};
 use std::path::PathBuf;

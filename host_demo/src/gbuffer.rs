@@ -1,13 +1,28 @@
 //! G-buffer for the demo host: world position, camera-facing geometric normal, reversed-Z depth.
 //!
-//! Reads: prim buffer. Writes: position, normal, depth.
+//! Reads: the pipeline's prim buffer. Writes: position, normal, depth. Shaders: `gbuffer.vert` and
+//! `gbuffer.frag` in `host_demo/shaders/`.
 
-use crate::gpu_types::GBufferPush;
-use crate::{shader, PassError};
+use crate::shader;
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec4};
+use passes::PassError;
 use rhi::{
     BindGroup, BindingKind, Buffer, ColorTarget, DepthState, DepthTarget, Device, Encoder, Format,
     GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, ImageUsage, Resource,
 };
+
+/// Push constants of the G-buffer (`gbuffer_push.glsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct GBufferPush {
+    /// proj * view with the camera at the origin.
+    pub view_proj_rel: Mat4,
+    /// Camera position in frame coordinates (xyz).
+    pub camera_pos: Vec4,
+}
+
+const _: () = assert!(std::mem::size_of::<GBufferPush>() == 80);
 
 /// The G-buffer's images.
 pub struct GBufferTargets {

@@ -1,15 +1,12 @@
 //! The demo host's frame: prim buffer → G-buffer → [`ShadowPipeline`], submitted and waited for, with
 //! read-back of every output the plan produced.
 
-use crate::frame_plan::{PassId, ResourceId};
-use crate::gbuffer::{GBufferPass, GBufferTargets};
-use crate::gpu_types::GBufferPush;
-use crate::prim_buffer::Geometry;
-use crate::shadow_pipeline::{
-    FrameInputs, FrameReport, ShadowConfig, ShadowInputs, ShadowPipeline,
-};
-use crate::PassError;
+use crate::gbuffer::{GBufferPass, GBufferPush, GBufferTargets};
 use glam::DVec3;
+use passes::{
+    FrameInputs, FrameReport, Geometry, PassError, PassId, ResourceId, ShadowConfig, ShadowInputs,
+    ShadowPipeline,
+};
 use rhi::{Barrier, Buffer, BufferUsage, Device, Image, MemoryLocation, ResourceState as S};
 
 /// Everything the frame produced, read back to the host. Row-major, y = 0 at the top. Outputs the plan
@@ -24,7 +21,7 @@ pub struct FrameImages {
     pub depth: Vec<f32>,
     /// Ray-traced visibility (1 = lit).
     pub visibility: Vec<f32>,
-    /// Blocker distance (see [`crate::ray_trace::RayTracePass::blocker_distance`]).
+    /// Blocker distance (see [`passes::ray_trace::RayTracePass::blocker_distance`]).
     pub blocker_distance: Vec<f32>,
     /// Occupancy view, N×N RGBA8.
     pub occupancy: Vec<[u8; 4]>,
@@ -247,7 +244,7 @@ pub fn read_images(device: &Device, images: &[(&Image, S)]) -> Result<Vec<Vec<u8
 
 /// Copies `buffers` (storage writes made visible by the frame's last UAV barrier) into host memory, waits,
 /// and returns their bytes.
-pub fn read_buffers(device: &Device, buffers: &[&Buffer]) -> Result<Vec<Vec<u8>>, PassError> {
+fn read_buffers(device: &Device, buffers: &[&Buffer]) -> Result<Vec<Vec<u8>>, PassError> {
     let staging = buffers
         .iter()
         .map(|b| {
