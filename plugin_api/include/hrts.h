@@ -692,6 +692,9 @@ typedef struct HrtsFrameReport {
   // The primitive map's fit this frame: frame coordinates to homogeneous texel space, 16 floats,
   // column-major (frame coordinates are world minus the geometry's origin).
   float map_to_texels[16];
+  // How many times this light's passes were built since the context was created: a configuration,
+  // geometry or targets call that changed nothing of this light leaves it as it was.
+  uint32_t light_builds;
 } HrtsFrameReport;
 
 // Every result, in value order.
@@ -721,9 +724,9 @@ enum HrtsResult hrts_get_memory_stats(struct HrtsMemoryStats *out);
 // A static name for a result code (also for values this library does not know: `HRTS_RESULT_UNKNOWN`).
 const char *hrts_result_name(int32_t result);
 
-// The message of the last failed call on `context`, or, if `context` is NULL or not live, of the last
-// failed call on this thread. Empty if none. A successful call does not clear it. Valid until the next
-// failing call on the same context (or thread), and for a context until it is destroyed.
+// The message of the last call on `context` if it failed, or, if `context` is NULL or not live, of the
+// last call on this thread if it failed; empty after a successful call. Valid until the next call on the
+// same context (or thread).
 //
 // # Safety
 // `context` is NULL or a handle returned by `hrts_context_create`.
@@ -813,14 +816,21 @@ enum HrtsResult hrts_record_frame(struct HrtsContext *context, const struct Hrts
 // `HRTS_PASS_MASK_SCREEN_SPACE` after its G-buffer, in the same or a later command buffer of the same
 // queue, submitted in recording order.
 //
-// A call whose lowest pass comes after the last pass recorded in the current frame continues that frame
-// (its camera and light must be the same); any other call begins a new frame. Passes the frame does not
-// run (not needed by the configuration, or up to date) record nothing. Within a frame, every pass that
-// runs must be recorded, in order: a call that leaves out such a pass before its last requested one fails
-// with `HRTS_RESULT_ERROR_INVALID_STATE`. `HRTS_PASS_OUTPUT_COPY` ends the frame.
+// Every light's passes of the mask are recorded, light after light. A call with the `frame_index` of the
+// frame being recorded and whose lowest pass comes after the last pass recorded continues that frame (its
+// camera and lights must be the same); a call with a greater `frame_index` begins a new frame (abandoning
+// an unfinished one); any other call fails. Passes the frame does not run (not needed by the
+// configuration, up to date, or shared) record nothing. Within a frame, every pass that runs must be
+// recorded, in order: a call that leaves out such a pass before its last requested one fails with
+// `HRTS_RESULT_ERROR_INVALID_STATE` and records nothing. `HRTS_PASS_OUTPUT_COPY` ends the frame.
 //
-// Layouts: a call with a ray-trace, shadow-map-test or PCSS pass transitions depth and normal from
-// `depth_layout` and `normal_layout` and back; the output copy takes the output image from
+// Frames in flight: recording frame `f` states that every frame up to `f - frames_in_flight` has
+// completed on the GPU; the plugin's per-frame data is ring-buffered that deep, and its constants go
+// into the command buffer itself, so the engine never waits for the plugin. Each call's commands are
+// ordered after everything earlier on the queue that used the same plugin resources.
+//
+// Layouts: a call with a primitive-map, ray-trace, shadow-map-test or PCSS pass transitions depth and
+// normal from `depth_layout` and `normal_layout` and back; the output copy takes the output image from
 // `output_layout_before` to `output_layout_after`. Other calls leave the engine's images alone. The
 // plugin binds its own pipelines and descriptor sets and sets viewport and scissor: re-bind yours after.
 //

@@ -88,6 +88,8 @@ pub(crate) struct Context {
     pub(crate) progress: FrameProgress,
     /// The index of the last frame begun.
     pub(crate) last_frame: Option<u64>,
+    /// How many times each light's passes were built.
+    pub(crate) light_builds: Vec<u32>,
     /// The message of the last call if it failed.
     pub(crate) last_error: Option<std::ffi::CString>,
 }
@@ -128,6 +130,7 @@ impl Context {
             targets: None,
             progress: FrameProgress::default(),
             last_frame: None,
+            light_builds: vec![0],
             last_error: None,
         })
     }
@@ -198,6 +201,7 @@ impl Context {
                 self.progress = FrameProgress::default();
             }
         }
+        self.light_builds.resize(lights.len(), 0);
         self.lights = lights;
         Ok(())
     }
@@ -303,7 +307,7 @@ impl Context {
         if self.built.is_none() {
             self.built = Some(self.build_shared()?);
         }
-        let (device, lights) = (&self.device, &self.lights);
+        let (device, lights, builds) = (&self.device, &self.lights, &mut self.light_builds);
         let built = self
             .built
             .as_mut()
@@ -328,6 +332,7 @@ impl Context {
                     }
                 })?;
                 *slot = Some(pipeline);
+                builds[i] += 1;
             }
         }
         Ok(built)
@@ -481,6 +486,7 @@ impl Context {
             }
         }
         out.output_resource = resource_index(report.output)?;
+        out.light_builds = self.light_builds.get(light as usize).copied().unwrap_or(0);
         Ok(())
     }
 

@@ -646,6 +646,9 @@ pub struct HrtsFrameReport {
     /// The primitive map's fit this frame: frame coordinates to homogeneous texel space, 16 floats,
     /// column-major (frame coordinates are world minus the geometry's origin).
     pub map_to_texels: [f32; 16],
+    /// How many times this light's passes were built since the context was created: a configuration,
+    /// geometry or targets call that changed nothing of this light leaves it as it was.
+    pub light_builds: u32,
 }
 
 /// A copy of a plugin resource into an engine buffer, recorded after a complete frame.
