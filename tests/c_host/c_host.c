@@ -1176,6 +1176,24 @@ static void several_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g)
     CHECK(report(ctx, next_frame - 1, 0, &rep) == HRTS_RESULT_OK &&
               rep.pass_status[HRTS_PASS_PRIM_BUFFER] == HRTS_PASS_STATUS_UP_TO_DATE,
           "second frame: prim buffer %u", rep.pass_status[HRTS_PASS_PRIM_BUFFER]);
+    /* reconfiguring one light rebuilds that light's passes only */
+    HrtsConfig cfgs[N];
+    for (int i = 0; i < N; i++) cfgs[i] = config(HRTS_SHADOW_MODE_HARD);
+    cfgs[3].mode = HRTS_SHADOW_MODE_HYBRID;
+    CHECK(hrts_configure_lights(ctx, N, cfgs) == HRTS_RESULT_OK, "reconfigure light 3: %s", hrts_last_error(ctx));
+    CHECK(run_frame(ctx, vis) == HRTS_RESULT_OK, "after reconfiguring light 3: %s", hrts_last_error(ctx));
+    int rebuilt = 0, kept = 0, same = 0;
+    for (int i = 0; i < N; i++) {
+        CHECK(report(ctx, next_frame - 1, (uint32_t)i, &rep) == HRTS_RESULT_OK, "report %d: %s", i, hrts_last_error(ctx));
+        if (rep.light_builds == 2) rebuilt += i == 3;
+        if (rep.light_builds == 1) kept += i != 3;
+        if (i != 3) {
+            int ne, sh, li;
+            same += count_mismatches(vis + i * W * H, tol, &lights[i], &ne, &sh, &li) == 0;
+        }
+    }
+    printf("reconfiguring light 3 of 8: %d light rebuilt, %d kept their passes, %d of them still exact\n", rebuilt, kept, same);
+    CHECK(rebuilt == 1 && kept == N - 1 && same == N - 1, "reconfiguring one light: %d rebuilt, %d kept, %d exact", rebuilt, kept, same);
     CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
 }
 
