@@ -787,33 +787,49 @@ impl ShadowPipeline {
         self.record_passes(enc, PassId::ALL)
     }
 
-    fn record_forward(
-        &mut self,
-        enc: &mut Encoder<'_>,
-        frame: &mut FrameState,
-        passes: &[PassId],
-    ) -> Result<(), PassError> {
-        let last = passes.iter().max().copied();
+    /// Whether [`ShadowPipeline::record_passes`] would accept `passes` now (without recording anything).
+    pub fn check_record(&self, passes: &[PassId]) -> Result<(), PassError> {
+        let frame = self
+            .frame
+            .as_ref()
+            .ok_or_else(|| PassError::InvalidConfig("no frame: call begin_frame first".into()))?;
+        self.check_forward(frame, passes)
+    }
+
+    /// The order checks of a recording call: passes after those already recorded, none that runs left out.
+    fn check_forward(&self, frame: &FrameState, passes: &[PassId]) -> Result<(), PassError> {
         if let Some(&first) = passes.iter().min().filter(|&&p| (p as usize) < frame.next) {
             return Err(PassError::InvalidConfig(format!(
                 "pass '{}' comes before a pass already recorded this frame: record passes in linear order",
                 first.name()
             )));
         }
-        let statuses = self.statuses.clone();
-        let runs = |p: PassId| statuses[p as usize].1 == PassStatus::Ran;
-        if let Some((&missing, last)) = last.and_then(|last| {
-            PassId::ALL[frame.next..=last as usize]
+        let runs = |p: PassId| self.statuses[p as usize].1 == PassStatus::Ran;
+        if let Some(last) = passes.iter().max() {
+            if let Some(missing) = PassId::ALL[frame.next..=*last as usize]
                 .iter()
                 .find(|&&p| runs(p) && !passes.contains(&p))
-                .map(|m| (m, last))
-        }) {
-            return Err(PassError::InvalidConfig(format!(
-                "pass '{}' runs this frame: record it (it comes before '{}')",
-                missing.name(),
-                last.name()
-            )));
+            {
+                return Err(PassError::InvalidConfig(format!(
+                    "pass '{}' runs this frame: record it (it comes before '{}')",
+                    missing.name(),
+                    last.name()
+                )));
+            }
         }
+        Ok(())
+    }
+
+    fn record_forward(
+        &mut self,
+        enc: &mut Encoder<'_>,
+        frame: &mut FrameState,
+        passes: &[PassId],
+    ) -> Result<(), PassError> {
+        self.check_forward(frame, passes)?;
+        let last = passes.iter().max().copied();
+        let statuses = self.statuses.clone();
+        let runs = |p: PassId| statuses[p as usize].1 == PassStatus::Ran;
         // Checked: from here on the call records.
         let timer = &self.slots[frame.slot].timer;
         if frame.timer_started {

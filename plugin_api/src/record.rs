@@ -121,6 +121,12 @@ impl Context {
                 }
             }
         }
+        // Every light accepts the passes before anything is recorded: a failed call records nothing.
+        for (i, pipeline) in built.lights.iter().flatten().enumerate() {
+            pipeline.check_record(&passes).map_err(|e| {
+                ApiError::new(HrtsResult::ErrorInvalidState, format!("light {i}: {e}"))
+            })?;
+        }
         // SAFETY: the engine guarantees the command buffer is recording, outside a render pass, on this
         // device and used by no other thread during the call (documented contract).
         let mut enc = unsafe { Encoder::from_raw_handle(device, f.command_buffer) };

@@ -219,25 +219,35 @@ fn load_buffers(
                 buffer: buffer.index(),
                 message,
             };
-            let source = match buffer.source() {
-                gltf::buffer::Source::Bin => "the GLB binary chunk".to_owned(),
+            let (source, data) = match buffer.source() {
+                gltf::buffer::Source::Bin => (
+                    "the GLB binary chunk".to_owned(),
+                    blob.take()
+                        .ok_or_else(|| "the GLB has no binary chunk".to_owned()),
+                ),
                 gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
-                    "its data: URI".to_owned()
+                    ("its data: URI".to_owned(), data_uri_bytes(uri))
+                }
+                gltf::buffer::Source::Uri(uri) if uri.contains(':') => {
+                    return Err(error(format!(
+                        "URI \"{uri}\": only data: URIs and relative file paths are read"
+                    )));
                 }
                 gltf::buffer::Source::Uri(uri) => {
-                    // The gltf crate unwraps the percent-decoding of relative URIs.
-                    if !uri.contains(':') && !percent_decodes_to_utf8(uri) {
+                    let Some(relative) = percent_decode(uri) else {
                         return Err(error(format!(
                             "URI \"{uri}\" does not percent-decode to UTF-8"
                         )));
-                    }
-                    format!("\"{uri}\" (relative to {})", base.display())
+                    };
+                    let file = base.join(relative);
+                    let source = format!("\"{uri}\" (relative to {})", base.display());
+                    let data = std::fs::read(&file)
+                        .map_err(|e| format!("cannot read {}: {e}", file.display()));
+                    (source, data)
                 }
             };
-            let data =
-                gltf::buffer::Data::from_source_and_blob(buffer.source(), Some(base), &mut blob)
-                    .map_err(|e| error(format!("cannot load {source}: {e}")))?;
-            let mut data = data.0;
+            let data = data.map_err(|m| error(format!("cannot load {source}: {m}")))?;
+            let mut data = data;
             if data.len() < buffer.length() {
                 return Err(error(format!(
                     "{source} holds {} bytes, but byteLength is {}",
@@ -251,8 +261,8 @@ fn load_buffers(
         .collect()
 }
 
-/// Whether `uri`, with its `%XX` escapes decoded, is valid UTF-8.
-fn percent_decodes_to_utf8(uri: &str) -> bool {
+/// `uri` with its `%XX` escapes decoded, if that is valid UTF-8.
+fn percent_decode(uri: &str) -> Option<String> {
     let bytes = uri.as_bytes();
     let mut decoded = Vec::with_capacity(bytes.len());
     let mut i = 0;
@@ -273,7 +283,21 @@ fn percent_decodes_to_utf8(uri: &str) -> bool {
             }
         }
     }
-    String::from_utf8(decoded).is_ok()
+    String::from_utf8(decoded).ok()
+}
+
+/// The bytes of a `data:[<mediatype>];base64,<data>` URI.
+fn data_uri_bytes(uri: &str) -> Result<Vec<u8>, String> {
+    use base64::Engine as _;
+    let (header, payload) = uri
+        .split_once(',')
+        .ok_or_else(|| "the data: URI has no ',' before its data".to_owned())?;
+    if !header.ends_with(";base64") {
+        return Err("the data: URI is not base64-encoded".into());
+    }
+    base64::engine::general_purpose::STANDARD
+        .decode(payload)
+        .map_err(|e| format!("the data: URI is not valid base64: {e}"))
 }
 
 /// `node 3 "name"`, or `node 3` without a name.

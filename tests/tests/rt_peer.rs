@@ -75,7 +75,11 @@ fn check(view: &View, max_near_edge_fraction: f64) {
         device.capabilities().driver
     );
     assert_exact_visibility(&c, max_near_edge_fraction);
-    assert!(peer.build_ms.is_finite() && peer.trace_ms.is_finite());
+    // Both traces are exact, so they agree wherever the reference decides (timings are the benchmark's).
+    assert_eq!(
+        differ_from_ours, 0,
+        "the peer and the primitive-map trace disagree outside near-edge pixels"
+    );
     assert_no_validation_errors(&device);
 }
 
