@@ -1,100 +1,13 @@
-//! Compiles the demo's GLSL shaders in `shaders/` (the G-buffer) to SPIR-V with the glslang crate and
-//! embeds the modules, as `passes/build.rs` does for the passes. Includes resolve in `shaders/`, then in
-//! `../passes/shaders/` (the prim buffer's `triangle.glsl`, whose layout the passes own).
-
-use glslang::{
-    include::{IncludeHandler, IncludeResult, IncludeType},
-    Compiler, CompilerOptions, ShaderInput, ShaderSource, ShaderStage, SourceLanguage,
-    SpirvVersion, Target, VulkanVersion,
-};
-use std::path::{Path, PathBuf};
-
-/// Include folders, searched in order.
-struct Includes(Vec<PathBuf>);
-
-impl IncludeHandler for Includes {
-    fn include(
-        &mut self,
-        _ty: IncludeType,
-        name: &str,
-        _includer: &str,
-        _depth: usize,
-    ) -> Option<IncludeResult> {
-        self.0.iter().find_map(|dir| {
-            let path = dir.join(name);
-            let data = std::fs::read_to_string(&path).ok()?;
-            println!("cargo:rerun-if-changed={}", path.display());
-            Some(IncludeResult {
-                name: path.to_string_lossy().into_owned(),
-                data,
-            })
-        })
-    }
-}
-
-fn stage_of(path: &Path) -> ShaderStage {
-    match path.extension().and_then(|e| e.to_str()) {
-        Some("vert") => ShaderStage::Vertex,
-        Some("frag") => ShaderStage::Fragment,
-        other => panic!("unknown shader stage {other:?} for {}", path.display()),
-    }
-}
+//! Compiles the demo's GLSL shaders in `shaders/` (the G-buffer) to SPIR-V and embeds the modules (see
+//! `shader_build`). Includes resolve in `shaders/`, then in `../passes/shaders/` (the prim buffer's
+//! `triangle.glsl`, whose layout the passes own).
 
 fn main() {
-    let manifest =
-        PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
-    let dir = manifest.join("shaders");
-    let include_dirs = vec![dir.clone(), manifest.join("../passes/shaders")];
-    let out = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
-    println!("cargo:rerun-if-changed={}", dir.display());
-    let compiler = Compiler::acquire().expect("glslang initialises");
-    let options = CompilerOptions {
-        source_language: SourceLanguage::GLSL,
-        target: Target::Vulkan {
-            version: VulkanVersion::Vulkan1_3,
-            spirv_version: SpirvVersion::SPIRV1_6,
-        },
-        version_profile: None,
-        messages: glslang::ShaderMessage::DEFAULT,
-    };
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("shaders/ exists")
-        .map(|e| e.expect("readable entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e != "glsl"))
-        .collect();
-    entries.sort();
-    let mut table = String::from(
-        "/// Every embedded shader module, by file name.\npub const ALL: &[(&str, &[u8])] = &[\n",
+    let manifest = std::path::PathBuf::from(
+        std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"),
     );
-    for path in entries {
-        println!("cargo:rerun-if-changed={}", path.display());
-        let name = path
-            .file_name()
-            .and_then(|n| n.to_str())
-            .expect("utf-8 shader name")
-            .to_owned();
-        let text = std::fs::read_to_string(&path).expect("readable shader");
-        let source = ShaderSource::from(text);
-        let mut includes = Includes(include_dirs.clone());
-        let input = ShaderInput::new(
-            &source,
-            stage_of(&path),
-            &options,
-            None::<&[(&str, Option<&str>)]>,
-            Some(&mut includes),
-        )
-        .unwrap_or_else(|e| panic!("{name}: {e}"));
-        let shader = compiler
-            .create_shader(input)
-            .unwrap_or_else(|e| panic!("{name}: {e}"));
-        let words = shader.compile().unwrap_or_else(|e| panic!("{name}: {e}"));
-        let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
-        let file = format!("{name}.spv");
-        std::fs::write(out.join(&file), bytes).expect("write SPIR-V");
-        table.push_str(&format!(
-            "    (\"{name}\", include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{file}\"))),\n"
-        ));
-    }
-    table.push_str("];\n");
-    std::fs::write(out.join("shaders.rs"), table).expect("write shader table");
+    shader_build::embed_shaders(
+        &manifest.join("shaders"),
+        &[manifest.join("../passes/shaders")],
+    );
 }

@@ -34,12 +34,7 @@ mod shaders {
 
 /// SPIR-V words of the demo's embedded shader `name` (file name in `host_demo/shaders/`).
 pub fn shader(name: &str) -> Result<Vec<u32>, PassError> {
-    let bytes = shaders::ALL
-        .iter()
-        .find(|(n, _)| *n == name)
-        .map(|(_, b)| *b)
-        .ok_or_else(|| PassError::InvalidConfig(format!("no embedded demo shader named {name}")))?;
-    Ok(bytemuck::pod_collect_to_vec(bytes))
+    passes::embedded_shader(shaders::ALL, name)
 }
 
 /// A scene with its camera and light, ready to render.

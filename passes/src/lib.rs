@@ -47,7 +47,12 @@ mod shaders {
 
 /// SPIR-V words of the embedded shader `name` (file name in `shaders/`).
 pub fn shader(name: &str) -> Result<Vec<u32>, PassError> {
-    let bytes = shaders::ALL
+    embedded_shader(shaders::ALL, name)
+}
+
+/// SPIR-V words of shader `name` in a table of embedded modules (as `shader_build` writes them).
+pub fn embedded_shader(table: &[(&str, &[u8])], name: &str) -> Result<Vec<u32>, PassError> {
+    let bytes = table
         .iter()
         .find(|(n, _)| *n == name)
         .map(|(_, b)| *b)

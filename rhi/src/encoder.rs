@@ -648,30 +648,7 @@ impl<'a> Encoder<'a> {
                 "image copy between different sizes or formats".into(),
             ));
         }
-        let layers = vk::ImageSubresourceLayers::default()
-            .aspect_mask(src.format().aspect())
-            .mip_level(0)
-            .base_array_layer(0)
-            .layer_count(src.layers());
-        let region = vk::ImageCopy::default()
-            .src_subresource(layers)
-            .dst_subresource(layers)
-            .extent(vk::Extent3D {
-                width: src.width(),
-                height: src.height(),
-                depth: 1,
-            });
-        // SAFETY: sizes and formats checked; the images are in the stated layouts by contract.
-        unsafe {
-            self.d().cmd_copy_image(
-                self.cmd,
-                src.raw,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                dst.raw,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &[region],
-            )
-        };
+        self.record_image_copy(src, dst, 0, src.layers());
         Ok(())
     }
 
@@ -686,22 +663,30 @@ impl<'a> Encoder<'a> {
                 dst.layers()
             )));
         }
+        self.record_image_copy(src, dst, layer, 1);
+        Ok(())
+    }
+
+    /// Records the copy of `layers` layers of `src`, from its first, into `dst` from layer `dst_layer`
+    /// (checked by the callers).
+    fn record_image_copy(&mut self, src: &Image, dst: &Image, dst_layer: u32, layers: u32) {
         let subresource = |base| {
             vk::ImageSubresourceLayers::default()
                 .aspect_mask(src.format().aspect())
                 .mip_level(0)
                 .base_array_layer(base)
-                .layer_count(1)
+                .layer_count(layers)
         };
         let region = vk::ImageCopy::default()
             .src_subresource(subresource(0))
-            .dst_subresource(subresource(layer))
+            .dst_subresource(subresource(dst_layer))
             .extent(vk::Extent3D {
                 width: src.width(),
                 height: src.height(),
                 depth: 1,
             });
-        // SAFETY: sizes, formats and the layer checked; the images are in the stated layouts by contract.
+        // SAFETY: the callers checked sizes, formats and layers; the images are in the stated layouts by
+        // contract.
         unsafe {
             self.d().cmd_copy_image(
                 self.cmd,
@@ -712,7 +697,6 @@ impl<'a> Encoder<'a> {
                 &[region],
             )
         };
-        Ok(())
     }
 
     /// Copies `src` into `dst` (whole `src`).

@@ -168,21 +168,23 @@ impl MeshBuilder {
     }
 }
 
+/// Sum of the signed volumes of the tetrahedra from the origin to every triangle (the enclosed volume
+/// of a closed, outward-wound mesh), for the crate's tests.
+#[cfg(test)]
+pub(crate) fn signed_volume(scene: &Scene) -> f32 {
+    (0..scene.triangle_count())
+        .map(|i| {
+            let [a, b, c] = scene.triangle(i);
+            a.dot(b.cross(c)) / 6.0
+        })
+        .sum()
+}
+
 #[cfg(test)]
 mod tests {
     use std::collections::HashMap;
 
     use super::*;
-
-    /// Sum of the signed volumes of the tetrahedra from the origin to every triangle.
-    fn signed_volume(scene: &Scene) -> f32 {
-        (0..scene.triangle_count())
-            .map(|i| {
-                let [a, b, c] = scene.triangle(i);
-                a.dot(b.cross(c)) / 6.0
-            })
-            .sum()
-    }
 
     /// Asserts that every directed edge occurs once and its reverse once (closed, consistently
     /// wound) and that no triangle repeats a vertex.

@@ -258,14 +258,7 @@ mod tests {
         (t[1] - t[0]).cross(t[2] - t[0])
     }
 
-    fn signed_volume(scene: &Scene) -> f32 {
-        (0..scene.triangle_count())
-            .map(|i| {
-                let [a, b, c] = scene.triangle(i);
-                a.dot(b.cross(c)) / 6.0
-            })
-            .sum()
-    }
+    use crate::mesh_builder::signed_volume;
 
     #[test]
     fn basic_queries() {

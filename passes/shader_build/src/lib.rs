@@ -1,0 +1,105 @@
+//! For build scripts: compiles every GLSL shader of a folder to SPIR-V with the glslang crate (Vulkan 1.3,
+//! SPIR-V 1.6) and writes `$OUT_DIR/shaders.rs`, a table `ALL: &[(&str, &[u8])]` of the modules by file
+//! name, for `include!`. A shader that does not compile fails the build with glslang's message.
+
+use glslang::{
+    include::{IncludeHandler, IncludeResult, IncludeType},
+    Compiler, CompilerOptions, ShaderInput, ShaderSource, ShaderStage, SourceLanguage,
+    SpirvVersion, Target, VulkanVersion,
+};
+use std::path::{Path, PathBuf};
+
+/// Include folders, searched in order.
+struct Includes(Vec<PathBuf>);
+
+impl IncludeHandler for Includes {
+    fn include(
+        &mut self,
+        _ty: IncludeType,
+        name: &str,
+        _includer: &str,
+        _depth: usize,
+    ) -> Option<IncludeResult> {
+        self.0.iter().find_map(|dir| {
+            let path = dir.join(name);
+            let data = std::fs::read_to_string(&path).ok()?;
+            println!("cargo:rerun-if-changed={}", path.display());
+            Some(IncludeResult {
+                name: path.to_string_lossy().into_owned(),
+                data,
+            })
+        })
+    }
+}
+
+fn stage_of(path: &Path) -> ShaderStage {
+    match path.extension().and_then(|e| e.to_str()) {
+        Some("vert") => ShaderStage::Vertex,
+        Some("geom") => ShaderStage::Geometry,
+        Some("frag") => ShaderStage::Fragment,
+        Some("comp") => ShaderStage::Compute,
+        Some("rgen") => ShaderStage::RayGeneration,
+        Some("rmiss") => ShaderStage::Miss,
+        other => panic!("unknown shader stage {other:?} for {}", path.display()),
+    }
+}
+
+/// Compiles every shader in `dir` (`.glsl` files are includes only), resolving includes in `dir` and then
+/// in `include_dirs`, and writes the SPIR-V modules and `shaders.rs` into `$OUT_DIR`.
+pub fn embed_shaders(dir: &Path, include_dirs: &[PathBuf]) {
+    let out = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
+    println!("cargo:rerun-if-changed={}", dir.display());
+    let compiler = Compiler::acquire().expect("glslang initialises");
+    let options = CompilerOptions {
+        source_language: SourceLanguage::GLSL,
+        target: Target::Vulkan {
+            version: VulkanVersion::Vulkan1_3,
+            spirv_version: SpirvVersion::SPIRV1_6,
+        },
+        version_profile: None,
+        messages: glslang::ShaderMessage::DEFAULT,
+    };
+    let search: Vec<PathBuf> = std::iter::once(dir.to_path_buf())
+        .chain(include_dirs.iter().cloned())
+        .collect();
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.expect("readable entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e != "glsl"))
+        .collect();
+    entries.sort();
+    let mut table = String::from(
+        "/// Every embedded shader module, by file name.\npub const ALL: &[(&str, &[u8])] = &[\n",
+    );
+    for path in entries {
+        println!("cargo:rerun-if-changed={}", path.display());
+        let name = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .expect("utf-8 shader name")
+            .to_owned();
+        let text = std::fs::read_to_string(&path).expect("readable shader");
+        let source = ShaderSource::from(text);
+        let mut includes = Includes(search.clone());
+        let input = ShaderInput::new(
+            &source,
+            stage_of(&path),
+            &options,
+            None::<&[(&str, Option<&str>)]>,
+            Some(&mut includes),
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let shader = compiler
+            .create_shader(input)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let words = shader.compile().unwrap_or_else(|e| panic!("{name}: {e}"));
+        let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+        let file = format!("{name}.spv");
+        std::fs::write(out.join(&file), bytes).expect("write SPIR-V");
+        table.push_str(&format!(
+            "    (\"{name}\", include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{file}\"))),\n"
+        ));
+    }
+    table.push_str("];\n");
+    std::fs::write(out.join("shaders.rs"), table).expect("write shader table");
+}
