@@ -18,6 +18,7 @@ pub mod ray_dump;
 pub mod render;
 pub mod renderer;
 pub mod report;
+pub mod scene_plan;
 pub mod tiers;
 pub mod tradeoff;
 
