@@ -19,6 +19,8 @@ pub mod render;
 pub mod renderer;
 pub mod report;
 pub mod scene_plan;
+pub mod scene_render;
+pub mod shading;
 pub mod tiers;
 pub mod tradeoff;
 
