@@ -4,6 +4,10 @@
 //! The demo's own G-buffer ([`gbuffer`], shaders in `host_demo/shaders/` embedded at build time) and
 //! the frame that drives it with a [`passes::ShadowPipeline`] ([`ShadowRenderer`]) live here, not in
 //! the shipped `passes` library: an engine brings its own G-buffer.
+//!
+//! A glTF scene's lights decide its shadows: [`scene_plan`] derives, without a GPU, which shadow each
+//! light gets and through which frusta; [`scene_render`] renders them through the plugin and reports per
+//! light what ran, what was kept and why; [`shading`] sums the lights into the shaded image.
 
 pub mod accuracy;
 pub mod bench;

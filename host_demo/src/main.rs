@@ -278,10 +278,10 @@ fn plan(args: &PlanArgs) -> Result<()> {
         file.scene.triangle_count(),
         args.width,
         args.height,
-        if file.camera.is_some() && args.camera_pos.is_none() && args.camera_target.is_none() {
-            "from the file"
-        } else {
-            "framed by the demo"
+        match (&file.camera, args.camera_pos.or(args.camera_target)) {
+            (_, Some(_)) => "from the command line",
+            (Some(_), None) => "from the file",
+            (None, None) => "framed by the demo",
         }
     );
     print!("{}", plan.describe());

@@ -1,5 +1,6 @@
 //! The demo's frames through the plugin's C ABI, the way an engine integrates it. The demo owns the
-//! device, the scene's vertex and index buffers, a G-buffer and the visibility image; the plugin adopts
+//! device, the scene's vertex and index buffers, a G-buffer and the visibility image (a layer per
+//! light: the plugin shades any number of lights, each with its own configuration); the plugin adopts
 //! the device (`hrts_context_create`), reads the scene from the demo's buffers
 //! (`hrts_set_geometry_vulkan`) and records into the demo's command buffer (`hrts_record_passes`): the
 //! light-space passes before the G-buffer, the screen-space passes and the output copy after it. Debug

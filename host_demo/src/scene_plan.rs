@@ -532,13 +532,24 @@ fn closest_point(p: DVec3, t: &[DVec3; 3]) -> DVec3 {
     }
     let denominator = va + vb + vc;
     if denominator == 0.0 || !denominator.is_finite() {
-        // A degenerate triangle: the nearest of its vertices and edge points found above.
-        return [a, b, c]
+        // A degenerate triangle: the nearest point of its edges.
+        return [(a, b), (b, c), (c, a)]
             .into_iter()
+            .map(|(from, to)| closest_on_segment(p, from, to))
             .min_by(|x, y| x.distance_squared(p).total_cmp(&y.distance_squared(p)))
             .unwrap_or(a);
     }
     a + ab * (vb / denominator) + ac * (vc / denominator)
+}
+
+/// The point of the segment from `a` to `b` closest to `p`.
+fn closest_on_segment(p: DVec3, a: DVec3, b: DVec3) -> DVec3 {
+    let ab = b - a;
+    let length2 = ab.length_squared();
+    if length2 == 0.0 {
+        return a;
+    }
+    a + ab * ((p - a).dot(ab) / length2).clamp(0.0, 1.0)
 }
 
 /// A square pyramid from `apex` along `forward`, `tan_half` wide along `right` and `up`.
@@ -1118,6 +1129,50 @@ mod tests {
         assert!(text.contains("fill: point"), "{text}");
         assert!(text.contains("no pass (casts no shadows)"), "{text}");
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn closest_points_on_triangles() {
+        let t = [DVec3::ZERO, DVec3::X * 2.0, DVec3::Y * 2.0];
+        let cases = [
+            (DVec3::new(0.5, 0.5, 3.0), DVec3::new(0.5, 0.5, 0.0)),
+            (DVec3::new(-1.0, -1.0, 0.0), DVec3::ZERO),
+            (DVec3::new(3.0, -1.0, 1.0), DVec3::X * 2.0),
+            (DVec3::new(1.0, -2.0, 0.0), DVec3::X),
+            (DVec3::new(-2.0, 1.0, 0.0), DVec3::Y),
+            (DVec3::new(2.0, 2.0, 0.0), DVec3::new(1.0, 1.0, 0.0)),
+        ];
+        for (p, expected) in cases {
+            let c = closest_point(p, &t);
+            assert!(c.abs_diff_eq(expected, 1e-12), "{p}: {c}");
+        }
+        // Against a dense sampling of the triangle.
+        let mut rng = scene::SplitMix64::new(3);
+        for _ in 0..200 {
+            let p = DVec3::new(
+                rng.uniform_f64(-3.0, 3.0),
+                rng.uniform_f64(-3.0, 3.0),
+                rng.uniform_f64(-3.0, 3.0),
+            );
+            let d = closest_point(p, &t).distance(p);
+            let mut sampled = f64::INFINITY;
+            for i in 0..=100 {
+                for j in 0..=(100 - i) {
+                    let q = t[1] * (f64::from(i) / 100.0) + t[2] * (f64::from(j) / 100.0);
+                    sampled = sampled.min(q.distance(p));
+                }
+            }
+            assert!(
+                d <= sampled + 1e-12 && sampled - d < 0.03,
+                "{p}: {d} vs {sampled}"
+            );
+        }
+        // Degenerate triangles: a point, and a segment seen from beside its middle.
+        let point = [DVec3::ZERO, DVec3::ZERO, DVec3::ZERO];
+        assert_eq!(closest_point(DVec3::ONE, &point), DVec3::ZERO);
+        let segment = [DVec3::ZERO, DVec3::X * 4.0, DVec3::X * 2.0];
+        let c = closest_point(DVec3::new(1.0, 1.0, 0.0), &segment);
+        assert!(c.abs_diff_eq(DVec3::X, 1e-12), "{c}");
     }
 
     #[test]
