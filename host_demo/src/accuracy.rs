@@ -1,14 +1,14 @@
 //! Accuracy of a rendered frame against the exact CPU reference, as counts: primitive-map texel lists
 //! against exact conservative binning, and ray-traced visibility against exact visibility.
 
-use crate::FrameImages;
-use crate::View;
+use crate::{CameraMatrices, FrameImages, View};
 use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
 use passes::{PrimitiveMapConfig, GUARD_WORDS};
 use reference::{
     conservative_texel_sets, overlaps_texel_with_margin, reference_visibility, FaceSelection,
-    Light, PixelClass, RefScene, VisibilityParams,
+    Light, PixelClass, RefScene, VisibilityParams, VisibilityReference,
 };
+use scene::{Camera, Scene};
 
 /// Margin (texels) within which an extra primitive-map entry is legitimate: every binning path accepts
 /// texels grown by 1/512 texel plus the f32 projection error bound, and bins a sliver thinner than 1/16
@@ -142,15 +142,25 @@ pub struct VisibilityComparison {
 /// GPU's ray-origin offset, and above the receiver displacement of 1/512-pixel vertex snapping down to
 /// view angles of a few degrees.
 pub fn tolerance_per_distance(view: &View) -> f64 {
-    2.0 * (view.camera.fov_y_radians as f64 / 2.0).tan() / view.height as f64 / 16.0
+    camera_tolerance_per_distance(&view.camera, view.height)
+}
+
+/// [`tolerance_per_distance`] of `camera` for a frame `height` pixels high.
+fn camera_tolerance_per_distance(camera: &Camera, height: u32) -> f64 {
+    2.0 * (camera.fov_y_radians as f64 / 2.0).tan() / height as f64 / 16.0
 }
 
 /// Absolute floor of the reference tolerance: 64 f32 ulps of the largest frame coordinate. The passes work
 /// relative to the centre of the scene (the frame origin) and to the camera, so what matters is the scene's
 /// radius and the camera's distance from its centre, not where the scene sits in the world.
 pub fn absolute_tolerance(view: &View) -> f64 {
-    let b = view.scene.bounds();
-    let from_center = (view.camera.position - b.center()).length();
+    scene_absolute_tolerance(&view.scene, &view.camera)
+}
+
+/// [`absolute_tolerance`] of `scene` seen from `camera`.
+fn scene_absolute_tolerance(scene: &Scene, camera: &Camera) -> f64 {
+    let b = scene.bounds();
+    let from_center = (camera.position - b.center()).length();
     let magnitude = f64::from(b.radius().max(from_center));
     64.0 * f64::from(f32::EPSILON) * magnitude
 }
@@ -158,18 +168,31 @@ pub fn absolute_tolerance(view: &View) -> f64 {
 /// The exact reference's view of `view`: the camera matrices composed in f64 as the passes do (relative to
 /// the camera, the rays starting at the view matrix's own eye), the light, and the tolerances.
 pub fn visibility_params(view: &View) -> VisibilityParams {
-    let inputs = view.frame_inputs();
-    let view_matrix = inputs.view.as_dmat4();
+    let light = Light::Directional {
+        direction: view.light.direction.as_dvec3(),
+    };
+    scene_visibility_params(&view.scene, &view.camera, view.width, view.height, light)
+}
+
+/// The exact reference's view of `scene` through `camera` in a `width` x `height` frame lit by `light`
+/// (see [`visibility_params`]).
+pub fn scene_visibility_params(
+    scene: &Scene,
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    light: Light,
+) -> VisibilityParams {
+    let matrices = CameraMatrices::of_camera(camera, width, height);
+    let view_matrix = matrices.view.as_dmat4();
     VisibilityParams {
-        width: view.width,
-        height: view.height,
-        view_proj: inputs.proj.as_dmat4() * view_matrix,
+        width,
+        height,
+        view_proj: matrices.proj.as_dmat4() * view_matrix,
         camera_position: view_matrix.inverse().transform_point3(DVec3::ZERO),
-        light: Light::Directional {
-            direction: inputs.light.direction().as_dvec3(),
-        },
-        tolerance: absolute_tolerance(view),
-        tolerance_per_distance: tolerance_per_distance(view),
+        light,
+        tolerance: scene_absolute_tolerance(scene, camera),
+        tolerance_per_distance: camera_tolerance_per_distance(camera, height),
         pixel_tolerance: 1.0 / 128.0,
     }
 }
@@ -181,19 +204,38 @@ pub fn compare_visibility(
     images: &FrameImages,
 ) -> VisibilityComparison {
     let params = visibility_params(view);
-    let (tolerance, per_distance) = (params.tolerance, params.tolerance_per_distance);
     let r = reference_visibility(rs, &params);
+    let far = (view.camera.position - view.scene.bounds().center()).length() as f64
+        + view.scene.bounds().radius() as f64;
+    let bd_bound = 4.0 * (params.tolerance + far * params.tolerance_per_distance);
+    compare_with_reference(
+        &r,
+        &images.visibility,
+        Some((&images.blocker_distance, bd_bound)),
+        None,
+    )
+}
+
+/// Compares GPU visibility (row-major, like the reference) with the exact reference `r`: every pixel,
+/// or those `considered` holds true for. With `blocker`, the GPU blocker distances and their error bound
+/// are compared too, on shadowed pixels with a certain nearest blocker.
+pub fn compare_with_reference(
+    r: &VisibilityReference,
+    visibility: &[f32],
+    blocker: Option<(&[f32], f64)>,
+    considered: Option<&[bool]>,
+) -> VisibilityComparison {
     let mut c = VisibilityComparison {
         near_edge_mask: vec![false; r.class.len()],
         ..VisibilityComparison::default()
     };
-    let far = (view.camera.position - view.scene.bounds().center()).length() as f64
-        + view.scene.bounds().radius() as f64;
-    let bd_bound = 4.0 * (tolerance + far * per_distance);
     for (i, class) in r.class.iter().enumerate() {
-        let (x, y) = (i as u32 % view.width, i as u32 / view.width);
-        let vis = images.visibility[i];
-        let bd = images.blocker_distance[i];
+        if considered.is_some_and(|m| !m[i]) {
+            continue;
+        }
+        let (x, y) = (i as u32 % r.width, i as u32 / r.width);
+        let vis = visibility[i];
+        let bd = blocker.map_or(0.0, |(b, _)| b[i]);
         c.pixels += 1;
         if !vis.is_finite() || !bd.is_finite() {
             c.non_finite += 1;
@@ -222,6 +264,9 @@ pub fn compare_visibility(
             }
             continue;
         }
+        let Some((_, bd_bound)) = blocker else {
+            continue;
+        };
         let ref_bd = r.blocker_distance[i];
         if *class == PixelClass::Shadowed && ref_bd.is_finite() && ref_bd > 0.0 {
             let err = (f64::from(bd) - ref_bd).abs();

@@ -3,9 +3,9 @@
 //! Reads: the pipeline's prim buffer. Writes: position, normal, depth. Shaders: `gbuffer.vert` and
 //! `gbuffer.frag` in `host_demo/shaders/`.
 
-use crate::shader;
+use crate::{shader, CameraMatrices};
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec4};
+use glam::{DMat4, DVec3, Mat4, Vec4};
 use passes::PassError;
 use rhi::{
     BindGroup, BindingKind, Buffer, ColorTarget, DepthState, DepthTarget, Device, Encoder, Format,
@@ -23,6 +23,27 @@ pub struct GBufferPush {
 }
 
 const _: () = assert!(std::mem::size_of::<GBufferPush>() == 80);
+
+impl GBufferPush {
+    /// The constants of `camera` for a prim buffer relative to `origin`: the view-projection of
+    /// coordinates relative to the camera, composed in f64 as the plugin composes its own
+    /// (`passes::camera_in_frame`), so that the G-buffer and the plugin agree on every pixel's ray.
+    pub fn for_camera(camera: &CameraMatrices, origin: DVec3) -> Result<Self, PassError> {
+        let relative_view =
+            camera.view.as_dmat4() * DMat4::from_translation(camera.position.as_dvec3());
+        let view_proj_rel = (camera.proj.as_dmat4() * relative_view).as_mat4();
+        let camera_frame = (camera.position.as_dvec3() - origin).as_vec3();
+        if !view_proj_rel.is_finite() || !camera_frame.is_finite() {
+            return Err(PassError::InvalidConfig(
+                "camera matrices are not finite".into(),
+            ));
+        }
+        Ok(Self {
+            view_proj_rel,
+            camera_pos: camera_frame.extend(1.0),
+        })
+    }
+}
 
 /// The G-buffer's images.
 pub struct GBufferTargets {

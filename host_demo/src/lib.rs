@@ -4,6 +4,10 @@
 //! The demo's own G-buffer ([`gbuffer`], shaders in `host_demo/shaders/` embedded at build time) and
 //! the frame that drives it with a [`passes::ShadowPipeline`] ([`ShadowRenderer`]) live here, not in
 //! the shipped `passes` library: an engine brings its own G-buffer.
+//!
+//! A glTF scene's lights decide its shadows: [`scene_plan`] derives, without a GPU, which shadow each
+//! light gets and through which frusta; [`scene_render`] renders them through the plugin and reports per
+//! light what ran, what was kept and why; [`shading`] sums the lights into the shaded image.
 
 pub mod accuracy;
 pub mod bench;
@@ -18,6 +22,9 @@ pub mod ray_dump;
 pub mod render;
 pub mod renderer;
 pub mod report;
+pub mod scene_plan;
+pub mod scene_render;
+pub mod shading;
 pub mod tiers;
 pub mod tradeoff;
 
@@ -82,37 +89,72 @@ impl View {
         }
     }
 
-    /// Uploads the scene: one draw per object, identity transforms, frame origin at the centre of its bounds.
+    /// Uploads the scene ([`upload_scene`]).
     pub fn upload(&self, device: &Device) -> Result<Geometry, PassError> {
-        let positions: Vec<f32> = self
-            .scene
-            .positions
-            .iter()
-            .flat_map(|p| p.to_array())
-            .collect();
-        let draws: Vec<Draw> = self
-            .scene
-            .objects
-            .iter()
-            .map(|o| Draw {
-                first_index: o.first_triangle * 3,
-                index_count: o.triangle_count * 3,
-                model: Mat4::IDENTITY,
-            })
-            .collect();
-        Geometry::upload(
-            device,
-            &positions,
-            &self.scene.indices,
-            &draws,
-            self.frame_origin(),
-        )
+        upload_scene(device, &self.scene)
     }
 
-    /// The frame origin: the centre of the scene's bounds in f32, as the plugin derives it from the bounds
-    /// an engine passes (`HrtsVulkanGeometry::bounds`).
+    /// The frame origin of the scene ([`frame_origin`]).
     pub fn frame_origin(&self) -> DVec3 {
-        self.scene.bounds().center().as_dvec3()
+        frame_origin(&self.scene)
+    }
+}
+
+/// Uploads `scene`: one draw per object, identity transforms, frame origin at the centre of its bounds.
+pub fn upload_scene(device: &Device, scene: &Scene) -> Result<Geometry, PassError> {
+    let positions: Vec<f32> = scene.positions.iter().flat_map(|p| p.to_array()).collect();
+    let draws: Vec<Draw> = scene
+        .objects
+        .iter()
+        .map(|o| Draw {
+            first_index: o.first_triangle * 3,
+            index_count: o.triangle_count * 3,
+            model: Mat4::IDENTITY,
+        })
+        .collect();
+    Geometry::upload(
+        device,
+        &positions,
+        &scene.indices,
+        &draws,
+        frame_origin(scene),
+    )
+}
+
+/// The frame origin of `scene`: the centre of its bounds in f32, as the plugin derives it from the bounds
+/// an engine passes (`HrtsVulkanGeometry::bounds`).
+pub fn frame_origin(scene: &Scene) -> DVec3 {
+    scene.bounds().center().as_dvec3()
+}
+
+/// The camera of a frame as the engine hands it to the plugin and draws its G-buffer with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CameraMatrices {
+    /// World to view.
+    pub view: Mat4,
+    /// View to clip: reversed Z, Vulkan conventions.
+    pub proj: Mat4,
+    /// Camera position in world space.
+    pub position: Vec3,
+}
+
+impl CameraMatrices {
+    /// The matrices of `camera` for a `width` x `height` frame.
+    pub fn of_camera(camera: &Camera, width: u32, height: u32) -> Self {
+        Self {
+            view: camera.view(),
+            proj: camera.proj(width as f32 / height.max(1) as f32),
+            position: camera.position,
+        }
+    }
+
+    /// The camera of `inputs`.
+    pub fn of_frame(inputs: &FrameInputs) -> Self {
+        Self {
+            view: inputs.view,
+            proj: inputs.proj,
+            position: inputs.camera_position,
+        }
     }
 }
 

@@ -3,12 +3,17 @@
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 use glam::Vec3;
-use host_demo::render::{parse_binning, parse_faces, render_to_folder, RenderOptions};
+use host_demo::render::{
+    parse_binning, parse_faces, render_to_folder, world_space_scale_of, RenderOptions,
+    SoftShadowArgs,
+};
+use host_demo::scene_plan::{held_still, plan_scene, scene_camera, PlanSettings};
+use host_demo::scene_render::render_scene_to_folder;
 use host_demo::{parse_vec3, View};
 use passes::{BinningRequest, FaceMode, PrimitiveMapConfig};
 use rhi::Device;
-use scene::{Camera, DirectionalLight};
-use std::path::PathBuf;
+use scene::{Aabb, Camera, DirectionalLight, SceneFile};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -30,7 +35,19 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render one view: G-buffer, primitive map, ray-traced shadows; writes EXR/PNG/JSON and prints GPU timings.
+    /// With --scene, every light of a glTF scene as the scene's plan says (see `plan`).
     Render(RenderArgs),
+    /// Print the plan of a glTF scene without rendering (no GPU): per light the shadow it gets (none, hard or
+    /// hybrid) and why, its shadow frusta, configuration, passes and resources.
+    Plan(PlanArgs),
+    /// Write the example glTF scene (ground, boxes, a moving cart; a sized sun, a zero-size rim light, a
+    /// sized spot light, a moving point lamp and a fill light that casts no shadows): binary glTF if FILE
+    /// ends in .glb, else glTF JSON with the buffer embedded.
+    ExampleScene {
+        /// Where to write the scene.
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Run the hard numerical cases against the exact reference and print a table; fails if any case fails.
     Hardcases(host_demo::hardcases::HardcasesArgs),
     /// The talk's side-by-sides on one view (shadow map 3K/8K, ray traced x64/x32, PCSS, hybrid standard and
@@ -62,6 +79,11 @@ enum Command {
 
 #[derive(clap::Args)]
 struct RenderArgs {
+    /// glTF 2.0 scene (.gltf or .glb) whose lights (KHR_lights_punctual) decide the shadows: renders every
+    /// light, writes the shaded image, each light's visibility (PNG and EXR) and scene_report.json, and
+    /// prints the plan and each frame's per-light report.
+    #[arg(long, conflicts_with_all = ["obj", "no_ground", "light_dir", "dump_rays", "mode", "angular_radius"])]
+    scene: Option<PathBuf>,
     /// OBJ file to load (default: the built-in procedural scene).
     #[arg(long)]
     obj: Option<PathBuf>,
@@ -100,7 +122,8 @@ struct RenderArgs {
     /// sw (geometry-shader conservative raster).
     #[arg(long, default_value = "auto", value_parser = parse_binning)]
     binning: BinningRequest,
-    /// Frames to render (timings are medians over all but the first).
+    /// Frames to render (timings are medians over all but the first; at least 2 with --scene, so that the
+    /// second frame's report shows what was kept).
     #[arg(long, default_value_t = 5)]
     frames: u32,
     /// Also write the frame's shadow rays and triangles (rays.f32, triangles.f32, rays.json) for
@@ -111,11 +134,196 @@ struct RenderArgs {
     /// runs it (the map's statistics are gathered anyway).
     #[arg(long)]
     no_occupancy: bool,
+    /// With --scene: hold the scene still. The demo does not animate scenes; with --still every object and
+    /// light counts as static, so the second frame reuses the prim buffer and every shadow map. Without it,
+    /// what the scene marks as moving is re-rendered every frame.
+    #[arg(long, requires = "scene")]
+    still: bool,
     #[command(flatten)]
-    soft: host_demo::render::SoftShadowArgs,
+    soft: SoftShadowArgs,
+}
+
+#[derive(clap::Args)]
+struct PlanArgs {
+    /// glTF 2.0 scene (.gltf or .glb).
+    #[arg(long)]
+    scene: PathBuf,
+    /// Frame width in pixels (with the height, the aspect of the camera's view).
+    #[arg(long, default_value_t = 1280)]
+    width: u32,
+    /// Frame height in pixels.
+    #[arg(long, default_value_t = 720)]
+    height: u32,
+    /// Camera position "x,y,z" (default: the scene's camera, else framed automatically).
+    #[arg(long, value_parser = parse_vec3)]
+    camera_pos: Option<Vec3>,
+    /// Camera target "x,y,z" (default: the scene's camera's, else the scene centre).
+    #[arg(long, value_parser = parse_vec3)]
+    camera_target: Option<Vec3>,
+    /// Primitive map size N.
+    #[arg(long, default_value_t = 1024)]
+    map_size: u32,
+    /// Shadow map size (square) of the sized lights.
+    #[arg(long, default_value_t = 3072)]
+    shadow_map_size: u32,
+    /// Turn off FXAA over the ray-traced shadows.
+    #[arg(long)]
+    no_antialiasing: bool,
+    /// Hold the scene still: every object and light counts as static (see `render --still`).
+    #[arg(long)]
+    still: bool,
+}
+
+/// Loads a glTF scene for `--scene`, held still with `still`; an OBJ file is pointed to `--obj`.
+fn load_scene(path: &Path, still: bool) -> Result<SceneFile> {
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"))
+    {
+        bail!(
+            "{}: --scene takes a glTF 2.0 scene (.gltf or .glb); load an OBJ model with --obj",
+            path.display()
+        );
+    }
+    let file = scene::load_gltf(path)?;
+    if still {
+        println!("--still: every object and light of the scene counts as static");
+        return Ok(held_still(&file));
+    }
+    Ok(file)
+}
+
+/// `camera` moved to `position` and looking at `target` where given (the target defaults to the centre
+/// of `bounds` when only the position is given).
+fn camera_with(
+    camera: Camera,
+    bounds: &Aabb,
+    position: Option<Vec3>,
+    target: Option<Vec3>,
+) -> Result<Camera> {
+    if position.is_none() && target.is_none() {
+        return Ok(camera);
+    }
+    let position = position.unwrap_or(camera.position);
+    let target = target.unwrap_or(bounds.center());
+    if (position - target).length() == 0.0 {
+        bail!("camera position and target coincide");
+    }
+    let forward = (target - position).normalize();
+    let up = if forward.cross(Vec3::Y).length() < 1e-3 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    };
+    Ok(Camera {
+        position,
+        target,
+        up,
+        ..camera
+    })
+}
+
+/// The camera and plan settings of a scene for a `width` x `height` frame.
+fn scene_setup(
+    file: &SceneFile,
+    (width, height): (u32, u32),
+    (position, target): (Option<Vec3>, Option<Vec3>),
+    map: PrimitiveMapConfig,
+    soft: &SoftShadowArgs,
+) -> Result<(Camera, PlanSettings)> {
+    if width == 0 || height == 0 {
+        bail!("--width and --height must be positive");
+    }
+    let aspect = width as f32 / height as f32;
+    let camera = camera_with(
+        scene_camera(file, aspect),
+        &file.scene.bounds(),
+        position,
+        target,
+    )?;
+    let base = soft.shadow_config(map, world_space_scale_of(&file.scene));
+    Ok((
+        camera,
+        PlanSettings {
+            base,
+            width,
+            height,
+        },
+    ))
+}
+
+fn plan(args: &PlanArgs) -> Result<()> {
+    let file = load_scene(&args.scene, args.still)?;
+    let soft = SoftShadowArgs {
+        shadow_map_size: args.shadow_map_size,
+        no_antialiasing: args.no_antialiasing,
+        ..SoftShadowArgs::default()
+    };
+    let map = PrimitiveMapConfig {
+        size: args.map_size,
+        ..PrimitiveMapConfig::default()
+    };
+    let (camera, settings) = scene_setup(
+        &file,
+        (args.width, args.height),
+        (args.camera_pos, args.camera_target),
+        map,
+        &soft,
+    )?;
+    let plan = plan_scene(&file, &camera, &settings)
+        .with_context(|| format!("planning {}", args.scene.display()))?;
+    println!(
+        "scene {}: {} triangles, {}x{} px, camera {}",
+        args.scene.display(),
+        file.scene.triangle_count(),
+        args.width,
+        args.height,
+        match (&file.camera, args.camera_pos.or(args.camera_target)) {
+            (_, Some(_)) => "from the command line",
+            (Some(_), None) => "from the file",
+            (None, None) => "framed by the demo",
+        }
+    );
+    print!("{}", plan.describe());
+    Ok(())
+}
+
+fn render_scene(cli: &Cli, args: &RenderArgs, path: &Path) -> Result<()> {
+    if args.frames < 2 {
+        bail!("--frames must be at least 2 with --scene: the second frame's report shows what was kept");
+    }
+    let file = load_scene(path, args.still)?;
+    let map = PrimitiveMapConfig {
+        size: args.map_size,
+        faces: args.faces,
+        binning: args.binning,
+        entry_budget: u64::from(args.map_budget_mb) << 20,
+        ..PrimitiveMapConfig::default()
+    };
+    let (camera, settings) = scene_setup(
+        &file,
+        (args.width, args.height),
+        (args.camera_pos, args.camera_target),
+        map,
+        &args.soft,
+    )?;
+    let device = device(cli)?;
+    render_scene_to_folder(
+        &device,
+        &file,
+        path,
+        &camera,
+        &settings,
+        args.frames,
+        &args.out,
+    )?;
+    host_demo::check_validation(&device)
 }
 
 fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
+    if let Some(path) = &args.scene {
+        return render_scene(cli, args, path);
+    }
     if args.width == 0 || args.height == 0 {
         bail!("--width and --height must be positive");
     }
@@ -135,26 +343,12 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
         view.light =
             DirectionalLight::new(d).context("--light-dir must be a non-zero finite vector")?;
     }
-    if args.camera_pos.is_some() || args.camera_target.is_some() {
-        let bounds = view.scene.bounds();
-        let position = args.camera_pos.unwrap_or(view.camera.position);
-        let target = args.camera_target.unwrap_or(bounds.center());
-        if (position - target).length() == 0.0 {
-            bail!("camera position and target coincide");
-        }
-        let forward = (target - position).normalize();
-        let up = if forward.cross(Vec3::Y).length() < 1e-3 {
-            Vec3::Z
-        } else {
-            Vec3::Y
-        };
-        view.camera = Camera {
-            position,
-            target,
-            up,
-            ..view.camera
-        };
-    }
+    view.camera = camera_with(
+        view.camera,
+        &view.scene.bounds(),
+        args.camera_pos,
+        args.camera_target,
+    )?;
     let device = device(cli)?;
     let options = RenderOptions {
         map: PrimitiveMapConfig {
@@ -186,6 +380,10 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Render(args) => render(&cli, args),
+        Command::Plan(args) => plan(args),
+        Command::ExampleScene { out } => scene::gltf_scene::write_example_scene(out)
+            .map_err(anyhow::Error::from)
+            .map(|()| println!("example scene written to {}", out.display())),
         Command::Hardcases(args) => {
             host_demo::hardcases::run_cli(cli.device.clone(), cli.validation, args)
         }

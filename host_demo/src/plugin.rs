@@ -1,5 +1,6 @@
 //! The demo's frames through the plugin's C ABI, the way an engine integrates it. The demo owns the
-//! device, the scene's vertex and index buffers, a G-buffer and the visibility image; the plugin adopts
+//! device, the scene's vertex and index buffers, a G-buffer and the visibility image (a layer per
+//! light: the plugin shades any number of lights, each with its own configuration); the plugin adopts
 //! the device (`hrts_context_create`), reads the scene from the demo's buffers
 //! (`hrts_set_geometry_vulkan`) and records into the demo's command buffer (`hrts_record_passes`): the
 //! light-space passes before the G-buffer, the screen-space passes and the output copy after it. Debug
@@ -7,20 +8,21 @@
 //! So what the demo shows is what an integrator gets.
 
 use crate::gbuffer::{GBufferPass, GBufferPush, GBufferTargets};
-use crate::{read_images, FrameImages, FrameOutput, View};
+use crate::{read_images, upload_scene, CameraMatrices, FrameImages, FrameOutput, View};
 use anyhow::{bail, Context as _, Result};
 use glam::Mat4;
 use hrts_plugin::*;
 use passes::prim_buffer::PrimBufferPass;
 use passes::MapStats;
 use passes::{
-    camera_in_frame, BinningPath, FrameInputs, FrameReport, Geometry, Light, PassId, PassStatus,
-    ResourceId, ResourceReport, ShadowConfig, SkipReason,
+    BinningPath, FrameInputs, FrameReport, Geometry, Light, PassId, PassStatus, ResourceId,
+    ResourceReport, ShadowConfig, SkipReason,
 };
 use rhi::{
     Barrier, Buffer, BufferUsage, ConservativeRasterTier, Device, Format, GpuTimer, Image,
     ImageDesc, ImageUsage, MemoryLocation, PassTiming, ResourceState as S,
 };
+use scene::{Aabb, Scene};
 use std::ffi::{c_char, CStr, CString};
 
 /// "libhrts API major.minor.patch", as the loaded library reports it.
@@ -65,77 +67,153 @@ impl Drop for Context {
     }
 }
 
-/// The demo frame driven through the C ABI.
+/// What one plugin light's passes did in a frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LightFrameReport {
+    /// The plugin's report of the light, as the Rust [`FrameReport`].
+    pub report: FrameReport,
+    /// How many times the plugin built the light's passes since the context was created
+    /// (`HrtsFrameReport::light_builds`).
+    pub light_builds: u32,
+}
+
+/// What a frame of several lights did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LightsFrame {
+    /// The frame's index (`HrtsFrame::frame_index`).
+    pub frame_index: u64,
+    /// One report per plugin light, in configuration order (none when no light was given to the plugin).
+    pub lights: Vec<LightFrameReport>,
+    /// The demo's own GPU times (the G-buffer) and, when the plugin recorded passes, [`SCREEN_SPACE_WALL`].
+    pub host_timings: Vec<PassTiming>,
+}
+
+/// The demo frame driven through the C ABI, for any number of lights: the plugin gets the lights it is
+/// configured with (none: it records nothing, and the demo draws its G-buffer alone), and writes light
+/// `i`'s visibility to layer `i` of the demo's visibility image.
 pub struct PluginRenderer {
     context: Context,
     geometry: Geometry,
     prim_buffer: PrimBufferPass,
     gbuffer: GBufferPass,
     targets: GBufferTargets,
-    output: Image,
+    /// The visibility image, one layer per light (none before lights are configured).
+    output: Option<Image>,
+    /// Visibility images replaced by one with more layers: the plugin retired the passes writing them
+    /// once the frames recorded so far complete, so they are kept as long as the renderer.
+    replaced_outputs: Vec<Image>,
+    /// The configurations the plugin holds, one per light.
+    configured: Vec<ShadowConfig>,
     timer: GpuTimer,
     dynamic_geometry: bool,
     frames: u64,
+    frames_with_plugin_passes: u64,
     native_tier: ConservativeRasterTier,
 }
 
 impl PluginRenderer {
     /// Uploads `view`'s scene into the demo's buffers, creates the G-buffer and the visibility image for
-    /// its size, and a plugin context on `device` configured with `config`.
+    /// its size, and a plugin context on `device` configured with `config` (one light).
     pub fn new(device: &Device, view: &View, config: impl Into<ShadowConfig>) -> Result<Self> {
         let config = config.into();
-        let (width, height) = (view.width, view.height);
+        let mut renderer = Self::for_scene(
+            device,
+            &view.scene,
+            view.width,
+            view.height,
+            !config.static_geometry,
+        )?;
+        renderer.configure_lights(device, &[config])?;
+        Ok(renderer)
+    }
+
+    /// Uploads `scene` into the demo's buffers, creates the G-buffer for a `width` x `height` frame and a
+    /// plugin context on `device` that has the geometry but no light yet ([`PluginRenderer::configure_lights`]).
+    /// `dynamic_geometry`: the demo rebuilds its own prim buffer every frame, as the plugin does when a
+    /// light's configuration says so.
+    pub fn for_scene(
+        device: &Device,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        dynamic_geometry: bool,
+    ) -> Result<Self> {
         if width == 0 || height == 0 {
             bail!("frame size must be non-zero");
         }
-        let geometry = view.upload(device).context("uploading the scene")?;
+        let geometry = upload_scene(device, scene).context("uploading the scene")?;
         let prim_buffer = PrimBufferPass::new(device, &geometry)?;
         let gbuffer = GBufferPass::new(device, prim_buffer.prims())?;
         let targets = GBufferTargets::new(device, width, height)?;
-        let output = device.create_image(&ImageDesc {
-            name: "visibility",
-            format: Format::R32Float,
-            width,
-            height,
-            layers: 1,
-            usage: ImageUsage::COPY_DST | ImageUsage::COPY_SRC | ImageUsage::SAMPLED,
-        })?;
         let context = create_context(device)?;
-        let hrts_config = config_to_c(&config).map_err(anyhow::Error::msg)?;
-        // SAFETY: live context, valid struct.
-        context.check("hrts_configure", unsafe {
-            hrts_configure(context.0, &hrts_config)
-        })?;
-        set_geometry(&context, &geometry, view)?;
-        let t = &targets;
-        let c_targets = HrtsTargets {
-            struct_size: size_of::<HrtsTargets>() as u32,
-            width,
-            height,
-            depth_image: t.depth.raw_handle(),
-            depth_usage: t.depth.raw_usage(),
-            normal_image: t.normal.raw_handle(),
-            normal_usage: t.normal.raw_usage(),
-            output_image: output.raw_handle(),
-            output_usage: output.raw_usage(),
-            output_layers: 1,
-        };
-        // SAFETY: live context; the images live as long as the renderer, which destroys the context first.
-        context.check("hrts_set_targets", unsafe {
-            hrts_set_targets(context.0, &c_targets)
-        })?;
+        set_geometry(&context, &geometry, &scene.bounds())?;
         Ok(Self {
             context,
             geometry,
             prim_buffer,
             gbuffer,
             targets,
-            output,
+            output: None,
+            replaced_outputs: Vec::new(),
+            configured: Vec::new(),
             timer: device.create_timer(4)?,
-            dynamic_geometry: !config.static_geometry,
+            dynamic_geometry,
             frames: 0,
+            frames_with_plugin_passes: 0,
             native_tier: device.capabilities().conservative_raster_tier,
         })
+    }
+
+    /// Gives the plugin one configuration per light (`hrts_configure_lights`; none: later frames give the
+    /// plugin nothing). The plugin keeps the passes of every light whose configuration is unchanged, unless
+    /// the number of lights changes. A visibility image with too few layers is replaced
+    /// (`hrts_set_targets`, which rebuilds every light).
+    pub fn configure_lights(&mut self, device: &Device, configs: &[ShadowConfig]) -> Result<()> {
+        if configs.is_empty() || configs == self.configured.as_slice() {
+            self.configured = configs.to_vec();
+            return Ok(());
+        }
+        let layers = configs.len() as u32;
+        if self.output.as_ref().is_none_or(|o| o.layers() < layers) {
+            let output = device.create_image(&ImageDesc {
+                name: "visibility",
+                format: Format::R32Float,
+                width: self.targets.depth.width(),
+                height: self.targets.depth.height(),
+                layers,
+                usage: ImageUsage::COPY_DST | ImageUsage::COPY_SRC | ImageUsage::SAMPLED,
+            })?;
+            let t = &self.targets;
+            let c_targets = HrtsTargets {
+                struct_size: size_of::<HrtsTargets>() as u32,
+                width: t.depth.width(),
+                height: t.depth.height(),
+                depth_image: t.depth.raw_handle(),
+                depth_usage: t.depth.raw_usage(),
+                normal_image: t.normal.raw_handle(),
+                normal_usage: t.normal.raw_usage(),
+                output_image: output.raw_handle(),
+                output_usage: output.raw_usage(),
+                output_layers: layers,
+            };
+            // SAFETY: live context; the images live as long as the renderer, which destroys the context
+            // first.
+            self.context.check("hrts_set_targets", unsafe {
+                hrts_set_targets(self.context.0, &c_targets)
+            })?;
+            self.replaced_outputs.extend(self.output.replace(output));
+        }
+        let c_configs = configs
+            .iter()
+            .map(config_to_c)
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(anyhow::Error::msg)?;
+        // SAFETY: live context; `c_configs` holds `layers` valid configurations.
+        self.context.check("hrts_configure_lights", unsafe {
+            hrts_configure_lights(self.context.0, layers, c_configs.as_ptr())
+        })?;
+        self.configured = configs.to_vec();
+        Ok(())
     }
 
     /// The demo's prim buffer (`GpuTriangle`s relative to the frame origin), filled by the first frame.
@@ -153,21 +231,49 @@ impl PluginRenderer {
         &self.geometry
     }
 
+    /// Frames rendered in which the plugin recorded passes (a frame without lights records none).
+    pub fn frames_with_plugin_passes(&self) -> u64 {
+        self.frames_with_plugin_passes
+    }
+
+    /// Renders one frame of one light ([`PluginRenderer::render_lights`]) and returns the plugin's report
+    /// plus the G-buffer's GPU time and [`SCREEN_SPACE_WALL`].
+    pub fn render(&mut self, device: &Device, inputs: &FrameInputs) -> Result<FrameReport> {
+        let frame =
+            self.render_lights(device, &CameraMatrices::of_frame(inputs), &[inputs.light])?;
+        let Some(light) = frame.lights.into_iter().next() else {
+            bail!("the frame reported no light");
+        };
+        let mut report = light.report;
+        report.timings.extend(frame.host_timings);
+        Ok(report)
+    }
+
     /// Renders one frame and waits for it, in two submissions: the demo's prim buffer (first frame, or
     /// every frame with dynamic geometry), the plugin's light-space passes and the demo's G-buffer; then
-    /// the plugin's screen-space passes (primitive map, ray trace, soft shadows) and output copy. Returns
-    /// the plugin's report plus the G-buffer's GPU time and [`SCREEN_SPACE_WALL`], the host's wall clock
-    /// of the second submission (what a CPU device such as lavapipe spends on it: its timestamps do not
-    /// see compute work).
-    pub fn render(&mut self, device: &Device, inputs: &FrameInputs) -> Result<FrameReport> {
-        let (view_proj_rel, camera_frame) = camera_in_frame(inputs, self.geometry.origin())?;
-        let push = GBufferPush {
-            view_proj_rel,
-            camera_pos: camera_frame.extend(1.0),
-        };
+    /// the plugin's screen-space passes (primitive map, ray trace, soft shadows) and output copy. `lights`
+    /// holds one light per configured light (none: the plugin records nothing). Returns the plugin's
+    /// report of each light, the G-buffer's GPU time and, with lights, [`SCREEN_SPACE_WALL`]: the host's
+    /// wall clock of the second submission (what a CPU device such as lavapipe spends on it: its
+    /// timestamps do not see compute work).
+    pub fn render_lights(
+        &mut self,
+        device: &Device,
+        camera: &CameraMatrices,
+        lights: &[Light],
+    ) -> Result<LightsFrame> {
+        if lights.len() != self.configured.len() {
+            bail!(
+                "{} lights given for a frame, {} configured",
+                lights.len(),
+                self.configured.len()
+            );
+        }
+        let push = GBufferPush::for_camera(camera, self.geometry.origin())?;
         let tris = self.geometry.triangle_count();
         let rebuild_prims = self.frames == 0 || self.dynamic_geometry;
-        let light = c_light(&inputs.light);
+        let c_lights: Vec<HrtsLight> = lights.iter().map(c_light).collect();
+        let with_plugin = !c_lights.is_empty();
         let t = &self.targets;
         device.submit_and_wait(|enc| {
             if rebuild_prims {
@@ -177,8 +283,10 @@ impl PluginRenderer {
                 enc.barriers(&[Barrier::Uav]);
             }
             enc.attach_timer(&self.timer);
-            let frame = c_frame(enc.raw_handle(), self.frames, inputs, &light);
-            self.record_passes(&frame, HRTS_PASS_MASK_LIGHT_SPACE)?;
+            if with_plugin {
+                let frame = c_frame(enc.raw_handle(), self.frames, camera, &c_lights);
+                self.record_passes(&frame, HRTS_PASS_MASK_LIGHT_SPACE)?;
+            }
             let undefined_to = |image, after| Barrier::Image {
                 image,
                 before: S::Undefined,
@@ -206,20 +314,34 @@ impl PluginRenderer {
             ]);
             Ok(())
         })?;
-        let start = std::time::Instant::now();
-        device.submit_and_wait(|enc| {
-            let frame = c_frame(enc.raw_handle(), self.frames, inputs, &light);
-            self.record_passes(&frame, HRTS_PASS_MASK_SCREEN_SPACE)
-        })?;
-        let wall = start.elapsed().as_secs_f64() * 1e3;
-        let mut report = self.report(self.frames)?;
+        let mut reports = Vec::new();
+        let mut host_timings = Vec::new();
+        if with_plugin {
+            let start = std::time::Instant::now();
+            device.submit_and_wait(|enc| {
+                let frame = c_frame(enc.raw_handle(), self.frames, camera, &c_lights);
+                self.record_passes(&frame, HRTS_PASS_MASK_SCREEN_SPACE)
+            })?;
+            let wall = start.elapsed().as_secs_f64() * 1e3;
+            for light in 0..c_lights.len() as u32 {
+                reports.push(self.report(self.frames, light)?);
+            }
+            host_timings.extend(self.timer.resolve()?);
+            host_timings.push(PassTiming {
+                name: SCREEN_SPACE_WALL.into(),
+                ms: wall,
+            });
+            self.frames_with_plugin_passes += 1;
+        } else {
+            host_timings.extend(self.timer.resolve()?);
+        }
+        let frame_index = self.frames;
         self.frames += 1;
-        report.timings.extend(self.timer.resolve()?);
-        report.timings.push(PassTiming {
-            name: SCREEN_SPACE_WALL.into(),
-            ms: wall,
-        });
-        Ok(report)
+        Ok(LightsFrame {
+            frame_index,
+            lights: reports,
+            host_timings,
+        })
     }
 
     fn record_passes(&self, frame: &HrtsFrame, mask: u32) -> rhi::Result<()> {
@@ -230,14 +352,14 @@ impl PluginRenderer {
             .map_err(recording_error)
     }
 
-    /// The plugin's report of frame `frame` (completed), as the Rust [`FrameReport`].
-    fn report(&self, frame: u64) -> Result<FrameReport> {
+    /// The plugin's report of `light` in frame `frame` (completed), as the Rust [`FrameReport`].
+    fn report(&self, frame: u64, light: u32) -> Result<LightFrameReport> {
         // SAFETY: plain-old-data C struct; every field is valid zeroed.
         let mut r: HrtsFrameReport = unsafe { std::mem::zeroed() };
         r.struct_size = size_of::<HrtsFrameReport>() as u32;
         // SAFETY: live context, valid out pointer.
         self.context.check("hrts_get_frame_report", unsafe {
-            hrts_get_frame_report(self.context.0, frame, 0, &mut r)
+            hrts_get_frame_report(self.context.0, frame, light, &mut r)
         })?;
         let timings = r.passes[..r.pass_count as usize]
             .iter()
@@ -269,6 +391,9 @@ impl PluginRenderer {
                     s if s == HrtsPassStatus::UpToDate as u32 => {
                         PassStatus::Skipped(SkipReason::UpToDate)
                     }
+                    s if s == HrtsPassStatus::Shared as u32 => {
+                        PassStatus::Skipped(SkipReason::Shared)
+                    }
                     _ => PassStatus::Skipped(SkipReason::NotRequested),
                 };
                 (p, status)
@@ -294,7 +419,7 @@ impl PluginRenderer {
         }
         let output = resource_from_c(r.output_resource)
             .context("the report names an unknown output resource")?;
-        Ok(FrameReport {
+        let report = FrameReport {
             timings,
             binning_path,
             stats: MapStats {
@@ -311,21 +436,64 @@ impl PluginRenderer {
             passes,
             resources,
             output,
+        };
+        Ok(LightFrameReport {
+            report,
+            light_builds: r.light_builds,
         })
     }
 
-    /// Reads back the last frame: the demo's G-buffer and visibility image, and every plugin resource of
-    /// [`FrameImages`] the configuration allocates (the list entries only if `with_entries`) through
-    /// `hrts_record_resource_readback`.
-    pub fn read_back(&self, device: &Device, with_entries: bool) -> Result<FrameImages> {
-        let mut own = self.targets.outputs();
-        own.push((&self.output, S::ShaderResource, FrameOutput::Output));
-        let images: Vec<(&Image, S)> = own.iter().map(|&(i, s, _)| (i, s)).collect();
+    /// Reads back the last frame's G-buffer and the visibility of every light (one vector per layer of
+    /// the visibility image; none without lights).
+    pub fn read_frame(&self, device: &Device) -> Result<(FrameImages, Vec<Vec<f32>>)> {
+        let own = self.targets.outputs();
+        let mut images: Vec<(&Image, S)> = own.iter().map(|&(i, s, _)| (i, s)).collect();
+        let output = self.output.as_ref().filter(|_| !self.configured.is_empty());
+        images.extend(output.map(|o| (o, S::ShaderResource)));
+        let mut bytes = read_images(device, &images)?;
+        let layers = match output {
+            Some(_) => {
+                let all: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes.pop().unwrap_or_default());
+                let pixels =
+                    self.targets.depth.width() as usize * self.targets.depth.height() as usize;
+                all.chunks_exact(pixels)
+                    .take(self.configured.len())
+                    .map(<[f32]>::to_vec)
+                    .collect()
+            }
+            None => Vec::new(),
+        };
         let origin = self.geometry.origin();
         let mut frame = FrameImages::default();
-        for ((_, _, output), bytes) in own.iter().zip(read_images(device, &images)?) {
-            frame.insert(*output, &bytes, origin);
+        for ((_, _, output), bytes) in own.iter().zip(&bytes) {
+            frame.insert(*output, bytes, origin);
         }
+        Ok((frame, layers))
+    }
+
+    /// Reads back the last frame of light 0 ([`PluginRenderer::read_back_light`]).
+    pub fn read_back(&self, device: &Device, with_entries: bool) -> Result<FrameImages> {
+        self.read_back_light(device, 0, with_entries)
+    }
+
+    /// Reads back the last frame: the demo's G-buffer, `light`'s layer of the visibility image, and every
+    /// plugin resource of [`FrameImages`] the light's configuration allocates (the list entries only if
+    /// `with_entries`) through `hrts_record_resource_readback`.
+    pub fn read_back_light(
+        &self,
+        device: &Device,
+        light: u32,
+        with_entries: bool,
+    ) -> Result<FrameImages> {
+        let (mut frame, mut layers) = self.read_frame(device)?;
+        if light as usize >= layers.len() {
+            bail!(
+                "light {light} does not exist ({} configured)",
+                self.configured.len()
+            );
+        }
+        frame.output = layers.swap_remove(light as usize);
+        let origin = self.geometry.origin();
         let mut sources: Vec<(Destination, ResourceId)> = FrameOutput::PIPELINE
             .iter()
             .map(|&(output, id)| (Destination::Image(output), id))
@@ -342,7 +510,7 @@ impl PluginRenderer {
             info.struct_size = size_of::<HrtsResourceInfo>() as u32;
             // SAFETY: live context, valid out pointer.
             self.context.check("hrts_get_resource_info", unsafe {
-                hrts_get_resource_info(self.context.0, 0, resource, &mut info)
+                hrts_get_resource_info(self.context.0, light, resource, &mut info)
             })?;
             if info.allocated {
                 let buffer = device.create_buffer(
@@ -360,7 +528,7 @@ impl PluginRenderer {
                     struct_size: size_of::<HrtsResourceReadback>() as u32,
                     command_buffer: enc.raw_handle(),
                     resource: *resource,
-                    light: 0,
+                    light,
                     buffer: buffer.raw_handle(),
                     buffer_size: buffer.size(),
                     offset: 0,
@@ -454,9 +622,9 @@ fn create_context(device: &Device) -> Result<Context> {
     Ok(Context(context))
 }
 
-/// Hands the demo's vertex and index buffers to the plugin, with the scene bounds of `view` (the plugin's
-/// frame origin is their centre, as the demo's).
-fn set_geometry(context: &Context, geometry: &Geometry, view: &View) -> Result<()> {
+/// Hands the demo's vertex and index buffers to the plugin, with the scene's `bounds` (the plugin's frame
+/// origin is their centre, as the demo's).
+fn set_geometry(context: &Context, geometry: &Geometry, bounds: &Aabb) -> Result<()> {
     let (vertices, vertex) = geometry.vertices();
     let (indices, index) = geometry.indices();
     let draws: Vec<HrtsDraw> = geometry
@@ -468,7 +636,6 @@ fn set_geometry(context: &Context, geometry: &Geometry, view: &View) -> Result<(
             transform: d.model.to_cols_array(),
         })
         .collect();
-    let bounds = view.scene.bounds();
     let mut b = [0.0f32; 6];
     b[..3].copy_from_slice(&bounds.min.to_array());
     b[3..].copy_from_slice(&bounds.max.to_array());
@@ -523,24 +690,24 @@ fn c_light(light: &Light) -> HrtsLight {
     }
 }
 
-/// The C frame `frame_index` of `inputs` with its one light `light`, recorded into `command_buffer`; depth
-/// and normal are sampled (`SHADER_READ_ONLY_OPTIMAL`) and the visibility image is left ready for sampling.
+/// The C frame `frame_index` of `camera` with `lights`, recorded into `command_buffer`; depth and normal
+/// are sampled (`SHADER_READ_ONLY_OPTIMAL`) and the visibility image is left ready for sampling.
 fn c_frame(
     command_buffer: u64,
     frame_index: u64,
-    inputs: &FrameInputs,
-    light: &HrtsLight,
+    camera: &CameraMatrices,
+    lights: &[HrtsLight],
 ) -> HrtsFrame {
     let sampled = S::ShaderResource.raw_layout();
     HrtsFrame {
         struct_size: size_of::<HrtsFrame>() as u32,
         command_buffer,
         frame_index,
-        view: inputs.view.to_cols_array(),
-        proj: inputs.proj.to_cols_array(),
-        camera_position: inputs.camera_position.to_array(),
-        lights: light,
-        light_count: 1,
+        view: camera.view.to_cols_array(),
+        proj: camera.proj.to_cols_array(),
+        camera_position: camera.position.to_array(),
+        lights: lights.as_ptr(),
+        light_count: lights.len() as u32,
         depth_layout: sampled,
         normal_layout: sampled,
         output_layout_before: S::Undefined.raw_layout(),

@@ -11,6 +11,7 @@ use passes::{
     ShadowMode, SkipReason,
 };
 use rhi::Device;
+use scene::Scene;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -80,37 +81,59 @@ pub struct RenderOptions {
 /// The world-space scale of a view's model: the bounding radius of its objects (the ground plane
 /// aside), at least a millimetre.
 pub fn default_world_space_scale(view: &View) -> f32 {
-    focus_bounds(&view.scene).radius().max(1e-3)
+    world_space_scale_of(&view.scene)
 }
 
-impl RenderOptions {
-    /// The pipeline configuration: the plan's final output plus every intermediate the demo writes.
-    pub fn shadow_config(&self, view: &View) -> ShadowConfig {
-        let s = &self.soft;
+/// The world-space scale of a scene's model: the bounding radius of its objects (the ground plane
+/// aside), at least a millimetre.
+pub fn world_space_scale_of(scene: &Scene) -> f32 {
+    focus_bounds(scene).radius().max(1e-3)
+}
+
+impl SoftShadowArgs {
+    /// The configuration these options describe over the primitive map `map`, with the hybrid's WSS
+    /// `default_world_space_scale` unless `--wss` sets it; static geometry, a moving light, no extra
+    /// output.
+    pub fn shadow_config(
+        &self,
+        map: PrimitiveMapConfig,
+        default_world_space_scale: f32,
+    ) -> ShadowConfig {
         ShadowConfig {
-            mode: s.mode,
-            antialiasing: !s.no_antialiasing,
+            mode: self.mode,
+            antialiasing: !self.no_antialiasing,
             static_geometry: true,
-            // Every frame re-renders the light-space maps, so that their timings are medians too.
             static_light: false,
-            map: self.map,
+            map,
             shadow_map: ShadowMapConfig {
-                size: s.shadow_map_size,
+                size: self.shadow_map_size,
                 ..ShadowMapConfig::default()
             },
             pcss: PcssConfig {
-                angular_radius: s.angular_radius,
-                blocker_search_taps: s.search_taps,
-                pcf_taps: s.pcf_taps,
-                filter: s.filter,
+                angular_radius: self.angular_radius,
+                blocker_search_taps: self.search_taps,
+                pcf_taps: self.pcf_taps,
+                filter: self.filter,
                 ..PcssConfig::default()
             },
             hybrid: HybridConfig {
-                world_space_scale: s.wss.unwrap_or_else(|| default_world_space_scale(view)),
-                hard_shadow_percentage: s.phs,
+                world_space_scale: self.wss.unwrap_or(default_world_space_scale),
+                hard_shadow_percentage: self.phs,
             },
-            extra_outputs: demo_outputs(s.mode, self.occupancy_view),
             ..ShadowConfig::default()
+        }
+    }
+}
+
+impl RenderOptions {
+    /// The pipeline configuration: the plan's final output plus every intermediate the demo writes. Every
+    /// frame re-renders the light-space maps (a moving light), so that their timings are medians too.
+    pub fn shadow_config(&self, view: &View) -> ShadowConfig {
+        ShadowConfig {
+            extra_outputs: demo_outputs(self.soft.mode, self.occupancy_view),
+            ..self
+                .soft
+                .shadow_config(self.map, default_world_space_scale(view))
         }
     }
 }

@@ -2,6 +2,7 @@
 //! read-back of every output the plan produced.
 
 use crate::gbuffer::{GBufferPass, GBufferPush, GBufferTargets};
+use crate::CameraMatrices;
 use glam::DVec3;
 use passes::{
     FrameInputs, FrameReport, Geometry, PassError, PassId, ResourceId, ShadowConfig, ShadowInputs,
@@ -95,11 +96,10 @@ impl ShadowRenderer {
         device: &Device,
         inputs: &FrameInputs,
     ) -> Result<FrameReport, PassError> {
-        let (view_proj_rel, camera_frame) = self.pipeline.camera_in_frame(inputs)?;
-        let push = GBufferPush {
-            view_proj_rel,
-            camera_pos: camera_frame.extend(1.0),
-        };
+        let push = GBufferPush::for_camera(
+            &CameraMatrices::of_frame(inputs),
+            self.pipeline.geometry().origin(),
+        )?;
         let tris = self.pipeline.geometry().triangle_count();
         let Self {
             targets,

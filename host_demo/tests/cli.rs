@@ -162,3 +162,201 @@ fn render_writes_every_output() {
     assert!(json["gpu_ms"]["ray trace"].as_f64().unwrap() > 0.0);
     assert!(!json["device"]["name"].as_str().unwrap().is_empty());
 }
+
+/// Writes the example glTF scene into `dir` through the CLI.
+fn example_scene(dir: &Path) -> PathBuf {
+    let path = dir.join("example.gltf");
+    let output = host_demo(&["example-scene", "--out", path.to_str().unwrap()]);
+    assert!(
+        output.status.success(),
+        "stderr: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    path
+}
+
+#[test]
+fn malformed_gltf_is_a_clear_error() {
+    let dir = temp_dir("malformed-gltf");
+    let out = dir.join("out");
+    let cases: [(&str, &[u8]); 5] = [
+        ("not_json.gltf", b"{ this is not json"),
+        ("old.gltf", br#"{"asset": {"version": "1.0"}}"#),
+        (
+            "bad_accessor.gltf",
+            br#"{"asset": {"version": "2.0"}, "meshes": [{"primitives": [{"attributes": {"POSITION": 7}}]}]}"#,
+        ),
+        ("truncated.glb", b"glTF\x02\x00\x00\x00\xff\x00\x00\x00"),
+        ("empty.gltf", br#"{"asset": {"version": "2.0"}}"#),
+    ];
+    for (name, bytes) in cases {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).expect("write scene");
+        for command in ["render", "plan"] {
+            let mut args = vec![command, "--scene", path.to_str().unwrap()];
+            if command == "render" {
+                args.extend(["--out", out.to_str().unwrap()]);
+            }
+            let output = host_demo(&args);
+            let stderr = String::from_utf8_lossy(&output.stderr);
+            assert_clean_failure(&output, &stderr, path.to_str().unwrap());
+        }
+    }
+    let missing = dir.join("nope.gltf");
+    let output = host_demo(&["plan", "--scene", missing.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_clean_failure(&output, &stderr, "nope.gltf");
+    let obj = dir.join("model.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("write obj");
+    let output = host_demo(&["plan", "--scene", obj.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_clean_failure(&output, &stderr, "--obj");
+    let example = example_scene(&dir);
+    let output = host_demo(&[
+        "render",
+        "--scene",
+        example.to_str().unwrap(),
+        "--frames",
+        "1",
+    ]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_clean_failure(&output, &stderr, "--frames must be at least 2");
+}
+
+#[test]
+fn plan_prints_every_light_without_a_device() {
+    let dir = temp_dir("plan");
+    let example = example_scene(&dir);
+    let output = host_demo(&[
+        "--device",
+        "no such device",
+        "plan",
+        "--scene",
+        example.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "stdout: {stdout}\nstderr: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    for expected in [
+        "shadowed through 8 plugin lights",
+        "[0] sun: directional",
+        "-> hybrid (sized light: PCSS with pcss_angular_radius 0.01 rad",
+        "[1] rim: directional",
+        "-> hard (zero-size light",
+        "[2] spot: spot at",
+        "[3] fill: point",
+        "-> no pass (casts no shadows): visibility 1",
+        "[4] cart_lamp: point",
+        "faces not built (no receiver in view within reach): +Y",
+        "dynamic (not static: cart_body, cart_load)",
+    ] {
+        assert!(
+            stdout.contains(expected),
+            "'{expected}' missing in:\n{stdout}"
+        );
+    }
+}
+
+/// Renders the example scene held still (or not) and returns stdout and scene_report.json.
+fn render_example(dir: &Path, still: bool) -> (String, serde_json::Value) {
+    let example = example_scene(dir);
+    let out = dir.join(if still { "still" } else { "moving" });
+    let mut args = vec![
+        "--validation",
+        "render",
+        "--scene",
+        example.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--width",
+        "160",
+        "--height",
+        "120",
+        "--map-size",
+        "128",
+        "--shadow-map-size",
+        "256",
+        "--frames",
+        "2",
+    ];
+    if still {
+        args.push("--still");
+    }
+    let output = host_demo(&args);
+    let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(
+        output.status.success(),
+        "stdout: {stdout}\nstderr: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    for (i, name) in ["sun", "rim", "spot", "fill", "cart_lamp"]
+        .iter()
+        .enumerate()
+    {
+        for ext in ["png", "exr"] {
+            let p = out.join(format!("visibility_{i}_{name}.{ext}"));
+            assert!(p.metadata().is_ok_and(|m| m.len() > 0), "{p:?} missing");
+        }
+    }
+    for f in ["shaded.png", "shaded.exr", "scene_report.json"] {
+        assert!(
+            out.join(f).metadata().is_ok_and(|m| m.len() > 0),
+            "{f} missing"
+        );
+    }
+    let json =
+        serde_json::from_str(&std::fs::read_to_string(out.join("scene_report.json")).unwrap())
+            .expect("scene_report.json");
+    (stdout, json)
+}
+
+#[test]
+fn scene_render_reports_what_each_light_ran_and_kept() {
+    let dir = temp_dir("scene-render");
+    let (stdout, json) = render_example(&dir, true);
+    assert!(stdout.contains("frame 1: per light"), "{stdout}");
+    assert!(
+        stdout.contains("fill: no pass (casts no shadows)"),
+        "{stdout}"
+    );
+    assert_eq!(json["plugin_lights"], 8);
+    let frames = json["frames"].as_array().expect("frames");
+    assert_eq!(frames.len(), 2);
+    let second = frames[1]["lights"].as_array().expect("lights");
+    assert_eq!(second.len(), 8);
+    for light in second {
+        assert_eq!(light["light_builds"], 1, "{light}");
+        assert_eq!(light["pass_status"]["prim buffer"], "UP_TO_DATE", "{light}");
+        let expected = if light["mode"] == "hard" {
+            "NOT_IN_PLAN"
+        } else {
+            "UP_TO_DATE"
+        };
+        assert_eq!(light["pass_status"]["shadow map"], expected, "{light}");
+        assert_eq!(light["pass_status"]["ray trace"], "RAN", "{light}");
+        assert!(
+            light["resource_bytes"]["prim list entries"]
+                .as_u64()
+                .unwrap()
+                > 0
+        );
+    }
+    assert_eq!(second[1]["scene_light"], "rim");
+    assert!(second[1]["resource_bytes"].get("shadow map").is_none());
+    assert!(second[0]["resource_bytes"]["shadow map"].as_u64().unwrap() > 0);
+
+    // As the scene says: the cart moves, so the prim buffer is rebuilt (by the first light, shared by
+    // the others) and every shadow map re-rendered.
+    let (stdout, json) = render_example(&dir, false);
+    assert!(stdout.contains("dynamic (not static: cart_body, cart_load)"));
+    let second = json["frames"][1]["lights"].as_array().expect("lights");
+    assert_eq!(second[0]["pass_status"]["prim buffer"], "RAN");
+    for light in &second[1..] {
+        assert_eq!(light["pass_status"]["prim buffer"], "SHARED", "{light}");
+        assert_eq!(light["light_builds"], 1, "{light}");
+    }
+    assert_eq!(second[0]["pass_status"]["shadow map"], "RAN");
+}

@@ -1,0 +1,1206 @@
+//! The plan of a glTF scene: which shadow each light gets, derived from what the scene declares (its
+//! lights' kinds, sizes and flags, which objects move) and from what the camera sees. Pure: no GPU.
+//!
+//! Per light, in this order:
+//! - a light that casts no shadow, emits nothing (zero colour or intensity), or whose influence (its cone
+//!   and range) misses every receiver in view gets **no pass**: it is not given to the plugin, and its
+//!   visibility is 1;
+//! - a **zero-size** light gets exact ray-traced hard shadows: mode hard, so no shadow map and no PCSS
+//!   are allocated;
+//! - a **sized** light gets the hybrid: its angular radius (directional) becomes
+//!   `pcss_angular_radius`, its radius (spot, point) `pcss_spot_radius`.
+//!
+//! A shadowed light is one or more *shadow frusta*, each one light of the plugin:
+//! - a directional light: one orthographic frustum enclosing the scene ([`DirectionalLight::view_proj`]);
+//! - a spot light whose cone is at most [`MAX_SPOT_FRUSTUM_HALF_ANGLE`] wide: one perspective frustum
+//!   around its cone;
+//! - a point light, or a wider spot light: the faces of a cube around it (each a 90° perspective
+//!   frustum) that hold a receiver in view within the light's reach; the others are not built. A spot
+//!   light's cube is turned to its axis and has no back face.
+//!
+//! The plugin counts pixels outside a frustum as lit, so a light's visibility is the minimum of its
+//! frusta's visibilities. Frusta are widened by 1% beyond the cone or the cube face, so that neighbouring
+//! faces overlap instead of leaving a crack to rounding.
+//!
+//! "Receivers in view" are the scene's triangles that are not entirely outside one plane of the camera
+//! frustum (occlusion is not considered), and a triangle is within a light's reach when its bounding
+//! sphere meets the light's range and cone: the tests keep every light and face that may light a visible
+//! pixel, and may keep a few that do not.
+//!
+//! Caching: a light marked static sets `static_light`; any object that is not static makes the geometry
+//! dynamic for every light (the plugin shares one prim buffer between its lights).
+
+use anyhow::{bail, Result};
+use glam::{DVec3, DVec4, Mat4, Vec3};
+use hrts_plugin::HRTS_MAX_LIGHTS;
+use passes::{FaceMode, FramePlan, Light, ResourceId, ShadowConfig, ShadowMode};
+use scene::{Aabb, Camera, DirectionalLight, LightKind, LightSize, SceneFile, SceneLight};
+use std::f64::consts::FRAC_PI_2;
+use std::fmt::Write as _;
+
+/// Widest half-angle of a spot light's cone shadowed through one perspective frustum (60°); a wider
+/// spot light is shadowed through the faces of a cube, like a point light.
+pub const MAX_SPOT_FRUSTUM_HALF_ANGLE: f32 = std::f32::consts::FRAC_PI_3;
+
+/// Each frustum's half-width (as the tangent of its half-angle) is this much wider than the cone or cube
+/// face it covers.
+const FRUSTUM_WIDENING: f32 = 1.01;
+
+/// The far plane of a spot or point frustum is this much beyond the farthest receiver.
+const FAR_MARGIN: f32 = 1.01;
+
+/// The near plane of a spot or point frustum is at least this fraction of the far plane's distance.
+const MIN_NEAR_FRACTION: f32 = 1e-3;
+
+/// What the plan needs besides the scene and the camera.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanSettings {
+    /// The configuration every shadowed light starts from: primitive map, shadow map size, PCSS taps and
+    /// filter, hybrid blend, antialiasing. The plan sets the mode, the light size, `static_light` and
+    /// `static_geometry` (and both faces in the primitive map of spot and point lights).
+    pub base: ShadowConfig,
+    /// Frame width in pixels (with the height, the aspect of the camera's frustum).
+    pub width: u32,
+    /// Frame height in pixels.
+    pub height: u32,
+}
+
+/// Why a light gets no pass.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NoPassReason {
+    /// The scene says it casts no shadows.
+    CastsNoShadows,
+    /// Its colour or intensity is zero.
+    EmitsNothing,
+    /// No receiver is in view at all.
+    NothingInView,
+    /// No receiver in view is within its cone and range.
+    OutOfReach,
+}
+
+impl NoPassReason {
+    /// A phrase for reports.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::CastsNoShadows => "casts no shadows",
+            Self::EmitsNothing => "emits nothing (zero colour or intensity)",
+            Self::NothingInView => "no receiver in view",
+            Self::OutOfReach => "no receiver in view within its cone and range",
+        }
+    }
+}
+
+/// One frustum of a shadowed light: one light of the plugin.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShadowFrustum {
+    /// Which part of the light it covers: "whole" for a directional light or a single spot frustum, else
+    /// the cube face ("+X" ... "-Z" for a point light; "front", "right", "left", "up", "down" around a
+    /// spot light's axis).
+    pub label: String,
+    /// The light as the plugin takes it: direction, position and view-projection.
+    pub light: Light,
+}
+
+/// The passes of a light the plugin shadows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShadowedLight {
+    /// The configuration of each of its frusta.
+    pub config: ShadowConfig,
+    /// The passes and resources the plugin derives from the configuration.
+    pub frame_plan: FramePlan,
+    /// Its frusta, in a fixed order (cube faces in the order of their labels above).
+    pub frusta: Vec<ShadowFrustum>,
+    /// The cube faces left out because no receiver in view within the light's reach lies in them.
+    pub culled_faces: Vec<String>,
+}
+
+/// What the plan does with a light.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LightDecision {
+    /// No pass: the light is not given to the plugin and its visibility is 1.
+    NoPass(NoPassReason),
+    /// Shadowed by the plugin.
+    Shadowed(Box<ShadowedLight>),
+}
+
+/// The plan of one light of the scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LightPlan {
+    /// The light as the scene declares it.
+    pub light: SceneLight,
+    /// What the plan does with it.
+    pub decision: LightDecision,
+}
+
+impl LightPlan {
+    /// The shadowed light, if the plugin shadows it.
+    pub fn shadowed(&self) -> Option<&ShadowedLight> {
+        match &self.decision {
+            LightDecision::Shadowed(s) => Some(s),
+            LightDecision::NoPass(_) => None,
+        }
+    }
+
+    /// The decision and its reason, as a phrase: "hard (zero-size light: ...)", "no pass (...)".
+    pub fn describe_decision(&self) -> String {
+        let Some(shadowed) = self.shadowed() else {
+            let LightDecision::NoPass(reason) = self.decision else {
+                unreachable!("a light is shadowed or not")
+            };
+            return format!("no pass ({}): visibility 1", reason.describe());
+        };
+        match self.light.size {
+            LightSize::Zero => "hard (zero-size light: exact ray-traced hard shadows; no shadow map, no PCSS)".to_owned(),
+            LightSize::AngularRadius(a) => format!(
+                "hybrid (sized light: PCSS with pcss_angular_radius {a} rad, blended with the exact ray trace)"
+            ),
+            LightSize::Radius(r) => format!(
+                "hybrid (sized light: PCSS with pcss_spot_radius {r} m, blended with the exact ray trace{})",
+                if shadowed.frusta.len() > 1 { ", per cube face" } else { "" }
+            ),
+        }
+    }
+}
+
+/// One light of the plugin: a frustum of a shadowed scene light.
+#[derive(Debug, Clone, Copy)]
+pub struct PluginLight<'a> {
+    /// Index of the scene light.
+    pub scene_light: usize,
+    /// The frustum.
+    pub frustum: &'a ShadowFrustum,
+    /// Its configuration.
+    pub config: &'a ShadowConfig,
+}
+
+/// The plan of a scene seen by a camera.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScenePlan {
+    /// Whether any object moves: the prim buffer is rebuilt every frame (and so every light-space pass).
+    pub dynamic_geometry: bool,
+    /// The objects that are not static.
+    pub moving_objects: Vec<String>,
+    /// Triangles of the scene in view (receivers).
+    pub receivers_in_view: usize,
+    /// Triangles of the scene.
+    pub triangles: usize,
+    /// One plan per scene light, in the scene's order.
+    pub lights: Vec<LightPlan>,
+}
+
+impl ScenePlan {
+    /// The plugin's lights: every frustum of every shadowed light, in scene order.
+    pub fn plugin_lights(&self) -> Vec<PluginLight<'_>> {
+        self.lights
+            .iter()
+            .enumerate()
+            .filter_map(|(i, l)| l.shadowed().map(|s| (i, s)))
+            .flat_map(|(scene_light, s)| {
+                s.frusta.iter().map(move |frustum| PluginLight {
+                    scene_light,
+                    frustum,
+                    config: &s.config,
+                })
+            })
+            .collect()
+    }
+
+    /// The configuration of each plugin light ([`ScenePlan::plugin_lights`] order).
+    pub fn plugin_configs(&self) -> Vec<ShadowConfig> {
+        self.plugin_lights().iter().map(|l| *l.config).collect()
+    }
+
+    /// The light of each plugin light for a frame ([`ScenePlan::plugin_lights`] order).
+    pub fn plugin_frame_lights(&self) -> Vec<Light> {
+        self.plugin_lights()
+            .iter()
+            .map(|l| l.frustum.light)
+            .collect()
+    }
+
+    /// The plan as text: the geometry's caching, then per light its declaration, decision, frusta, the
+    /// passes the plugin runs and the resources it allocates.
+    pub fn describe(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "geometry: {}",
+            if self.dynamic_geometry {
+                format!(
+                    "dynamic (not static: {}): the prim buffer is rebuilt, and every shadow map re-rendered, each frame",
+                    self.moving_objects.join(", ")
+                )
+            } else {
+                "static: the prim buffer is built once, and the shadow maps of static lights are kept".to_owned()
+            }
+        );
+        let _ = writeln!(
+            s,
+            "receivers in view: {} of {} triangles; the primitive map of every frustum is refitted to them every frame",
+            self.receivers_in_view, self.triangles
+        );
+        let plugin_lights = self.plugin_lights();
+        let _ = writeln!(
+            s,
+            "lights: {}, shadowed through {} plugin light{} (shadow frusta)",
+            self.lights.len(),
+            plugin_lights.len(),
+            if plugin_lights.len() == 1 { "" } else { "s" }
+        );
+        for (i, plan) in self.lights.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "  [{i}] {}: {}",
+                plan.light.name,
+                describe_light(&plan.light)
+            );
+            let _ = writeln!(s, "      -> {}", plan.describe_decision());
+            let Some(shadowed) = plan.shadowed() else {
+                continue;
+            };
+            let first = plugin_lights
+                .iter()
+                .position(|l| l.scene_light == i)
+                .unwrap_or_default();
+            let frusta: Vec<String> = shadowed
+                .frusta
+                .iter()
+                .enumerate()
+                .map(|(k, f)| format!("{} (plugin light {})", f.label, first + k))
+                .collect();
+            let _ = write!(s, "      frusta: {}", frusta.join(", "));
+            if !shadowed.culled_faces.is_empty() {
+                let _ = write!(
+                    s,
+                    "; faces not built (no receiver in view within reach): {}",
+                    shadowed.culled_faces.join(", ")
+                );
+            }
+            let _ = writeln!(s);
+            let c = &shadowed.config;
+            let _ = writeln!(
+                s,
+                "      config: mode {}, FXAA {}, static_light {}, dynamic_geometry {}, map {}², shadow map {}",
+                c.mode.name(),
+                if c.antialiasing { "on" } else { "off" },
+                c.static_light,
+                !c.static_geometry,
+                c.map.size,
+                if shadowed.frame_plan.resources().contains(ResourceId::ShadowMap) {
+                    format!("{0}x{0}", c.shadow_map.size)
+                } else {
+                    "none".to_owned()
+                }
+            );
+            let passes: Vec<&str> = shadowed
+                .frame_plan
+                .passes()
+                .iter()
+                .map(|p| p.name())
+                .collect();
+            let _ = writeln!(s, "      passes: {}", passes.join(", "));
+            let resources: Vec<&str> = shadowed
+                .frame_plan
+                .resources()
+                .iter()
+                .map(|r| r.name())
+                .collect();
+            let _ = writeln!(s, "      resources: {}", resources.join(", "));
+        }
+        s
+    }
+}
+
+/// "spot at (x, y, z) along (..), cones 0.25/0.45 rad, range 15 m, radius 0.05 m, static".
+pub fn describe_light(light: &SceneLight) -> String {
+    let v = |v: Vec3| format!("({:.2}, {:.2}, {:.2})", v.x, v.y, v.z);
+    let range = |r: Option<f32>| r.map_or("unlimited range".to_owned(), |r| format!("range {r} m"));
+    let kind = match light.kind {
+        LightKind::Directional { direction } => format!("directional along {}", v(direction)),
+        LightKind::Spot {
+            position,
+            direction,
+            inner_cone,
+            outer_cone,
+            range: r,
+        } => format!(
+            "spot at {} along {}, cones {inner_cone}/{outer_cone} rad, {}",
+            v(position),
+            v(direction),
+            range(r)
+        ),
+        LightKind::Point { position, range: r } => {
+            format!("point at {}, {}", v(position), range(r))
+        }
+    };
+    let size = match light.size {
+        LightSize::Zero => "zero size".to_owned(),
+        LightSize::AngularRadius(a) => format!("angular radius {a} rad"),
+        LightSize::Radius(r) => format!("radius {r} m"),
+    };
+    format!(
+        "{kind}, {size}, {}{}",
+        if light.is_static { "static" } else { "moving" },
+        if light.casts_shadows {
+            ""
+        } else {
+            ", casts no shadows"
+        }
+    )
+}
+
+/// `file` held still: every object and light marked static. The demo does not animate its scenes, so
+/// rendering a scene held still shows what a scene that does not move keeps from frame to frame.
+pub fn held_still(file: &SceneFile) -> SceneFile {
+    let mut still = file.clone();
+    still.static_objects.iter_mut().for_each(|s| *s = true);
+    still.lights.iter_mut().for_each(|l| l.is_static = true);
+    still
+}
+
+/// The camera of a scene: the file's, else one framing its objects (the ground aside) as the demo frames
+/// every scene.
+pub fn scene_camera(file: &SceneFile, aspect: f32) -> Camera {
+    file.camera
+        .unwrap_or_else(|| Camera::frame(&crate::focus_bounds(&file.scene), aspect))
+}
+
+/// Derives the plan of `file` seen through `camera`.
+///
+/// # Errors
+///
+/// A frame size of zero, `static_objects` not matching the objects, or more shadow frusta than the
+/// plugin shades ([`HRTS_MAX_LIGHTS`]).
+pub fn plan_scene(file: &SceneFile, camera: &Camera, settings: &PlanSettings) -> Result<ScenePlan> {
+    if settings.width == 0 || settings.height == 0 {
+        bail!("the frame size must be positive");
+    }
+    if file.static_objects.len() != file.scene.objects.len() {
+        bail!(
+            "the scene has {} objects but {} static flags",
+            file.scene.objects.len(),
+            file.static_objects.len()
+        );
+    }
+    let moving_objects: Vec<String> = file
+        .scene
+        .objects
+        .iter()
+        .zip(&file.static_objects)
+        .filter(|(_, &is_static)| !is_static)
+        .map(|(o, _)| o.name.clone())
+        .collect();
+    let dynamic_geometry = !moving_objects.is_empty();
+    let aspect = settings.width as f32 / settings.height as f32;
+    let receivers = receivers_in_view(file, camera, aspect);
+    let bounds = file.scene.bounds();
+    let lights: Vec<LightPlan> = file
+        .lights
+        .iter()
+        .map(|light| LightPlan {
+            light: light.clone(),
+            decision: decide(light, &receivers, &bounds, settings, dynamic_geometry),
+        })
+        .collect();
+    let plan = ScenePlan {
+        dynamic_geometry,
+        moving_objects,
+        receivers_in_view: receivers.len(),
+        triangles: file.scene.triangle_count(),
+        lights,
+    };
+    let frusta = plan.plugin_lights().len();
+    if frusta > HRTS_MAX_LIGHTS as usize {
+        let per_light: Vec<String> = plan
+            .lights
+            .iter()
+            .filter_map(|l| {
+                l.shadowed()
+                    .map(|s| format!("{} {}", l.light.name, s.frusta.len()))
+            })
+            .collect();
+        bail!(
+            "the scene needs {frusta} shadow frusta ({}), but the plugin shades at most {HRTS_MAX_LIGHTS} lights per context",
+            per_light.join(", ")
+        );
+    }
+    Ok(plan)
+}
+
+/// The scene's triangles (f64) not entirely outside one plane of the camera frustum.
+fn receivers_in_view(file: &SceneFile, camera: &Camera, aspect: f32) -> Vec<[DVec3; 3]> {
+    let m = camera.proj(aspect).as_dmat4() * camera.view().as_dmat4();
+    let (r0, r1, r2, r3) = (m.row(0), m.row(1), m.row(2), m.row(3));
+    // Inside: -w <= x <= w, -w <= y <= w, 0 <= z <= w (reversed Z: z > w is nearer than the near plane).
+    let planes = [r3 + r0, r3 - r0, r3 + r1, r3 - r1, r2, r3 - r2];
+    (0..file.scene.triangle_count())
+        .map(|t| file.scene.triangle(t).map(|v| v.as_dvec3()))
+        .filter(|t| !planes.iter().any(|&p| outside_plane(p, t)))
+        .collect()
+}
+
+/// Whether every vertex of `t` lies strictly on the negative side of the plane `p` (`dot(p, (v, 1))`).
+fn outside_plane(p: DVec4, t: &[DVec3; 3]) -> bool {
+    t.iter().all(|v| p.dot(v.extend(1.0)) < 0.0)
+}
+
+/// Where a spot or point light reaches: a ball of its range, within its cone.
+#[derive(Debug, Clone, Copy)]
+struct Reach {
+    position: DVec3,
+    range: Option<f64>,
+    cone: Option<Cone>,
+}
+
+/// A spot light's cone.
+#[derive(Debug, Clone, Copy)]
+struct Cone {
+    /// Unit axis.
+    axis: DVec3,
+    /// Half-angle, at most 90°.
+    half_angle: f64,
+    /// A square pyramid holding the cone (for half-angles below 90°).
+    enclosing: Option<Pyramid>,
+}
+
+impl Reach {
+    /// Whether `t` may meet the reach: within the range exactly, and, for the cone, neither wholly behind
+    /// the light, nor outside the cone's enclosing pyramid, nor with its bounding sphere outside the cone
+    /// (conservative: true whenever `t` does meet it).
+    fn touches(&self, t: &[DVec3; 3]) -> bool {
+        if self
+            .range
+            .is_some_and(|range| closest_point(self.position, t).distance(self.position) > range)
+        {
+            return false;
+        }
+        let Some(cone) = self.cone else {
+            return true;
+        };
+        if t.iter().all(|v| (*v - self.position).dot(cone.axis) < 0.0) {
+            return false;
+        }
+        if cone.enclosing.is_some_and(|p| !p.touches(t)) {
+            return false;
+        }
+        let center = (t[0] + t[1] + t[2]) / 3.0;
+        let radius = t.iter().map(|v| v.distance(center)).fold(0.0, f64::max);
+        let v = center - self.position;
+        let along = v.dot(cone.axis);
+        let across = (v - cone.axis * along).length();
+        let beyond = across.atan2(along) - cone.half_angle;
+        let distance = if beyond <= 0.0 {
+            0.0
+        } else if beyond >= FRAC_PI_2 {
+            v.length()
+        } else {
+            v.length() * beyond.sin()
+        };
+        distance <= radius
+    }
+}
+
+/// The point of triangle `t` closest to `p` (Ericson, *Real-Time Collision Detection*, 5.1.5).
+fn closest_point(p: DVec3, t: &[DVec3; 3]) -> DVec3 {
+    let [a, b, c] = *t;
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let denominator = va + vb + vc;
+    if denominator == 0.0 || !denominator.is_finite() {
+        // A degenerate triangle: the nearest point of its edges.
+        return [(a, b), (b, c), (c, a)]
+            .into_iter()
+            .map(|(from, to)| closest_on_segment(p, from, to))
+            .min_by(|x, y| x.distance_squared(p).total_cmp(&y.distance_squared(p)))
+            .unwrap_or(a);
+    }
+    a + ab * (vb / denominator) + ac * (vc / denominator)
+}
+
+/// The point of the segment from `a` to `b` closest to `p`.
+fn closest_on_segment(p: DVec3, a: DVec3, b: DVec3) -> DVec3 {
+    let ab = b - a;
+    let length2 = ab.length_squared();
+    if length2 == 0.0 {
+        return a;
+    }
+    a + ab * ((p - a).dot(ab) / length2).clamp(0.0, 1.0)
+}
+
+/// A square pyramid from `apex` along `forward`, `tan_half` wide along `right` and `up`.
+#[derive(Debug, Clone, Copy)]
+struct Pyramid {
+    apex: DVec3,
+    forward: DVec3,
+    right: DVec3,
+    up: DVec3,
+    tan_half: f64,
+}
+
+impl Pyramid {
+    /// The pyramid of a perspective view from `apex` along unit `forward` with `up_hint` (not parallel to
+    /// `forward`) giving its up, as `Mat4::look_to_rh` orients it.
+    fn new(apex: Vec3, forward: Vec3, up_hint: Vec3, tan_half: f32) -> Self {
+        let right = forward.cross(up_hint).normalize();
+        Self {
+            apex: apex.as_dvec3(),
+            forward: forward.as_dvec3(),
+            right: right.as_dvec3(),
+            up: right.cross(forward).as_dvec3(),
+            tan_half: f64::from(tan_half),
+        }
+    }
+
+    /// Whether `t` is not entirely outside one of the four side planes, or behind the apex.
+    fn touches(&self, t: &[DVec3; 3]) -> bool {
+        let f = self.forward * self.tan_half;
+        let normals = [
+            f - self.right,
+            f + self.right,
+            f - self.up,
+            f + self.up,
+            self.forward,
+        ];
+        !normals.iter().any(|n| {
+            let plane = n.extend(-n.dot(self.apex));
+            outside_plane(plane, t)
+        })
+    }
+}
+
+/// The perspective frustum of a light at `position` looking along `forward` (unit), `tan_half` wide on
+/// both axes, with `up_hint` (not parallel to `forward`) giving its up; and its pyramid.
+fn perspective_frustum(
+    position: Vec3,
+    forward: Vec3,
+    up_hint: Vec3,
+    tan_half: f32,
+    (near, far): (f32, f32),
+) -> (Light, Pyramid) {
+    let view = Mat4::look_to_rh(position, forward, up_hint);
+    let proj = Mat4::perspective_rh(2.0 * tan_half.atan(), 1.0, near, far);
+    let pyramid = Pyramid::new(position, forward, up_hint, tan_half);
+    let light = Light::Spot {
+        position,
+        direction: forward,
+        view_proj: proj * view,
+    };
+    (light, pyramid)
+}
+
+/// An up direction for a view along `forward`: +Y unless `forward` is within about 1° of ±Y, then +Z.
+fn up_hint(forward: Vec3) -> Vec3 {
+    if forward.y.abs() > 1f32.to_radians().cos() {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    }
+}
+
+/// Near and far planes of a perspective frustum at `position`: far just beyond the farthest corner of the
+/// scene's bounds (or the range, if nearer); near at half the distance to the bounds, at least
+/// [`MIN_NEAR_FRACTION`] of far.
+fn depth_range(position: Vec3, bounds: &Aabb, range: Option<f32>) -> (f32, f32) {
+    let farthest = bounds
+        .corners()
+        .iter()
+        .map(|c| c.distance(position))
+        .fold(0.0, f32::max);
+    let far = (range.map_or(farthest, |r| r.min(farthest)) * FAR_MARGIN).max(f32::MIN_POSITIVE);
+    let nearest = (position.clamp(bounds.min, bounds.max) - position).length();
+    let near = (nearest * 0.5).max(far * MIN_NEAR_FRACTION);
+    (near, far.max(near * 2.0))
+}
+
+/// The cube faces around a light as (label, forward, up hint): world axes for a point light; the spot's
+/// axis and the four directions across it (no back face) for a spot light.
+fn cube_faces(axis: Option<Vec3>) -> Vec<(&'static str, Vec3, Vec3)> {
+    match axis {
+        None => vec![
+            ("+X", Vec3::X, Vec3::Y),
+            ("-X", Vec3::NEG_X, Vec3::Y),
+            ("+Y", Vec3::Y, Vec3::Z),
+            ("-Y", Vec3::NEG_Y, Vec3::Z),
+            ("+Z", Vec3::Z, Vec3::Y),
+            ("-Z", Vec3::NEG_Z, Vec3::Y),
+        ],
+        Some(axis) => {
+            let right = axis.cross(up_hint(axis)).normalize();
+            let up = right.cross(axis);
+            vec![
+                ("front", axis, up),
+                ("right", right, up),
+                ("left", -right, up),
+                ("up", up, axis),
+                ("down", -up, axis),
+            ]
+        }
+    }
+}
+
+/// The decision for one light.
+fn decide(
+    light: &SceneLight,
+    receivers: &[[DVec3; 3]],
+    bounds: &Aabb,
+    settings: &PlanSettings,
+    dynamic_geometry: bool,
+) -> LightDecision {
+    use LightDecision::NoPass;
+    if !light.casts_shadows {
+        return NoPass(NoPassReason::CastsNoShadows);
+    }
+    if light.intensity == 0.0 || light.color == Vec3::ZERO {
+        return NoPass(NoPassReason::EmitsNothing);
+    }
+    if receivers.is_empty() {
+        return NoPass(NoPassReason::NothingInView);
+    }
+    let (position, range, cone) = match light.kind {
+        LightKind::Directional { direction } => {
+            let view_proj = DirectionalLight { direction }.view_proj(bounds);
+            let frustum = ShadowFrustum {
+                label: "whole".into(),
+                light: Light::Directional {
+                    direction,
+                    view_proj,
+                },
+            };
+            return shadowed(light, settings, dynamic_geometry, vec![frustum], Vec::new());
+        }
+        LightKind::Spot {
+            position,
+            direction,
+            outer_cone,
+            range,
+            ..
+        } => (position, range, Some((direction, outer_cone))),
+        LightKind::Point { position, range } => (position, range, None),
+    };
+    let reach = Reach {
+        position: position.as_dvec3(),
+        range: range.map(f64::from),
+        cone: cone.map(|(axis, angle)| Cone {
+            axis: axis.as_dvec3(),
+            half_angle: f64::from(angle),
+            enclosing: (angle < std::f32::consts::FRAC_PI_2).then(|| {
+                Pyramid::new(
+                    position,
+                    axis,
+                    up_hint(axis),
+                    angle.tan() * FRUSTUM_WIDENING,
+                )
+            }),
+        }),
+    };
+    let reached: Vec<&[DVec3; 3]> = receivers.iter().filter(|t| reach.touches(t)).collect();
+    if reached.is_empty() {
+        return NoPass(NoPassReason::OutOfReach);
+    }
+    let depths = depth_range(position, bounds, range);
+    if let Some((axis, outer_cone)) = cone.filter(|&(_, a)| a <= MAX_SPOT_FRUSTUM_HALF_ANGLE) {
+        let tan_half = outer_cone.tan() * FRUSTUM_WIDENING;
+        let (frustum, _) = perspective_frustum(position, axis, up_hint(axis), tan_half, depths);
+        let whole = ShadowFrustum {
+            label: "whole".into(),
+            light: frustum,
+        };
+        return shadowed(light, settings, dynamic_geometry, vec![whole], Vec::new());
+    }
+    let mut frusta = Vec::new();
+    let mut culled_faces = Vec::new();
+    for (label, forward, up) in cube_faces(cone.map(|(axis, _)| axis)) {
+        let (frustum, pyramid) =
+            perspective_frustum(position, forward, up, FRUSTUM_WIDENING, depths);
+        if reached.iter().any(|t| pyramid.touches(t)) {
+            frusta.push(ShadowFrustum {
+                label: label.into(),
+                light: frustum,
+            });
+        } else {
+            culled_faces.push(label.to_owned());
+        }
+    }
+    if frusta.is_empty() {
+        return NoPass(NoPassReason::OutOfReach);
+    }
+    shadowed(light, settings, dynamic_geometry, frusta, culled_faces)
+}
+
+/// A shadowed light: its configuration from the settings' base and the light's size and flags.
+fn shadowed(
+    light: &SceneLight,
+    settings: &PlanSettings,
+    dynamic_geometry: bool,
+    frusta: Vec<ShadowFrustum>,
+    culled_faces: Vec<String>,
+) -> LightDecision {
+    let mut config = settings.base;
+    config.static_geometry = !dynamic_geometry;
+    config.static_light = light.is_static;
+    match light.size {
+        LightSize::Zero => config.mode = ShadowMode::Hard,
+        LightSize::AngularRadius(a) => {
+            config.mode = ShadowMode::Hybrid;
+            config.pcss.angular_radius = a;
+        }
+        LightSize::Radius(r) => {
+            config.mode = ShadowMode::Hybrid;
+            config.pcss.spot_radius = r;
+        }
+    }
+    if !matches!(light.kind, LightKind::Directional { .. }) {
+        // A front-only primitive map needs a directional light.
+        config.map.faces = FaceMode::Both;
+    }
+    LightDecision::Shadowed(Box::new(ShadowedLight {
+        config,
+        frame_plan: FramePlan::derive(config.plan_request()),
+        frusta,
+        culled_faces,
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use passes::PassId;
+    use scene::Scene;
+
+    /// A 10 m ground square at y = 0 and a 1 m box on it at the origin, both static.
+    fn ground_and_box(lights: Vec<SceneLight>) -> SceneFile {
+        let mut scene = Scene::axis_box(
+            "ground",
+            Vec3::new(-5.0, -0.1, -5.0),
+            Vec3::new(5.0, 0.0, 5.0),
+        );
+        scene.append(&Scene::axis_box(
+            "box",
+            Vec3::new(-0.5, 0.0, -0.5),
+            Vec3::new(0.5, 1.0, 0.5),
+        ));
+        SceneFile {
+            static_objects: vec![true; scene.objects.len()],
+            scene,
+            lights,
+            camera: Some(Camera {
+                position: Vec3::new(4.0, 4.0, 6.0),
+                target: Vec3::ZERO,
+                up: Vec3::Y,
+                fov_y_radians: 0.8,
+                near: 0.05,
+            }),
+            skipped_primitives: 0,
+        }
+    }
+
+    fn light(name: &str, kind: LightKind, size: LightSize) -> SceneLight {
+        let light = SceneLight {
+            name: name.into(),
+            kind,
+            color: Vec3::ONE,
+            intensity: 1.0,
+            size,
+            casts_shadows: true,
+            is_static: true,
+        };
+        light.validate().expect("valid test light");
+        light
+    }
+
+    fn sun(size: LightSize) -> SceneLight {
+        light(
+            "sun",
+            LightKind::Directional {
+                direction: Vec3::new(0.3, -1.0, 0.2).normalize(),
+            },
+            size,
+        )
+    }
+
+    fn spot(position: Vec3, direction: Vec3, outer_cone: f32, range: Option<f32>) -> SceneLight {
+        light(
+            "spot",
+            LightKind::Spot {
+                position,
+                direction: direction.normalize(),
+                inner_cone: outer_cone * 0.5,
+                outer_cone,
+                range,
+            },
+            LightSize::Radius(0.05),
+        )
+    }
+
+    fn settings() -> PlanSettings {
+        PlanSettings {
+            base: ShadowConfig::default(),
+            width: 160,
+            height: 120,
+        }
+    }
+
+    fn plan(file: &SceneFile) -> ScenePlan {
+        plan_scene(file, &file.camera.expect("camera"), &settings()).expect("plan")
+    }
+
+    fn only(file: SceneFile) -> LightPlan {
+        let mut p = plan(&file);
+        assert_eq!(p.lights.len(), 1);
+        p.lights.remove(0)
+    }
+
+    #[test]
+    fn a_zero_size_light_gets_hard_shadows_without_shadow_map_or_pcss() {
+        let p = only(ground_and_box(vec![sun(LightSize::Zero)]));
+        let s = p.shadowed().expect("shadowed");
+        assert_eq!(s.config.mode, ShadowMode::Hard);
+        assert_eq!(s.frusta.len(), 1);
+        assert!(matches!(s.frusta[0].light, Light::Directional { .. }));
+        for r in [ResourceId::ShadowMap, ResourceId::Pcss] {
+            assert!(!s.frame_plan.resources().contains(r), "{r:?}");
+        }
+        assert!(!s.frame_plan.runs(PassId::ShadowMap) && !s.frame_plan.runs(PassId::Pcss));
+        assert!(s.frame_plan.runs(PassId::RayTrace));
+        assert!(p.describe_decision().starts_with("hard"));
+    }
+
+    #[test]
+    fn a_sized_light_gets_the_hybrid_with_its_size() {
+        let p = only(ground_and_box(vec![sun(LightSize::AngularRadius(0.03))]));
+        let s = p.shadowed().expect("shadowed");
+        assert_eq!(s.config.mode, ShadowMode::Hybrid);
+        assert_eq!(s.config.pcss.angular_radius, 0.03);
+        assert!(s.frame_plan.runs(PassId::ShadowMap) && s.frame_plan.runs(PassId::Blend));
+        let p = only(ground_and_box(vec![spot(
+            Vec3::new(0.0, 4.0, 0.0),
+            Vec3::NEG_Y,
+            0.5,
+            Some(10.0),
+        )]));
+        let s = p.shadowed().expect("shadowed");
+        assert_eq!(s.config.mode, ShadowMode::Hybrid);
+        assert_eq!(s.config.pcss.spot_radius, 0.05);
+        assert_eq!(s.config.map.faces, FaceMode::Both);
+        assert_eq!(s.frusta.len(), 1);
+        let Light::Spot {
+            position,
+            direction,
+            view_proj,
+        } = s.frusta[0].light
+        else {
+            panic!("a spot frustum")
+        };
+        assert_eq!(position, Vec3::new(0.0, 4.0, 0.0));
+        assert_eq!(direction, Vec3::NEG_Y);
+        // The frustum holds the cone: a point on the cone's edge projects inside, just.
+        let edge = position + Vec3::new(0.5f32.tan(), -1.0, 0.0) * 2.0;
+        let ndc = view_proj.project_point3(edge);
+        assert!(ndc.x.abs().max(ndc.y.abs()) < 1.0 && ndc.x.abs().max(ndc.y.abs()) > 0.98);
+        assert!((0.0..1.0).contains(&ndc.z));
+    }
+
+    #[test]
+    fn a_light_without_shadows_or_emission_gets_no_pass() {
+        let dark = SceneLight {
+            casts_shadows: false,
+            ..sun(LightSize::Zero)
+        };
+        let p = only(ground_and_box(vec![dark]));
+        assert_eq!(
+            p.decision,
+            LightDecision::NoPass(NoPassReason::CastsNoShadows)
+        );
+        assert!(p.describe_decision().contains("visibility 1"));
+        let black = SceneLight {
+            color: Vec3::ZERO,
+            ..sun(LightSize::Zero)
+        };
+        let p = only(ground_and_box(vec![black]));
+        assert_eq!(
+            p.decision,
+            LightDecision::NoPass(NoPassReason::EmitsNothing)
+        );
+    }
+
+    #[test]
+    fn a_spot_light_missing_every_receiver_gets_no_pass() {
+        // Pointing at the sky.
+        let away = spot(Vec3::new(0.0, 3.0, 0.0), Vec3::Y, 0.4, None);
+        let p = only(ground_and_box(vec![away]));
+        assert_eq!(p.decision, LightDecision::NoPass(NoPassReason::OutOfReach));
+        // Pointing down, but its range ends 1 m short of the box.
+        let short = spot(Vec3::new(0.0, 3.0, 0.0), Vec3::NEG_Y, 0.4, Some(1.0));
+        let p = only(ground_and_box(vec![short]));
+        assert_eq!(p.decision, LightDecision::NoPass(NoPassReason::OutOfReach));
+        // Pointing at ground out of view (behind the camera).
+        let behind = spot(Vec3::new(4.0, 3.0, 30.0), Vec3::NEG_Y, 0.2, None);
+        let mut file = ground_and_box(vec![behind]);
+        file.scene.append(&Scene::axis_box(
+            "far ground",
+            Vec3::new(0.0, -0.1, 25.0),
+            Vec3::new(8.0, 0.0, 35.0),
+        ));
+        file.static_objects.push(true);
+        let p = only(file);
+        assert_eq!(p.decision, LightDecision::NoPass(NoPassReason::OutOfReach));
+        // Reaching the box: shadowed.
+        let reaching = spot(Vec3::new(0.0, 3.0, 0.0), Vec3::NEG_Y, 0.4, Some(2.5));
+        assert!(only(ground_and_box(vec![reaching])).shadowed().is_some());
+    }
+
+    #[test]
+    fn a_camera_looking_away_leaves_nothing_in_view() {
+        let mut file = ground_and_box(vec![sun(LightSize::Zero)]);
+        let camera = Camera {
+            position: Vec3::new(0.0, 2.0, 0.0),
+            target: Vec3::new(0.0, 3.0, 0.0),
+            up: Vec3::Z,
+            ..file.camera.expect("camera")
+        };
+        file.camera = Some(camera);
+        let p = plan(&file);
+        assert_eq!(p.receivers_in_view, 0);
+        assert_eq!(
+            p.lights[0].decision,
+            LightDecision::NoPass(NoPassReason::NothingInView)
+        );
+        assert!(p.plugin_lights().is_empty());
+    }
+
+    #[test]
+    fn a_point_light_is_shadowed_through_the_faces_its_receivers_need() {
+        let lamp = light(
+            "lamp",
+            LightKind::Point {
+                position: Vec3::new(2.0, 1.5, 2.0),
+                range: Some(20.0),
+            },
+            LightSize::Radius(0.1),
+        );
+        let p = only(ground_and_box(vec![lamp]));
+        let s = p.shadowed().expect("shadowed");
+        let labels: Vec<&str> = s.frusta.iter().map(|f| f.label.as_str()).collect();
+        // Nothing lies above the lamp: no +Y face.
+        assert_eq!(labels, ["+X", "-X", "-Y", "+Z", "-Z"]);
+        assert_eq!(s.culled_faces, ["+Y"]);
+        assert_eq!(s.config.mode, ShadowMode::Hybrid);
+        assert_eq!(s.config.pcss.spot_radius, 0.1);
+        // A short range keeps only the faces that reach the ground and box within it.
+        let near_lamp = light(
+            "lamp",
+            LightKind::Point {
+                position: Vec3::new(0.0, 1.6, 0.0),
+                range: Some(0.7),
+            },
+            LightSize::Zero,
+        );
+        let p = only(ground_and_box(vec![near_lamp]));
+        let s = p.shadowed().expect("shadowed");
+        let labels: Vec<&str> = s.frusta.iter().map(|f| f.label.as_str()).collect();
+        assert_eq!(labels, ["-Y"]);
+        assert_eq!(s.config.mode, ShadowMode::Hard);
+    }
+
+    #[test]
+    fn cube_faces_cover_every_direction_inside_their_frusta() {
+        let lamp = light(
+            "lamp",
+            LightKind::Point {
+                position: Vec3::new(0.3, 2.0, -0.2),
+                range: None,
+            },
+            LightSize::Zero,
+        );
+        let bounds = ground_and_box(Vec::new()).scene.bounds();
+        let position = lamp.kind.position().expect("position");
+        let depths = depth_range(position, &bounds, None);
+        let faces: Vec<Light> = cube_faces(None)
+            .into_iter()
+            .map(|(_, f, up)| perspective_frustum(position, f, up, FRUSTUM_WIDENING, depths).0)
+            .collect();
+        let mut rng = scene::SplitMix64::new(7);
+        for _ in 0..2000 {
+            let d = Vec3::new(
+                rng.uniform_f32(-1.0, 1.0),
+                rng.uniform_f32(-1.0, 1.0),
+                rng.uniform_f32(-1.0, 1.0),
+            );
+            let Some(d) = d.try_normalize() else { continue };
+            let p = position + d * 1.5;
+            let inside = faces.iter().filter(|f| {
+                let c = f.view_proj() * p.extend(1.0);
+                c.w > 0.0 && c.x.abs() < c.w * 0.999 && c.y.abs() < c.w * 0.999
+            });
+            assert!(inside.count() >= 1, "direction {d} is in no face");
+        }
+        // A wide spot light: the front face and the four across its axis, no back face.
+        let wide = spot(Vec3::new(0.0, 3.0, 0.0), Vec3::NEG_Y, 1.3, None);
+        let p = only(ground_and_box(vec![wide]));
+        let s = p.shadowed().expect("shadowed");
+        let labels: Vec<&str> = s.frusta.iter().map(|f| f.label.as_str()).collect();
+        assert_eq!(labels, ["front", "right", "left", "up", "down"]);
+    }
+
+    #[test]
+    fn static_flags_decide_the_caching() {
+        let moving = SceneLight {
+            is_static: false,
+            ..sun(LightSize::Zero)
+        };
+        let mut file = ground_and_box(vec![sun(LightSize::Zero), moving]);
+        let p = plan(&file);
+        assert!(!p.dynamic_geometry && p.moving_objects.is_empty());
+        let configs = p.plugin_configs();
+        assert_eq!(configs.len(), 2);
+        assert!(configs[0].static_light && !configs[1].static_light);
+        assert!(configs.iter().all(|c| c.static_geometry));
+        file.static_objects[1] = false;
+        let p = plan(&file);
+        assert!(p.dynamic_geometry);
+        assert_eq!(p.moving_objects, ["box"]);
+        assert!(p.plugin_configs().iter().all(|c| !c.static_geometry));
+        assert!(p.describe().contains("dynamic (not static: box)"));
+        let p = plan(&held_still(&file));
+        assert!(!p.dynamic_geometry);
+        assert!(p
+            .plugin_configs()
+            .iter()
+            .all(|c| c.static_geometry && c.static_light));
+    }
+
+    #[test]
+    fn the_example_scene_plan() {
+        let dir = std::env::temp_dir().join(format!("hrts-plan-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let path = dir.join("example.gltf");
+        scene::gltf_scene::write_example_scene(&path).expect("write example");
+        let file = scene::load_gltf(&path).expect("load example");
+        let p = plan_scene(&file, &scene_camera(&file, 4.0 / 3.0), &settings()).expect("plan");
+        let decisions: Vec<(&str, Option<ShadowMode>, usize)> = p
+            .lights
+            .iter()
+            .map(|l| {
+                (
+                    l.light.name.as_str(),
+                    l.shadowed().map(|s| s.config.mode),
+                    l.shadowed().map_or(0, |s| s.frusta.len()),
+                )
+            })
+            .collect();
+        assert_eq!(
+            decisions,
+            [
+                ("sun", Some(ShadowMode::Hybrid), 1),
+                ("rim", Some(ShadowMode::Hard), 1),
+                ("spot", Some(ShadowMode::Hybrid), 1),
+                ("fill", None, 0),
+                ("cart_lamp", Some(ShadowMode::Hybrid), 5),
+            ]
+        );
+        assert!(p.dynamic_geometry);
+        assert_eq!(p.plugin_lights().len(), 8);
+        let text = p.describe();
+        assert!(text.contains("fill: point"), "{text}");
+        assert!(text.contains("no pass (casts no shadows)"), "{text}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn closest_points_on_triangles() {
+        let t = [DVec3::ZERO, DVec3::X * 2.0, DVec3::Y * 2.0];
+        let cases = [
+            (DVec3::new(0.5, 0.5, 3.0), DVec3::new(0.5, 0.5, 0.0)),
+            (DVec3::new(-1.0, -1.0, 0.0), DVec3::ZERO),
+            (DVec3::new(3.0, -1.0, 1.0), DVec3::X * 2.0),
+            (DVec3::new(1.0, -2.0, 0.0), DVec3::X),
+            (DVec3::new(-2.0, 1.0, 0.0), DVec3::Y),
+            (DVec3::new(2.0, 2.0, 0.0), DVec3::new(1.0, 1.0, 0.0)),
+        ];
+        for (p, expected) in cases {
+            let c = closest_point(p, &t);
+            assert!(c.abs_diff_eq(expected, 1e-12), "{p}: {c}");
+        }
+        // Against a dense sampling of the triangle.
+        let mut rng = scene::SplitMix64::new(3);
+        for _ in 0..200 {
+            let p = DVec3::new(
+                rng.uniform_f64(-3.0, 3.0),
+                rng.uniform_f64(-3.0, 3.0),
+                rng.uniform_f64(-3.0, 3.0),
+            );
+            let d = closest_point(p, &t).distance(p);
+            let mut sampled = f64::INFINITY;
+            for i in 0..=100 {
+                for j in 0..=(100 - i) {
+                    let q = t[1] * (f64::from(i) / 100.0) + t[2] * (f64::from(j) / 100.0);
+                    sampled = sampled.min(q.distance(p));
+                }
+            }
+            assert!(
+                d <= sampled + 1e-12 && sampled - d < 0.03,
+                "{p}: {d} vs {sampled}"
+            );
+        }
+        // Degenerate triangles: a point, and a segment seen from beside its middle.
+        let point = [DVec3::ZERO, DVec3::ZERO, DVec3::ZERO];
+        assert_eq!(closest_point(DVec3::ONE, &point), DVec3::ZERO);
+        let segment = [DVec3::ZERO, DVec3::X * 4.0, DVec3::X * 2.0];
+        let c = closest_point(DVec3::new(1.0, 1.0, 0.0), &segment);
+        assert!(c.abs_diff_eq(DVec3::X, 1e-12), "{c}");
+    }
+
+    #[test]
+    fn more_frusta_than_the_plugin_shades_is_an_error() {
+        let lamps: Vec<SceneLight> = (0..4)
+            .map(|i| {
+                light(
+                    &format!("lamp{i}"),
+                    LightKind::Point {
+                        position: Vec3::new(i as f32 - 1.5, 0.5, 1.5),
+                        range: None,
+                    },
+                    LightSize::Zero,
+                )
+            })
+            .collect();
+        let file = ground_and_box(lamps);
+        let error = plan_scene(&file, &file.camera.expect("camera"), &settings())
+            .expect_err("too many frusta")
+            .to_string();
+        assert!(error.contains("at most 16"), "{error}");
+        let mut mismatched = ground_and_box(Vec::new());
+        mismatched.static_objects.pop();
+        assert!(plan_scene(
+            &mismatched,
+            &mismatched.camera.expect("camera"),
+            &settings()
+        )
+        .is_err());
+    }
+}

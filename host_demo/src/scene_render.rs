@@ -1,0 +1,478 @@
+//! `host_demo render --scene`: a glTF scene's lights through the plugin's C ABI as the scene's plan
+//! ([`crate::scene_plan`]) says, each frustum one light of the plugin, the shaded image and every light's
+//! visibility, and per frame and light what ran, what was reused and why, and the memory it holds.
+
+use crate::output::{write_exr_rgba, write_exr_scalar, write_png};
+use crate::plugin::{LightFrameReport, LightsFrame, PluginRenderer};
+use crate::scene_plan::{plan_scene, PlanSettings, ScenePlan};
+use crate::shading::{shade, tone_map};
+use crate::{CameraMatrices, FrameImages};
+use anyhow::{Context, Result};
+use glam::Vec3;
+use passes::{PassId, PassStatus, ResourceId, SkipReason};
+use rhi::Device;
+use scene::{Camera, SceneFile};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Linear radiance of the background of the shaded image (a pale blue sky once tone mapped).
+const SKY_RADIANCE: Vec3 = Vec3::new(0.35, 0.5, 0.8);
+
+/// A scene's frames through the plugin.
+pub struct SceneRenderer {
+    plugin: PluginRenderer,
+    width: u32,
+    height: u32,
+}
+
+/// A frame read back: the G-buffer and the visibility of every light.
+#[derive(Debug, Clone, Default)]
+pub struct SceneImages {
+    /// The demo's G-buffer (position, normal, depth).
+    pub gbuffer: FrameImages,
+    /// Per scene light: the minimum over its frusta's visibilities, or 1 everywhere for a light without
+    /// a pass.
+    pub visibility: Vec<Vec<f32>>,
+    /// Per plugin light (frustum): its layer of the visibility image.
+    pub frusta: Vec<Vec<f32>>,
+}
+
+impl SceneRenderer {
+    /// Uploads `file`'s scene and creates the G-buffer and a plugin context for a `width` x `height`
+    /// frame; the geometry is dynamic if any object is not static.
+    pub fn new(device: &Device, file: &SceneFile, width: u32, height: u32) -> Result<Self> {
+        let dynamic_geometry = file.static_objects.iter().any(|&s| !s);
+        let plugin =
+            PluginRenderer::for_scene(device, &file.scene, width, height, dynamic_geometry)?;
+        Ok(Self {
+            plugin,
+            width,
+            height,
+        })
+    }
+
+    /// The plugin driver.
+    pub fn plugin(&self) -> &PluginRenderer {
+        &self.plugin
+    }
+
+    /// Renders one frame of `plan` seen through `camera`: configures the plugin with the plan's frusta
+    /// (unchanged lights keep their passes) and records them. Returns the plugin's report per frustum.
+    pub fn render(
+        &mut self,
+        device: &Device,
+        camera: &Camera,
+        plan: &ScenePlan,
+    ) -> Result<LightsFrame> {
+        self.plugin
+            .configure_lights(device, &plan.plugin_configs())?;
+        self.plugin.render_lights(
+            device,
+            &CameraMatrices::of_camera(camera, self.width, self.height),
+            &plan.plugin_frame_lights(),
+        )
+    }
+
+    /// Reads back the last frame: the G-buffer, every frustum's visibility and every scene light's
+    /// visibility (the minimum over its frusta: the plugin counts pixels outside a frustum as lit).
+    pub fn read_back(&self, device: &Device, plan: &ScenePlan) -> Result<SceneImages> {
+        let (gbuffer, frusta) = self.plugin.read_frame(device)?;
+        let pixels = self.width as usize * self.height as usize;
+        let mut visibility = vec![vec![1.0f32; pixels]; plan.lights.len()];
+        for (light, layer) in plan.plugin_lights().iter().zip(&frusta) {
+            for (v, &f) in visibility[light.scene_light].iter_mut().zip(layer) {
+                *v = v.min(f);
+            }
+        }
+        Ok(SceneImages {
+            gbuffer,
+            visibility,
+            frusta,
+        })
+    }
+}
+
+/// The C name of a pass status in the report: `RAN`, `UP_TO_DATE`, `SHARED` or `NOT_IN_PLAN`.
+pub fn status_name(status: PassStatus) -> &'static str {
+    match status {
+        PassStatus::Ran => "RAN",
+        PassStatus::Skipped(SkipReason::UpToDate) => "UP_TO_DATE",
+        PassStatus::Skipped(SkipReason::Shared) => "SHARED",
+        PassStatus::Skipped(SkipReason::NotRequested) => "NOT_IN_PLAN",
+    }
+}
+
+/// Why a light's light-space passes ran or were reused this frame.
+fn light_space_reason(
+    report: &LightFrameReport,
+    built_now: bool,
+    static_light: bool,
+    dynamic_geometry: bool,
+) -> String {
+    if built_now {
+        return format!(
+            "passes built this frame (build {}): everything in the plan ran",
+            report.light_builds
+        );
+    }
+    let prims = match report.report.status(PassId::PrimBuffer) {
+        Some(PassStatus::Ran) => "prim buffer rebuilt by this light (dynamic geometry)",
+        Some(PassStatus::Skipped(SkipReason::Shared)) => {
+            "prim buffer rebuilt this frame by an earlier light (dynamic geometry)"
+        }
+        _ => "prim buffer reused (static geometry)",
+    };
+    let shadow_map = match report.report.status(PassId::ShadowMap) {
+        Some(PassStatus::Ran) if dynamic_geometry => "shadow map re-rendered: the geometry moves",
+        Some(PassStatus::Ran) if !static_light => "shadow map re-rendered: the light is not static",
+        Some(PassStatus::Ran) => "shadow map re-rendered: the light changed",
+        Some(PassStatus::Skipped(SkipReason::UpToDate)) => {
+            "shadow map reused: a static light over static geometry, unchanged since it ran"
+        }
+        _ => "no shadow map in the plan",
+    };
+    format!("{prims}; {shadow_map}; the primitive map is refitted to the view every frame")
+}
+
+/// `bytes` in KiB or MiB.
+fn size(bytes: u64) -> String {
+    if bytes < 1 << 20 {
+        format!("{:.1} KiB", bytes as f64 / 1024.0)
+    } else {
+        format!("{:.2} MiB", bytes as f64 / f64::from(1 << 20))
+    }
+}
+
+/// What a frame did, per light, as text: for each light what the plan gave it and the memory it holds,
+/// and for each of its frusta the pass statuses, how many times its passes were built, why its
+/// light-space passes ran or were reused, and the memory of each resource; lights without a pass say so.
+/// `previous` is the frame before (its builds tell which lights were rebuilt).
+pub fn describe_frame(
+    plan: &ScenePlan,
+    frame: &LightsFrame,
+    previous: Option<&LightsFrame>,
+) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "frame {}: per light (pass statuses RAN / UP_TO_DATE / SHARED / NOT_IN_PLAN)",
+        frame.frame_index
+    );
+    let plugin_lights = plan.plugin_lights();
+    let own_bytes = |report: &LightFrameReport| -> u64 {
+        report
+            .report
+            .resources
+            .iter()
+            .filter(|r| r.resource != ResourceId::PrimBuffer)
+            .map(|r| r.bytes)
+            .sum()
+    };
+    for (i, light) in plan.lights.iter().enumerate() {
+        let mine: Vec<(usize, &LightFrameReport)> = frame
+            .lights
+            .iter()
+            .enumerate()
+            .filter(|&(k, _)| plugin_lights.get(k).is_some_and(|l| l.scene_light == i))
+            .collect();
+        let Some(shadowed) = light.shadowed() else {
+            let _ = writeln!(
+                s,
+                "  {}: {}; holds nothing",
+                light.light.name,
+                light.describe_decision()
+            );
+            continue;
+        };
+        let total: u64 = mine.iter().map(|(_, r)| own_bytes(r)).sum();
+        let _ = writeln!(
+            s,
+            "  {}: {}, {} frust{}, holds {}",
+            light.light.name,
+            shadowed.config.mode.name(),
+            mine.len(),
+            if mine.len() == 1 { "um" } else { "a" },
+            size(total)
+        );
+        for (k, report) in mine {
+            let pl = &plugin_lights[k];
+            let built_now = previous
+                .and_then(|p| p.lights.get(k))
+                .is_none_or(|p| p.light_builds != report.light_builds);
+            let _ = writeln!(
+                s,
+                "    {} (plugin light {k}): passes built {} time{}",
+                pl.frustum.label,
+                report.light_builds,
+                if report.light_builds == 1 { "" } else { "s" }
+            );
+            let mut by_status: BTreeMap<&str, Vec<&str>> = BTreeMap::new();
+            for &(pass, status) in &report.report.passes {
+                by_status
+                    .entry(status_name(status))
+                    .or_default()
+                    .push(pass.name());
+            }
+            // The output copy (a pass of the C ABI only) ends every frame of a light.
+            by_status.entry("RAN").or_default().push("output copy");
+            for name in ["RAN", "UP_TO_DATE", "SHARED", "NOT_IN_PLAN"] {
+                if let Some(passes) = by_status.get(name) {
+                    let _ = writeln!(s, "      {name:<11} {}", passes.join(", "));
+                }
+            }
+            let _ = writeln!(
+                s,
+                "      why: {}",
+                light_space_reason(
+                    report,
+                    built_now,
+                    pl.config.static_light,
+                    !pl.config.static_geometry
+                )
+            );
+            let resources: Vec<String> = report
+                .report
+                .resources
+                .iter()
+                .filter(|r| r.resource != ResourceId::PrimBuffer)
+                .map(|r| format!("{} {}", r.resource.name(), size(r.bytes)))
+                .collect();
+            let _ = writeln!(
+                s,
+                "      memory {}: {}",
+                size(own_bytes(report)),
+                resources.join(", ")
+            );
+        }
+    }
+    let shared = frame.lights.iter().find_map(|r| {
+        r.report
+            .resources
+            .iter()
+            .find(|r| r.resource == ResourceId::PrimBuffer)
+    });
+    if let Some(prims) = shared {
+        let _ = writeln!(
+            s,
+            "  shared by the lights: prim buffer {}",
+            size(prims.bytes)
+        );
+    }
+    s
+}
+
+#[derive(Serialize)]
+struct LightJson {
+    name: String,
+    decision: String,
+    frusta: Vec<String>,
+    visibility_png: String,
+    visibility_exr: String,
+}
+
+#[derive(Serialize)]
+struct FrustumReportJson {
+    scene_light: String,
+    frustum: String,
+    mode: &'static str,
+    light_builds: u32,
+    pass_status: BTreeMap<&'static str, &'static str>,
+    resource_bytes: BTreeMap<&'static str, u64>,
+}
+
+#[derive(Serialize)]
+struct FrameReportJson {
+    frame_index: u64,
+    lights: Vec<FrustumReportJson>,
+}
+
+#[derive(Serialize)]
+struct SceneJson {
+    scene: String,
+    width: u32,
+    height: u32,
+    dynamic_geometry: bool,
+    plugin_lights: usize,
+    lights: Vec<LightJson>,
+    frames: Vec<FrameReportJson>,
+}
+
+/// A file name part of `name`: letters, digits, `_` and `-` kept, anything else `_`.
+fn file_part(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// The file names (PNG, EXR) of light `index`'s visibility.
+pub fn visibility_file_names(index: usize, name: &str) -> (String, String) {
+    let stem = format!("visibility_{index}_{}", file_part(name));
+    (format!("{stem}.png"), format!("{stem}.exr"))
+}
+
+/// Plans `file` (from `source`, for messages) seen through `camera`, renders `frames` frames, prints
+/// the plan and each frame's per-light report, and writes into `out`: `shaded.png` and `shaded.exr`
+/// (linear radiance), each light's visibility (`visibility_<i>_<name>.png` and `.exr`) and
+/// `scene_report.json`.
+pub fn render_scene_to_folder(
+    device: &Device,
+    file: &SceneFile,
+    source: &Path,
+    camera: &Camera,
+    settings: &PlanSettings,
+    frames: u32,
+    out: &Path,
+) -> Result<()> {
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let plan = plan_scene(file, camera, settings)
+        .with_context(|| format!("planning {}", source.display()))?;
+    let caps = device.capabilities();
+    println!(
+        "device: {} ({}, {}); shadows through the plugin's C ABI, {}",
+        caps.device_name,
+        caps.device_type,
+        caps.driver,
+        crate::plugin::api_version()
+    );
+    println!(
+        "scene {}: {} triangles, {}x{} px",
+        source.display(),
+        file.scene.triangle_count(),
+        settings.width,
+        settings.height
+    );
+    print!("{}", plan.describe());
+    let mut renderer = SceneRenderer::new(device, file, settings.width, settings.height)
+        .context("creating the renderer")?;
+    let mut reports: Vec<LightsFrame> = Vec::new();
+    for _ in 0..frames {
+        let frame = renderer
+            .render(device, camera, &plan)
+            .context("rendering")?;
+        print!("{}", describe_frame(&plan, &frame, reports.last()));
+        reports.push(frame);
+    }
+    let images = renderer.read_back(device, &plan).context("reading back")?;
+    let (w, h) = (settings.width, settings.height);
+    let radiance = shade(
+        &file.lights,
+        &images.visibility,
+        &images.gbuffer.position,
+        &images.gbuffer.normal,
+        SKY_RADIANCE,
+    );
+    write_png(&out.join("shaded.png"), w, h, &tone_map(&radiance))?;
+    let rgba: Vec<[f32; 4]> = radiance.iter().map(|c| c.extend(1.0).to_array()).collect();
+    write_exr_rgba(&out.join("shaded.exr"), w, h, &rgba)?;
+    let mut lights_json = Vec::new();
+    for (i, (light, visibility)) in plan.lights.iter().zip(&images.visibility).enumerate() {
+        let (png_name, exr_name) = visibility_file_names(i, &light.light.name);
+        let grey: Vec<[u8; 4]> = visibility
+            .iter()
+            .map(|&v| {
+                let g = (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+                [g, g, g, 255]
+            })
+            .collect();
+        write_png(&out.join(&png_name), w, h, &grey)?;
+        write_exr_scalar(&out.join(&exr_name), w, h, visibility)?;
+        lights_json.push(LightJson {
+            name: light.light.name.clone(),
+            decision: light.describe_decision(),
+            frusta: light
+                .shadowed()
+                .map(|s| s.frusta.iter().map(|f| f.label.clone()).collect())
+                .unwrap_or_default(),
+            visibility_png: png_name,
+            visibility_exr: exr_name,
+        });
+    }
+    let plugin_lights = plan.plugin_lights();
+    let frames_json = reports
+        .iter()
+        .map(|frame| FrameReportJson {
+            frame_index: frame.frame_index,
+            lights: frame
+                .lights
+                .iter()
+                .zip(&plugin_lights)
+                .map(|(report, pl)| FrustumReportJson {
+                    scene_light: plan.lights[pl.scene_light].light.name.clone(),
+                    frustum: pl.frustum.label.clone(),
+                    mode: pl.config.mode.name(),
+                    light_builds: report.light_builds,
+                    pass_status: report
+                        .report
+                        .passes
+                        .iter()
+                        .map(|&(p, st)| (p.name(), status_name(st)))
+                        .collect(),
+                    resource_bytes: report
+                        .report
+                        .resources
+                        .iter()
+                        .map(|r| (r.resource.name(), r.bytes))
+                        .collect(),
+                })
+                .collect(),
+        })
+        .collect();
+    let json = SceneJson {
+        scene: source.display().to_string(),
+        width: w,
+        height: h,
+        dynamic_geometry: plan.dynamic_geometry,
+        plugin_lights: plugin_lights.len(),
+        lights: lights_json,
+        frames: frames_json,
+    };
+    let text = serde_json::to_string_pretty(&json)?;
+    std::fs::write(out.join("scene_report.json"), text)
+        .with_context(|| format!("writing {}/scene_report.json", out.display()))?;
+    println!(
+        "outputs in {}: shaded.png, shaded.exr, scene_report.json, visibility_<light>_<name>.png/.exr",
+        out.display()
+    );
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn file_names_are_safe() {
+        assert_eq!(
+            visibility_file_names(3, "cart lamp/1"),
+            (
+                "visibility_3_cart_lamp_1.png".to_owned(),
+                "visibility_3_cart_lamp_1.exr".to_owned()
+            )
+        );
+    }
+
+    #[test]
+    fn status_names_are_the_c_names() {
+        assert_eq!(status_name(PassStatus::Ran), "RAN");
+        assert_eq!(
+            status_name(PassStatus::Skipped(SkipReason::UpToDate)),
+            "UP_TO_DATE"
+        );
+        assert_eq!(
+            status_name(PassStatus::Skipped(SkipReason::Shared)),
+            "SHARED"
+        );
+        assert_eq!(
+            status_name(PassStatus::Skipped(SkipReason::NotRequested)),
+            "NOT_IN_PLAN"
+        );
+    }
+}

@@ -1,0 +1,401 @@
+//! A glTF scene's lights through the plugin, as the scene's plan says (`host_demo::scene_plan`), on
+//! lavapipe: every shadowed light against the exact reference (a point light as the minimum over its cube
+//! faces), a scene whose lights need nothing records no plugin pass, and changing one light reruns only
+//! that light's passes.
+
+mod common;
+
+use common::{
+    assert_no_validation_errors, compare_with_reference, device, scene_visibility_params,
+};
+use glam::Vec3;
+use host_demo::plugin::{LightFrameReport, LightsFrame};
+use host_demo::scene_plan::{
+    plan_scene, scene_camera, LightDecision, NoPassReason, PlanSettings, ScenePlan,
+};
+use host_demo::scene_render::SceneRenderer;
+use passes::{
+    PassId, PassStatus, PrimitiveMapConfig, ResourceId, ShadowConfig, ShadowMapConfig, ShadowMode,
+    SkipReason,
+};
+use reference::{reference_visibility, RefScene};
+use rhi::Device;
+use scene::{Camera, LightKind, LightSize, SceneFile, SceneLight};
+use std::path::PathBuf;
+
+const WIDTH: u32 = 160;
+const HEIGHT: u32 = 120;
+
+/// The example scene of the `scene` crate (five lights: a sized sun, a zero-size rim light, a sized spot
+/// light, a fill light casting no shadows, a moving sized point lamp), written and loaded.
+fn example() -> SceneFile {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("scene_lights");
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join(format!("example-{}.gltf", std::process::id()));
+    scene::gltf_scene::write_example_scene(&path).expect("write the example");
+    let file = scene::load_gltf(&path).expect("load the example");
+    let _ = std::fs::remove_file(&path);
+    file
+}
+
+fn settings(antialiasing: bool) -> PlanSettings {
+    PlanSettings {
+        base: ShadowConfig {
+            antialiasing,
+            map: PrimitiveMapConfig {
+                size: 256,
+                ..PrimitiveMapConfig::default()
+            },
+            shadow_map: ShadowMapConfig {
+                size: 512,
+                ..ShadowMapConfig::default()
+            },
+            ..ShadowConfig::default()
+        },
+        width: WIDTH,
+        height: HEIGHT,
+    }
+}
+
+fn camera(file: &SceneFile) -> Camera {
+    scene_camera(file, WIDTH as f32 / HEIGHT as f32)
+}
+
+fn plan(file: &SceneFile, antialiasing: bool) -> ScenePlan {
+    plan_scene(file, &camera(file), &settings(antialiasing)).expect("plan")
+}
+
+/// Whether the light reaches `p` well inside its cone and range (pixels near the edge of its influence,
+/// where it gives almost no light, are not compared: a spot frustum ends just beyond the cone).
+fn well_inside_reach(light: &SceneLight, p: glam::DVec3) -> bool {
+    let within = |at: Vec3, range: Option<f32>| {
+        range.is_none_or(|r| p.distance(at.as_dvec3()) < f64::from(r) * 0.98)
+    };
+    match light.kind {
+        LightKind::Directional { .. } => true,
+        LightKind::Point { position, range } => within(position, range),
+        LightKind::Spot {
+            position,
+            direction,
+            outer_cone,
+            range,
+            ..
+        } => {
+            let to_p = (p - position.as_dvec3()).normalize();
+            within(position, range)
+                && to_p.dot(direction.as_dvec3()).acos() < f64::from(outer_cone) * 0.98
+        }
+    }
+}
+
+/// Every shadowed light of the example (a sized sun, a zero-size rim light, a sized spot light, a point
+/// lamp through five cube faces) matches the exact shadow: its ray-traced visibility (the minimum over the
+/// lamp's faces) has no mismatch outside near-edge pixels. Hard lights without FXAA write exactly that to
+/// their layer of the output; the fill light, casting no shadows, gets no pass and visibility 1.
+#[test]
+fn every_light_of_the_example_matches_the_exact_reference() {
+    let device = device();
+    let file = example();
+    let plan = plan(&file, false);
+    let plugin_lights = plan.plugin_lights();
+    assert_eq!(plugin_lights.len(), 8, "{}", plan.describe());
+    let mut renderer = SceneRenderer::new(&device, &file, WIDTH, HEIGHT).expect("renderer");
+    let frame = renderer
+        .render(&device, &camera(&file), &plan)
+        .expect("frame");
+    assert_eq!(frame.lights.len(), 8);
+    let images = renderer.read_back(&device, &plan).expect("read back");
+    let rs = RefScene::new(&file.scene);
+    for (i, light) in plan.lights.iter().enumerate() {
+        let name = &light.light.name;
+        let Some(shadowed) = light.shadowed() else {
+            assert_eq!(
+                light.decision,
+                LightDecision::NoPass(NoPassReason::CastsNoShadows)
+            );
+            assert_eq!(name, "fill");
+            assert!(images.visibility[i].iter().all(|&v| v == 1.0));
+            continue;
+        };
+        let frusta: Vec<u32> = (0..plugin_lights.len() as u32)
+            .filter(|&k| plugin_lights[k as usize].scene_light == i)
+            .collect();
+        let mut traced = vec![1.0f32; (WIDTH * HEIGHT) as usize];
+        for &k in &frusta {
+            let light_images = renderer
+                .plugin()
+                .read_back_light(&device, k, false)
+                .expect("read back a frustum");
+            for (t, &v) in traced.iter_mut().zip(&light_images.visibility) {
+                *t = t.min(v);
+            }
+            let report = &frame.lights[k as usize].report;
+            let has = |r: ResourceId| report.resources.iter().any(|x| x.resource == r);
+            let sized = shadowed.config.mode == ShadowMode::Hybrid;
+            assert_eq!(has(ResourceId::ShadowMap), sized, "{name}: shadow map");
+            assert_eq!(has(ResourceId::Pcss), sized, "{name}: PCSS");
+            assert!(has(ResourceId::PrimListEntries), "{name}: primitive map");
+            if !sized {
+                // Exact hard shadows: the output is the ray trace itself.
+                assert_eq!(images.frusta[k as usize], light_images.visibility, "{name}");
+            }
+        }
+        let reference_light = match light.light.kind {
+            LightKind::Directional { direction } => reference::Light::Directional {
+                direction: direction.as_dvec3(),
+            },
+            LightKind::Spot { position, .. } | LightKind::Point { position, .. } => {
+                reference::Light::Point {
+                    position: position.as_dvec3(),
+                }
+            }
+        };
+        let params =
+            scene_visibility_params(&file.scene, &camera(&file), WIDTH, HEIGHT, reference_light);
+        let r = reference_visibility(&rs, &params);
+        let considered: Vec<bool> = r
+            .position
+            .iter()
+            .map(|p| !p.is_finite() || well_inside_reach(&light.light, *p))
+            .collect();
+        let c = compare_with_reference(&r, &traced, None, Some(&considered));
+        println!(
+            "{name} ({} frusta, {}): {} pixels compared, {} shadowed, {} near an edge, {} mismatches",
+            frusta.len(),
+            shadowed.config.mode.name(),
+            c.pixels,
+            c.shadowed,
+            c.near_edge,
+            c.mismatches
+        );
+        assert_eq!(c.non_finite, 0, "{name}");
+        assert_eq!(
+            c.mismatches, 0,
+            "{name}: mismatching pixels (x, y, exact, gpu): {:?}",
+            c.examples
+        );
+        // The rim light comes from behind the camera: its shadows are mostly hidden.
+        assert!(
+            c.shadowed >= 10,
+            "{name}: too few shadowed pixels to compare"
+        );
+        assert!(
+            c.near_edge * 20 < c.pixels,
+            "{name}: {} of {} pixels near an edge",
+            c.near_edge,
+            c.pixels
+        );
+        // The scene light's visibility is the minimum over its frusta of their outputs.
+        if shadowed.config.mode == ShadowMode::Hard {
+            assert_eq!(images.visibility[i], traced, "{name}");
+        }
+    }
+    assert_no_validation_errors(&device);
+}
+
+/// A scene whose lights need nothing (one casts no shadow, a spot light points at the sky, a sun emits
+/// nothing) gives the plugin no light: no plugin pass is recorded, and every visibility is 1.
+#[test]
+fn lights_that_need_nothing_get_no_pass() {
+    let device = device();
+    let mut file = example();
+    let fill = file
+        .lights
+        .iter()
+        .find(|l| l.name == "fill")
+        .cloned()
+        .expect("fill light");
+    let skyward = SceneLight {
+        name: "skyward".into(),
+        kind: LightKind::Spot {
+            position: Vec3::new(0.0, 3.0, 0.0),
+            direction: Vec3::Y,
+            inner_cone: 0.2,
+            outer_cone: 0.4,
+            range: Some(20.0),
+        },
+        color: Vec3::ONE,
+        intensity: 50.0,
+        size: LightSize::Radius(0.1),
+        casts_shadows: true,
+        is_static: true,
+    };
+    let dark_sun = SceneLight {
+        name: "dark sun".into(),
+        kind: LightKind::Directional {
+            direction: Vec3::NEG_Y,
+        },
+        intensity: 0.0,
+        size: LightSize::Zero,
+        ..skyward.clone()
+    };
+    file.lights = vec![fill, skyward, dark_sun];
+    let plan = plan(&file, true);
+    let reasons: Vec<LightDecision> = plan.lights.iter().map(|l| l.decision.clone()).collect();
+    assert_eq!(
+        reasons,
+        [
+            LightDecision::NoPass(NoPassReason::CastsNoShadows),
+            LightDecision::NoPass(NoPassReason::OutOfReach),
+            LightDecision::NoPass(NoPassReason::EmitsNothing),
+        ]
+    );
+    let mut renderer = SceneRenderer::new(&device, &file, WIDTH, HEIGHT).expect("renderer");
+    for _ in 0..2 {
+        let frame = renderer
+            .render(&device, &camera(&file), &plan)
+            .expect("frame");
+        assert!(frame.lights.is_empty());
+    }
+    assert_eq!(renderer.plugin().frames_with_plugin_passes(), 0);
+    let images = renderer.read_back(&device, &plan).expect("read back");
+    assert!(images.frusta.is_empty());
+    assert_eq!(images.visibility.len(), 3);
+    assert!(images.visibility.iter().flatten().all(|&v| v == 1.0));
+    // The G-buffer was drawn: the scene is in view.
+    assert!(images.gbuffer.normal.iter().any(|n| n[3] == 1.0));
+    assert_no_validation_errors(&device);
+}
+
+fn status(report: &LightFrameReport, pass: PassId) -> PassStatus {
+    report.report.status(pass).expect("every pass has a status")
+}
+
+/// The name and frustum of every plugin light of `plan`.
+fn labels(plan: &ScenePlan) -> Vec<String> {
+    plan.plugin_lights()
+        .iter()
+        .map(|l| {
+            format!(
+                "{}/{}",
+                plan.lights[l.scene_light].light.name, l.frustum.label
+            )
+        })
+        .collect()
+}
+
+/// Checks a frame after a change to the lights of `changed` (plugin lights): their builds are as in
+/// `builds`; every other light was not rebuilt, reused the prim buffer and, if static with a shadow map,
+/// its shadow map.
+fn assert_only_changed_reran(
+    plan: &ScenePlan,
+    frame: &LightsFrame,
+    before: &LightsFrame,
+    changed: &[usize],
+    what: &str,
+) {
+    let names = labels(plan);
+    for (k, (report, light)) in frame.lights.iter().zip(plan.plugin_lights()).enumerate() {
+        let name = &names[k];
+        let earlier = before.lights[k].light_builds;
+        assert_eq!(
+            status(report, PassId::PrimBuffer),
+            PassStatus::Skipped(SkipReason::UpToDate),
+            "{what}: {name}'s prim buffer (static geometry)"
+        );
+        if changed.contains(&k) {
+            continue;
+        }
+        assert_eq!(report.light_builds, earlier, "{what}: {name} was rebuilt");
+        let expected = match (light.config.mode, light.config.static_light) {
+            (ShadowMode::Hard, _) => PassStatus::Skipped(SkipReason::NotRequested),
+            (_, true) => PassStatus::Skipped(SkipReason::UpToDate),
+            (_, false) => PassStatus::Ran,
+        };
+        assert_eq!(
+            status(report, PassId::ShadowMap),
+            expected,
+            "{what}: {name}'s shadow map"
+        );
+    }
+}
+
+/// With static geometry, the second frame reuses every static light's light-space passes; changing one
+/// light's size rebuilds that light's passes only, and moving the moving lamp reruns only its own
+/// light-space passes: the others' stay up to date and are not rebuilt, and their visibility is unchanged.
+#[test]
+fn changing_one_light_reruns_only_its_passes() {
+    let device = device();
+    let mut file = example();
+    // The cart is parked: all geometry static. The lamp on it still counts as a moving light.
+    file.static_objects.iter_mut().for_each(|s| *s = true);
+    let camera = camera(&file);
+    let mut plan = plan(&file, true);
+    assert!(!plan.dynamic_geometry);
+    let mut renderer = SceneRenderer::new(&device, &file, WIDTH, HEIGHT).expect("renderer");
+    let render = |renderer: &mut SceneRenderer, device: &Device, plan: &ScenePlan| {
+        renderer.render(device, &camera, plan).expect("frame")
+    };
+    let first = render(&mut renderer, &device, &plan);
+    assert!(first.lights.iter().all(|l| l.light_builds == 1));
+    assert!(first
+        .lights
+        .iter()
+        .all(|l| status(l, PassId::ShadowMap) != PassStatus::Skipped(SkipReason::UpToDate)));
+    let second = render(&mut renderer, &device, &plan);
+    let lamp: Vec<usize> = labels(&plan)
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.starts_with("cart_lamp/"))
+        .map(|(k, _)| k)
+        .collect();
+    assert_eq!(lamp.len(), 5);
+    assert_only_changed_reran(&plan, &second, &first, &[], "second frame");
+    let still = renderer.read_back(&device, &plan).expect("read back");
+
+    // A larger spot light: only its passes are rebuilt.
+    let spot = file
+        .lights
+        .iter()
+        .position(|l| l.name == "spot")
+        .expect("spot");
+    file.lights[spot].size = LightSize::Radius(0.2);
+    plan = plan_scene(&file, &camera, &settings(true)).expect("plan");
+    let spot_k = labels(&plan)
+        .iter()
+        .position(|l| l == "spot/whole")
+        .expect("spot frustum");
+    let resized = render(&mut renderer, &device, &plan);
+    assert_eq!(resized.lights[spot_k].light_builds, 2);
+    assert_eq!(
+        status(&resized.lights[spot_k], PassId::ShadowMap),
+        PassStatus::Ran
+    );
+    assert_only_changed_reran(&plan, &resized, &second, &[spot_k], "spot resized");
+
+    // The lamp moves 20 cm: same faces, no rebuild, only its light-space passes rerun.
+    let cart_lamp = file
+        .lights
+        .iter()
+        .position(|l| l.name == "cart_lamp")
+        .expect("lamp");
+    let LightKind::Point { position, range } = file.lights[cart_lamp].kind else {
+        panic!("the cart lamp is a point light");
+    };
+    file.lights[cart_lamp].kind = LightKind::Point {
+        position: position + Vec3::new(0.2, 0.0, 0.0),
+        range,
+    };
+    let before_labels = labels(&plan);
+    plan = plan_scene(&file, &camera, &settings(true)).expect("plan");
+    assert_eq!(labels(&plan), before_labels, "the lamp keeps its faces");
+    let moved = render(&mut renderer, &device, &plan);
+    for &k in &lamp {
+        assert_eq!(moved.lights[k].light_builds, 1, "the lamp is not rebuilt");
+        assert_eq!(status(&moved.lights[k], PassId::ShadowMap), PassStatus::Ran);
+    }
+    assert_only_changed_reran(&plan, &moved, &resized, &lamp, "lamp moved");
+    assert_eq!(moved.lights[spot_k].light_builds, 2);
+    let after = renderer.read_back(&device, &plan).expect("read back");
+    for name in ["sun", "rim"] {
+        let i = file.lights.iter().position(|l| l.name == name).expect(name);
+        assert_eq!(after.visibility[i], still.visibility[i], "{name} changed");
+    }
+    let lamp_changed = after.visibility[cart_lamp]
+        .iter()
+        .zip(&still.visibility[cart_lamp])
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(lamp_changed > 0, "the lamp's shadows did not follow it");
+    assert_no_validation_errors(&device);
+}
