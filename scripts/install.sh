@@ -21,7 +21,7 @@ case "$profile" in
 esac
 cargo="${CARGO:-cargo}"
 
-# What `cargo rustc -p plugin_api --crate-type staticlib -- --print native-static-libs` prints: the system
+# What `cargo rustc -p hrts --crate-type staticlib -- --print native-static-libs` prints: the system
 # libraries that Rust's std and the dependencies use (the Vulkan loader is opened with dlopen at run time).
 # glslang is only a build dependency (the shaders are compiled into the library), so libhrts.a holds no
 # C++ code and needs no -lstdc++.
