@@ -205,6 +205,8 @@ struct FrameState {
     next: usize,
     /// Whether a recording of this frame has reset and attached the GPU timer.
     timer_started: bool,
+    /// Whether the frame's completion marker is recorded.
+    marked: bool,
 }
 
 /// What the ring keeps of one frame in flight: its GPU timer, the map state read back, and its schedule.
@@ -682,6 +684,11 @@ impl ShadowPipeline {
                 "frame index {index} does not follow the last frame begun ({last}): frame indices must increase"
             )));
         }
+        if index == u64::MAX {
+            return Err(PassError::InvalidConfig(
+                "frame index u64::MAX is reserved".into(),
+            ));
+        }
         let constants = self.constants(inputs)?;
         if let Some(open) = self.frame.take() {
             for &(pass, status) in &self.statuses[open.next..] {
@@ -737,6 +744,7 @@ impl ShadowPipeline {
             records_prims: claim == PrimBufferClaim::Record,
             next: 0,
             timer_started: false,
+            marked: false,
         });
         Ok(())
     }
@@ -762,9 +770,9 @@ impl ShadowPipeline {
     /// shadow-map test, PCSS); every image a pass writes is left in `UnorderedAccess` state (the shadow
     /// map in `ShaderResource`), [`ShadowPipeline::output`] included.
     ///
-    /// Contract: the previous frame's recordings have completed on the GPU (constants live in
-    /// host-visible buffers written here), and every recording is submitted: passes skipped as up to
-    /// date reuse what the recording that last ran them wrote.
+    /// Contract: the frames-in-flight rule of [`ShadowPipeline::begin_frame_at`] (constants go into the
+    /// command buffer; read-backs have one slot per frame in flight), and every recording is submitted:
+    /// passes skipped as up to date reuse what the recording that last ran them wrote.
     pub fn record_passes(
         &mut self,
         enc: &mut Encoder<'_>,
@@ -842,7 +850,7 @@ impl ShadowPipeline {
             frame.timer_started = true;
         }
         let Some(last) = last else {
-            return Ok(());
+            return self.mark_if_finished(enc, frame);
         };
         for &pass in &PassId::ALL[frame.next..=last as usize] {
             if runs(pass) {
@@ -855,16 +863,30 @@ impl ShadowPipeline {
             frame.next = pass as usize + 1;
         }
         self.flush_uav(enc);
-        if frame.next == PassId::ALL.len() {
-            // The frame's end: the GPU marks the slot with the frame, so a report can tell whether the
-            // frame has completed without a fence.
-            let marker = (frame.index + 1).to_le_bytes();
-            enc.update_buffer(&self.slots[frame.slot].completion, 0, &marker)?;
-            enc.barriers(&[Barrier::Global {
-                before: S::CopyDest,
-                after: S::HostRead,
-            }]);
+        self.mark_if_finished(enc, frame)
+    }
+
+    /// Once no pass of the frame is left to record, has the GPU mark the slot with the frame after
+    /// everything recorded before, so a report can tell whether the frame has completed without a fence.
+    fn mark_if_finished(
+        &mut self,
+        enc: &mut Encoder<'_>,
+        frame: &mut FrameState,
+    ) -> Result<(), PassError> {
+        let finished = self.statuses[frame.next..]
+            .iter()
+            .all(|&(_, s)| s != PassStatus::Ran);
+        if !finished || frame.marked {
+            return Ok(());
         }
+        frame.marked = true;
+        let marker = (frame.index + 1).to_le_bytes();
+        enc.barriers(&[Barrier::Full]);
+        enc.update_buffer(&self.slots[frame.slot].completion, 0, &marker)?;
+        enc.barriers(&[Barrier::Global {
+            before: S::CopyDest,
+            after: S::HostRead,
+        }]);
         Ok(())
     }
 
@@ -994,6 +1016,14 @@ impl ShadowPipeline {
     pub fn report(&self) -> Result<FrameReport, PassError> {
         let slot = self.slot_of(self.last_frame)?;
         let timings = slot.timer.resolve()?;
+        if !self
+            .last_frame
+            .is_some_and(|f| slot_completed(slot, f).unwrap_or(false))
+        {
+            return Err(PassError::InvalidConfig(
+                "the last frame has not completed: report after its submission finished".into(),
+            ));
+        }
         self.report_with(slot, timings)
     }
 
@@ -1129,10 +1159,7 @@ fn camera_relative(inputs: &FrameInputs) -> DMat4 {
 
 /// Whether the GPU has run frame `frame`'s recording in `slot` to its end (its completion marker).
 fn slot_completed(slot: &FrameSlot, frame: u64) -> Result<bool, PassError> {
-    let marker: [u8; 8] = slot.completion.read()?[..8]
-        .try_into()
-        .map_err(|_| PassError::InvalidConfig("frame completion marker".into()))?;
-    Ok(u64::from_le_bytes(marker) == frame + 1)
+    Ok(slot.completion.read_u64_volatile(0)? == frame.wrapping_add(1))
 }
 
 /// Fills the lit image (mode none) with 1 and leaves it in `UnorderedAccess` state.

@@ -822,7 +822,9 @@ enum HrtsResult hrts_record_frame(struct HrtsContext *context, const struct Hrts
 // an unfinished one); any other call fails. Passes the frame does not run (not needed by the
 // configuration, up to date, or shared) record nothing. Within a frame, every pass that runs must be
 // recorded, in order: a call that leaves out such a pass before its last requested one fails with
-// `HRTS_RESULT_ERROR_INVALID_STATE` and records nothing. `HRTS_PASS_OUTPUT_COPY` ends the frame.
+// `HRTS_RESULT_ERROR_INVALID_STATE` and records nothing (its `frame_index` counts as used: the next frame
+// takes a greater one). `HRTS_PASS_OUTPUT_COPY` ends the frame. Submit every command buffer the plugin
+// recorded into: passes skipped as up to date reuse what earlier recordings wrote.
 //
 // Frames in flight: recording frame `f` states that every frame up to `f - frames_in_flight` has
 // completed on the GPU; the plugin's per-frame data is ring-buffered that deep, and its constants go

@@ -29,6 +29,9 @@ impl Context {
                 "pass mask 0x{mask:x} must be a non-empty set of HRTS_PASS_MASK_ALL (0x{HRTS_PASS_MASK_ALL:x}) bits"
             )));
         }
+        if f.frame_index == u64::MAX {
+            return Err(invalid("frame_index UINT64_MAX is reserved"));
+        }
         let inputs = frame_inputs(f)?;
         if inputs.len() != self.lights.len() {
             return Err(invalid(format!(

@@ -412,8 +412,10 @@ impl Device {
         }
         // SAFETY: as above.
         let device = unsafe { ash::Device::load(instance.fp_v1_0(), device) };
-        // SAFETY: the caller guarantees the queue exists (checked against the family's queue count above).
-        let queue = unsafe { device.get_device_queue(desc.queue_family_index, desc.queue_index) };
+        // The engine's queue is never fetched: the plugin only records into the engine's command buffers
+        // (`submit_and_wait` refuses adopted devices), and the family's queue count above is only a
+        // plausibility check of what the engine created.
+        let queue = vk::Queue::null();
         let f = desc.enabled_features;
         let features = vk::PhysicalDeviceFeatures::default()
             .geometry_shader(f.geometry_shader)

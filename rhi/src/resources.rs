@@ -552,6 +552,29 @@ impl Buffer {
         Ok(())
     }
 
+    /// Reads the `u64` at byte `offset` of a mapped buffer with a volatile load: for values the GPU may
+    /// write at any moment (such as a completion marker polled without a fence), which [`Buffer::read`]'s
+    /// slice must not alias.
+    pub fn read_u64_volatile(&self, offset: u64) -> Result<u64> {
+        let ptr = self
+            .allocation
+            .as_ref()
+            .and_then(|a| a.mapped_ptr())
+            .ok_or_else(|| RhiError::InvalidArgument("buffer is not host-visible".into()))?
+            .as_ptr()
+            .cast::<u8>();
+        if !offset.is_multiple_of(8) || offset.checked_add(8).is_none_or(|end| end > self.size) {
+            return Err(RhiError::InvalidArgument(format!(
+                "u64 read at offset {offset} of a {}-byte buffer",
+                self.size
+            )));
+        }
+        // SAFETY: the mapping covers `size` bytes and stays valid while `self` lives; the offset is in
+        // bounds and 8-aligned (mappings are at least 8-aligned); a volatile load of a plain integer
+        // tolerates concurrent device writes (it may see the old or the new value).
+        Ok(unsafe { std::ptr::read_volatile(ptr.add(offset as usize).cast::<u64>()) })
+    }
+
     /// The contents of a host-visible buffer (read after the GPU work that wrote it has completed).
     pub fn read(&self) -> Result<&[u8]> {
         self.allocation
