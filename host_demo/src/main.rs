@@ -102,12 +102,8 @@ struct RenderArgs {
     /// Direction the light travels, "x,y,z" (default: slanted, about 30° from vertical).
     #[arg(long, value_parser = parse_vec3)]
     light_dir: Option<Vec3>,
-    /// Camera position "x,y,z" (default: framed automatically).
-    #[arg(long, value_parser = parse_vec3)]
-    camera_pos: Option<Vec3>,
-    /// Camera target "x,y,z" (default: the scene centre).
-    #[arg(long, value_parser = parse_vec3)]
-    camera_target: Option<Vec3>,
+    #[command(flatten)]
+    camera: CameraArgs,
     /// Primitive map size N: texels per side of the light-space grid fitted to the visible receivers (moves
     /// cost, never exactness).
     #[arg(long, default_value_t = 1024)]
@@ -143,6 +139,17 @@ struct RenderArgs {
     soft: SoftShadowArgs,
 }
 
+/// Where the camera is, when not framed automatically (or, with `--scene`, taken from the file).
+#[derive(clap::Args)]
+struct CameraArgs {
+    /// Camera position "x,y,z" (default: the scene file's camera, else framed automatically).
+    #[arg(long, value_parser = parse_vec3)]
+    camera_pos: Option<Vec3>,
+    /// Camera target "x,y,z" (default: the scene file's camera's, else the scene centre).
+    #[arg(long, value_parser = parse_vec3)]
+    camera_target: Option<Vec3>,
+}
+
 #[derive(clap::Args)]
 struct PlanArgs {
     /// glTF 2.0 scene (.gltf or .glb).
@@ -154,12 +161,8 @@ struct PlanArgs {
     /// Frame height in pixels.
     #[arg(long, default_value_t = 720)]
     height: u32,
-    /// Camera position "x,y,z" (default: the scene's camera, else framed automatically).
-    #[arg(long, value_parser = parse_vec3)]
-    camera_pos: Option<Vec3>,
-    /// Camera target "x,y,z" (default: the scene's camera's, else the scene centre).
-    #[arg(long, value_parser = parse_vec3)]
-    camera_target: Option<Vec3>,
+    #[command(flatten)]
+    camera: CameraArgs,
     /// Primitive map size N.
     #[arg(long, default_value_t = 1024)]
     map_size: u32,
@@ -266,7 +269,7 @@ fn plan(args: &PlanArgs) -> Result<()> {
     let (camera, settings) = scene_setup(
         &file,
         (args.width, args.height),
-        (args.camera_pos, args.camera_target),
+        (args.camera.camera_pos, args.camera.camera_target),
         map,
         &soft,
     )?;
@@ -278,7 +281,10 @@ fn plan(args: &PlanArgs) -> Result<()> {
         file.scene.triangle_count(),
         args.width,
         args.height,
-        match (&file.camera, args.camera_pos.or(args.camera_target)) {
+        match (
+            &file.camera,
+            args.camera.camera_pos.or(args.camera.camera_target)
+        ) {
             (_, Some(_)) => "from the command line",
             (Some(_), None) => "from the file",
             (None, None) => "framed by the demo",
@@ -303,7 +309,7 @@ fn render_scene(cli: &Cli, args: &RenderArgs, path: &Path) -> Result<()> {
     let (camera, settings) = scene_setup(
         &file,
         (args.width, args.height),
-        (args.camera_pos, args.camera_target),
+        (args.camera.camera_pos, args.camera.camera_target),
         map,
         &args.soft,
     )?;
@@ -346,8 +352,8 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
     view.camera = camera_with(
         view.camera,
         &view.scene.bounds(),
-        args.camera_pos,
-        args.camera_target,
+        args.camera.camera_pos,
+        args.camera.camera_target,
     )?;
     let device = device(cli)?;
     let options = RenderOptions {

@@ -25,6 +25,17 @@ use rhi::{
 use scene::{Aabb, Scene};
 use std::ffi::{c_char, CStr, CString};
 
+/// The line the demo's commands print first: the device and the plugin's API version.
+pub fn device_banner(caps: &rhi::Capabilities) -> String {
+    format!(
+        "device: {} ({}, {}); shadows through the plugin's C ABI, {}",
+        caps.device_name,
+        caps.device_type,
+        caps.driver,
+        api_version()
+    )
+}
+
 /// "libhrts API major.minor.patch", as the loaded library reports it.
 pub fn api_version() -> String {
     let v = hrts_get_api_version();

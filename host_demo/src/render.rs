@@ -426,13 +426,7 @@ pub fn render_to_folder(
     std::fs::write(out.join("frame.json"), text)
         .with_context(|| format!("writing {}/frame.json", out.display()))?;
 
-    println!(
-        "device: {} ({}, {}); shadows through the plugin's C ABI, {}",
-        caps.device_name,
-        caps.device_type,
-        caps.driver,
-        crate::plugin::api_version()
-    );
+    println!("{}", crate::plugin::device_banner(caps));
     if report.status(PassId::PrimitiveMap) == Some(PassStatus::Skipped(SkipReason::NotRequested)) {
         println!(
             "scene: {} triangles, {}x{} px; no primitive map (the plan does not need one)",

@@ -335,13 +335,7 @@ pub fn render_scene_to_folder(
     let plan = plan_scene(file, camera, settings)
         .with_context(|| format!("planning {}", source.display()))?;
     let caps = device.capabilities();
-    println!(
-        "device: {} ({}, {}); shadows through the plugin's C ABI, {}",
-        caps.device_name,
-        caps.device_type,
-        caps.driver,
-        crate::plugin::api_version()
-    );
+    println!("{}", crate::plugin::device_banner(caps));
     println!(
         "scene {}: {} triangles, {}x{} px",
         source.display(),
