@@ -46,6 +46,10 @@ pub struct BenchArgs {
     /// Skip the exact CPU reference (wrong-pixel counts): minutes on two cores at 1080p.
     #[arg(long)]
     pub no_reference: bool,
+    /// Instead of the models: what each kind of light costs inside Sponza and the conference room (the
+    /// sun, a spot light and point lights inside), with GPU ms, memory and lists per light.
+    #[arg(long)]
+    pub lights: bool,
 }
 
 /// One benchmark model: a file of `../shared/models`, how it is shown, and the talk's GTX 980 times (ms)
@@ -386,7 +390,15 @@ pub fn run_bench(device: &Device, args: &BenchArgs) -> Result<String> {
 
 /// Entry point of the subcommand: prints the tables and writes them to `out` if given.
 pub fn run_cli(device: &Device, args: &BenchArgs, out: Option<&Path>) -> Result<()> {
-    let tables = run_bench(device, args)?;
+    let tables = if args.lights {
+        let models = match &args.models {
+            Some(dir) => dir.clone(),
+            None => scene::models_dir().map_err(anyhow::Error::msg)?,
+        };
+        crate::light_bench::run_light_bench(device, args, &models)?
+    } else {
+        run_bench(device, args)?
+    };
     println!("{tables}");
     if let Some(path) = out {
         std::fs::write(path, &tables).with_context(|| format!("writing {}", path.display()))?;

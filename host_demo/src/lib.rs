@@ -15,6 +15,7 @@ pub mod compare;
 pub mod gbuffer;
 pub mod hardcases;
 pub mod images;
+pub mod light_bench;
 pub mod output;
 pub mod peer;
 pub mod plugin;

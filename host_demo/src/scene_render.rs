@@ -9,7 +9,7 @@ use crate::shading::{shade, tone_map};
 use crate::{CameraMatrices, FrameImages};
 use anyhow::{Context, Result};
 use glam::Vec3;
-use passes::{PassId, PassStatus, ResourceId, SkipReason};
+use passes::{FrameReport, MapStats, PassId, PassStatus, ResourceId, SkipReason};
 use rhi::Device;
 use scene::{Camera, SceneFile};
 use serde::Serialize;
@@ -145,6 +145,36 @@ fn size(bytes: u64) -> String {
     }
 }
 
+/// GPU milliseconds of a light's passes this frame (all of them, and per pass).
+fn gpu_ms(report: &FrameReport) -> (f64, BTreeMap<String, f64>) {
+    let per_pass: BTreeMap<String, f64> = report
+        .timings
+        .iter()
+        .map(|t| (t.name.clone(), t.ms))
+        .collect();
+    (report.timings.iter().map(|t| t.ms).sum(), per_pass)
+}
+
+/// A light's GPU time and list statistics on one line.
+fn describe_cost(report: &FrameReport) -> String {
+    let (total, per_pass) = gpu_ms(report);
+    let passes: Vec<String> = per_pass
+        .iter()
+        .map(|(name, ms)| format!("{name} {ms:.3}"))
+        .collect();
+    let st = &report.stats;
+    format!(
+        "GPU {total:.3} ms ({}); lists: {} receiver px, {} triangles binned, {} entries, mean {:.1} / longest {}, {} texels past capacity",
+        passes.join(", "),
+        st.receiver_pixels,
+        st.triangles_binned,
+        st.entries,
+        st.mean_list(),
+        st.longest_list,
+        st.texels_past_capacity
+    )
+}
+
 /// What a frame did, per light, as text: for each light what the plan gave it and the memory it holds,
 /// and for each of its frusta the pass statuses, how many times its passes were built, why its
 /// light-space passes ran or were reused, and the memory of each resource; lights without a pass say so.
@@ -245,6 +275,7 @@ pub fn describe_frame(
                 size(own_bytes(report)),
                 resources.join(", ")
             );
+            let _ = writeln!(s, "      cost {}", describe_cost(&report.report));
         }
     }
     let shared = frame.lights.iter().find_map(|r| {
@@ -280,6 +311,35 @@ struct FrustumReportJson {
     light_builds: u32,
     pass_status: BTreeMap<&'static str, &'static str>,
     resource_bytes: BTreeMap<&'static str, u64>,
+    gpu_ms: f64,
+    pass_ms: BTreeMap<String, f64>,
+    lists: ListsJson,
+}
+
+/// A light's primitive-map statistics ([`MapStats`]) in `scene_report.json`.
+#[derive(Serialize)]
+struct ListsJson {
+    receiver_pixels: u32,
+    triangles_binned: u32,
+    entries: u32,
+    capacity: u32,
+    mean_list: f64,
+    longest_list: u32,
+    texels_past_capacity: u32,
+}
+
+impl From<&MapStats> for ListsJson {
+    fn from(s: &MapStats) -> Self {
+        Self {
+            receiver_pixels: s.receiver_pixels,
+            triangles_binned: s.triangles_binned,
+            entries: s.entries,
+            capacity: s.capacity,
+            mean_list: s.mean_list(),
+            longest_list: s.longest_list,
+            texels_past_capacity: s.texels_past_capacity,
+        }
+    }
 }
 
 #[derive(Serialize)]
@@ -415,6 +475,9 @@ pub fn render_scene_to_folder(
                         .iter()
                         .map(|r| (r.resource.name(), r.bytes))
                         .collect(),
+                    gpu_ms: gpu_ms(&report.report).0,
+                    pass_ms: gpu_ms(&report.report).1,
+                    lists: ListsJson::from(&report.report.stats),
                 })
                 .collect(),
         })

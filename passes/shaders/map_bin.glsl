@@ -4,17 +4,21 @@
 // triangle's margin overlaps the triangle (separating axes: the box axes are the caller's bounding box, the
 // edge normals are tested here, relative to the triangle's own vertices).
 
-// Mirrors the setup pass's output (48 bytes).
+// Mirrors the setup pass's output (64 bytes).
 struct BinTri {
-    vec4 ab;        // texel-space a.xy, b.xy (counter-clockwise; a segment's ends in MODE_SEGMENT)
-    vec4 cmd;       // c.xy, margin (texels), min depth key minus its error
+    vec4 ab;        // texel-space a.xy, b.xy (counter-clockwise; a segment's ends in MODE_SEGMENT);
+                    // MODE_CLIPPED: edge line 0 (xyz) and line 1's x
+    vec4 cmd;       // c.xy (MODE_CLIPPED: line 1's y and z), margin (texels), min depth key minus its error
     uvec4 info;     // x: bbox min (x | y << 16), y: bbox max, z: mode, w: tiles per bbox row
+    vec4 ext;       // MODE_CLIPPED: edge line 2 (xyz), orientation (+1, -1, or 0: either)
 };
 
 #define MODE_TRIANGLE 0u
 #define MODE_SEGMENT 1u
 #define MODE_POINT 2u
-#define MODE_COVER 3u       // a vertex behind a perspective light: every texel of the bbox
+#define MODE_COVER 3u       // every texel of the bbox (coordinates too large for edge functions)
+#define MODE_CLIPPED 4u     // perspective light, a vertex on or behind the light's plane (or next to it):
+                            // homogeneous edge functions, which keep exactly the part in front (below)
 #define BIN_TILE 4u
 
 // A texel is accepted when its square grown by the triangle's margin overlaps it; the margin is at least
@@ -35,6 +39,18 @@ bool bin_overlaps(BinTri t, vec2 centre) {
     if (t.info.z == MODE_SEGMENT) {
         vec2 e = b - a;
         return abs(cross2(e, centre - a)) <= grow * (abs(e.x) + abs(e.y));
+    }
+    if (t.info.z == MODE_CLIPPED) {
+        // Olano & Greer's homogeneous edge functions: the light's rays through the texel centre p hit
+        // the triangle in front of the light iff p = sum(l_i * h_i) with every l_i >= 0, i.e. iff every
+        // edge function has the orientation's sign (see clipped_setup in map_setup.comp).
+        vec3 p = vec3(centre, 1.0);
+        vec3 l0 = t.ab.xyz, l1 = vec3(t.ab.w, t.cmd.xy), l2 = t.ext.xyz;
+        vec3 f = vec3(dot(l0, p), dot(l1, p), dot(l2, p));
+        vec3 g = grow * vec3(abs(l0.x) + abs(l0.y), abs(l1.x) + abs(l1.y), abs(l2.x) + abs(l2.y));
+        bool positive = t.ext.w >= 0.0 && all(greaterThanEqual(f + g, vec3(0.0)));
+        bool negative = t.ext.w <= 0.0 && all(lessThanEqual(f - g, vec3(0.0)));
+        return positive || negative;
     }
     return true;    // a point or a cover: the bounding box decided
 }

@@ -10,6 +10,8 @@ layout(local_size_x = 1) in;
 layout(set = 0, binding = 0) buffer State { MapState ms; };
 layout(push_constant) uniform Push { MapPush pc; };
 
+const uint MIN_GRID = 16u;
+
 void main() {
     if (pc.mode == 0u) {
         ms.to_texels = mat4(1.0);
@@ -28,7 +30,17 @@ void main() {
     vec2 extent = max(hi - lo, max(abs(lo), abs(hi)) * 1e-6 + 1e-30);
     lo -= extent / 256.0;
     hi += extent / 256.0;
-    vec2 s = float(pc.size) / (hi - lo);
+    // With receiver culling, a texel holds a list only where a ray origin lies, so a grid much finer than
+    // the rays only multiplies the binning work of large triangles (a face of a point light that sees a
+    // handful of pixels would otherwise spread every triangle over N^2 texels). The grid keeps about 16
+    // texels per ray origin, at least MIN_GRID and at most N per side; without culling (a debug mode whose
+    // lists are compared texel by texel), always N.
+    uint n = pc.size;
+    if (pc.cull != 0u) {
+        n = clamp(4u * uint(ceil(sqrt(float(ms.receivers.w)))), min(MIN_GRID, pc.size), pc.size);
+    }
+    ms.fit.y = float(n);
+    vec2 s = float(n) / (hi - lo);
     // texel * w = s * (clip.xy - lo * clip.w)
     mat4 fit = mat4(1.0);
     fit[0][0] = s.x;

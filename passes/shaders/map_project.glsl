@@ -29,3 +29,17 @@ Projected project(mat4 m, vec3 p, bool perspective) {
     r.depth_err = perspective ? err.w : err.z;
     return r;
 }
+
+// A point in homogeneous texel space (x, y, w of `m`) with a bound on the f32 rounding of each component,
+// for triangles that reach the light's plane (map_setup.comp's clipped setup).
+struct HPoint {
+    vec3 h;
+    vec3 err;
+};
+
+HPoint project_h(mat4 m, vec3 p) {
+    precise vec4 c = m * vec4(p, 1.0);
+    vec3 ap = abs(p);
+    vec4 mag = abs(m[0]) * ap.x + abs(m[1]) * ap.y + abs(m[2]) * ap.z + abs(m[3]);
+    return HPoint(c.xyw, (PROJECTION_GAMMA * mag).xyw);
+}

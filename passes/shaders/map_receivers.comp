@@ -31,7 +31,7 @@ layout(push_constant) uniform Push { MapPush pc; };
 
 const uint NONE = 0xFFFFFFFFu;
 
-shared uint group_words[4];
+shared uint group_words[5];
 
 void main() {
     if (gl_LocalInvocationIndex == 0u) {
@@ -39,6 +39,7 @@ void main() {
         group_words[1] = pc.mode == 0u ? NONE : 0u;
         group_words[2] = 0u;
         group_words[3] = 0u;
+        group_words[4] = 0u;
     }
     barrier();
 
@@ -47,6 +48,7 @@ void main() {
     uvec4 mine = pc.mode == 0u ? uvec4(NONE, NONE, 0u, 0u) : uvec4(0u);
     uint open_texel = NONE;
     uint open_reach = 0u;
+    uint mine_rays = 0u;
     mat4 to_texels = ms.to_texels;
     for (uint q = 0u; q < 4u; ++q) {
         ivec2 px = ivec2(gl_GlobalInvocationID.xy) * 2 + ivec2(q & 1u, q >> 1u);
@@ -62,6 +64,7 @@ void main() {
         bool inside = lc.w > 0.0 && all(greaterThanEqual(ndc, vec2(-1.0))) && all(lessThan(ndc, vec2(1.0)));
         if (pc.mode == 0u) {
             if (traced && inside) {
+                mine_rays += 1u;
                 mine = uvec4(min(mine.xy, uvec2(ordered(ndc.x), ordered(ndc.y))),
                              max(mine.zw, uvec2(ordered(ndc.x), ordered(ndc.y))));
             }
@@ -72,7 +75,7 @@ void main() {
             continue;
         }
         Projected pr = project(to_texels, o, pc.to_light.w != 0.0);
-        int last = int(pc.size) - 1;
+        int last = int(ms.fit.y) - 1;
         ivec2 texel = clamp(ivec2(floor(pr.xy)), ivec2(0), ivec2(last));
         uint index = uint(texel.y) * pc.size + uint(texel.x);
         pixel_texel[pixel] = index;
@@ -92,11 +95,13 @@ void main() {
     if (pc.mode == 0u) {
         uvec2 lo = subgroupMin(mine.xy);
         uvec2 hi = subgroupMax(mine.zw);
+        uint rays = subgroupAdd(mine_rays);
         if (subgroupElect() && lo.x <= hi.x) {
             atomicMin(group_words[0], lo.x);
             atomicMin(group_words[1], lo.y);
             atomicMax(group_words[2], hi.x);
             atomicMax(group_words[3], hi.y);
+            atomicAdd(group_words[4], rays);
         }
     } else {
         uint count = subgroupAdd(mine.x);
@@ -130,6 +135,7 @@ void main() {
             atomicMin(ms.bounds.y, group_words[1]);
             atomicMax(ms.bounds.z, group_words[2]);
             atomicMax(ms.bounds.w, group_words[3]);
+            atomicAdd(ms.receivers.w, group_words[4]);
         }
     } else if (group_words[0] > 0u) {
         atomicAdd(ms.receivers.x, group_words[0]);

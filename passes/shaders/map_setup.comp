@@ -3,8 +3,10 @@
 // Per triangle: culls what can never shadow a ray origin of this frame, projects the rest into the fitted
 // map and counts the 4x4-texel tiles of its bounding box (the bin items, scanned into offsets next).
 // Culled: zero-area triangles with two equal vertices (the ray test's determinant is exactly 0 for them,
-// so they never hit), back faces in front-only mode, triangles outside the receivers' texels, and
-// triangles wholly farther from the light than every ray origin.
+// so they never hit), back faces in front-only mode, triangles outside the receivers' texels, triangles
+// wholly farther from the light than every ray origin, and, for a perspective light, triangles wholly on or
+// behind the light's plane. Triangles that cross that plane keep exactly their part in front of it
+// (clipped_setup).
 #include "triangle.glsl"
 #include "map_state.glsl"
 #include "map_project.glsl"
@@ -26,10 +28,151 @@ const float SEGMENT_THICKNESS = 1.0 / 16.0;
 
 uint pack_texel(ivec2 t) { return uint(t.x) | (uint(t.y) << 16); }
 
+// Unit roundoff of f32.
+const float U = 5.9604645e-8;
+// Rounds a bound computed in f32 (a few positive terms) up past its own rounding.
+const float ROUND_UP = 1.0 + 1.0 / 65536.0;
+
+// |a| x |b| term by term: bounds |a x b| and the rounding of computing it.
+vec3 cross_mag(vec3 a, vec3 b) {
+    return vec3(a.y * b.z + a.z * b.y, a.z * b.x + a.x * b.z, a.x * b.y + a.y * b.x);
+}
+
+// The homogeneous line through two homogeneous texel points (their cross product: the light's plane through
+// an edge) and a bound on how far the computed coefficients are from the exact line through the exact
+// points (the points' projection error, propagated, plus the rounding of the products).
+struct Line {
+    vec3 l;
+    vec3 e;
+};
+
+Line edge_line(HPoint a, HPoint b) {
+    precise vec3 l = vec3(a.h.y * b.h.z - a.h.z * b.h.y, a.h.z * b.h.x - a.h.x * b.h.z,
+                          a.h.x * b.h.y - a.h.y * b.h.x);
+    vec3 aa = abs(a.h), ab = abs(b.h);
+    vec3 e = cross_mag(a.err, ab) + cross_mag(aa, b.err) + cross_mag(a.err, b.err)
+           + 4.0 * U * cross_mag(aa, ab);
+    return Line(l, e * ROUND_UP);
+}
+
+// Clips the convex polygon `poly` (n vertices) to the half-plane dot(l, (x, y, 1)) + slack >= 0.
+int clip_polygon(inout vec2 poly[8], int n, vec3 l, float slack) {
+    vec2 kept[8];
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
+        vec2 a = poly[i], b = poly[(i + 1) % n];
+        float fa = dot(l, vec3(a, 1.0)) + slack, fb = dot(l, vec3(b, 1.0)) + slack;
+        if (fa >= 0.0) {
+            kept[m++] = a;
+        }
+        if ((fa >= 0.0) != (fb >= 0.0)) {
+            kept[m++] = a + clamp(fa / (fa - fb), 0.0, 1.0) * (b - a);
+        }
+    }
+    poly = kept;
+    return m;
+}
+
+// Bounding box (lo, hi) of the map square [0, N]^2 where every line, times `orientation`, is >= minus its
+// slack; false when that is empty.
+bool clipped_box(vec3 l[3], vec3 slack, float orientation, out vec2 lo, out vec2 hi) {
+    float n = ms.fit.y;
+    vec2 poly[8] = vec2[8](vec2(0.0), vec2(n, 0.0), vec2(n), vec2(0.0, n), vec2(0.0), vec2(0.0),
+                           vec2(0.0), vec2(0.0));
+    int count = 4;
+    for (int i = 0; i < 3 && count > 0; ++i) {
+        if (l[i] != vec3(0.0)) {
+            count = clip_polygon(poly, count, orientation * l[i], slack[i]);
+        }
+    }
+    lo = vec2(1.0 / 0.0);
+    hi = vec2(-1.0 / 0.0);
+    for (int i = 0; i < count; ++i) {
+        lo = min(lo, poly[i]);
+        hi = max(hi, poly[i]);
+    }
+    return count > 0;
+}
+
+// A triangle of a perspective light that reaches the light's plane (a vertex on or behind it, within its
+// projection error) or lies so close to it that its projection leaves the edge-function range.
+//
+// Why this is exact: only the part of a triangle in front of the light's plane can block a segment from a
+// receiver in front of it to the light (every point of such a segment has w > 0). The light's rays through
+// texel point p = (x, y, 1) hit the triangle in front of the light iff p = sum(l_i * h_i) with l_i >= 0,
+// h_i the vertices' homogeneous texel coordinates (x, y, w); by Cramer's rule l_i = det(p, h_j, h_k) / D,
+// D = det(h0, h1, h2). So the test is: every edge function E_i(p) = dot(p, h_j x h_k) has the sign of D
+// (Olano & Greer 1997, homogeneous rasterization). It needs no division by w and no clipped vertices, and
+// keeps exactly the front part of the triangle: the part behind the plane is never accepted. The bound on
+// each E_i's error (the vertices' projection error propagated through the cross product, the products'
+// rounding, and the evaluation at any texel of the map) becomes extra margin in texels, like every other
+// triangle's. When |D| is within its error bound the light lies in the triangle's plane (up to rounding)
+// and both signs are accepted: the projection is then a band around one line. The bounding box clips the
+// map square to the three half-planes with one more texel of slack and grows by one texel, which absorbs
+// the rounding of the clip.
+uint clipped_setup(HPoint h[3], float min_depth, float margin_base, inout BinTri bt) {
+    Line lines[3] = Line[3](edge_line(h[1], h[2]), edge_line(h[2], h[0]), edge_line(h[0], h[1]));
+    precise float d = dot(h[0].h, lines[0].l);
+    float d_err = (dot(h[0].err, abs(lines[0].l)) + dot(abs(h[0].h), lines[0].e)
+                   + dot(h[0].err, lines[0].e) + 4.0 * U * dot(abs(h[0].h), abs(lines[0].l))) * ROUND_UP;
+    float orientation = abs(d) > d_err ? sign(d) : 0.0;
+    // Any texel centre, grown by the base margin, lies within this distance of the map's origin per axis.
+    float reach = ms.fit.y + 1.0 + margin_base;
+    vec3 l[3];
+    float extra = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        vec3 c = lines[i].l, e = lines[i].e;
+        float s = max(max(abs(c.x), abs(c.y)), abs(c.z));
+        if (s > 0.0) {
+            int ex;
+            frexp(s, ex);   // scale by a power of two (exact) so that no product below overflows
+            c = ldexp(c, ivec3(-ex));
+            e = ldexp(e, ivec3(-ex));
+        }
+        float slack = ((e.x + 4.0 * U * abs(c.x)) * reach + (e.y + 4.0 * U * abs(c.y)) * reach
+                       + e.z + 4.0 * U * abs(c.z)) * ROUND_UP;
+        float norm = abs(c.x) + abs(c.y);
+        float grow = slack / norm;
+        if (!(grow <= FAR_TEXELS)) {
+            l[i] = vec3(0.0);   // no usable edge: it accepts every texel (conservative)
+        } else {
+            l[i] = c;
+            extra = max(extra, grow);
+        }
+    }
+    float margin = margin_base + extra;
+    float g = 1.5 + margin;    // half a texel, the margin, and the clip's one texel of slack
+    vec3 slack = g * vec3(abs(l[0].x) + abs(l[0].y), abs(l[1].x) + abs(l[1].y), abs(l[2].x) + abs(l[2].y));
+    vec2 lo = vec2(1.0 / 0.0), hi = vec2(-1.0 / 0.0);
+    bool any_part = false;
+    for (int k = 0; k < 2; ++k) {
+        float o = k == 0 ? 1.0 : -1.0;
+        vec2 blo, bhi;
+        if ((orientation == 0.0 || orientation == o) && clipped_box(l, slack, o, blo, bhi)) {
+            lo = min(lo, blo);
+            hi = max(hi, bhi);
+            any_part = true;
+        }
+    }
+    if (!any_part) {
+        return 0u;  // no part of it in front of the light projects into the map
+    }
+    int last = int(ms.fit.y) - 1;
+    ivec2 lo_t = clamp(ivec2(floor(lo)) - 1, ivec2(0), ivec2(last));
+    ivec2 hi_t = clamp(ivec2(floor(hi)) + 1, ivec2(0), ivec2(last));
+    bt.ab = vec4(l[0], l[1].x);
+    bt.cmd = vec4(l[1].yz, margin, min_depth);
+    bt.ext = vec4(l[2], orientation);
+    uvec2 tiles = (uvec2(hi_t - lo_t) + BIN_TILE) / BIN_TILE;
+    bt.info = uvec4(pack_texel(lo_t), pack_texel(hi_t), MODE_CLIPPED, tiles.x);
+    return tiles.x * tiles.y;
+}
+
 uint setup(uint index, out BinTri bt) {
     bt.ab = vec4(0.0);
     bt.cmd = vec4(0.0);
     bt.info = uvec4(0u);
+    bt.ext = vec4(0.0);
     if (ms.fit.x == 0.0) {
         return 0u;
     }
@@ -41,66 +184,78 @@ uint setup(uint index, out BinTri bt) {
         return 0u;
     }
     bool perspective = pc.to_light.w != 0.0;
+    float margin = ACCEPT_MARGIN + 2.0 * unordered(ms.receivers.y);
+    HPoint h[3];
+    bool reaches_plane = false;
+    if (perspective) {
+        h = HPoint[3](project_h(ms.to_texels, v0), project_h(ms.to_texels, v1),
+                      project_h(ms.to_texels, v2));
+        if (h[0].h.z + h[0].err.z <= 0.0 && h[1].h.z + h[1].err.z <= 0.0 && h[2].h.z + h[2].err.z <= 0.0) {
+            return 0u;  // wholly on or behind the light's plane: it blocks no segment in front of it
+        }
+        reaches_plane = h[0].h.z - h[0].err.z <= 0.0 || h[1].h.z - h[1].err.z <= 0.0
+                     || h[2].h.z - h[2].err.z <= 0.0;
+    }
     Projected p[3] = Projected[3](project(ms.to_texels, v0, perspective),
                                   project(ms.to_texels, v1, perspective),
                                   project(ms.to_texels, v2, perspective));
-    int last = int(pc.size) - 1;
-    ivec2 lo_t = ivec2(0), hi_t = ivec2(last);
-    uint mode = MODE_COVER;
-    float min_depth = -1.0 / 0.0;
-    bool behind = p[0].w <= 0.0 || p[1].w <= 0.0 || p[2].w <= 0.0;
-    if (!behind) {
-        min_depth = min(min(p[0].depth - p[0].depth_err, p[1].depth - p[1].depth_err),
-                        p[2].depth - p[2].depth_err);
-        if (pc.cull != 0u && min_depth > unordered(ms.receivers.z)) {
-            return 0u;  // behind every ray origin as seen from the light
-        }
-        float err = max(max(max(p[0].xy_err.x, p[0].xy_err.y), max(p[1].xy_err.x, p[1].xy_err.y)),
-                        max(p[2].xy_err.x, p[2].xy_err.y));
-        float margin = ACCEPT_MARGIN + err + 2.0 * unordered(ms.receivers.y);
-        vec2 lo = min(min(p[0].xy, p[1].xy), p[2].xy) - margin;
-        vec2 hi = max(max(p[0].xy, p[1].xy), p[2].xy) + margin;
-        if (any(greaterThan(lo, vec2(float(last) + 1.0))) || any(lessThan(hi, vec2(0.0)))) {
-            return 0u;  // outside the map: no ray origin projects there
-        }
-        lo_t = clamp(ivec2(floor(lo)), ivec2(0), ivec2(last));
-        hi_t = clamp(ivec2(floor(hi)), ivec2(0), ivec2(last));
-        bool far = any(greaterThan(abs(vec4(lo, hi)), vec4(FAR_TEXELS)));
-        if (!far) {
-            vec2 a = p[0].xy, b = p[1].xy, c = p[2].xy;
-            vec2 e[3] = vec2[3](b - a, c - b, a - c);
-            float area2 = cross2(e[0], -e[2]);
-            int longest = 0;
-            for (int i = 1; i < 3; ++i) {
-                if (dot(e[i], e[i]) > dot(e[longest], e[longest])) {
-                    longest = i;
-                }
-            }
-            float lmax = length(e[longest]);
-            if (lmax == 0.0) {
-                mode = MODE_POINT;
-            } else if (abs(area2) / lmax < SEGMENT_THICKNESS) {
-                // A sliver: the segment of its longest edge, with the margin grown by the sliver's
-                // thickness (the triangle lies within that distance of the segment). No raster path can
-                // lose it to vertex snapping.
-                mode = MODE_SEGMENT;
-                margin += abs(area2) / lmax;
-                a = p[longest].xy;
-                b = p[(longest + 1) % 3].xy;
-                c = b;
-            } else {
-                mode = MODE_TRIANGLE;
-                if (area2 < 0.0) {
-                    b = p[2].xy;
-                    c = p[1].xy;
-                }
-            }
-            bt.ab = vec4(a, b);
-            bt.cmd.xy = c;
-        }
-        bt.cmd.z = margin;
+    float min_depth = min(min(p[0].depth - p[0].depth_err, p[1].depth - p[1].depth_err),
+                          p[2].depth - p[2].depth_err);
+    if (pc.cull != 0u && min_depth > unordered(ms.receivers.z)) {
+        return 0u;  // behind every ray origin as seen from the light
     }
-    bt.cmd.w = min_depth;
+    if (reaches_plane) {
+        return clipped_setup(h, min_depth, margin, bt);
+    }
+    int last = int(ms.fit.y) - 1;
+    uint mode = MODE_COVER;
+    float err = max(max(max(p[0].xy_err.x, p[0].xy_err.y), max(p[1].xy_err.x, p[1].xy_err.y)),
+                    max(p[2].xy_err.x, p[2].xy_err.y));
+    margin += err;
+    vec2 lo = min(min(p[0].xy, p[1].xy), p[2].xy) - margin;
+    vec2 hi = max(max(p[0].xy, p[1].xy), p[2].xy) + margin;
+    bool far = any(greaterThan(abs(vec4(lo, hi)), vec4(FAR_TEXELS)));
+    if (far && perspective) {
+        return clipped_setup(h, min_depth, ACCEPT_MARGIN + 2.0 * unordered(ms.receivers.y), bt);
+    }
+    if (any(greaterThan(lo, vec2(float(last) + 1.0))) || any(lessThan(hi, vec2(0.0)))) {
+        return 0u;  // outside the map: no ray origin projects there
+    }
+    ivec2 lo_t = clamp(ivec2(floor(lo)), ivec2(0), ivec2(last));
+    ivec2 hi_t = clamp(ivec2(floor(hi)), ivec2(0), ivec2(last));
+    if (!far) {
+        vec2 a = p[0].xy, b = p[1].xy, c = p[2].xy;
+        vec2 e[3] = vec2[3](b - a, c - b, a - c);
+        float area2 = cross2(e[0], -e[2]);
+        int longest = 0;
+        for (int i = 1; i < 3; ++i) {
+            if (dot(e[i], e[i]) > dot(e[longest], e[longest])) {
+                longest = i;
+            }
+        }
+        float lmax = length(e[longest]);
+        if (lmax == 0.0) {
+            mode = MODE_POINT;
+        } else if (abs(area2) / lmax < SEGMENT_THICKNESS) {
+            // A sliver: the segment of its longest edge, with the margin grown by the sliver's
+            // thickness (the triangle lies within that distance of the segment). No raster path can
+            // lose it to vertex snapping.
+            mode = MODE_SEGMENT;
+            margin += abs(area2) / lmax;
+            a = p[longest].xy;
+            b = p[(longest + 1) % 3].xy;
+            c = b;
+        } else {
+            mode = MODE_TRIANGLE;
+            if (area2 < 0.0) {
+                b = p[2].xy;
+                c = p[1].xy;
+            }
+        }
+        bt.ab = vec4(a, b);
+        bt.cmd.xy = c;
+    }
+    bt.cmd.zw = vec2(margin, min_depth);
     uvec2 tiles = (uvec2(hi_t - lo_t) + BIN_TILE) / BIN_TILE;
     bt.info = uvec4(pack_texel(lo_t), pack_texel(hi_t), mode, tiles.x);
     return tiles.x * tiles.y;

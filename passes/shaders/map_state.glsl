@@ -5,8 +5,10 @@ struct MapState {
     mat4 to_texels;     // frame coordinates -> homogeneous map texel space: texel = floor(xy / w)
     uvec4 bounds;       // ordered-float light NDC bounds of the ray origins: min x, min y, max x, max y
     uvec4 receivers;    // x: pixels with a ray, y: ordered max texel-space error of a ray origin's
-                        // projection, z: ordered max depth key (plus error) of the ray origins, w: unused
-    vec4 fit;           // x: 1 when the map has receivers, yzw: unused
+                        // projection, z: ordered max depth key (plus error) of the ray origins, w: pixels
+                        // with a ray inside the light's frustum, counted by the bounds pass
+    vec4 fit;           // x: 1 when the map has receivers, y: texels per side of the fitted grid (at most
+                        // N; fewer when few rays need it, see map_fit.comp), zw: unused
     uvec4 totals;       // x: bin items (4x4 tiles of triangle bounding boxes), y: entries needed,
                         // z: entry capacity, w: triangles kept by the setup's culling
     uvec4 stats;        // x: texels with a list, y: longest list, z: texels past the capacity (traced

@@ -93,9 +93,10 @@ pub struct MapState {
     /// Ordered-float light NDC bounds of the ray origins (min x, min y, max x, max y).
     pub bounds: UVec4,
     /// x: pixels with a shadow ray, y: ordered largest texel error of a ray origin, z: ordered largest
-    /// depth key of the ray origins.
+    /// depth key of the ray origins, w: pixels with a ray inside the light's frustum (bounds pass).
     pub receivers: UVec4,
-    /// x: 1 when the map has receivers.
+    /// x: 1 when the map has receivers, y: texels per side of the fitted grid (N, or fewer with receiver
+    /// culling when few rays need it).
     pub fit: Vec4,
     /// x: bin items, y: entries needed, z: entry capacity, w: triangles binned (kept by the culling).
     pub totals: UVec4,

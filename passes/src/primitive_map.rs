@@ -353,7 +353,7 @@ impl PrimitiveMap {
             u64::from(width) * u64::from(height) * 4,
             copy,
         )?;
-        let bin_tris = storage("primitive map triangles", tris * 48, BufferUsage::default())?;
+        let bin_tris = storage("primitive map triangles", tris * 64, BufferUsage::default())?;
         let tile_offsets = storage(
             "primitive map tile offsets",
             (tris + 1) * 4,

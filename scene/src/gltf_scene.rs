@@ -36,7 +36,7 @@
 //!
 //! | key | type | applies to | meaning | default |
 //! |---|---|---|---|---|
-//! | `static` | bool | any node; lights | never moves or changes | inherited from the parent node; `false` at the roots |
+//! | `static` | bool | any node; lights | never moves or changes | inherited from the nearest ancestor node that sets it; otherwise `true` unless an animation targets the node or an ancestor (or, for a skinned mesh, the file has any animation) |
 //! | `casts_shadows` | bool | light nodes; lights | the light casts shadows | `true` |
 //! | `radius` | number, metres, ≥ 0 | spot/point light nodes; lights | radius of the spherical light | `0` |
 //! | `angular_radius` | number, radians, in `[0, pi/2)` | directional light nodes; lights | angular radius of the light's disc | `0` |
@@ -44,7 +44,8 @@
 //! A size of 0 gives [`LightSize::Zero`] (a zero-size light: hard shadows). A light takes each
 //! value from its node's extras, else from the light definition's extras, else (`static`) from
 //! the nearest ancestor node that sets it, else the default. A mesh node is static when it or
-//! its nearest ancestor that says so sets `static: true` ([`SceneFile::static_objects`]).
+//! its nearest ancestor that says so sets `static: true`, or, when none says, when no animation
+//! moves it ([`SceneFile::static_objects`]): a file without animations is static.
 //!
 //! # Errors
 //!
@@ -395,12 +396,20 @@ impl Loader<'_> {
             }
         };
         let mut visited = vec![false; document.nodes().len()];
-        let mut stack: Vec<(gltf::Node, Mat4, bool)> = roots
+        // Nodes an animation moves or deforms (any channel: translation, rotation, scale, weights).
+        let mut animated = vec![false; document.nodes().len()];
+        for channel in document.animations().flat_map(|a| a.channels()) {
+            animated[channel.target().node().index()] = true;
+        }
+        let any_animation = document.animations().next().is_some();
+        // Per node on the stack: its parent's world transform, the nearest explicit `static` above it, and
+        // whether an animation moves it or an ancestor.
+        let mut stack: Vec<(gltf::Node, Mat4, Option<bool>, bool)> = roots
             .into_iter()
             .rev()
-            .map(|node| (node, Mat4::IDENTITY, false))
+            .map(|node| (node, Mat4::IDENTITY, None, false))
             .collect();
-        while let Some((node, parent, parent_static)) = stack.pop() {
+        while let Some((node, parent, parent_explicit, parent_animated)) = stack.pop() {
             let name = describe("node", node.index(), node.name());
             if std::mem::replace(&mut visited[node.index()], true) {
                 return Err(self.gltf_error(format!(
@@ -412,7 +421,12 @@ impl Loader<'_> {
                 return Err(self.gltf_error(format!("{name} has a non-finite world transform")));
             }
             let hrts = extras::parse(node.extras(), self.path, &name)?;
-            let is_static = hrts.is_static.unwrap_or(parent_static);
+            let moves = parent_animated || animated[node.index()];
+            // A skinned mesh deforms with its joints: moving whenever the file animates anything.
+            let deforms = node.skin().is_some() && any_animation;
+            let explicit = hrts.is_static.or(parent_explicit);
+            let is_static = explicit.unwrap_or(!(moves || deforms));
+            let parent_static = parent_explicit.unwrap_or(!moves);
             if let Some(mesh) = node.mesh() {
                 self.add_mesh(&node, &mesh, world, is_static)?;
             }
@@ -441,7 +455,7 @@ impl Loader<'_> {
                 }
             }
             let first_child = stack.len();
-            stack.extend(node.children().map(|child| (child, world, is_static)));
+            stack.extend(node.children().map(|child| (child, world, explicit, moves)));
             stack[first_child..].reverse();
         }
         self.file.scene.validate_as(self.path)?;

@@ -19,7 +19,8 @@ use crate::{Scene, SceneError};
 /// - `"tower"`: a 0.6 x 2 x 0.6 m box at (1.5, 0, -1), turned 30° about +Y \[static\];
 /// - `"cart"`: a moving group at (0.3, 0, 1.6), turned -20° about +Y, with children
 ///   `"cart_body"` (a 1.2 x 0.6 x 0.8 m box), `"cart_load"` (a 0.4 m box on top, turned 45°) and
-///   the point light `"cart_lamp"`; not static, so neither are its children;
+///   the point light `"cart_lamp"`; moved by an animation (there and back in 4 s), so it and
+///   its children are not static;
 /// - lights: `"sun"` (directional along (0.68, -1, 0.05), angular radius 0.01 rad) \[static\],
 ///   `"rim"` (directional, zero size: hard shadows) \[static\], `"spot"` (spot at (-3, 3.5, 2.5)
 ///   aimed at the crate, cones 0.25/0.45 rad, radius 0.05 m, range 15 m) \[static\],
@@ -194,6 +195,15 @@ pub(super) fn example_document() -> (Value, Vec<u8>) {
     cart["children"] = json!(children);
     let cart = w.node(cart);
     w.root(cart);
+    w.translation_animation(
+        cart,
+        &[0.0, 2.0, 4.0],
+        &[
+            Vec3::new(0.3, 0.0, 1.6),
+            Vec3::new(1.1, 0.0, 1.2),
+            Vec3::new(0.3, 0.0, 1.6),
+        ],
+    );
 
     let camera = w.camera(json!({
         "name": "camera",

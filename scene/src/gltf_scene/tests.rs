@@ -311,7 +311,8 @@ fn mesh_hierarchy_and_primitive_modes() {
     scene.validate().unwrap();
     let names: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
     assert_eq!(names, ["root", "child", "square", "modes"]);
-    assert_eq!(file.static_objects, [true, true, false, false]);
+    // "modes" says nothing and no animation moves it: static.
+    assert_eq!(file.static_objects, [true, true, false, true]);
     assert_eq!(
         file.skipped_primitives, 4,
         "lines, points, line loop, line strip"
@@ -876,4 +877,33 @@ fn malformed_input_never_panics() {
         outcomes.contains("ok") && outcomes.len() > 3,
         "{outcomes:?}"
     );
+}
+
+/// A file without animations is static; an animation makes the node it targets and that node's children
+/// move; `extras.hrts.static` still overrides.
+#[test]
+fn animations_decide_what_moves() {
+    let mut w = GltfWriter::default();
+    let square = w.mesh("square", &SQUARE, &[0, 1, 2, 0, 2, 3]);
+    let still = w.node(json!({ "name": "still", "mesh": square }));
+    let cart = w.node(json!({ "name": "cart", "mesh": square }));
+    let wheel = w.node(json!({ "name": "wheel", "mesh": square }));
+    let pinned = w.node(json!({
+        "name": "pinned", "mesh": square, "extras": { "hrts": { "static": true } }
+    }));
+    w.root(still);
+    w.root(cart);
+    let (mut document, bin) = w.finish();
+    document["nodes"][cart]["children"] = json!([wheel, pinned]);
+    let dir = TempDir::new();
+    let file = dir.load_embedded("still.gltf", &document, &bin).unwrap();
+    assert_eq!(file.static_objects, [true, true, true, true]);
+    document["animations"] = json!([{
+        "channels": [{ "sampler": 0, "target": { "node": cart, "path": "translation" } }],
+        "samplers": [{ "input": 0, "output": 0 }],
+    }]);
+    let file = dir.load_embedded("moving.gltf", &document, &bin).unwrap();
+    let names: Vec<&str> = file.scene.objects.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(names, ["still", "cart", "wheel", "pinned"]);
+    assert_eq!(file.static_objects, [true, false, false, true]);
 }

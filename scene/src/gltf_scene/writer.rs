@@ -24,19 +24,24 @@ pub(super) struct GltfWriter {
     nodes: Vec<Value>,
     lights: Vec<Value>,
     cameras: Vec<Value>,
+    animations: Vec<Value>,
     roots: Vec<usize>,
 }
 
 impl GltfWriter {
-    /// Appends `bytes` to the buffer as a new buffer view; returns its index.
-    fn view(&mut self, bytes: &[u8], target: u32) -> usize {
+    /// Appends `bytes` to the buffer as a new buffer view (for vertices or indices when `target` says
+    /// so); returns its index.
+    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
         self.bin.resize(self.bin.len().next_multiple_of(4), 0);
-        self.buffer_views.push(json!({
+        let mut view = json!({
             "buffer": 0,
             "byteOffset": self.bin.len(),
             "byteLength": bytes.len(),
-            "target": target,
-        }));
+        });
+        if let Some(target) = target {
+            view["target"] = target.into();
+        }
+        self.buffer_views.push(view);
         self.bin.extend_from_slice(bytes);
         self.buffer_views.len() - 1
     }
@@ -52,7 +57,7 @@ impl GltfWriter {
         let finite = || positions.iter().copied().filter(|p| p.is_finite());
         let min = finite().reduce(Vec3::min).unwrap_or(Vec3::ZERO);
         let max = finite().reduce(Vec3::max).unwrap_or(Vec3::ZERO);
-        let view = self.view(&position_bytes, ARRAY_BUFFER);
+        let view = self.view(&position_bytes, Some(ARRAY_BUFFER));
         self.accessors.push(json!({
             "bufferView": view,
             "componentType": FLOAT,
@@ -63,7 +68,7 @@ impl GltfWriter {
         }));
         let position_accessor = self.accessors.len() - 1;
         let index_bytes: Vec<u8> = indices.iter().flat_map(|i| i.to_le_bytes()).collect();
-        let view = self.view(&index_bytes, ELEMENT_ARRAY_BUFFER);
+        let view = self.view(&index_bytes, Some(ELEMENT_ARRAY_BUFFER));
         self.accessors.push(json!({
             "bufferView": view,
             "componentType": UNSIGNED_INT,
@@ -78,6 +83,43 @@ impl GltfWriter {
             }],
         }));
         self.meshes.len() - 1
+    }
+
+    /// Adds an animation that moves `node` through `translations` at `times` (seconds, increasing),
+    /// interpolated linearly.
+    pub(super) fn translation_animation(
+        &mut self,
+        node: usize,
+        times: &[f32],
+        translations: &[Vec3],
+    ) {
+        let time_bytes: Vec<u8> = times.iter().flat_map(|t| t.to_le_bytes()).collect();
+        let view = self.view(&time_bytes, None);
+        self.accessors.push(json!({
+            "bufferView": view,
+            "componentType": FLOAT,
+            "count": times.len(),
+            "type": "SCALAR",
+            "min": [times.iter().copied().fold(f32::INFINITY, f32::min)],
+            "max": [times.iter().copied().fold(f32::NEG_INFINITY, f32::max)],
+        }));
+        let input = self.accessors.len() - 1;
+        let value_bytes: Vec<u8> = translations
+            .iter()
+            .flat_map(|p| p.to_array())
+            .flat_map(f32::to_le_bytes)
+            .collect();
+        let view = self.view(&value_bytes, None);
+        self.accessors.push(json!({
+            "bufferView": view,
+            "componentType": FLOAT,
+            "count": translations.len(),
+            "type": "VEC3",
+        }));
+        self.animations.push(json!({
+            "channels": [{ "sampler": 0, "target": { "node": node, "path": "translation" } }],
+            "samplers": [{ "input": input, "output": self.accessors.len() - 1, "interpolation": "LINEAR" }],
+        }));
     }
 
     /// Adds a `KHR_lights_punctual` light definition; returns its index.
@@ -117,6 +159,7 @@ impl GltfWriter {
             ("accessors", self.accessors),
             ("bufferViews", self.buffer_views),
             ("cameras", self.cameras),
+            ("animations", self.animations),
         ] {
             if !items.is_empty() {
                 document[key] = Value::Array(items);

@@ -1,0 +1,263 @@
+//! `host_demo bench --lights`: what each kind of light costs inside whole scenes. The shared Sponza and
+//! Conference models, seen from inside, each with one light at a time: the sun, a spot light inside and a
+//! point light at three positions inside, planned as `render --scene` plans a glTF scene (a point light
+//! through the cube faces that hold receivers in view) and drawn through the plugin's C ABI. Per light:
+//! frusta, GPU ms of its passes (the median over the frames after the first of the per-frame sum over its
+//! frusta), memory, and its lists (entries, mean and longest list, texels past capacity).
+
+use crate::bench::BenchArgs;
+use crate::plugin::LightsFrame;
+use crate::scene_plan::{plan_scene, PlanSettings};
+use crate::scene_render::SceneRenderer;
+use anyhow::{Context, Result};
+use glam::Vec3;
+use passes::{ResourceId, ShadowConfig};
+use rhi::Device;
+use scene::{Aabb, Camera, LightKind, LightSize, SceneFile, SceneLight};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// A scene of the benchmark: a model of the models folder and, as fractions of its bounds, the camera's
+/// position and target and the positions of the lights inside.
+struct LightScene {
+    file: &'static str,
+    camera: (Vec3, Vec3),
+    points: [Vec3; 3],
+    spot: Vec3,
+}
+
+const SCENES: [LightScene; 2] = [
+    LightScene {
+        file: "04_dabrovic_sponza_66k.obj",
+        camera: (Vec3::new(0.12, 0.2, 0.5), Vec3::new(0.8, 0.25, 0.45)),
+        points: [
+            Vec3::new(0.5, 0.35, 0.5),
+            Vec3::new(0.25, 0.12, 0.3),
+            Vec3::new(0.75, 0.7, 0.6),
+        ],
+        spot: Vec3::new(0.5, 0.8, 0.5),
+    },
+    LightScene {
+        file: "05_conference_clean_277k.obj",
+        camera: (Vec3::new(0.1, 0.6, 0.85), Vec3::new(0.75, 0.2, 0.25)),
+        points: [
+            Vec3::new(0.5, 0.6, 0.5),
+            Vec3::new(0.25, 0.35, 0.3),
+            Vec3::new(0.8, 0.85, 0.7),
+        ],
+        spot: Vec3::new(0.5, 0.9, 0.5),
+    },
+];
+
+/// The point `f` (fractions of each axis) of `bounds`.
+fn at(bounds: &Aabb, f: Vec3) -> Vec3 {
+    bounds.min + f * (bounds.max - bounds.min)
+}
+
+/// The benchmark's lights for a scene whose bounds are `bounds`: name and light.
+fn lights(scene: &LightScene, bounds: &Aabb) -> Vec<(String, SceneLight)> {
+    let light = |name: &str, kind: LightKind| SceneLight {
+        name: name.into(),
+        kind,
+        color: Vec3::ONE,
+        intensity: 100.0,
+        size: LightSize::Zero,
+        casts_shadows: true,
+        is_static: true,
+    };
+    let mut out = vec![(
+        "sun".to_owned(),
+        light(
+            "sun",
+            LightKind::Directional {
+                direction: Vec3::new(0.35, -1.0, 0.6).normalize(),
+            },
+        ),
+    )];
+    out.push((
+        "spot inside".to_owned(),
+        light(
+            "spot",
+            LightKind::Spot {
+                position: at(bounds, scene.spot),
+                direction: Vec3::new(0.2, -1.0, 0.1).normalize(),
+                inner_cone: 0.5,
+                outer_cone: 0.7,
+                range: None,
+            },
+        ),
+    ));
+    for (i, &p) in scene.points.iter().enumerate() {
+        let name = format!("point {}", i + 1);
+        out.push((
+            name.clone(),
+            light(
+                &name,
+                LightKind::Point {
+                    position: at(bounds, p),
+                    range: None,
+                },
+            ),
+        ));
+    }
+    out
+}
+
+/// What one light cost.
+struct LightCost {
+    name: String,
+    frusta: usize,
+    gpu_ms: f64,
+    bytes: u64,
+    entries: u64,
+    mean_list: f64,
+    longest: u32,
+    past_capacity: u64,
+}
+
+/// Median of `v` (0 when empty).
+fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// The GPU ms of every plugin light's own passes in `frame` (the shared prim buffer is not the light's).
+fn own_ms(frame: &LightsFrame) -> f64 {
+    frame
+        .lights
+        .iter()
+        .flat_map(|l| &l.report.timings)
+        .filter(|t| t.name != ResourceId::PrimBuffer.name())
+        .map(|t| t.ms)
+        .sum()
+}
+
+fn measure_light(
+    device: &Device,
+    file: &SceneFile,
+    camera: &Camera,
+    name: &str,
+    args: &BenchArgs,
+) -> Result<LightCost> {
+    let settings = PlanSettings {
+        base: ShadowConfig {
+            antialiasing: false,
+            ..ShadowConfig::default()
+        },
+        width: args.width,
+        height: args.height,
+    };
+    let plan = plan_scene(file, camera, &settings)?;
+    let mut renderer = SceneRenderer::new(device, file, args.width, args.height)?;
+    let mut samples = Vec::new();
+    let mut last = None;
+    for frame in 0..args.frames.max(2) {
+        let f = renderer.render(device, camera, &plan)?;
+        if frame > 0 {
+            samples.push(own_ms(&f));
+        }
+        last = Some(f);
+    }
+    let last = last.context("no frame rendered")?;
+    let reports: Vec<_> = last.lights.iter().map(|l| &l.report).collect();
+    let entries: u64 = reports.iter().map(|r| u64::from(r.stats.entries)).sum();
+    let texels: u64 = reports
+        .iter()
+        .map(|r| u64::from(r.stats.texels_with_list))
+        .sum();
+    Ok(LightCost {
+        name: name.to_owned(),
+        frusta: reports.len(),
+        gpu_ms: median(samples),
+        bytes: reports
+            .iter()
+            .flat_map(|r| &r.resources)
+            .filter(|r| r.resource != ResourceId::PrimBuffer)
+            .map(|r| r.bytes)
+            .sum(),
+        entries,
+        mean_list: if texels == 0 {
+            0.0
+        } else {
+            entries as f64 / texels as f64
+        },
+        longest: reports
+            .iter()
+            .map(|r| r.stats.longest_list)
+            .max()
+            .unwrap_or(0),
+        past_capacity: reports
+            .iter()
+            .map(|r| u64::from(r.stats.texels_past_capacity))
+            .sum(),
+    })
+}
+
+/// Runs the light benchmark and returns its Markdown table.
+pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Result<String> {
+    let caps = device.capabilities();
+    let mut out = format!(
+        "Device: {} ({}); {}×{}, hard shadows (zero-size lights), no FXAA; one light at a time, planned as \
+         `render --scene` plans it; GPU ms = median over {} frames after the first of the light's passes \
+         summed over its frusta (the shared prim buffer excluded); memory = the light's own resources.\n\n\
+         | scene | light | frusta | GPU ms | × sun | MiB | entries | mean list | longest | past capacity |\n\
+         |---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        caps.device_name,
+        caps.driver,
+        args.width,
+        args.height,
+        args.frames.max(2) - 1
+    );
+    let chosen: Vec<&LightScene> = SCENES
+        .iter()
+        .filter(|s| args.only.is_empty() || args.only.iter().any(|o| s.file.contains(o.as_str())))
+        .collect();
+    let total: usize = chosen.iter().map(|s| 2 + s.points.len()).sum();
+    let bar = crate::progress(total as u64, "bench --lights");
+    for scene_case in chosen {
+        let path = models.join(scene_case.file);
+        let scene =
+            scene::load_obj(&path).with_context(|| format!("loading {}", path.display()))?;
+        let bounds = scene.bounds();
+        let camera = Camera {
+            position: at(&bounds, scene_case.camera.0),
+            target: at(&bounds, scene_case.camera.1),
+            up: Vec3::Y,
+            fov_y_radians: 70f32.to_radians(),
+            near: bounds.radius() * 1e-3,
+        };
+        let mut sun_ms = None;
+        for (name, light) in lights(scene_case, &bounds) {
+            bar.set_message(format!("{} {name}", scene_case.file));
+            let file = SceneFile {
+                static_objects: vec![true; scene.objects.len()],
+                scene: scene.clone(),
+                lights: vec![light],
+                camera: Some(camera),
+                skipped_primitives: 0,
+            };
+            let c = measure_light(device, &file, &camera, &name, args)?;
+            let sun = *sun_ms.get_or_insert(c.gpu_ms);
+            let _ = writeln!(
+                out,
+                "| {} | {} | {} | {:.3} | {:.1} | {:.1} | {} | {:.1} | {} | {} |",
+                scene_case.file.trim_end_matches(".obj"),
+                c.name,
+                c.frusta,
+                c.gpu_ms,
+                if sun > 0.0 { c.gpu_ms / sun } else { 0.0 },
+                c.bytes as f64 / f64::from(1 << 20),
+                c.entries,
+                c.mean_list,
+                c.longest,
+                c.past_capacity
+            );
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    Ok(out)
+}
