@@ -6,12 +6,13 @@
 //! frusta), memory, and its lists (entries, mean and longest list, texels past capacity).
 
 use crate::bench::BenchArgs;
-use crate::plugin::LightsFrame;
+use crate::plugin::{c_point_light, LightsFrame, PluginRenderer};
 use crate::scene_plan::{plan_scene, PlanSettings};
 use crate::scene_render::SceneRenderer;
+use crate::CameraMatrices;
 use anyhow::{Context, Result};
 use glam::Vec3;
-use passes::{ResourceId, ShadowConfig};
+use passes::{ResourceId, ShadowConfig, ShadowMode};
 use rhi::Device;
 use scene::{Aabb, Camera, LightKind, LightSize, SceneFile, SceneLight};
 use std::fmt::Write as _;
@@ -196,6 +197,56 @@ fn measure_light(
     })
 }
 
+/// The cost of the first point light of `file` given to the plugin as a point light (the C ABI's
+/// `HRTS_LIGHT_TYPE_POINT`): the plugin fits and records all six cube faces, and combines them.
+fn measure_native_point(
+    device: &Device,
+    file: &SceneFile,
+    camera: &Camera,
+    position: Vec3,
+    args: &BenchArgs,
+) -> Result<LightCost> {
+    let mut plugin =
+        PluginRenderer::for_scene(device, &file.scene, args.width, args.height, false)?;
+    plugin.configure_lights(
+        device,
+        &[ShadowConfig {
+            mode: ShadowMode::Hard,
+            antialiasing: false,
+            ..ShadowConfig::default()
+        }],
+    )?;
+    let matrices = CameraMatrices::of_camera(camera, args.width, args.height);
+    let mut samples = Vec::new();
+    let mut last = None;
+    for frame in 0..args.frames.max(2) {
+        let f = plugin.render_c_lights(device, &matrices, vec![c_point_light(position, 0.0)])?;
+        if frame > 0 {
+            samples.push(f.lights.iter().map(|l| l.gpu_ms).sum());
+        }
+        last = Some(f);
+    }
+    let last = last.context("no frame rendered")?;
+    let light = last.lights.first().context("no light reported")?;
+    let st = &light.report.stats;
+    Ok(LightCost {
+        name: "point 1, native (6 faces)".to_owned(),
+        frusta: light.frusta as usize,
+        gpu_ms: median(samples),
+        bytes: light
+            .report
+            .resources
+            .iter()
+            .filter(|r| r.resource != ResourceId::PrimBuffer)
+            .map(|r| r.bytes)
+            .sum(),
+        entries: u64::from(st.entries),
+        mean_list: st.mean_list(),
+        longest: st.longest_list,
+        past_capacity: u64::from(st.texels_past_capacity),
+    })
+}
+
 /// Runs the light benchmark and returns its Markdown table.
 pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Result<String> {
     let caps = device.capabilities();
@@ -215,7 +266,7 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
         .iter()
         .filter(|s| args.only.is_empty() || args.only.iter().any(|o| s.file.contains(o.as_str())))
         .collect();
-    let total: usize = chosen.iter().map(|s| 2 + s.points.len()).sum();
+    let total: usize = chosen.iter().map(|s| 3 + s.points.len()).sum();
     let bar = crate::progress(total as u64, "bench --lights");
     for scene_case in chosen {
         let path = models.join(scene_case.file);
@@ -229,18 +280,37 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
             fov_y_radians: 70f32.to_radians(),
             near: bounds.radius() * 1e-3,
         };
-        let mut sun_ms = None;
+        let file_with = |lights: Vec<SceneLight>| SceneFile {
+            static_objects: vec![true; scene.objects.len()],
+            scene: scene.clone(),
+            lights,
+            camera: Some(camera),
+            skipped_primitives: 0,
+        };
+        let mut costs = Vec::new();
         for (name, light) in lights(scene_case, &bounds) {
             bar.set_message(format!("{} {name}", scene_case.file));
-            let file = SceneFile {
-                static_objects: vec![true; scene.objects.len()],
-                scene: scene.clone(),
-                lights: vec![light],
-                camera: Some(camera),
-                skipped_primitives: 0,
-            };
-            let c = measure_light(device, &file, &camera, &name, args)?;
-            let sun = *sun_ms.get_or_insert(c.gpu_ms);
+            costs.push(measure_light(
+                device,
+                &file_with(vec![light]),
+                &camera,
+                &name,
+                args,
+            )?);
+            bar.inc(1);
+        }
+        bar.set_message(format!("{} native point light", scene_case.file));
+        let first_point = at(&bounds, scene_case.points[0]);
+        costs.push(measure_native_point(
+            device,
+            &file_with(Vec::new()),
+            &camera,
+            first_point,
+            args,
+        )?);
+        bar.inc(1);
+        let sun = costs[0].gpu_ms;
+        for c in &costs {
             let _ = writeln!(
                 out,
                 "| {} | {} | {} | {:.3} | {:.1} | {:.1} | {} | {:.1} | {} | {} |",
@@ -255,7 +325,6 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
                 c.longest,
                 c.past_capacity
             );
-            bar.inc(1);
         }
     }
     bar.finish_and_clear();

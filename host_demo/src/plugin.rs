@@ -86,6 +86,10 @@ pub struct LightFrameReport {
     /// How many times the plugin built the light's passes since the context was created
     /// (`HrtsFrameReport::light_builds`).
     pub light_builds: u32,
+    /// Frusta the plugin shadowed the light through (`HrtsFrameReport::frusta`: 6 for a point light).
+    pub frusta: u32,
+    /// GPU milliseconds of all of the light's passes (`HrtsFrameReport::gpu_milliseconds`).
+    pub gpu_ms: f64,
 }
 
 /// What a frame of several lights did.
@@ -273,6 +277,18 @@ impl PluginRenderer {
         camera: &CameraMatrices,
         lights: &[Light],
     ) -> Result<LightsFrame> {
+        self.render_c_lights(device, camera, lights.iter().map(c_light).collect())
+    }
+
+    /// [`render_lights`](Self::render_lights) with the lights as the C ABI takes them (point lights, spot
+    /// lights whose frusta the plugin fits).
+    pub fn render_c_lights(
+        &mut self,
+        device: &Device,
+        camera: &CameraMatrices,
+        c_lights: Vec<HrtsLight>,
+    ) -> Result<LightsFrame> {
+        let lights = &c_lights;
         if lights.len() != self.configured.len() {
             bail!(
                 "{} lights given for a frame, {} configured",
@@ -283,7 +299,6 @@ impl PluginRenderer {
         let push = GBufferPush::for_camera(camera, self.geometry.origin())?;
         let tris = self.geometry.triangle_count();
         let rebuild_prims = self.frames == 0 || self.dynamic_geometry;
-        let c_lights: Vec<HrtsLight> = lights.iter().map(c_light).collect();
         let with_plugin = !c_lights.is_empty();
         let t = &self.targets;
         device.submit_and_wait(|enc| {
@@ -451,6 +466,8 @@ impl PluginRenderer {
         Ok(LightFrameReport {
             report,
             light_builds: r.light_builds,
+            frusta: r.frusta,
+            gpu_ms: r.gpu_milliseconds,
         })
     }
 
@@ -698,6 +715,21 @@ fn c_light(light: &Light) -> HrtsLight {
         position,
         direction: direction.to_array(),
         view_proj: view_proj.to_cols_array(),
+        range: 0.0,
+        outer_cone: 0.0,
+    }
+}
+
+/// The C point light at `position` within `range` (0: unlimited): the plugin shadows it through its cube
+/// faces and writes their minimum to the light's layer.
+pub fn c_point_light(position: glam::Vec3, range: f32) -> HrtsLight {
+    HrtsLight {
+        light_type: HrtsLightType::Point as u32,
+        position: position.to_array(),
+        direction: [0.0; 3],
+        view_proj: [0.0; 16],
+        range,
+        outer_cone: 0.0,
     }
 }
 

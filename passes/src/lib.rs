@@ -10,6 +10,7 @@ pub mod fxaa;
 pub mod gpu_types;
 pub mod hybrid;
 pub mod light;
+pub mod min_combine;
 pub mod pcss;
 pub mod prim_buffer;
 pub mod primitive_map;
@@ -28,7 +29,8 @@ pub use frame_plan::{
 };
 pub use gpu_types::MapStats;
 pub use hybrid::HybridConfig;
-pub use light::Light;
+pub use light::{point_light_faces, spot_light_frusta, Light};
+pub use min_combine::MinCombine;
 pub use pcss::PcssConfig;
 pub use prim_buffer::{Draw, Geometry, IndexFormat, IndexLayout, SharedGeometry, VertexLayout};
 pub use primitive_map::{

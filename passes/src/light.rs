@@ -62,6 +62,93 @@ impl Light {
     }
 }
 
+/// Tangent of the half-angle of each cube face of a point light: a little over 45° so that every direction
+/// lies strictly inside at least one face, whatever the rounding of its projection.
+pub const CUBE_FACE_TAN_HALF: f32 = 1.0 + 1.0 / 256.0;
+
+/// Widest spot cone (half-angle, radians) given one perspective frustum; wider cones are shadowed
+/// through the cube faces around their axis.
+pub const MAX_SINGLE_FRUSTUM_CONE: f32 = std::f32::consts::FRAC_PI_3;
+
+/// Near plane of a perspective projection the plugin fits for a local light: this fraction of its range,
+/// or [`DEFAULT_LOCAL_NEAR`] world units for a light of unlimited range. The far plane is at infinity.
+pub const NEAR_FRACTION_OF_RANGE: f32 = 1.0 / 1024.0;
+
+/// Near plane (world units) of a fitted projection for a light of unlimited range.
+pub const DEFAULT_LOCAL_NEAR: f32 = 0.01;
+
+/// An up direction for a view along `forward` (unit): +Y unless `forward` is within about 1° of ±Y, then +Z.
+fn up_hint(forward: Vec3) -> Vec3 {
+    if forward.y.abs() > 1f32.to_radians().cos() {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    }
+}
+
+/// The near plane of a projection fitted for a local light of `range` (`None`: unlimited).
+fn fitted_near(range: Option<f32>) -> f32 {
+    range.map_or(DEFAULT_LOCAL_NEAR, |r| r * NEAR_FRACTION_OF_RANGE)
+}
+
+/// The light of a perspective frustum at `position` looking along `forward` (unit), `tan_half` wide on both
+/// axes, with standard depth from `near` to infinity.
+fn perspective(position: Vec3, forward: Vec3, up: Vec3, tan_half: f32, near: f32) -> Light {
+    let view = Mat4::look_to_rh(position, forward, up);
+    Light::Spot {
+        position,
+        direction: forward,
+        view_proj: Mat4::perspective_infinite_rh(2.0 * tan_half.atan(), 1.0, near) * view,
+    }
+}
+
+/// The frusta that shadow a point light at `position` of `range` (`None`: unlimited): the six cube faces
+/// along ±X, ±Y, ±Z, each [`CUBE_FACE_TAN_HALF`] wide, so that every direction lies inside one. A pixel
+/// outside a face's frustum is lit in that face's visibility: the light's visibility is the minimum over
+/// its faces.
+pub fn point_light_faces(position: Vec3, range: Option<f32>) -> [Light; 6] {
+    let near = fitted_near(range);
+    [
+        (Vec3::X, Vec3::Y),
+        (Vec3::NEG_X, Vec3::Y),
+        (Vec3::Y, Vec3::Z),
+        (Vec3::NEG_Y, Vec3::Z),
+        (Vec3::Z, Vec3::Y),
+        (Vec3::NEG_Z, Vec3::Y),
+    ]
+    .map(|(forward, up)| perspective(position, forward, up, CUBE_FACE_TAN_HALF, near))
+}
+
+/// The frusta that shadow a spot light at `position` pointing along `direction` with a cone of half-angle
+/// `outer_cone` (radians, in (0, π/2]) and `range`: one perspective frustum just wider than the cone up to
+/// [`MAX_SINGLE_FRUSTUM_CONE`], else the cube faces around its axis that the cone reaches (its axis and the
+/// four across it).
+pub fn spot_light_frusta(
+    position: Vec3,
+    direction: Vec3,
+    outer_cone: f32,
+    range: Option<f32>,
+) -> Vec<Light> {
+    let axis = direction.normalize();
+    let near = fitted_near(range);
+    if outer_cone <= MAX_SINGLE_FRUSTUM_CONE {
+        let tan_half = outer_cone.tan() * CUBE_FACE_TAN_HALF;
+        return vec![perspective(position, axis, up_hint(axis), tan_half, near)];
+    }
+    let right = axis.cross(up_hint(axis)).normalize();
+    let up = right.cross(axis);
+    [
+        (axis, up),
+        (right, up),
+        (-right, up),
+        (up, axis),
+        (-up, axis),
+    ]
+    .into_iter()
+    .map(|(forward, up)| perspective(position, forward, up, CUBE_FACE_TAN_HALF, near))
+    .collect()
+}
+
 /// Relative tolerance of the checks that a matrix matches the light it is given for.
 const MATCH_TOLERANCE: f64 = 1e-3;
 
@@ -269,6 +356,54 @@ mod tests {
         let f = LightFrame::new(&spot(), DVec3::ZERO).unwrap();
         let expected = 2.0 * (0.5f32).tan() / 1000.0;
         assert!((f.gpu(1000, 0.0).params.x - expected).abs() < 1e-6);
+    }
+
+    /// Every direction projects strictly inside at least one cube face, and each face is a valid spot
+    /// light of the pipeline; a narrow spot gets one frustum containing its cone, a wide one five faces.
+    #[test]
+    fn fitted_frusta_cover_their_lights() {
+        let position = Vec3::new(1.0, 2.0, -3.0);
+        let faces = point_light_faces(position, Some(10.0));
+        let mut rng = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f32 / (1u64 << 53) as f32 * 2.0 - 1.0
+        };
+        let inside = |light: &Light, p: Vec3| {
+            let c = light.view_proj() * p.extend(1.0);
+            c.w > 0.0 && c.x.abs() < c.w && c.y.abs() < c.w
+        };
+        for _ in 0..2000 {
+            let d = Vec3::new(next(), next(), next());
+            if d.length_squared() < 1e-6 {
+                continue;
+            }
+            let p = position + d * 5.0;
+            assert!(faces.iter().any(|f| inside(f, p)), "{d}");
+        }
+        for f in &faces {
+            LightFrame::new(f, DVec3::ZERO).unwrap();
+        }
+        let narrow = spot_light_frusta(position, Vec3::new(0.2, -1.0, 0.1), 0.5, None);
+        assert_eq!(narrow.len(), 1);
+        LightFrame::new(&narrow[0], DVec3::new(4.0, 0.0, 1.0)).unwrap();
+        let axis = Vec3::new(0.2, -1.0, 0.1).normalize();
+        for _ in 0..500 {
+            let d = (axis + Vec3::new(next(), next(), next()) * 0.45).normalize();
+            if d.angle_between(axis) < 0.5 {
+                assert!(inside(&narrow[0], position + d * 3.0), "{d}");
+            }
+        }
+        let wide = spot_light_frusta(position, axis, 1.4, Some(20.0));
+        assert_eq!(wide.len(), 5);
+        for _ in 0..500 {
+            let d = Vec3::new(next(), next(), next()).normalize();
+            if d.angle_between(axis) < 1.4 {
+                assert!(wide.iter().any(|f| inside(f, position + d * 3.0)), "{d}");
+            }
+        }
     }
 
     #[test]

@@ -9,7 +9,7 @@
 
 // Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 // version differs.
-#define HRTS_API_VERSION (3 << 22)
+#define HRTS_API_VERSION (4 << 22)
 
 // The most lights one context shades (`hrts_configure_lights`).
 #define HRTS_MAX_LIGHTS 16
@@ -164,8 +164,12 @@ enum HrtsLightType
  {
   // Parallel light along `direction`, orthographic `view_proj`.
   HRTS_LIGHT_TYPE_DIRECTIONAL = 0,
-  // Spot light at `position` pointing along `direction`, perspective `view_proj`.
+  // Spot light at `position` pointing along `direction`: the engine's perspective `view_proj`, or, when
+  // `view_proj` is all zeros, frusta the plugin fits to `outer_cone` and `range`.
   HRTS_LIGHT_TYPE_SPOT = 1,
+  // Point light at `position`, shining in every direction within `range`: the plugin shadows it
+  // through the six cube faces around it and writes their minimum to the light's output layer.
+  HRTS_LIGHT_TYPE_POINT = 2,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -570,13 +574,22 @@ typedef struct HrtsTargets {
 typedef struct HrtsLight {
   // `HrtsLightType`.
   uint32_t light_type;
-  // Spot light: emitter position in world space (ignored for directional lights).
+  // Spot and point lights: emitter position in world space (ignored for directional lights).
   float position[3];
-  // Direction the light travels, or the spot light's axis (need not be normalised; non-zero).
+  // Direction the light travels, or the spot light's axis (need not be normalised; non-zero; ignored
+  // for point lights).
   float direction[3];
   // The light's view-projection enclosing shadow casters and receivers (column-major): orthographic
-  // for a directional light, perspective with its eye at `position` for a spot light.
+  // for a directional light (required), perspective with its eye at `position` for a spot light, or
+  // all zeros for the plugin to fit a spot light's frusta itself (ignored for point lights). A fitted
+  // frustum has its near plane at `range / 1024` (0.01 without a range) and its far plane at infinity.
   float view_proj[16];
+  // Spot and point lights: distance beyond which the light has no effect, or 0 for unlimited. It sets
+  // the near plane of the frusta the plugin fits; shadows stay exact at every distance.
+  float range;
+  // Spot lights whose frusta the plugin fits: half-angle of the cone in radians, in (0, π/2]. Up to
+  // π/3 one frustum covers it; wider cones use the five cube faces around the axis. Ignored otherwise.
+  float outer_cone;
 } HrtsLight;
 
 // One frame to record into the engine's command buffer.
@@ -695,6 +708,13 @@ typedef struct HrtsFrameReport {
   // How many times this light's passes were built since the context was created: a configuration,
   // geometry or targets call that changed nothing of this light leaves it as it was.
   uint32_t light_builds;
+  // Frusta the light is shadowed through: 1, or the cube faces of a point light (6) or of a wide spot
+  // light (5). Statistics, pass times and memory above are summed over them (the longest list is the
+  // longest of any; `map_to_texels` is the first frustum's).
+  uint32_t frusta;
+  // GPU milliseconds of all of this light's passes in the frame (every frustum, the minimum over
+  // them, and the light's share of nothing else).
+  double gpu_milliseconds;
 } HrtsFrameReport;
 
 // Every result, in value order.

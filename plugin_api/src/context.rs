@@ -9,8 +9,8 @@ use crate::geometry::{cpu_geometry, geometry_from, vulkan_geometry, GeometrySour
 use crate::types::*;
 use passes::retire::{completed_before, RetireQueue};
 use passes::{
-    BinningRequest, FrameInputs, PassStatus, ResourceId, ShadowConfig, ShadowInputs,
-    ShadowPipeline, SharedGeometry, SkipReason,
+    BinningRequest, FrameInputs, FrameReport, MinCombine, PassStatus, ResourceId, ShadowConfig,
+    ShadowInputs, ShadowPipeline, SharedGeometry, SkipReason,
 };
 use rhi::{Device, Format, Image, ImageDesc, ImageUsage};
 use std::sync::Arc;
@@ -26,10 +26,41 @@ pub(crate) struct TargetSource {
     pub(crate) output_layers: u32,
 }
 
+/// The passes of one light: one pipeline per frustum it is shadowed through and, for several, the
+/// minimum over their outputs.
+pub(crate) struct LightPasses {
+    pub(crate) frusta: Vec<ShadowPipeline>,
+    pub(crate) combine: Option<MinCombine>,
+}
+
+impl LightPasses {
+    /// The light's visibility, copied to its layer of the engine's output.
+    pub(crate) fn output(&self) -> &Image {
+        self.combine
+            .as_ref()
+            .map_or_else(|| self.frusta[0].output(), |c| &c.output)
+    }
+
+    /// The pipeline of a light of one frustum: its resources can be described and read back.
+    pub(crate) fn single(&self, light: u32) -> ApiResult<&ShadowPipeline> {
+        match self.frusta.as_slice() {
+            [one] => Ok(one),
+            many => Err(ApiError::new(
+                HrtsResult::ErrorInvalidState,
+                format!(
+                    "light {light} is shadowed through {} frusta (a point light's cube faces or a wide spot \
+                     light's): its per-frustum resources cannot be read back; its visibility is in its output layer",
+                    many.len()
+                ),
+            )),
+        }
+    }
+}
+
 /// The passes of every light and the engine images they are bound to (the pipelines drop first).
 pub(crate) struct Built {
-    /// One pipeline per light; `None` for a light reconfigured since (rebuilt before the next frame).
-    pub(crate) lights: Vec<Option<ShadowPipeline>>,
+    /// The passes of each light; `None` for a light reconfigured since (rebuilt before the next frame).
+    pub(crate) lights: Vec<Option<LightPasses>>,
     pub(crate) shared: Arc<SharedGeometry>,
     pub(crate) depth: Image,
     pub(crate) normal: Image,
@@ -37,8 +68,8 @@ pub(crate) struct Built {
 }
 
 impl Built {
-    /// The pipeline of `light`, once built.
-    pub(crate) fn light(&self, light: u32) -> ApiResult<&ShadowPipeline> {
+    /// The passes of `light`, once built.
+    pub(crate) fn light(&self, light: u32) -> ApiResult<&LightPasses> {
         match self.lights.get(light as usize) {
             Some(Some(p)) => Ok(p),
             Some(None) => Err(ApiError::new(
@@ -55,7 +86,7 @@ impl Built {
 
 /// What reconfiguration replaced, held until the frames that used it completed.
 pub(crate) struct Retired {
-    _pipelines: Vec<ShadowPipeline>,
+    _pipelines: Vec<LightPasses>,
     _built: Option<Built>,
 }
 
@@ -71,7 +102,7 @@ pub(crate) struct FrameProgress {
 /// A frame recorded pass by pass and not finished yet.
 pub(crate) struct OpenFrame {
     pub(crate) index: u64,
-    pub(crate) inputs: Vec<FrameInputs>,
+    pub(crate) inputs: Vec<Vec<FrameInputs>>,
     pub(crate) last_pass: u32,
 }
 
@@ -90,6 +121,8 @@ pub(crate) struct Context {
     pub(crate) last_frame: Option<u64>,
     /// How many times each light's passes were built.
     pub(crate) light_builds: Vec<u32>,
+    /// How many frusta each light was last given (its passes hold one pipeline per frustum).
+    pub(crate) frusta: Vec<usize>,
     /// The message of the last call if it failed.
     pub(crate) last_error: Option<std::ffi::CString>,
 }
@@ -131,6 +164,7 @@ impl Context {
             progress: FrameProgress::default(),
             last_frame: None,
             light_builds: vec![0],
+            frusta: vec![1],
             last_error: None,
         })
     }
@@ -202,8 +236,30 @@ impl Context {
             }
         }
         self.light_builds.resize(lights.len(), 0);
+        self.frusta.resize(lights.len(), 1);
         self.lights = lights;
         Ok(())
+    }
+
+    /// Takes each light's number of frusta this frame: a light whose number changed (a spot light turned
+    /// point light, say) has its passes rebuilt.
+    pub(crate) fn set_frusta(&mut self, frusta: &[usize]) {
+        let mut replaced = Vec::new();
+        for (i, (&new, old)) in frusta.iter().zip(&mut self.frusta).enumerate() {
+            if new != *old {
+                *old = new;
+                if let Some(passes) = self.built.as_mut().and_then(|b| b.lights[i].take()) {
+                    replaced.push(passes);
+                }
+            }
+        }
+        if !replaced.is_empty() {
+            self.retire(Retired {
+                _pipelines: replaced,
+                _built: None,
+            });
+            self.progress = FrameProgress::default();
+        }
     }
 
     /// A configuration checked against the device.
@@ -312,18 +368,37 @@ impl Context {
             .built
             .as_mut()
             .ok_or_else(|| ApiError::new(HrtsResult::ErrorInternal, "passes not built"))?;
-        for (i, (slot, config)) in built.lights.iter_mut().zip(lights).enumerate() {
+        for (i, ((slot, config), &frusta)) in built
+            .lights
+            .iter_mut()
+            .zip(lights)
+            .zip(&self.frusta)
+            .enumerate()
+        {
             if slot.is_none() {
                 let inputs = ShadowInputs {
                     depth: &built.depth,
                     normal: &built.normal,
                 };
-                let pipeline = ShadowPipeline::with_shared_geometry(
-                    device,
-                    built.shared.clone(),
-                    &inputs,
-                    *config,
-                )
+                let passes = (|| -> Result<LightPasses, passes::PassError> {
+                    let frusta = (0..frusta)
+                        .map(|_| {
+                            ShadowPipeline::with_shared_geometry(
+                                device,
+                                built.shared.clone(),
+                                &inputs,
+                                *config,
+                            )
+                        })
+                        .collect::<Result<Vec<_>, _>>()?;
+                    let combine = if frusta.len() > 1 {
+                        let outputs: Vec<&Image> = frusta.iter().map(|p| p.output()).collect();
+                        Some(MinCombine::new(device, &outputs)?)
+                    } else {
+                        None
+                    };
+                    Ok(LightPasses { frusta, combine })
+                })()
                 .map_err(|e| {
                     let e = ApiError::from(e);
                     ApiError {
@@ -331,7 +406,7 @@ impl Context {
                         ..e
                     }
                 })?;
-                *slot = Some(pipeline);
+                *slot = Some(passes);
                 builds[i] += 1;
             }
         }
@@ -436,39 +511,55 @@ impl Context {
                 "no frame has been recorded since the last configuration, geometry or targets call",
             )
         })?;
-        let pipeline = built.light(light)?;
-        let report = pipeline
-            .try_report_frame(frame_index)
-            .map_err(|e| ApiError::new(HrtsResult::ErrorInvalidArgument, e.to_string()))?
-            .ok_or_else(|| {
-                ApiError::new(
-                    HrtsResult::NotReady,
-                    format!("frame {frame_index} has not completed on the GPU: ask after its fence signalled"),
-                )
-            })?;
-        out.binning_path = binning_path_to_c(report.binning_path) as u32;
-        out.tier = report.binning_path.tier() as u32;
-        let st = &report.stats;
-        out.texels_past_capacity = st.texels_past_capacity;
-        out.longest_list = st.longest_list;
-        out.texels_with_list = st.texels_with_list;
-        out.entries = st.entries;
-        out.entry_capacity = st.capacity;
-        out.receiver_pixels = st.receiver_pixels;
-        out.receiver_texels = st.receiver_texels;
-        out.triangles_binned = st.triangles_binned;
-        out.map_to_texels = report.map_to_texels.to_cols_array();
-        out.pass_count = report.timings.len().min(HRTS_MAX_REPORTED_PASSES) as u32;
-        for (slot, t) in out.passes.iter_mut().zip(&report.timings) {
+        let passes = built.light(light)?;
+        let reports = passes
+            .frusta
+            .iter()
+            .map(|p| {
+                p.try_report_frame(frame_index)
+                    .map_err(|e| ApiError::new(HrtsResult::ErrorInvalidArgument, e.to_string()))?
+                    .ok_or_else(|| {
+                        ApiError::new(
+                            HrtsResult::NotReady,
+                            format!("frame {frame_index} has not completed on the GPU: ask after its fence signalled"),
+                        )
+                    })
+            })
+            .collect::<ApiResult<Vec<FrameReport>>>()?;
+        let first = &reports[0];
+        out.binning_path = binning_path_to_c(first.binning_path) as u32;
+        out.tier = first.binning_path.tier() as u32;
+        let sum = |f: fn(&FrameReport) -> u32| {
+            reports.iter().map(f).fold(0u32, |a, b| a.saturating_add(b))
+        };
+        out.texels_past_capacity = sum(|r| r.stats.texels_past_capacity);
+        out.longest_list = reports
+            .iter()
+            .map(|r| r.stats.longest_list)
+            .max()
+            .unwrap_or(0);
+        out.texels_with_list = sum(|r| r.stats.texels_with_list);
+        out.entries = sum(|r| r.stats.entries);
+        out.entry_capacity = sum(|r| r.stats.capacity);
+        out.receiver_pixels = sum(|r| r.stats.receiver_pixels);
+        out.receiver_texels = sum(|r| r.stats.receiver_texels);
+        out.triangles_binned = sum(|r| r.stats.triangles_binned);
+        out.map_to_texels = first.map_to_texels.to_cols_array();
+        let timings: Vec<_> = reports.iter().flat_map(|r| &r.timings).collect();
+        out.pass_count = timings.len().min(HRTS_MAX_REPORTED_PASSES) as u32;
+        for (slot, t) in out.passes.iter_mut().zip(&timings) {
             slot.name = [0; 32];
             for (dst, src) in slot.name.iter_mut().zip(t.name.bytes().take(31)) {
                 *dst = src as std::ffi::c_char;
             }
             slot.milliseconds = t.ms;
         }
+        out.gpu_milliseconds = timings.iter().map(|t| t.ms).sum();
         out.pass_status = [HrtsPassStatus::NotInPlan as u32; HRTS_PASS_COUNT];
-        for (i, &(_, status)) in report.passes.iter().enumerate() {
+        for (i, &(_, status)) in first.passes.iter().enumerate() {
+            let ran = reports.iter().any(|r| r.passes[i].1 == PassStatus::Ran);
             out.pass_status[i] = match status {
+                _ if ran => HrtsPassStatus::Ran,
                 PassStatus::Ran => HrtsPassStatus::Ran,
                 PassStatus::Skipped(SkipReason::UpToDate) => HrtsPassStatus::UpToDate,
                 PassStatus::Skipped(SkipReason::NotRequested) => HrtsPassStatus::NotInPlan,
@@ -478,15 +569,22 @@ impl Context {
         out.pass_status[HrtsPass::OutputCopy as usize] = HrtsPassStatus::Ran as u32;
         out.resource_bytes = [0; HRTS_RESOURCE_COUNT];
         out.prim_buffer_bytes = 0;
-        for r in &report.resources {
+        for r in reports.iter().flat_map(|r| &r.resources) {
             if let Some(i) = RESOURCES.iter().position(|&id| id == r.resource) {
-                out.resource_bytes[i] = r.bytes;
+                out.resource_bytes[i] += r.bytes;
             } else if r.resource == ResourceId::PrimBuffer {
                 out.prim_buffer_bytes = r.bytes;
             }
         }
-        out.output_resource = resource_index(report.output)?;
+        if let (Some(combine), Some(i)) = (
+            &passes.combine,
+            RESOURCES.iter().position(|&id| id == first.output),
+        ) {
+            out.resource_bytes[i] += combine.bytes();
+        }
+        out.output_resource = resource_index(first.output)?;
         out.light_builds = self.light_builds.get(light as usize).copied().unwrap_or(0);
+        out.frusta = reports.len() as u32;
         Ok(())
     }
 
@@ -498,7 +596,7 @@ impl Context {
     ) -> ApiResult<()> {
         check_size::<HrtsResourceInfo>(out.struct_size, "HrtsResourceInfo")?;
         let id = resource_id(resource)?;
-        let pipeline = self.ensure_built()?.light(light)?;
+        let pipeline = self.ensure_built()?.light(light)?.single(light)?;
         match (pipeline.image(id), pipeline.buffer(id)) {
             (Some(image), _) => {
                 out.allocated = true;

@@ -103,8 +103,9 @@ pub(crate) fn resource_index(id: ResourceId) -> ApiResult<u32> {
         })
 }
 
-/// The camera and each light of a frame (every field checked): one `FrameInputs` per light.
-pub(crate) fn frame_inputs(f: &HrtsFrame) -> ApiResult<Vec<FrameInputs>> {
+/// The camera and each light of a frame (every field checked): per light, one `FrameInputs` per frustum
+/// it is shadowed through.
+pub(crate) fn frame_inputs(f: &HrtsFrame) -> ApiResult<Vec<Vec<FrameInputs>>> {
     finite(&f.view, "view")?;
     finite(&f.proj, "proj")?;
     finite(&f.camera_position, "camera_position")?;
@@ -126,40 +127,76 @@ pub(crate) fn frame_inputs(f: &HrtsFrame) -> ApiResult<Vec<FrameInputs>> {
         .iter()
         .enumerate()
         .map(|(i, l)| {
-            Ok(FrameInputs {
-                view: mat4(&f.view),
-                proj: mat4(&f.proj),
-                camera_position: Vec3::from_array(f.camera_position),
-                light: light_from_c(l, i)?,
-            })
+            Ok(light_frusta(l, i)?
+                .into_iter()
+                .map(|light| FrameInputs {
+                    view: mat4(&f.view),
+                    proj: mat4(&f.proj),
+                    camera_position: Vec3::from_array(f.camera_position),
+                    light,
+                })
+                .collect())
         })
         .collect()
 }
 
-/// The light of `lights[index]` (every field checked).
-fn light_from_c(l: &HrtsLight, index: usize) -> ApiResult<Light> {
+/// The frusta of `lights[index]` (every field checked): the light as given, or the frusta the plugin
+/// fits to a point light or to a spot light without a `view_proj`.
+fn light_frusta(l: &HrtsLight, index: usize) -> ApiResult<Vec<Light>> {
     let field = |name: &str| format!("lights[{index}].{name}");
     finite(&l.direction, &field("direction"))?;
     finite(&l.view_proj, &field("view_proj"))?;
     finite(&l.position, &field("position"))?;
-    let direction = Vec3::from_array(l.direction);
-    if direction.length_squared() == 0.0 {
-        return Err(invalid(format!("{} is zero", field("direction"))));
-    }
-    let view_proj = mat4(&l.view_proj);
-    let spot = enum_value(
+    let kind = enum_value(
         l.light_type,
         &[
-            (HrtsLightType::Directional as u32, false),
-            (HrtsLightType::Spot as u32, true),
+            (
+                HrtsLightType::Directional as u32,
+                HrtsLightType::Directional,
+            ),
+            (HrtsLightType::Spot as u32, HrtsLightType::Spot),
+            (HrtsLightType::Point as u32, HrtsLightType::Point),
         ],
         &field("light_type"),
         "HrtsLightType",
     )?;
+    let position = Vec3::from_array(l.position);
+    if kind != HrtsLightType::Directional && !(l.range.is_finite() && l.range >= 0.0) {
+        return Err(invalid(format!(
+            "{} must be 0 (unlimited) or a positive finite distance, got {}",
+            field("range"),
+            l.range
+        )));
+    }
+    let range = (l.range > 0.0).then_some(l.range);
+    if kind == HrtsLightType::Point {
+        return Ok(passes::point_light_faces(position, range).to_vec());
+    }
+    let direction = Vec3::from_array(l.direction);
+    if direction.length_squared() == 0.0 {
+        return Err(invalid(format!("{} is zero", field("direction"))));
+    }
+    let fitted = l.view_proj.iter().all(|&x| x == 0.0);
+    if kind == HrtsLightType::Spot && fitted {
+        if !(l.outer_cone > 0.0 && l.outer_cone <= std::f32::consts::FRAC_PI_2) {
+            return Err(invalid(format!(
+                "{} must be within (0, pi/2] radians for a spot light whose frusta the plugin fits, got {}",
+                field("outer_cone"),
+                l.outer_cone
+            )));
+        }
+        return Ok(passes::spot_light_frusta(
+            position,
+            direction,
+            l.outer_cone,
+            range,
+        ));
+    }
+    let view_proj = mat4(&l.view_proj);
     // Passed on as given: the passes normalise in f64 (normalising here in f32 would round twice).
-    Ok(if spot {
+    Ok(vec![if kind == HrtsLightType::Spot {
         Light::Spot {
-            position: Vec3::from_array(l.position),
+            position,
             direction,
             view_proj,
         }
@@ -168,7 +205,7 @@ fn light_from_c(l: &HrtsLight, index: usize) -> ApiResult<Light> {
             direction,
             view_proj,
         }
-    })
+    }])
 }
 
 pub(crate) fn enum_value<T>(

@@ -90,6 +90,7 @@ impl Context {
         if !continues {
             self.begin_frame(f.frame_index)?;
         }
+        self.set_frusta(&inputs.iter().map(Vec::len).collect::<Vec<_>>());
         self.ensure_built()?;
         let frame_index = f.frame_index;
         let (device, built) = match self.built.as_mut() {
@@ -99,8 +100,10 @@ impl Context {
         if !continues {
             self.progress.open = None;
             self.last_frame = Some(frame_index);
-            for (pipeline, light_inputs) in built.lights.iter_mut().flatten().zip(&inputs) {
-                pipeline.begin_frame_at(light_inputs, frame_index)?;
+            for (passes, light_inputs) in built.lights.iter_mut().flatten().zip(&inputs) {
+                for (pipeline, frustum_inputs) in passes.frusta.iter_mut().zip(light_inputs) {
+                    pipeline.begin_frame_at(frustum_inputs, frame_index)?;
+                }
             }
         }
         let passes: Vec<PassId> = (0..HRTS_PASS_COUNT as u32)
@@ -108,7 +111,13 @@ impl Context {
             .filter_map(pass_from_index)
             .collect();
         if copy_output {
-            for (i, pipeline) in built.lights.iter().flatten().enumerate() {
+            for (i, pipeline) in built
+                .lights
+                .iter()
+                .flatten()
+                .enumerate()
+                .flat_map(|(i, l)| l.frusta.iter().map(move |p| (i, p)))
+            {
                 if let Some(missing) = pipeline
                     .passes_to_record()
                     .into_iter()
@@ -125,7 +134,13 @@ impl Context {
             }
         }
         // Every light accepts the passes before anything is recorded: a failed call records nothing.
-        for (i, pipeline) in built.lights.iter().flatten().enumerate() {
+        for (i, pipeline) in built
+            .lights
+            .iter()
+            .flatten()
+            .enumerate()
+            .flat_map(|(i, l)| l.frusta.iter().map(move |p| (i, p)))
+        {
             pipeline.check_record(&passes).map_err(|e| {
                 ApiError::new(HrtsResult::ErrorInvalidState, format!("light {i}: {e}"))
             })?;
@@ -138,7 +153,12 @@ impl Context {
             engine_inputs(&mut enc, built, f, true);
         }
         let mut recorded = Ok(());
-        for pipeline in built.lights.iter_mut().flatten() {
+        for pipeline in built
+            .lights
+            .iter_mut()
+            .flatten()
+            .flat_map(|l| l.frusta.iter_mut())
+        {
             recorded = pipeline.record_passes(&mut enc, &passes);
             if recorded.is_err() {
                 break;
@@ -176,7 +196,7 @@ impl Context {
             ));
         }
         let id = resource_id(r.resource)?;
-        let pipeline = self.finished_frame()?.light(r.light)?;
+        let pipeline = self.finished_frame()?.light(r.light)?.single(r.light)?;
         let (image, list) = (pipeline.image(id), pipeline.buffer(id));
         let bytes = match (image, list) {
             (Some(image), _) => image.byte_size(),
@@ -275,9 +295,22 @@ fn engine_inputs(enc: &mut Encoder<'_>, b: &Built, f: &HrtsFrame, to_shader: boo
     ]);
 }
 
-/// Copies each light's final visibility into its layer of the engine's output image.
+/// Copies each light's final visibility into its layer of the engine's output image: for a light of
+/// several frusta, first the minimum over them.
 fn record_output_copy(enc: &mut Encoder<'_>, b: &Built, f: &HrtsFrame) -> ApiResult<()> {
-    let outputs: Vec<_> = b.lights.iter().flatten().map(|p| p.output()).collect();
+    let combines: Vec<_> = b
+        .lights
+        .iter()
+        .flatten()
+        .filter_map(|l| l.combine.as_ref())
+        .collect();
+    if !combines.is_empty() {
+        enc.barriers(&[Barrier::Uav]);
+        for combine in combines {
+            combine.record(enc)?;
+        }
+    }
+    let outputs: Vec<_> = b.lights.iter().flatten().map(|l| l.output()).collect();
     let each = |before, after| -> Vec<Barrier<'_>> {
         outputs
             .iter()

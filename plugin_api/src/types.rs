@@ -6,7 +6,7 @@ use std::ffi::c_char;
 
 /// Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 /// version differs.
-pub const HRTS_API_VERSION: u32 = 3 << 22;
+pub const HRTS_API_VERSION: u32 = 4 << 22;
 
 /// The most lights one context shades (`hrts_configure_lights`).
 pub const HRTS_MAX_LIGHTS: u32 = 16;
@@ -234,8 +234,12 @@ pub enum HrtsShadowMode {
 pub enum HrtsLightType {
     /// Parallel light along `direction`, orthographic `view_proj`.
     Directional = 0,
-    /// Spot light at `position` pointing along `direction`, perspective `view_proj`.
+    /// Spot light at `position` pointing along `direction`: the engine's perspective `view_proj`, or, when
+    /// `view_proj` is all zeros, frusta the plugin fits to `outer_cone` and `range`.
     Spot = 1,
+    /// Point light at `position`, shining in every direction within `range`: the plugin shadows it
+    /// through the six cube faces around it and writes their minimum to the light's output layer.
+    Point = 2,
 }
 
 /// Index element type of engine geometry.
@@ -512,13 +516,22 @@ pub struct HrtsTargets {
 pub struct HrtsLight {
     /// `HrtsLightType`.
     pub light_type: u32,
-    /// Spot light: emitter position in world space (ignored for directional lights).
+    /// Spot and point lights: emitter position in world space (ignored for directional lights).
     pub position: [f32; 3],
-    /// Direction the light travels, or the spot light's axis (need not be normalised; non-zero).
+    /// Direction the light travels, or the spot light's axis (need not be normalised; non-zero; ignored
+    /// for point lights).
     pub direction: [f32; 3],
     /// The light's view-projection enclosing shadow casters and receivers (column-major): orthographic
-    /// for a directional light, perspective with its eye at `position` for a spot light.
+    /// for a directional light (required), perspective with its eye at `position` for a spot light, or
+    /// all zeros for the plugin to fit a spot light's frusta itself (ignored for point lights). A fitted
+    /// frustum has its near plane at `range / 1024` (0.01 without a range) and its far plane at infinity.
     pub view_proj: [f32; 16],
+    /// Spot and point lights: distance beyond which the light has no effect, or 0 for unlimited. It sets
+    /// the near plane of the frusta the plugin fits; shadows stay exact at every distance.
+    pub range: f32,
+    /// Spot lights whose frusta the plugin fits: half-angle of the cone in radians, in (0, π/2]. Up to
+    /// π/3 one frustum covers it; wider cones use the five cube faces around the axis. Ignored otherwise.
+    pub outer_cone: f32,
 }
 
 /// One frame to record into the engine's command buffer.
@@ -649,6 +662,13 @@ pub struct HrtsFrameReport {
     /// How many times this light's passes were built since the context was created: a configuration,
     /// geometry or targets call that changed nothing of this light leaves it as it was.
     pub light_builds: u32,
+    /// Frusta the light is shadowed through: 1, or the cube faces of a point light (6) or of a wide spot
+    /// light (5). Statistics, pass times and memory above are summed over them (the longest list is the
+    /// longest of any; `map_to_texels` is the first frustum's).
+    pub frusta: u32,
+    /// GPU milliseconds of all of this light's passes in the frame (every frustum, the minimum over
+    /// them, and the light's share of nothing else).
+    pub gpu_milliseconds: f64,
 }
 
 /// A copy of a plugin resource into an engine buffer, recorded after a complete frame.

@@ -169,6 +169,32 @@ static Emitter spot(V3 pos, V3 target, double fov) {
     return e;
 }
 
+/* A point light at `pos`: the plugin fits its cube faces (no matrix). */
+static Emitter point(V3 pos) {
+    Emitter e;
+    memset(&e, 0, sizeof e);
+    e.spot = 1; /* shadow rays end at the emitter, as for a spot light */
+    e.pos = pos;
+    e.c.light_type = HRTS_LIGHT_TYPE_POINT;
+    e.c.position[0] = (float)pos.x;
+    e.c.position[1] = (float)pos.y;
+    e.c.position[2] = (float)pos.z;
+    return e;
+}
+
+/* A spot light at `pos` aiming at `target` with a cone of half-angle `cone`, its frusta fitted by the
+ * plugin (view_proj all zeros). */
+static Emitter fitted_spot(V3 pos, V3 target, double cone) {
+    Emitter e = point(pos);
+    e.dir = norm3(sub3(target, pos));
+    e.c.light_type = HRTS_LIGHT_TYPE_SPOT;
+    e.c.direction[0] = (float)e.dir.x;
+    e.c.direction[1] = (float)e.dir.y;
+    e.c.direction[2] = (float)e.dir.z;
+    e.c.outer_cone = (float)cone;
+    return e;
+}
+
 /* Camera ray through pixel (x, y) centre. */
 static V3 pixel_ray(double x, double y) {
     double f = 1.0 / tan(FOV_Y / 2), aspect = (double)W / H;
@@ -1197,6 +1223,68 @@ static void several_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g)
     CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
 }
 
+/* ---------- lights given as lights ---------- */
+/* A point light and a wide spot light given without matrices: the plugin fits their frusta (six cube faces,
+ * five faces around the spot's axis), writes the minimum over them to each light's one layer, and reports
+ * them as one light each; both match the exact shadow. A light that turns from point to spot is rebuilt
+ * and stays exact. Bad local lights are refused with a message, and a point light's per-face resources
+ * cannot be read back. */
+static void native_local_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
+    enum { N = 2 };
+    Emitter lights[N] = {point(v3(0.9, 2.3, 0.7)), fitted_spot(v3(-1.5, 3.2, 1.8), v3(0, 0, 0), 1.35)};
+    set_lights(lights, N);
+    HrtsContext *ctx = create_context(vk, 2);
+    CHECK(configure_all(ctx, N, HRTS_SHADOW_MODE_HARD) == HRTS_RESULT_OK, "configure: %s", hrts_last_error(ctx));
+    HrtsTargets t = targets();
+    CHECK(hrts_set_geometry_cpu(ctx, g) == HRTS_RESULT_OK && hrts_set_targets(ctx, &t) == HRTS_RESULT_OK,
+          "geometry and targets: %s", hrts_last_error(ctx));
+    static float vis[N * W * H];
+    uint64_t first = next_frame;
+    CHECK(run_frame(ctx, vis) == HRTS_RESULT_OK, "point and fitted spot: %s", hrts_last_error(ctx));
+    double tol = edge_tolerance();
+    const uint32_t want_frusta[N] = {6, 5};
+    for (int i = 0; i < N; i++) {
+        int near_edge, shadowed, lit;
+        int mismatches = count_mismatches(vis + i * W * H, tol, &lights[i], &near_edge, &shadowed, &lit);
+        HrtsFrameReport rep;
+        CHECK(report(ctx, first, (uint32_t)i, &rep) == HRTS_RESULT_OK, "report %d: %s", i, hrts_last_error(ctx));
+        printf("%s: %u frusta, %.3f GPU ms, %u entries (longest list %u); %d lit, %d shadowed, %d near-edge, %d mismatches\n",
+               i == 0 ? "point light" : "fitted spot light", rep.frusta, rep.gpu_milliseconds, rep.entries,
+               rep.longest_list, lit, shadowed, near_edge, mismatches);
+        CHECK(rep.frusta == want_frusta[i], "light %d: %u frusta", i, rep.frusta);
+        CHECK(rep.gpu_milliseconds > 0.0 && rep.texels_past_capacity == 0, "light %d: report", i);
+        CHECK(mismatches == 0, "light %d: %d pixels differ from the exact shadow", i, mismatches);
+        CHECK(shadowed > 100 && lit > 1000 && near_edge * 100 <= 4 * W * H, "light %d: %d shadowed, %d lit, %d near-edge px",
+              i, shadowed, lit, near_edge);
+    }
+    float one[W * H];
+    CHECK(read_resource(ctx, 0, HRTS_RESOURCE_RT_VISIBILITY, one, sizeof one) == HRTS_RESULT_ERROR_INVALID_STATE &&
+              strlen(hrts_last_error(ctx)) > 0,
+          "a point light's per-face resources are refused");
+    /* the point light turns into a narrow fitted spot light: only it is rebuilt */
+    lights[0] = fitted_spot(v3(0.9, 2.3, 0.7), v3(-0.5, 0, -0.6), 0.9);
+    set_lights(lights, N);
+    CHECK(run_frame(ctx, vis) == HRTS_RESULT_OK, "point light turned spot: %s", hrts_last_error(ctx));
+    HrtsFrameReport r0, r1;
+    CHECK(report(ctx, next_frame - 1, 0, &r0) == HRTS_RESULT_OK && report(ctx, next_frame - 1, 1, &r1) == HRTS_RESULT_OK,
+          "reports: %s", hrts_last_error(ctx));
+    int ne, sh, li;
+    int mismatches = count_mismatches(vis, tol, &lights[0], &ne, &sh, &li);
+    printf("turned spot: %u frustum, builds %u and %u, %d shadowed, %d mismatches\n", r0.frusta, r0.light_builds,
+           r1.light_builds, sh, mismatches);
+    CHECK(r0.frusta == 1 && r0.light_builds == 2 && r1.light_builds == 1 && mismatches == 0 && sh > 100,
+          "a light that changes type is rebuilt alone and stays exact");
+    /* bad local lights: a negative range, a fitted spot light without a cone */
+    c_lights[0].range = -1.0f;
+    CHECK(run_frame(ctx, NULL) == HRTS_RESULT_ERROR_INVALID_ARGUMENT && strstr(hrts_last_error(ctx), "range"),
+          "a negative range is refused: %s", hrts_last_error(ctx));
+    c_lights[0].range = 0.0f;
+    c_lights[0].outer_cone = 0.0f;
+    CHECK(run_frame(ctx, NULL) == HRTS_RESULT_ERROR_INVALID_ARGUMENT && strstr(hrts_last_error(ctx), "outer_cone"),
+          "a fitted spot light without a cone is refused: %s", hrts_last_error(ctx));
+    CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
+}
+
 /* ---------- frames in flight ---------- */
 /* The scene of frame i of the moving sequence: the camera orbits, a directional light turns and a spot
  * light circles. */
@@ -1502,6 +1590,7 @@ int main(void) {
 
     phase = "several lights";
     several_lights(&vk, &g);
+    native_local_lights(&vk, &g);
     phase = "frames in flight";
     frames_in_flight(&vk, &g);
     phase = "create/destroy cycles";

@@ -9,11 +9,12 @@ use common::{
     assert_no_validation_errors, compare_with_reference, device, scene_visibility_params,
 };
 use glam::Vec3;
-use host_demo::plugin::{LightFrameReport, LightsFrame};
+use host_demo::plugin::{c_point_light, LightFrameReport, LightsFrame, PluginRenderer};
 use host_demo::scene_plan::{
     plan_scene, scene_camera, LightDecision, NoPassReason, PlanSettings, ScenePlan,
 };
 use host_demo::scene_render::SceneRenderer;
+use host_demo::CameraMatrices;
 use passes::{
     PassId, PassStatus, PrimitiveMapConfig, ResourceId, ShadowConfig, ShadowMapConfig, ShadowMode,
     SkipReason,
@@ -261,6 +262,13 @@ fn boxes_scene(
 #[test]
 fn a_point_light_inside_a_closed_room_matches_the_exact_reference() {
     let device = device();
+    let file = closed_room(Vec3::new(0.15, 2.5, 0.1));
+    let plan = assert_lights_match_reference(&device, &file, &camera(&file), 200, 5, &[]);
+    assert!(plan.plugin_lights().len() >= 4, "{}", plan.describe());
+}
+
+/// The closed room of [`a_point_light_inside_a_closed_room_matches_the_exact_reference`] with its lamp.
+fn closed_room(lamp: Vec3) -> SceneFile {
     let boxes = [
         // Walls 10 cm thick around a 6 x 3 x 6 m room.
         (
@@ -309,14 +317,67 @@ fn a_point_light_inside_a_closed_room_matches_the_exact_reference() {
             Vec3::new(0.9, 2.23, 1.9),
         ),
     ];
-    let file = boxes_scene(
+    boxes_scene(
         &boxes,
-        vec![point_light("lamp", Vec3::new(0.15, 2.5, 0.1))],
+        vec![point_light("lamp", lamp)],
         Vec3::new(2.4, 2.2, 2.6),
         Vec3::new(-0.5, 0.6, -0.6),
+    )
+}
+
+/// A point light given to the plugin as a point light (the C ABI's `HRTS_LIGHT_TYPE_POINT`, no matrix):
+/// the plugin shadows it through its six cube faces and writes their minimum to the light's one layer,
+/// which matches the exact reference; the report covers the six faces.
+#[test]
+fn a_native_point_light_matches_the_exact_reference() {
+    let device = device();
+    let lamp = Vec3::new(0.15, 2.5, 0.1);
+    let file = closed_room(lamp);
+    let camera = camera(&file);
+    let mut plugin =
+        PluginRenderer::for_scene(&device, &file.scene, WIDTH, HEIGHT, false).expect("plugin");
+    let config = ShadowConfig {
+        mode: ShadowMode::Hard,
+        antialiasing: false,
+        ..settings(false).base
+    };
+    plugin
+        .configure_lights(&device, &[config])
+        .expect("configure");
+    let matrices = CameraMatrices::of_camera(&camera, WIDTH, HEIGHT);
+    let mut frame = None;
+    for _ in 0..2 {
+        frame = Some(
+            plugin
+                .render_c_lights(&device, &matrices, vec![c_point_light(lamp, 0.0)])
+                .expect("frame"),
+        );
+    }
+    let frame = frame.expect("a frame");
+    let report = &frame.lights[0].report;
+    assert_eq!(report.stats.texels_past_capacity, 0);
+    assert!(report.stats.receiver_pixels > 0);
+    let (_, layers) = plugin.read_frame(&device).expect("read back");
+    let rs = RefScene::new(&file.scene);
+    let params = scene_visibility_params(
+        &file.scene,
+        &camera,
+        WIDTH,
+        HEIGHT,
+        reference::Light::Point {
+            position: lamp.as_dvec3(),
+        },
     );
-    let plan = assert_lights_match_reference(&device, &file, &camera(&file), 200, 5, &[]);
-    assert!(plan.plugin_lights().len() >= 4, "{}", plan.describe());
+    let r = reference_visibility(&rs, &params);
+    let c = compare_with_reference(&r, &layers[0], None, None);
+    println!(
+        "native point light: {} pixels, {} shadowed, {} near an edge, {} mismatches; {:?}",
+        c.pixels, c.shadowed, c.near_edge, c.mismatches, report.stats
+    );
+    assert_eq!(c.non_finite, 0);
+    assert_eq!(c.mismatches, 0, "(x, y, exact, gpu): {:?}", c.examples);
+    assert!(c.shadowed >= 200, "{} shadowed pixels", c.shadowed);
+    assert_no_validation_errors(&device);
 }
 
 /// Lights lying on geometry: a point light exactly in the plane of a box's top (the top's triangles are

@@ -1,0 +1,66 @@
+//! The visibility of a light shadowed through several frusta (a point light's cube faces, a wide spot
+//! light's faces): the minimum over the frusta's outputs, each of which is lit outside its own frustum.
+//!
+//! Reads: each frustum's output. Writes: the combined visibility.
+
+use crate::screen_pass::{visibility_image, ScreenPass};
+use crate::PassError;
+use rhi::{Barrier, BindingKind, Device, Encoder, Image, Resource, ResourceState as S};
+
+/// The min-combine pass of one light and its output.
+pub struct MinCombine {
+    steps: Vec<ScreenPass>,
+    /// `R32_SFLOAT` visibility of the light.
+    pub output: Image,
+}
+
+impl MinCombine {
+    /// Creates the pass over `frusta` (at least one, all of the same size).
+    pub fn new(device: &Device, frusta: &[&Image]) -> Result<Self, PassError> {
+        let first = frusta
+            .first()
+            .ok_or_else(|| PassError::InvalidConfig("a light needs at least one frustum".into()))?;
+        let output = visibility_image(
+            device,
+            "light visibility (min over frusta)",
+            first.width(),
+            first.height(),
+        )?;
+        let steps = frusta
+            .iter()
+            .map(|frustum| {
+                ScreenPass::new(
+                    device,
+                    "min over frusta",
+                    "min_combine.comp",
+                    &[BindingKind::StorageImage, BindingKind::StorageImage],
+                    &[Resource::Image(frustum), Resource::Image(&output)],
+                    12,
+                )
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(Self { steps, output })
+    }
+
+    /// GPU bytes of the combined image.
+    pub fn bytes(&self) -> u64 {
+        self.output.byte_size()
+    }
+
+    /// Records the minimum over the frusta's outputs (in `UnorderedAccess` state); the output's former
+    /// contents are discarded and it is left in `UnorderedAccess` state.
+    pub fn record(&self, enc: &mut Encoder<'_>) -> Result<(), PassError> {
+        let (width, height) = (self.output.width(), self.output.height());
+        enc.barriers(&[Barrier::Image {
+            image: &self.output,
+            before: S::Undefined,
+            after: S::UnorderedAccess,
+        }]);
+        for (i, step) in self.steps.iter().enumerate() {
+            let push: [u32; 3] = [width, height, u32::from(i > 0)];
+            step.record(enc, bytemuck::bytes_of(&push), width, height)?;
+            enc.barriers(&[Barrier::Uav]);
+        }
+        Ok(())
+    }
+}
