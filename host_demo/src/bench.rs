@@ -50,6 +50,10 @@ pub struct BenchArgs {
     /// sun, a spot light and point lights inside), with GPU ms, memory and lists per light.
     #[arg(long)]
     pub lights: bool,
+    /// With --lights: also this many point lights at once, given to the plugin as point lights (one
+    /// context, spread over each scene's interior; at most the plugin's light limit). 0: none.
+    #[arg(long, default_value_t = 0, requires = "lights")]
+    pub point_lights: u32,
 }
 
 /// One benchmark model: a file of `../shared/models`, how it is shown, and the talk's GTX 980 times (ms)

@@ -109,6 +109,8 @@ struct LightCost {
     name: String,
     frusta: usize,
     gpu_ms: f64,
+    map_ms: f64,
+    trace_ms: f64,
     bytes: u64,
     entries: u64,
     mean_list: f64,
@@ -125,15 +127,27 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// The GPU ms of every plugin light's own passes in `frame` (the shared prim buffer is not the light's).
-fn own_ms(frame: &LightsFrame) -> f64 {
+/// GPU ms of the passes of `frame`'s lights whose name passes `keep`.
+fn frame_ms(frame: &LightsFrame, keep: impl Fn(&str) -> bool) -> f64 {
     frame
         .lights
         .iter()
         .flat_map(|l| &l.report.timings)
-        .filter(|t| t.name != ResourceId::PrimBuffer.name())
+        .filter(|t| keep(&t.name))
         .map(|t| t.ms)
         .sum()
+}
+
+/// Medians over frames of every light's own passes (the shared prim buffer is not the light's), of its
+/// primitive-map passes and of its ray trace.
+fn medians(frames: &[LightsFrame]) -> (f64, f64, f64) {
+    let of =
+        |keep: &dyn Fn(&str) -> bool| median(frames.iter().map(|f| frame_ms(f, keep)).collect());
+    (
+        of(&|n| n != ResourceId::PrimBuffer.name()),
+        of(&|n| n.starts_with("primitive map")),
+        of(&|n| n == "ray trace"),
+    )
 }
 
 fn measure_light(
@@ -153,16 +167,12 @@ fn measure_light(
     };
     let plan = plan_scene(file, camera, &settings)?;
     let mut renderer = SceneRenderer::new(device, file, args.width, args.height)?;
-    let mut samples = Vec::new();
-    let mut last = None;
-    for frame in 0..args.frames.max(2) {
-        let f = renderer.render(device, camera, &plan)?;
-        if frame > 0 {
-            samples.push(own_ms(&f));
-        }
-        last = Some(f);
+    let mut frames = Vec::new();
+    for _ in 0..args.frames.max(2) {
+        frames.push(renderer.render(device, camera, &plan)?);
     }
-    let last = last.context("no frame rendered")?;
+    let (gpu_ms, map_ms, trace_ms) = medians(&frames[1..]);
+    let last = frames.last().context("no frame rendered")?;
     let reports: Vec<_> = last.lights.iter().map(|l| &l.report).collect();
     let entries: u64 = reports.iter().map(|r| u64::from(r.stats.entries)).sum();
     let texels: u64 = reports
@@ -172,7 +182,9 @@ fn measure_light(
     Ok(LightCost {
         name: name.to_owned(),
         frusta: reports.len(),
-        gpu_ms: median(samples),
+        gpu_ms,
+        map_ms,
+        trace_ms,
         bytes: reports
             .iter()
             .flat_map(|r| &r.resources)
@@ -197,46 +209,51 @@ fn measure_light(
     })
 }
 
-/// The cost of the first point light of `file` given to the plugin as a point light (the C ABI's
-/// `HRTS_LIGHT_TYPE_POINT`): the plugin fits and records all six cube faces, and combines them.
-fn measure_native_point(
+/// The cost of point lights at `positions` given to the plugin as point lights (the C ABI's
+/// `HRTS_LIGHT_TYPE_POINT`) in one context: the plugin fits and records all six cube faces of each, and
+/// combines them. Statistics are those of the first light; time and memory are the sum over all.
+fn measure_native_points(
     device: &Device,
     file: &SceneFile,
     camera: &Camera,
-    position: Vec3,
+    positions: &[Vec3],
+    name: String,
     args: &BenchArgs,
 ) -> Result<LightCost> {
     let mut plugin =
         PluginRenderer::for_scene(device, &file.scene, args.width, args.height, false)?;
-    plugin.configure_lights(
-        device,
-        &[ShadowConfig {
-            mode: ShadowMode::Hard,
-            antialiasing: false,
-            ..ShadowConfig::default()
-        }],
-    )?;
+    let config = ShadowConfig {
+        mode: ShadowMode::Hard,
+        antialiasing: false,
+        ..ShadowConfig::default()
+    };
+    plugin.configure_lights(device, &vec![config; positions.len()])?;
     let matrices = CameraMatrices::of_camera(camera, args.width, args.height);
-    let mut samples = Vec::new();
-    let mut last = None;
-    for frame in 0..args.frames.max(2) {
-        let f = plugin.render_c_lights(device, &matrices, vec![c_point_light(position, 0.0)])?;
-        if frame > 0 {
-            samples.push(f.lights.iter().map(|l| l.gpu_ms).sum());
-        }
-        last = Some(f);
+    let lights: Vec<_> = positions.iter().map(|&p| c_point_light(p, 0.0)).collect();
+    let mut frames = Vec::new();
+    for _ in 0..args.frames.max(2) {
+        frames.push(plugin.render_c_lights(device, &matrices, lights.clone())?);
     }
-    let last = last.context("no frame rendered")?;
+    let (_, map_ms, trace_ms) = medians(&frames[1..]);
+    let gpu_ms = median(
+        frames[1..]
+            .iter()
+            .map(|f| f.lights.iter().map(|l| l.gpu_ms).sum())
+            .collect(),
+    );
+    let last = frames.last().context("no frame rendered")?;
     let light = last.lights.first().context("no light reported")?;
     let st = &light.report.stats;
     Ok(LightCost {
-        name: "point 1, native (6 faces)".to_owned(),
-        frusta: light.frusta as usize,
-        gpu_ms: median(samples),
-        bytes: light
-            .report
-            .resources
+        name,
+        frusta: last.lights.iter().map(|l| l.frusta as usize).sum(),
+        gpu_ms,
+        map_ms,
+        trace_ms,
+        bytes: last
+            .lights
             .iter()
+            .flat_map(|l| &l.report.resources)
             .filter(|r| r.resource != ResourceId::PrimBuffer)
             .map(|r| r.bytes)
             .sum(),
@@ -254,8 +271,8 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
         "Device: {} ({}); {}×{}, hard shadows (zero-size lights), no FXAA; one light at a time, planned as \
          `render --scene` plans it; GPU ms = median over {} frames after the first of the light's passes \
          summed over its frusta (the shared prim buffer excluded); memory = the light's own resources.\n\n\
-         | scene | light | frusta | GPU ms | × sun | MiB | entries | mean list | longest | past capacity |\n\
-         |---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+         | scene | light | frusta | GPU ms | × sun | map ms | ray trace ms | MiB | entries | mean list | longest | past capacity |\n\
+         |---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         caps.device_name,
         caps.driver,
         args.width,
@@ -266,7 +283,10 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
         .iter()
         .filter(|s| args.only.is_empty() || args.only.iter().any(|o| s.file.contains(o.as_str())))
         .collect();
-    let total: usize = chosen.iter().map(|s| 3 + s.points.len()).sum();
+    let total: usize = chosen
+        .iter()
+        .map(|s| 3 + s.points.len() + usize::from(args.point_lights > 0))
+        .sum();
     let bar = crate::progress(total as u64, "bench --lights");
     for scene_case in chosen {
         let path = models.join(scene_case.file);
@@ -301,24 +321,54 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
         }
         bar.set_message(format!("{} native point light", scene_case.file));
         let first_point = at(&bounds, scene_case.points[0]);
-        costs.push(measure_native_point(
+        costs.push(measure_native_points(
             device,
             &file_with(Vec::new()),
             &camera,
-            first_point,
+            &[first_point],
+            "point 1, native (6 faces)".to_owned(),
             args,
         )?);
         bar.inc(1);
+        if args.point_lights > 0 {
+            bar.set_message(format!(
+                "{} {} point lights",
+                scene_case.file, args.point_lights
+            ));
+            let n = args.point_lights;
+            // On a ring around the interior's centre, alternating between two heights.
+            let positions: Vec<Vec3> = (0..n)
+                .map(|i| {
+                    let a = i as f32 / n as f32 * std::f32::consts::TAU;
+                    let f = Vec3::new(
+                        0.5 + 0.3 * a.cos(),
+                        if i % 2 == 0 { 0.2 } else { 0.5 },
+                        0.5 + 0.3 * a.sin(),
+                    );
+                    at(&bounds, f)
+                })
+                .collect();
+            costs.push(measure_native_points(
+                device,
+                &file_with(Vec::new()),
+                &camera,
+                &positions,
+                format!("{n} point lights, native, all together"),
+                args,
+            )?);
+        }
         let sun = costs[0].gpu_ms;
         for c in &costs {
             let _ = writeln!(
                 out,
-                "| {} | {} | {} | {:.3} | {:.1} | {:.1} | {} | {:.1} | {} | {} |",
+                "| {} | {} | {} | {:.3} | {:.1} | {:.3} | {:.3} | {:.1} | {} | {:.1} | {} | {} |",
                 scene_case.file.trim_end_matches(".obj"),
                 c.name,
                 c.frusta,
                 c.gpu_ms,
                 if sun > 0.0 { c.gpu_ms / sun } else { 0.0 },
+                c.map_ms,
+                c.trace_ms,
                 c.bytes as f64 / f64::from(1 << 20),
                 c.entries,
                 c.mean_list,

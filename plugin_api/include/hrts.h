@@ -11,8 +11,8 @@
 // version differs.
 #define HRTS_API_VERSION (4 << 22)
 
-// The most lights one context shades (`hrts_configure_lights`).
-#define HRTS_MAX_LIGHTS 16
+// The most lights one context shades (`hrts_configure_lights`); a point light counts once.
+#define HRTS_MAX_LIGHTS 64
 
 // The most frames in flight a context supports (`HrtsContextCreateInfo::frames_in_flight`).
 #define HRTS_MAX_FRAMES_IN_FLIGHT 8
@@ -34,8 +34,8 @@
 // Number of `HrtsResource` values.
 #define HRTS_RESOURCE_COUNT 12
 
-// Maximum passes in a report.
-#define HRTS_MAX_REPORTED_PASSES 32
+// Maximum passes in a report (every pass of a light shadowed through six cube faces fits).
+#define HRTS_MAX_REPORTED_PASSES 128
 
 // Result of every call. Append-only: values never change meaning.
 typedef enum HrtsResult {

@@ -8,8 +8,8 @@ use std::ffi::c_char;
 /// version differs.
 pub const HRTS_API_VERSION: u32 = 4 << 22;
 
-/// The most lights one context shades (`hrts_configure_lights`).
-pub const HRTS_MAX_LIGHTS: u32 = 16;
+/// The most lights one context shades (`hrts_configure_lights`); a point light counts once.
+pub const HRTS_MAX_LIGHTS: u32 = 64;
 
 /// The most frames in flight a context supports (`HrtsContextCreateInfo::frames_in_flight`).
 pub const HRTS_MAX_FRAMES_IN_FLIGHT: u32 = 8;
@@ -616,8 +616,8 @@ pub struct HrtsPassTiming {
     pub milliseconds: f64,
 }
 
-/// Maximum passes in a report.
-pub const HRTS_MAX_REPORTED_PASSES: usize = 32;
+/// Maximum passes in a report (every pass of a light shadowed through six cube faces fits).
+pub const HRTS_MAX_REPORTED_PASSES: usize = 128;
 
 /// What one light's passes did in one frame (`hrts_get_frame_report`).
 #[repr(C)]

@@ -1234,6 +1234,9 @@ static void native_local_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometr
     Emitter lights[N] = {point(v3(0.9, 2.3, 0.7)), fitted_spot(v3(-1.5, 3.2, 1.8), v3(0, 0, 0), 1.35)};
     set_lights(lights, N);
     HrtsContext *ctx = create_context(vk, 2);
+    /* a context takes HRTS_MAX_LIGHTS lights, a point light counting once */
+    CHECK(HRTS_MAX_LIGHTS >= 64 && configure_all(ctx, HRTS_MAX_LIGHTS, HRTS_SHADOW_MODE_HARD) == HRTS_RESULT_OK,
+          "configure %d lights: %s", HRTS_MAX_LIGHTS, hrts_last_error(ctx));
     CHECK(configure_all(ctx, N, HRTS_SHADOW_MODE_HARD) == HRTS_RESULT_OK, "configure: %s", hrts_last_error(ctx));
     HrtsTargets t = targets();
     CHECK(hrts_set_geometry_cpu(ctx, g) == HRTS_RESULT_OK && hrts_set_targets(ctx, &t) == HRTS_RESULT_OK,
