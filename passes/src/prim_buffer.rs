@@ -152,12 +152,17 @@ impl Geometry {
         {
             return bad(format!("vertex layout {vertex:?}: stride must be a multiple of 4 and >= 12, offset a multiple of 4, count > 0"));
         }
-        let vertex_end =
-            vertex.offset + u64::from(vertex.count - 1) * u64::from(vertex.stride) + 12;
-        if vertex_end > vertices.size() {
+        // Checked: an offset near u64::MAX must not wrap past the bounds check.
+        let vertex_end = u64::from(vertex.count - 1)
+            .checked_mul(u64::from(vertex.stride))
+            .and_then(|b| b.checked_add(vertex.offset))
+            .and_then(|b| b.checked_add(12));
+        if vertex_end.is_none_or(|end| end > vertices.size()) {
             return bad(format!(
-                "{} vertices need {vertex_end} bytes, the vertex buffer has {}",
+                "{} vertices of stride {} at offset {} do not fit the vertex buffer of {} bytes",
                 vertex.count,
+                vertex.stride,
+                vertex.offset,
                 vertices.size()
             ));
         }
@@ -167,12 +172,22 @@ impl Geometry {
                 "index layout {index:?}: offset must be a multiple of 4, count > 0"
             ));
         }
-        let index_end = index.offset + u64::from(index.count) * index.format.bytes();
-        if index_end > indices.size() {
+        let index_end = (u64::from(index.count) * index.format.bytes()).checked_add(index.offset);
+        if index_end.is_none_or(|end| end > indices.size()) {
             return bad(format!(
-                "{} indices need {index_end} bytes, the index buffer has {}",
+                "{} indices at offset {} do not fit the index buffer of {} bytes",
                 index.count,
+                index.offset,
                 indices.size()
+            ));
+        }
+        // The shaders address both buffers in 32-bit words and elements.
+        if u32::try_from(vertex.offset / 4).is_err()
+            || u32::try_from(index.offset / index.format.bytes()).is_err()
+        {
+            return bad(format!(
+                "vertex offset {} or index offset {} is beyond what the shaders address (2^32 words or indices)",
+                vertex.offset, index.offset
             ));
         }
         let mut triangle_count = 0u32;

@@ -357,7 +357,9 @@ pub unsafe extern "C" fn hrts_set_geometry_cpu(
 }
 
 /// Sets the shadow-casting geometry from the engine's Vulkan buffers (read by the GPU every time the prim
-/// buffer is rebuilt; they must outlive the context or the next geometry call).
+/// buffer is rebuilt). They must stay alive until the context is destroyed or, after the
+/// next geometry call, until every frame recorded before that call has completed (`frames_in_flight`
+/// frames later): frames still in flight read them.
 ///
 /// # Safety
 /// As for `hrts_get_capabilities`; the buffers are live `VkBuffer`s of the adopted device.

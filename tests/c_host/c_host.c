@@ -817,7 +817,7 @@ enum {
     CONFIG_NAN_LIGHT_SIZE, CONFIG_NEGATIVE_WSS, CONFIG_PCF_TAPS, CONFIG_SHADOW_MAP_ZERO, CONFIG_DEFAULTS_NULL,
     CONFIG_FILTER, CONFIG_EXTRA_OUTPUT, CONFIG_FILTER_RADII, CONFIG_SLOPE_BIAS, LIGHTS_ZERO, LIGHTS_TOO_MANY,
     LIGHTS_NULL, LIGHTS_SECOND_INVALID, GEOMETRY_NULL_POSITIONS, GEOMETRY_STRIDE, GEOMETRY_NAN, GEOMETRY_INDEX,
-    GEOMETRY_NO_DRAWS, VULKAN_GEOMETRY_INDEX_TYPE, TARGETS_ZERO_WIDTH, TARGETS_DEPTH_USAGE, TARGETS_OUTPUT_USAGE,
+    GEOMETRY_NO_DRAWS, VULKAN_GEOMETRY_INDEX_TYPE, VULKAN_GEOMETRY_VERTEX_OFFSET_WRAP, VULKAN_GEOMETRY_INDEX_OFFSET_WRAP, TARGETS_ZERO_WIDTH, TARGETS_DEPTH_USAGE, TARGETS_OUTPUT_USAGE,
     TARGETS_NULL_NORMAL, TARGETS_ZERO_LAYERS, FRAME_ZERO_DIRECTION, FRAME_NAN_PROJECTION, FRAME_LIGHT_TYPE,
     FRAME_NULL_COMMAND_BUFFER, FRAME_STRUCT_SIZE, FRAME_NULL_LIGHTS, FRAME_LIGHT_COUNT_ZERO, FRAME_LIGHT_COUNT_OTHER,
     FRAME_INDEX_REPEATED, FRAME_INDEX_BACKWARDS, REPORT_STRUCT_SIZE, REPORT_OLD_FRAME, REPORT_NO_SUCH_LIGHT,
@@ -873,6 +873,8 @@ static const struct {
     [GEOMETRY_INDEX] = {"geometry(index out of range)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [GEOMETRY_NO_DRAWS] = {"geometry(no draws)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [VULKAN_GEOMETRY_INDEX_TYPE] = {"vulkan geometry(unknown index type)", HRTS_RESULT_ERROR_INVALID_ENUM},
+    [VULKAN_GEOMETRY_VERTEX_OFFSET_WRAP] = {"vulkan geometry(vertex offset UINT64_MAX - 3)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [VULKAN_GEOMETRY_INDEX_OFFSET_WRAP] = {"vulkan geometry(index offset UINT64_MAX - 3)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [TARGETS_ZERO_WIDTH] = {"targets(zero width)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [TARGETS_DEPTH_USAGE] = {"targets(depth not SAMPLED)", HRTS_RESULT_ERROR_IMAGE_USAGE},
     [TARGETS_OUTPUT_USAGE] = {"targets(output not TRANSFER_DST)", HRTS_RESULT_ERROR_IMAGE_USAGE},
@@ -1013,6 +1015,30 @@ static HrtsResult misuse_call(int id, Misuse *m) {
         vg.vertex_buffer = 1;
         vg.index_buffer = 1;
         vg.index_type = 5;
+        return hrts_set_geometry_vulkan(ctx, &vg);
+    }
+    case VULKAN_GEOMETRY_VERTEX_OFFSET_WRAP:
+    case VULKAN_GEOMETRY_INDEX_OFFSET_WRAP: {
+        /* offsets whose end wraps past 2^64 must fail the bounds check, not pass it (handles never used) */
+        HrtsVulkanGeometry vg;
+        memset(&vg, 0, sizeof vg);
+        vg.struct_size = sizeof vg;
+        vg.vertex_buffer = 1;
+        vg.vertex_buffer_size = 1024;
+        vg.vertex_stride = 12;
+        vg.vertex_count = 12;
+        vg.index_buffer = 1;
+        vg.index_buffer_size = 1024;
+        vg.index_type = HRTS_INDEX_TYPE_UINT32;
+        vg.index_count = 42;
+        vg.draws = g.draws;
+        vg.draw_count = g.draw_count;
+        const float bounds[6] = {-4.0f, 0.0f, -4.0f, 4.0f, 1.6f, 4.0f};
+        memcpy(vg.bounds, bounds, sizeof bounds);
+        if (id == VULKAN_GEOMETRY_VERTEX_OFFSET_WRAP)
+            vg.vertex_offset = UINT64_MAX - 3;
+        else
+            vg.index_offset = UINT64_MAX - 3;
         return hrts_set_geometry_vulkan(ctx, &vg);
     }
     case TARGETS_ZERO_WIDTH: t.width = 0; return hrts_set_targets(ctx, &t);
