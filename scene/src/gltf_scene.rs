@@ -22,7 +22,22 @@
 //!   1 m ahead. Orthographic cameras are ignored.
 //!
 //! Buffers may be external files (relative to the glTF file), `data:` URIs or the GLB binary
-//! chunk. Images, materials, normals, skins, animations and morph targets are not read.
+//! chunk. Images, textures, materials, normals, skins, animations and morph targets are not read
+//! (a texture without `source` is fine); an accessor without `bufferView` is all zeros, or what
+//! its `sparse` values put there.
+//!
+//! # Extensions
+//!
+//! - `KHR_mesh_quantization`: `POSITION` may be `BYTE`, `UNSIGNED_BYTE`, `SHORT` or
+//!   `UNSIGNED_SHORT`, normalized or not, dequantized exactly as the specification says and then
+//!   transformed like float positions.
+//! - `EXT_meshopt_compression` and `KHR_meshopt_compression`: buffer views are decoded with
+//!   meshoptimizer's decoders, every size checked first (see `compression`); placeholder
+//!   fallback buffers without data are not loaded.
+//! - `KHR_draco_mesh_compression` is not decoded: a Draco primitive without uncompressed
+//!   fallback accessors is an error that says how to write the file without Draco.
+//! - A required extension that is none of these, `KHR_lights_punctual`, nor one that changes only
+//!   materials, textures or images is an error; one error lists them all.
 //!
 //! # The `hrts` extras
 //!
