@@ -16,6 +16,7 @@ pub mod gbuffer;
 pub mod hardcases;
 pub mod images;
 pub mod light_bench;
+pub mod load_report;
 pub mod output;
 pub mod peer;
 pub mod plugin;

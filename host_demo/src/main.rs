@@ -48,6 +48,9 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// What loading a glTF scene costs: load time and peak resident memory; or write generated test scenes
+    /// (float, meshopt, quantized + meshopt) to measure it on.
+    LoadReport(host_demo::load_report::LoadReportArgs),
     /// Run the hard numerical cases against the exact reference and print a table; fails if any case fails.
     Hardcases(host_demo::hardcases::HardcasesArgs),
     /// The talk's side-by-sides on one view (shadow map 3K/8K, ray traced x64/x32, PCSS, hybrid standard and
@@ -390,6 +393,7 @@ fn main() -> ExitCode {
         Command::ExampleScene { out } => scene::gltf_scene::write_example_scene(out)
             .map_err(anyhow::Error::from)
             .map(|()| println!("example scene written to {}", out.display())),
+        Command::LoadReport(args) => host_demo::load_report::run_cli(args),
         Command::Hardcases(args) => {
             host_demo::hardcases::run_cli(cli.device.clone(), cli.validation, args)
         }

@@ -22,7 +22,22 @@
 //!   1 m ahead. Orthographic cameras are ignored.
 //!
 //! Buffers may be external files (relative to the glTF file), `data:` URIs or the GLB binary
-//! chunk. Images, materials, normals, skins, animations and morph targets are not read.
+//! chunk. Images, textures, materials, normals, skins, animations and morph targets are not read
+//! (a texture without `source` is fine); an accessor without `bufferView` is all zeros, or what
+//! its `sparse` values put there.
+//!
+//! # Extensions
+//!
+//! - `KHR_mesh_quantization`: `POSITION` may be `BYTE`, `UNSIGNED_BYTE`, `SHORT` or
+//!   `UNSIGNED_SHORT`, normalized or not, dequantized exactly as the specification says and then
+//!   transformed like float positions.
+//! - `EXT_meshopt_compression` and `KHR_meshopt_compression`: buffer views are decoded with
+//!   meshoptimizer's decoders, every size checked first (see `compression`); placeholder
+//!   fallback buffers without data are not loaded.
+//! - `KHR_draco_mesh_compression` is not decoded: a Draco primitive without uncompressed
+//!   fallback accessors is an error that says how to write the file without Draco.
+//! - A required extension that is none of these, `KHR_lights_punctual`, nor one that changes only
+//!   materials, textures or images is an error; one error lists them all.
 //!
 //! # The `hrts` extras
 //!
@@ -62,6 +77,7 @@ use std::f32::consts::PI;
 use std::path::Path;
 
 use glam::{Mat4, Quat, Vec3};
+use gltf::json::validation::Validate as _;
 use gltf::khr_lights_punctual::Kind;
 use gltf::mesh::Mode;
 use gltf::scene::Transform;
@@ -69,14 +85,20 @@ use gltf::scene::Transform;
 use crate::{Camera, LightKind, LightSize, Object, Scene, SceneError, SceneLight};
 
 mod accessor;
+mod compression;
 mod example;
+mod export;
 mod extras;
 mod writer;
 
 #[cfg(test)]
+mod production_tests;
+#[cfg(test)]
 mod tests;
 
 pub use example::write_example_scene;
+pub use export::{write_scene, GltfEncoding};
+pub use writer::{Quantization, QuantizedComponent};
 
 /// A scene loaded from a glTF file: geometry, lights, which objects are static, the camera.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -111,9 +133,10 @@ pub fn load_gltf(path: &Path) -> Result<SceneFile, SceneError> {
     let base = path.parent().unwrap_or_else(|| Path::new("."));
     let (document, blob) = parse_document(&bytes, path)?;
     let buffers = load_buffers(&document, blob, base, path)?;
+    let data = accessor::BufferData::new(buffers, document.views().len());
     Loader {
         path,
-        buffers: &buffers,
+        data: &data,
         file: SceneFile::default(),
     }
     .load(&document)
@@ -167,8 +190,83 @@ fn parse_document(
             }
         }
     }
-    let document = gltf::Document::from_json(root).map_err(|e| error(e.to_string()))?;
-    Ok((document, blob))
+    check_required_extensions(&root.extensions_required).map_err(error)?;
+    let mut problems = Vec::new();
+    root.validate(&root, gltf::json::Path::new, &mut |path, problem| {
+        let path = path();
+        if !tolerated(&path, problem) {
+            problems.push(format!("{path}: {problem}"));
+        }
+    });
+    if !problems.is_empty() {
+        return Err(error(format!("invalid glTF: {}", problems.join("; "))));
+    }
+    Ok((gltf::Document::from_json_without_validation(root), blob))
+}
+
+/// Extensions whose content is read.
+const READ_EXTENSIONS: [&str; 4] = [
+    "KHR_lights_punctual",
+    "KHR_mesh_quantization",
+    "EXT_meshopt_compression",
+    "KHR_meshopt_compression",
+];
+
+/// Whether a required extension changes only what is not read (materials, textures, images).
+fn changes_nothing_read(extension: &str) -> bool {
+    extension.starts_with("KHR_materials_")
+        || [
+            "KHR_texture_transform",
+            "KHR_texture_basisu",
+            "EXT_texture_webp",
+            "EXT_texture_avif",
+            "MSFT_texture_dds",
+        ]
+        .contains(&extension)
+}
+
+/// The extension of Draco-compressed primitives, which is not decoded.
+const DRACO: &str = "KHR_draco_mesh_compression";
+
+/// What to do about a Draco-compressed file.
+const DRACO_ADVICE: &str = "Draco-compressed geometry is not decoded (no maintained Rust decoder); write the file without Draco, e.g. `gltf-transform meshopt IN OUT` (EXT_meshopt_compression, which is read) or your exporter with Draco compression off";
+
+/// One error listing every required extension that is neither read nor irrelevant to what is read.
+fn check_required_extensions(required: &[String]) -> Result<(), String> {
+    let unsupported: Vec<&str> = required
+        .iter()
+        .map(String::as_str)
+        .filter(|e| !READ_EXTENSIONS.contains(e) && !changes_nothing_read(e))
+        .collect();
+    if unsupported.is_empty() {
+        return Ok(());
+    }
+    let mut message = format!(
+        "extensionsRequired lists {} that this loader does not support: {} (supported: {}, and extensions that only change materials, textures or images)",
+        if unsupported.len() == 1 { "an extension" } else { "extensions" },
+        unsupported.join(", "),
+        READ_EXTENSIONS.join(", ")
+    );
+    if unsupported.contains(&DRACO) {
+        message += &format!(". {DRACO}: {DRACO_ADVICE}");
+    }
+    Err(message)
+}
+
+/// Whether a problem found by the gltf crate's validation is legal glTF that the loader handles
+/// itself: required extensions (checked by [`check_required_extensions`]) and accessors without a
+/// buffer view (all zeros, or filled by `sparse` or an extension).
+fn tolerated(path: &gltf::json::Path, problem: gltf::json::validation::Error) -> bool {
+    let path = path.as_str();
+    let accessor_view = path.strip_prefix("accessors[").and_then(|rest| {
+        rest.strip_suffix("].bufferView")
+            .filter(|index| index.bytes().all(|b| b.is_ascii_digit()))
+    });
+    match problem {
+        gltf::json::validation::Error::Missing => accessor_view.is_some(),
+        gltf::json::validation::Error::Unsupported => path.starts_with("extensionsRequired["),
+        _ => false,
+    }
 }
 
 /// Checks the 12-byte GLB header against the file length, before the gltf crate (which would
@@ -205,13 +303,20 @@ fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
     Ok(())
 }
 
-/// The bytes of every buffer, cut to its `byteLength`.
+/// The bytes of every buffer, cut to its `byteLength`; `None` for a buffer without data that only
+/// meshopt-compressed buffer views use (their uncompressed fallback, left out of the file).
 fn load_buffers(
     document: &gltf::Document,
     mut blob: Option<Vec<u8>>,
     base: &Path,
     path: &Path,
-) -> Result<Vec<Vec<u8>>, SceneError> {
+) -> Result<Vec<Option<Vec<u8>>>, SceneError> {
+    let mut placeholder = vec![false; document.buffers().len()];
+    for view in document.views() {
+        if compression::compression(&view).is_some() {
+            placeholder[view.buffer().index()] = true;
+        }
+    }
     document
         .buffers()
         .map(|buffer| {
@@ -221,6 +326,9 @@ fn load_buffers(
                 message,
             };
             let (source, data) = match buffer.source() {
+                gltf::buffer::Source::Bin if blob.is_none() && placeholder[buffer.index()] => {
+                    return Ok(None);
+                }
                 gltf::buffer::Source::Bin => (
                     "the GLB binary chunk".to_owned(),
                     blob.take()
@@ -257,7 +365,7 @@ fn load_buffers(
                 )));
             }
             data.truncate(buffer.length());
-            Ok(data)
+            Ok(Some(data))
         })
         .collect()
 }
@@ -369,7 +477,7 @@ fn local_transform(node: &gltf::Node) -> Mat4 {
 /// The state of one load.
 struct Loader<'a> {
     path: &'a Path,
-    buffers: &'a [Vec<u8>],
+    data: &'a accessor::BufferData,
     file: SceneFile,
 }
 
@@ -484,13 +592,24 @@ impl Loader<'_> {
                 self.file.skipped_primitives += 1;
                 continue;
             };
+            // Draco primitives without required Draco keep uncompressed accessors as fallback;
+            // without them there is nothing to read.
+            let unbacked = |a: &gltf::Accessor| a.view().is_none() && a.sparse().is_none();
+            if primitive.extension_value(DRACO).is_some()
+                && (unbacked(&position_accessor)
+                    || primitive.indices().is_some_and(|i| unbacked(&i)))
+            {
+                return Err(self.gltf_error(format!(
+                    "{what}: its geometry is only in {DRACO}. {DRACO_ADVICE}"
+                )));
+            }
             let accessor_error = |accessor: &gltf::Accessor, message: String| {
                 self.gltf_error(format!("{what}: accessor {}: {message}", accessor.index()))
             };
-            let local = accessor::read_positions(&position_accessor, self.buffers)
+            let local = accessor::read_positions(&position_accessor, self.data)
                 .map_err(|m| accessor_error(&position_accessor, m))?;
             let indices = match primitive.indices() {
-                Some(indices) => accessor::read_indices(&indices, self.buffers)
+                Some(indices) => accessor::read_indices(&indices, self.data)
                     .map_err(|m| accessor_error(&indices, m))?,
                 None => (0..local.len() as u32).collect(),
             };

@@ -9,10 +9,10 @@ use super::writer::{data_uri, glb, to_json_bytes, GltfWriter};
 use super::*;
 
 /// A fresh directory in the system temporary directory, removed on drop.
-struct TempDir(PathBuf);
+pub(super) struct TempDir(pub(super) PathBuf);
 
 impl TempDir {
-    fn new() -> Self {
+    pub(super) fn new() -> Self {
         static NEXT: AtomicUsize = AtomicUsize::new(0);
         let path = std::env::temp_dir().join(format!(
             "scene-gltf-test-{}-{}",
@@ -23,14 +23,14 @@ impl TempDir {
         Self(path)
     }
 
-    fn write(&self, name: &str, bytes: &[u8]) -> PathBuf {
+    pub(super) fn write(&self, name: &str, bytes: &[u8]) -> PathBuf {
         let path = self.0.join(name);
         std::fs::write(&path, bytes).unwrap();
         path
     }
 
     /// Writes `document` as glTF JSON with `bin` embedded as a `data:` URI, and loads it.
-    fn load_embedded(
+    pub(super) fn load_embedded(
         &self,
         name: &str,
         document: &Value,
@@ -47,7 +47,7 @@ impl Drop for TempDir {
 }
 
 /// [`load_gltf`], checking that every error names the file.
-fn load(path: &Path) -> Result<SceneFile, SceneError> {
+pub(super) fn load(path: &Path) -> Result<SceneFile, SceneError> {
     let result = load_gltf(path);
     if let Err(e) = &result {
         let name = path.display().to_string();
@@ -89,10 +89,10 @@ fn light_ref(light: usize) -> Value {
     json!({ "KHR_lights_punctual": { "light": light } })
 }
 
-const TRIANGLE: [Vec3; 3] = [Vec3::ZERO, Vec3::X, Vec3::Y];
+pub(super) const TRIANGLE: [Vec3; 3] = [Vec3::ZERO, Vec3::X, Vec3::Y];
 
 /// A writer holding one root node with a unit triangle, so that every document has geometry.
-fn with_triangle() -> GltfWriter {
+pub(super) fn with_triangle() -> GltfWriter {
     let mut w = GltfWriter::default();
     let mesh = w.mesh("triangle", &TRIANGLE, &[0, 1, 2]);
     let node = w.node(json!({ "name": "triangle", "mesh": mesh }));
@@ -778,7 +778,7 @@ fn malformed_lights_and_extras() {
 }
 
 /// Deterministic pseudo-random numbers (xorshift64*).
-fn random(state: &mut u64) -> u64 {
+pub(super) fn random(state: &mut u64) -> u64 {
     *state ^= *state >> 12;
     *state ^= *state << 25;
     *state ^= *state >> 27;
