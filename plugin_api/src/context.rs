@@ -68,6 +68,15 @@ pub(crate) struct Built {
 }
 
 impl Built {
+    /// Every built pipeline, one per frustum, with the index of its light.
+    pub(crate) fn pipelines(&self) -> impl Iterator<Item = (usize, &ShadowPipeline)> {
+        self.lights
+            .iter()
+            .enumerate()
+            .filter_map(|(i, l)| l.as_ref().map(|l| (i, l)))
+            .flat_map(|(i, l)| l.frusta.iter().map(move |p| (i, p)))
+    }
+
     /// The passes of `light`, once built.
     pub(crate) fn light(&self, light: u32) -> ApiResult<&LightPasses> {
         match self.lights.get(light as usize) {

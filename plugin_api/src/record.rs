@@ -111,13 +111,7 @@ impl Context {
             .filter_map(pass_from_index)
             .collect();
         if copy_output {
-            for (i, pipeline) in built
-                .lights
-                .iter()
-                .flatten()
-                .enumerate()
-                .flat_map(|(i, l)| l.frusta.iter().map(move |p| (i, p)))
-            {
+            for (i, pipeline) in built.pipelines() {
                 if let Some(missing) = pipeline
                     .passes_to_record()
                     .into_iter()
@@ -134,13 +128,7 @@ impl Context {
             }
         }
         // Every light accepts the passes before anything is recorded: a failed call records nothing.
-        for (i, pipeline) in built
-            .lights
-            .iter()
-            .flatten()
-            .enumerate()
-            .flat_map(|(i, l)| l.frusta.iter().map(move |p| (i, p)))
-        {
+        for (i, pipeline) in built.pipelines() {
             pipeline.check_record(&passes).map_err(|e| {
                 ApiError::new(HrtsResult::ErrorInvalidState, format!("light {i}: {e}"))
             })?;
