@@ -32,13 +32,13 @@ pub struct BenchArgs {
     #[arg(long)]
     pub models: Option<PathBuf>,
     /// Frames per configuration; medians over all but the first.
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..))]
     pub frames: u32,
     /// Frame width.
-    #[arg(long, default_value_t = 1920)]
+    #[arg(long, default_value_t = 1920, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
     pub width: u32,
     /// Frame height.
-    #[arg(long, default_value_t = 1080)]
+    #[arg(long, default_value_t = 1080, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
     pub height: u32,
     /// Only the models whose file name contains one of these (comma-separated; default all).
     #[arg(long, value_delimiter = ',')]

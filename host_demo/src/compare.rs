@@ -27,10 +27,10 @@ pub struct CompareArgs {
     #[arg(long, default_value = "compare")]
     pub out: PathBuf,
     /// Width of each panel in pixels.
-    #[arg(long, default_value_t = 480)]
+    #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
     pub width: u32,
     /// Height of each panel in pixels.
-    #[arg(long, default_value_t = 270)]
+    #[arg(long, default_value_t = 270, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
     pub height: u32,
     /// Camera position "x,y,z" (default: a close-up of the character, the fence and the sphere).
     #[arg(long, value_parser = parse_vec3)]
@@ -45,7 +45,7 @@ pub struct CompareArgs {
     #[arg(long, value_parser = parse_vec3)]
     pub close_up_target: Option<Vec3>,
     /// Frames per panel (timings are medians over all but the first).
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..))]
     pub frames: u32,
 }
 

@@ -15,6 +15,14 @@ pub mod compare;
 pub mod gbuffer;
 pub mod hardcases;
 pub mod images;
+
+/// Limits of the command line's options, checked before any GPU work.
+pub mod limits {
+    /// Largest frame (or shadow map) side in pixels.
+    pub const FRAME_SIDE: u32 = 16384;
+    /// Largest primitive map size N (texel coordinates are packed in 16 bits).
+    pub const MAP_SIZE: u32 = u16::MAX as u32;
+}
 pub mod light_bench;
 pub mod load_report;
 pub mod output;
@@ -160,13 +168,92 @@ impl CameraMatrices {
     }
 }
 
-/// A progress bar of `len` steps on stderr for long runs (hidden when stderr is not a terminal).
-pub fn progress(len: u64, what: &str) -> indicatif::ProgressBar {
-    let style = indicatif::ProgressStyle::with_template("{msg} {bar:30} {pos}/{len} ({elapsed})")
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
-    indicatif::ProgressBar::new(len)
-        .with_style(style)
-        .with_message(what.to_owned())
+/// Progress of a long run of `len` steps on stderr: a bar on a terminal; elsewhere (a pipe, a CI log,
+/// `nohup`) one plain line per step, so that a run never looks hung.
+pub fn progress(len: u64, what: &str) -> Progress {
+    let bar = std::io::IsTerminal::is_terminal(&std::io::stderr()).then(|| {
+        let style =
+            indicatif::ProgressStyle::with_template("{msg} {bar:30} {pos}/{len} ({elapsed})")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+        indicatif::ProgressBar::new(len)
+            .with_style(style)
+            .with_message(what.to_owned())
+    });
+    Progress {
+        bar,
+        what: what.to_owned(),
+        len,
+        done: std::cell::Cell::new(0),
+        announced: std::cell::Cell::new(false),
+        start: std::time::Instant::now(),
+    }
+}
+
+/// See [`progress`].
+pub struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+    what: String,
+    len: u64,
+    done: std::cell::Cell<u64>,
+    /// Whether the current step's line was printed.
+    announced: std::cell::Cell<bool>,
+    start: std::time::Instant,
+}
+
+impl Progress {
+    /// Names the step that starts now (off a terminal: prints its line).
+    pub fn set_message(&self, message: impl Into<String>) {
+        let message = message.into();
+        match &self.bar {
+            Some(bar) => bar.set_message(message),
+            None => {
+                self.announced.set(true);
+                eprintln!(
+                    "{}",
+                    self.line((self.done.get() + 1).min(self.len), &message)
+                );
+            }
+        }
+    }
+
+    /// Marks `n` steps done (off a terminal: prints a line for a step that was not named).
+    pub fn inc(&self, n: u64) {
+        self.done.set(self.done.get() + n);
+        match &self.bar {
+            Some(bar) => bar.inc(n),
+            None => {
+                if !self.announced.replace(false) {
+                    eprintln!("{}", self.line(self.done.get(), "done"));
+                }
+            }
+        }
+    }
+
+    /// Ends the run (clears the bar).
+    pub fn finish_and_clear(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
+
+    /// "what [step/len] message (elapsed, about how long is left)", `step` counted from 1.
+    fn line(&self, step: u64, message: &str) -> String {
+        let done = self.done.get();
+        let elapsed = self.start.elapsed().as_secs_f64();
+        let remaining = self.len.saturating_sub(done);
+        let left = if done == 0 || remaining == 0 {
+            String::new()
+        } else {
+            format!(
+                ", about {:.0} s left",
+                elapsed / done as f64 * remaining as f64
+            )
+        };
+        format!(
+            "{} [{}/{}] {message} ({elapsed:.0} s elapsed{left})",
+            self.what, step, self.len
+        )
+    }
 }
 
 /// Bounds of every object but one named "ground" (all of the scene if that is all there is).

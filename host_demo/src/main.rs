@@ -53,11 +53,13 @@ enum Command {
     LoadReport(host_demo::load_report::LoadReportArgs),
     /// Run the hard numerical cases against the exact reference and print a table; fails if any case fails.
     Hardcases(host_demo::hardcases::HardcasesArgs),
-    /// The talk's side-by-sides on one view (shadow map 3K/8K, ray traced x64/x32, PCSS, hybrid standard and
-    /// shrinking): labelled composite PNG, the individual pictures and a caption file.
+    /// The talk's side-by-sides on one view (shadow map 3K/8K, ray traced with primitive maps 1K/256, PCSS
+    /// 3K, hybrid standard and shrinking, the lerp factor): labelled composite PNG, the individual pictures
+    /// and a caption file.
     Compare(host_demo::compare::CompareArgs),
-    /// The talk's timing tables (~10K/65K/240K triangles, 1920x1080, SM 3K, PM 1Kx1Kx32/64) next to its
-    /// GTX 980 column: GPU timestamps, medians over frames.
+    /// The talk's timing tables (~10K/65K/240K triangles, 1920x1080, shadow map 3072², primitive map 1024²
+    /// fitted to the receivers, lists of their own length) next to its GTX 980 column, and every model of
+    /// the models folder: GPU timestamps, medians over frames. With --lights: local lights inside scenes.
     Bench {
         #[command(flatten)]
         args: host_demo::bench::BenchArgs,
@@ -97,22 +99,22 @@ struct RenderArgs {
     #[arg(long, default_value = "out")]
     out: PathBuf,
     /// Frame width in pixels.
-    #[arg(long, default_value_t = 1280)]
+    #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
     width: u32,
     /// Frame height in pixels.
-    #[arg(long, default_value_t = 720)]
+    #[arg(long, default_value_t = 720, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
     height: u32,
-    /// Direction the light travels, "x,y,z" (default: slanted, about 30° from vertical).
+    /// Direction the light travels, "x,y,z" (default: slanted, about 34° from vertical).
     #[arg(long, value_parser = parse_vec3)]
     light_dir: Option<Vec3>,
     #[command(flatten)]
     camera: CameraArgs,
     /// Primitive map size N: texels per side of the light-space grid fitted to the visible receivers (moves
     /// cost, never exactness).
-    #[arg(long, default_value_t = 1024)]
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::MAP_SIZE)))]
     map_size: u32,
     /// Largest memory of the primitive map's list entries, in MiB (the lists grow to what frames need).
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..))]
     map_budget_mb: u32,
     /// Faces stored: both (open geometry) or front (closed meshes only).
     #[arg(long, default_value = "both", value_parser = parse_faces)]
@@ -123,7 +125,7 @@ struct RenderArgs {
     binning: BinningRequest,
     /// Frames to render (timings are medians over all but the first; at least 2 with --scene, so that the
     /// second frame's report shows what was kept).
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
     frames: u32,
     /// Also write the frame's shadow rays and triangles (rays.f32, triangles.f32, rays.json) for
     /// scripts/embree_compare.py.
@@ -159,18 +161,18 @@ struct PlanArgs {
     #[arg(long)]
     scene: PathBuf,
     /// Frame width in pixels (with the height, the aspect of the camera's view).
-    #[arg(long, default_value_t = 1280)]
+    #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
     width: u32,
     /// Frame height in pixels.
-    #[arg(long, default_value_t = 720)]
+    #[arg(long, default_value_t = 720, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
     height: u32,
     #[command(flatten)]
     camera: CameraArgs,
     /// Primitive map size N.
-    #[arg(long, default_value_t = 1024)]
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::MAP_SIZE)))]
     map_size: u32,
     /// Shadow map size (square) of the sized lights.
-    #[arg(long, default_value_t = 3072)]
+    #[arg(long, default_value_t = 3072, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
     shadow_map_size: u32,
     /// Turn off FXAA over the ray-traced shadows.
     #[arg(long)]
@@ -330,11 +332,14 @@ fn render_scene(cli: &Cli, args: &RenderArgs, path: &Path) -> Result<()> {
 }
 
 fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
+    if args.out.exists() && !args.out.is_dir() {
+        bail!(
+            "--out {} is a file, not a folder: name a folder (it is created if missing)",
+            args.out.display()
+        );
+    }
     if let Some(path) = &args.scene {
         return render_scene(cli, args, path);
-    }
-    if args.width == 0 || args.height == 0 {
-        bail!("--width and --height must be positive");
     }
     let scene = match &args.obj {
         Some(path) => {

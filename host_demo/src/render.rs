@@ -27,7 +27,7 @@ pub struct SoftShadowArgs {
     #[arg(long)]
     pub no_antialiasing: bool,
     /// Shadow map size (square).
-    #[arg(long, default_value_t = 3072)]
+    #[arg(long, default_value_t = 3072, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
     pub shadow_map_size: u32,
     /// PCSS penumbra filter: shrinking or standard.
     #[arg(long, default_value = "shrinking", value_parser = parse_filter)]
@@ -36,10 +36,10 @@ pub struct SoftShadowArgs {
     #[arg(long, default_value_t = 0.02)]
     pub angular_radius: f32,
     /// PCSS blocker-search taps.
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..))]
     pub search_taps: u32,
     /// PCSS PCF taps.
-    #[arg(long, default_value_t = 32)]
+    #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..))]
     pub pcf_taps: u32,
     /// Hybrid WSS, world-space scale (default: the bounding radius of the scene's objects, ground aside).
     #[arg(long)]
@@ -185,7 +185,7 @@ struct MapJson {
     binning_path: &'static str,
     tier: &'static str,
     /// Frame coordinates to homogeneous texel space, fitted to the receivers (16 floats, column-major).
-    to_texels: [f32; 16],
+    map_to_texels: [f32; 16],
     receiver_pixels: u32,
     receiver_texels: u32,
     triangles_binned: u32,
@@ -388,7 +388,7 @@ pub fn render_to_folder(
             },
             binning_path: report.binning_path.name(),
             tier: report.binning_path.tier().name(),
-            to_texels: report.map_to_texels.to_cols_array(),
+            map_to_texels: report.map_to_texels.to_cols_array(),
             receiver_pixels: stats.receiver_pixels,
             receiver_texels: stats.receiver_texels,
             triangles_binned: stats.triangles_binned,
@@ -460,18 +460,25 @@ pub fn render_to_folder(
             );
         }
     }
-    println!(
-        "shadows: {} (FXAA {}), shadow map {}x{}, PCSS {} filter {}+{} taps, WSS {:.3}, PHS {}",
-        s.mode.name(),
-        if s.no_antialiasing { "off" } else { "on" },
-        s.shadow_map_size,
+    // Only the settings of the passes the mode runs.
+    let fxaa = format!("FXAA {}", if s.no_antialiasing { "off" } else { "on" });
+    let soft = format!(
+        "shadow map {0}x{0}, PCSS {1} filter {2}+{3} taps",
         s.shadow_map_size,
         filter_name(s.filter),
         s.search_taps,
-        s.pcf_taps,
-        config.hybrid.world_space_scale,
-        config.hybrid.hard_shadow_percentage
+        s.pcf_taps
     );
+    let settings = match s.mode {
+        ShadowMode::None => "nothing to compute: every pixel lit".to_owned(),
+        ShadowMode::Hard => fxaa,
+        ShadowMode::Soft => soft,
+        ShadowMode::Hybrid => format!(
+            "{fxaa}, {soft}, WSS {:.3}, PHS {}",
+            config.hybrid.world_space_scale, config.hybrid.hard_shadow_percentage
+        ),
+    };
+    println!("shadows: {} ({settings})", s.mode.name());
     print_plan(&report);
     println!("{:<28} {:>10}", "pass", "GPU ms");
     for (name, ms) in &timings {

@@ -23,13 +23,13 @@ pub struct AccuracyArgs {
     #[arg(long)]
     pub obj: Option<PathBuf>,
     /// Frame width.
-    #[arg(long, default_value_t = 640)]
+    #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
     pub width: u32,
     /// Frame height.
-    #[arg(long, default_value_t = 360)]
+    #[arg(long, default_value_t = 360, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
     pub height: u32,
     /// Frames per configuration (timings are medians over all but the first).
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
     pub frames: u32,
 }
 

@@ -33,17 +33,17 @@ pub struct TradeoffArgs {
     #[arg(long)]
     pub builtin: bool,
     /// Frame width.
-    #[arg(long, default_value_t = 640)]
+    #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
     pub width: u32,
     /// Frame height.
-    #[arg(long, default_value_t = 360)]
+    #[arg(long, default_value_t = 360, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
     pub height: u32,
     /// Frames per method. Timings are medians over the second half: the first half lets a GPU that idled
     /// while the method's pipelines were created reach its clocks again.
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..))]
     pub frames: u32,
     /// Ground truth: n×n stratified light samples per penumbra pixel.
-    #[arg(long, default_value_t = 32)]
+    #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..))]
     pub strata: u32,
     /// Angular radius of the directional light in radians, for PCSS and the ground truth alike.
     #[arg(long, default_value_t = 0.02)]

@@ -89,19 +89,17 @@ fn missing_file_and_bad_options_are_clear_errors() {
     ]);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert_clean_failure(&output, &stderr, "--light-dir");
-    let output = host_demo(&[
-        "render",
-        "--map-budget-mb",
-        "0",
-        "--width",
-        "16",
-        "--height",
-        "16",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
+    // --out naming a file, not a folder.
+    let file = dir.join("a-file");
+    std::fs::write(&file, "x").expect("write a file");
+    let output = host_demo(&["render", "--out", file.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&output.stderr);
-    assert_clean_failure(&output, &stderr, "budget");
+    assert_clean_failure(&output, &stderr, "--out");
+    assert!(stderr.contains("is a file"), "{stderr}");
+    // An OS error is said once.
+    let output = host_demo(&["render", "--obj", dir.join("nope.obj").to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(stderr.matches("os error").count(), 1, "{stderr}");
 }
 
 #[test]
@@ -359,4 +357,82 @@ fn scene_render_reports_what_each_light_ran_and_kept() {
         assert_eq!(light["light_builds"], 1, "{light}");
     }
     assert_eq!(second[0]["pass_status"]["shadow map"], "RAN");
+}
+
+/// Options out of range are refused before any GPU work, naming the flag, the value and the range.
+#[test]
+fn out_of_range_options_name_the_flag_and_the_range() {
+    for (args, flag, range) in [
+        (&["render", "--frames", "0"][..], "--frames", "1.."),
+        (
+            &["render", "--map-budget-mb", "0"][..],
+            "--map-budget-mb",
+            "1..",
+        ),
+        (
+            &["render", "--map-size", "0"][..],
+            "--map-size",
+            "1..=65535",
+        ),
+        (&["render", "--width", "0"][..], "--width", "1..=16384"),
+        (&["bench", "--frames", "0"][..], "--frames", "1.."),
+        (
+            &["tradeoff", "--height", "99999"][..],
+            "--height",
+            "1..=16384",
+        ),
+    ] {
+        let output = host_demo(args);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success(), "{args:?} accepted");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert!(
+            stderr.contains(flag) && stderr.contains(range),
+            "{args:?}: {stderr}"
+        );
+    }
+}
+
+/// Without a Vulkan driver, the error says how to get one.
+#[test]
+fn no_vulkan_driver_names_the_setup_script() {
+    let dir = temp_dir("no-driver");
+    let output = Command::new(env!("CARGO_BIN_EXE_host_demo"))
+        .args(["render", "--width", "16", "--height", "16", "--out"])
+        .arg(dir.join("out"))
+        .env("VK_ICD_FILENAMES", dir.join("no-such-driver.json"))
+        .env("VK_DRIVER_FILES", dir.join("no-such-driver.json"))
+        .output()
+        .expect("host_demo runs");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_clean_failure(&output, &stderr, "scripts/setup.sh");
+    assert!(stderr.contains("lavapipe"), "{stderr}");
+}
+
+/// Off a terminal (stderr piped, as in a CI log), a long run prints one plain progress line per step,
+/// the first before any GPU work of the first step.
+#[test]
+fn long_runs_print_a_line_per_step_off_a_terminal() {
+    let output = host_demo(&[
+        "bench",
+        "--only",
+        "scorpion,plates",
+        "--frames",
+        "2",
+        "--width",
+        "48",
+        "--height",
+        "32",
+        "--no-reference",
+    ]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    let lines: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("bench ["))
+        .collect();
+    assert_eq!(lines.len(), 2, "{stderr}");
+    assert!(lines[0].starts_with("bench [1/2] 01_scorpion"), "{stderr}");
+    assert!(lines[1].starts_with("bench [2/2] 07_veach"), "{stderr}");
+    assert!(lines[1].contains("s elapsed, about"), "{stderr}");
 }

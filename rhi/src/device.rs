@@ -12,6 +12,10 @@ use std::mem::ManuallyDrop;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 
+/// What to do when no Vulkan driver or device is found.
+const NO_DRIVER_ADVICE: &str = "Run scripts/setup.sh from the checkout (it installs Mesa's lavapipe, a CPU Vulkan \
+     driver, with the Vulkan loader and validation layers), or install your GPU's Vulkan driver; check that \
+     VK_ICD_FILENAMES / VK_DRIVER_FILES, if set, name an existing driver manifest.";
 /// How to create a headless device.
 #[derive(Debug, Clone, Default)]
 pub struct DeviceDesc {
@@ -257,7 +261,20 @@ impl Device {
             info = info.push_next(&mut messenger_info);
         }
         // SAFETY: all pointers in `info` outlive the call.
-        let instance = unsafe { entry.create_instance(&info, None) }.call("vkCreateInstance")?;
+        let instance = match unsafe { entry.create_instance(&info, None) } {
+            Ok(instance) => instance,
+            Err(vk::Result::ERROR_INCOMPATIBLE_DRIVER) => {
+                return Err(RhiError::NoDevice(format!(
+                    "vkCreateInstance found no Vulkan driver (ERROR_INCOMPATIBLE_DRIVER). {NO_DRIVER_ADVICE}"
+                )))
+            }
+            Err(result) => {
+                return Err(RhiError::Vulkan {
+                    call: "vkCreateInstance",
+                    result,
+                })
+            }
+        };
         let messenger = if desc.validation && has_debug_utils {
             let utils = ash::ext::debug_utils::Instance::new(&entry, &instance);
             // SAFETY: `messenger_info` points at `validation`, which `Shared` keeps alive past the messenger.
@@ -875,9 +892,7 @@ fn select_physical_device(instance: &ash::Instance, filter: Option<&str>) -> Res
     }
     best.ok_or_else(|| {
         if report.is_empty() {
-            RhiError::NoDevice(
-                "no Vulkan devices found (install mesa-vulkan-drivers for lavapipe)".into(),
-            )
+            RhiError::NoDevice(format!("no Vulkan devices found. {NO_DRIVER_ADVICE}"))
         } else {
             RhiError::NoDevice(report.join("; "))
         }

@@ -12,7 +12,7 @@ pub struct DirectionalLight {
 }
 
 impl DirectionalLight {
-    /// A slanted default, about 35° from vertical: `normalize(0.68, -1.0, 0.05)`. It comes from the left of
+    /// A slanted default, about 34° from vertical: `normalize(0.68, -1.0, 0.05)`. It comes from the left of
     /// the default camera (which looks from +x+z), so shadows fall to the side where they can be seen.
     pub fn slanted() -> Self {
         Self {

@@ -23,10 +23,10 @@ use crate::{Object, Scene, SceneError};
 /// All errors name the file:
 /// - [`SceneError::Io`] if the file cannot be read,
 /// - [`SceneError::Parse`] for text that is not UTF-8 or not well-formed OBJ (bad numbers, faces
-///   with fewer than three vertices, index 0, relative indices before the first vertex, ...),
+///   with fewer than three vertices, index 0, relative indices before the first vertex, faces
+///   referencing vertices not defined before them, ...), with the line and the corner as written,
 /// - [`SceneError::NonFinite`] for NaN or infinite vertex coordinates (including overflow such as
 ///   `1e39`),
-/// - [`SceneError::IndexOutOfRange`] for faces referencing vertices not defined before them,
 /// - [`SceneError::Empty`] if there is no triangle.
 pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
     let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
@@ -98,19 +98,8 @@ pub(crate) fn parse_obj(bytes: &[u8], path: &Path) -> Result<Scene, SceneError> 
 /// A problem found while normalising, before the file path is attached.
 #[derive(Debug)]
 enum ObjError {
-    Parse {
-        line: usize,
-        message: String,
-    },
-    NonFinite {
-        vertex: usize,
-        value: f32,
-    },
-    IndexOutOfRange {
-        triangle: usize,
-        index: u32,
-        count: usize,
-    },
+    Parse { line: usize, message: String },
+    NonFinite { vertex: usize, value: f32 },
 }
 
 impl ObjError {
@@ -125,16 +114,6 @@ impl ObjError {
                 path,
                 vertex,
                 value,
-            },
-            ObjError::IndexOutOfRange {
-                triangle,
-                index,
-                count,
-            } => SceneError::IndexOutOfRange {
-                path,
-                triangle,
-                index,
-                count,
             },
         }
     }
@@ -180,11 +159,12 @@ fn normalize(text: &str) -> Result<String, ObjError> {
                 for corner in corners {
                     let index = resolve_corner(corner, vertex_count).map_err(|e| match e {
                         CornerError::Malformed(message) => parse_error(message),
-                        CornerError::OutOfRange(index) => ObjError::IndexOutOfRange {
-                            triangle: first_triangle,
-                            index: u32::try_from(index).unwrap_or(u32::MAX),
-                            count: vertex_count,
-                        },
+                        CornerError::OutOfRange => parse_error(format!(
+                            "face corner '{corner}' (triangle {}) references a vertex that does not exist: \
+                             {vertex_count} vertices are defined before it (OBJ indices start at 1; \
+                             negative ones count back from the last vertex defined)",
+                            first_triangle + 1
+                        )),
                     })?;
                     let _ = write!(out, " {}", index + 1);
                 }
@@ -222,8 +202,8 @@ fn parse_position<'a>(tokens: impl Iterator<Item = &'a str>) -> Result<Vec3, Str
 /// Why a face corner could not be resolved.
 enum CornerError {
     Malformed(String),
-    /// Zero-based index at or beyond the number of vertices defined so far.
-    OutOfRange(u64),
+    /// An index at or beyond the number of vertices defined so far.
+    OutOfRange,
 }
 
 /// Resolves a face corner `v`, `v/vt`, `v//vn` or `v/vt/vn` to a zero-based position index.
@@ -244,7 +224,7 @@ fn resolve_corner(corner: &str, vertex_count: usize) -> Result<usize, CornerErro
     if index > 0 {
         let zero_based = index.unsigned_abs() - 1;
         if zero_based >= count {
-            return Err(CornerError::OutOfRange(zero_based));
+            return Err(CornerError::OutOfRange);
         }
         Ok(zero_based as usize)
     } else if index < 0 {
@@ -309,9 +289,11 @@ mod tests {
         match result {
             Ok(_) => "ok",
             Err(SceneError::Io { .. }) => "io",
+            Err(SceneError::Parse { message, .. }) if message.contains("does not exist") => {
+                "out-of-range"
+            }
             Err(SceneError::Parse { .. }) => "parse",
             Err(SceneError::NonFinite { .. }) => "non-finite",
-            Err(SceneError::IndexOutOfRange { .. }) => "out-of-range",
             Err(SceneError::Empty { .. }) => "empty",
             Err(_) => "other",
         }
@@ -499,17 +481,11 @@ mod tests {
         let err = load_text("v 0 0 0\nv 0 nan 0\n").unwrap_err();
         assert!(matches!(err, SceneError::NonFinite { vertex: 1, value, .. } if value.is_nan()));
         let err = load_text(&format!("{TRIANGLE}f 1 2 3\nf 1 2 3 2 9\n")).unwrap_err();
+        let message = err.to_string();
+        assert!(matches!(err, SceneError::Parse { .. }), "{err:?}");
         assert!(
-            matches!(
-                err,
-                SceneError::IndexOutOfRange {
-                    triangle: 1,
-                    index: 8,
-                    count: 3,
-                    ..
-                }
-            ),
-            "{err:?}"
+            message.contains("line 5") && message.contains("'9'") && message.contains("3 vertices"),
+            "{message}"
         );
         let err = load_text(&format!("{TRIANGLE}\n\nf 1 2 x\n")).unwrap_err();
         assert!(err.to_string().contains("line 6"), "{err}");
