@@ -540,7 +540,7 @@ impl PluginRenderer {
             self.context.check("hrts_get_resource_info", unsafe {
                 hrts_get_resource_info(self.context.0, light, resource, &mut info)
             })?;
-            if info.allocated {
+            if info.allocated != 0 {
                 let buffer = device.create_buffer(
                     id.name(),
                     info.bytes,
@@ -621,17 +621,17 @@ fn create_context(device: &Device) -> Result<Context> {
         queue_index: desc.queue_index,
         enabled_extensions: name_ptrs.as_ptr(),
         enabled_extension_count: name_ptrs.len() as u32,
-        geometry_shader: f.geometry_shader,
-        fragment_stores_and_atomics: f.fragment_stores_and_atomics,
-        depth_clamp: f.depth_clamp,
-        debug_utils: desc.debug_utils,
+        geometry_shader: f.geometry_shader.into(),
+        fragment_stores_and_atomics: f.fragment_stores_and_atomics.into(),
+        depth_clamp: f.depth_clamp.into(),
+        debug_utils: desc.debug_utils.into(),
     };
     let info = HrtsContextCreateInfo {
         struct_size: size_of::<HrtsContextCreateInfo>() as u32,
         api_version: HRTS_API_VERSION,
         vulkan: &vulkan,
         device_name_filter: std::ptr::null(),
-        enable_validation: false,
+        enable_validation: 0,
         frames_in_flight: 0,
     };
     let mut context = std::ptr::null_mut();

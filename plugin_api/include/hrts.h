@@ -320,6 +320,10 @@ typedef struct HrtsAllocationCallbacks {
   void (*free)(void *user_data, void *memory, size_t size, size_t alignment);
 } HrtsAllocationCallbacks;
 
+// A flag in the C structs: 0 is false, any other value true. (A Rust `bool` would make any byte but 0
+// and 1 undefined behaviour when the engine writes it.)
+typedef uint32_t HrtsBool;
+
 // Memory the plugin holds, process-wide (all contexts).
 typedef struct HrtsMemoryStats {
   // `sizeof(HrtsMemoryStats)`, set by the caller.
@@ -328,7 +332,7 @@ typedef struct HrtsMemoryStats {
   uint64_t host_bytes;
   // Whether the plugin counts its host memory: true in its shared and static libraries, whose global
   // allocator counts it; false when a Rust program links the plugin's rlib and keeps its own allocator.
-  bool host_bytes_counted;
+  HrtsBool host_bytes_counted;
   // GPU bytes allocated by the plugin and not freed (excludes what the Vulkan driver keeps internally).
   uint64_t gpu_bytes;
 } HrtsMemoryStats;
@@ -357,13 +361,13 @@ typedef struct HrtsVulkanDevice {
   // Number of entries in `enabled_extensions`.
   uint32_t enabled_extension_count;
   // Whether `geometryShader` is enabled (needed by the software conservative-raster path).
-  bool geometry_shader;
+  HrtsBool geometry_shader;
   // Whether `fragmentStoresAndAtomics` is enabled (required).
-  bool fragment_stores_and_atomics;
+  HrtsBool fragment_stores_and_atomics;
   // Whether `depthClamp` is enabled.
-  bool depth_clamp;
+  HrtsBool depth_clamp;
   // Whether the instance enabled `VK_EXT_debug_utils` (per-pass debug labels).
-  bool debug_utils;
+  HrtsBool debug_utils;
 } HrtsVulkanDevice;
 
 // How to create a context.
@@ -378,7 +382,7 @@ typedef struct HrtsContextCreateInfo {
   // Own device only: pick the device whose name contains this (NULL: best GPU, else lavapipe).
   const char *device_name_filter;
   // Own device only: enable the Khronos validation layer.
-  bool enable_validation;
+  HrtsBool enable_validation;
   // The most frames the engine records before waiting for the oldest to complete, 1..=
   // `HRTS_MAX_FRAMES_IN_FLIGHT` (0: 3). Recording frame `frame_index` states that every frame up to
   // `frame_index - frames_in_flight` has completed on the GPU.
@@ -394,15 +398,15 @@ typedef struct HrtsCapabilities {
   // Binning path `HRTS_BINNING_PATH_AUTO` resolves to (`HrtsBinningPath`).
   uint32_t default_binning_path;
   // Geometry shaders available (software path possible).
-  bool geometry_shader;
+  HrtsBool geometry_shader;
   // Timestamp queries available (per-pass GPU times in the report).
-  bool timestamps;
+  HrtsBool timestamps;
   // `VK_KHR_ray_query` present.
-  bool ray_query;
+  HrtsBool ray_query;
   // `VK_KHR_ray_tracing_pipeline` present.
-  bool ray_tracing_pipeline;
+  HrtsBool ray_tracing_pipeline;
   // `VK_EXT_fragment_shader_interlock` present.
-  bool fragment_shader_interlock;
+  HrtsBool fragment_shader_interlock;
   // Largest primitive map size N.
   uint32_t max_map_size;
   // Largest primitive-map entry budget in KiB (the device's largest storage buffer).
@@ -421,10 +425,10 @@ typedef struct HrtsConfig {
   // `HrtsShadowMode` (default hybrid).
   uint32_t mode;
   // FXAA over the ray-traced shadow (default true).
-  bool antialiasing;
+  HrtsBool antialiasing;
   // The light does not move between frames: the shadow map is kept (default false). The primitive map
   // follows the camera and is rebuilt every frame.
-  bool static_light;
+  HrtsBool static_light;
   // Primitive map N: texels per side of the light-space grid fitted to the receivers each frame,
   // 1..=max_map_size (default 1024). It moves cost, never exactness.
   uint32_t map_size;
@@ -465,16 +469,16 @@ typedef struct HrtsConfig {
   float shadow_map_slope_bias;
   // The geometry changes every frame: the prim buffer is rebuilt each frame (default false: built once
   // per `hrts_set_geometry_*`).
-  bool dynamic_geometry;
+  HrtsBool dynamic_geometry;
   // Resources to produce besides those the mode needs, for `hrts_record_resource_readback` (bit
   // `1 << HrtsResource`; default 0). E.g. the shadow-map visibility for comparisons.
   uint32_t extra_outputs;
   // Debug: 4096 words after the list entries, filled with `0xFFFFFFFF` and never written: a read-back of
   // `HRTS_RESOURCE_PRIM_LIST_ENTRIES` shows any write past the capacity (default false).
-  bool guard_entries;
+  HrtsBool guard_entries;
   // Debug: bin every texel of the fitted grid, not only those holding ray origins, and keep triangles
   // behind every ray origin: lists comparable with exact conservative binning (default false).
-  bool debug_bin_all_texels;
+  HrtsBool debug_bin_all_texels;
   // Entries the primitive map's lists start with (default 0: estimated from map_size and the
   // triangles). An engine that knows its scene can size them and avoid the frame of a growth.
   uint32_t map_initial_entries;
@@ -627,7 +631,7 @@ typedef struct HrtsResourceInfo {
   // `sizeof(HrtsResourceInfo)`, set by the caller.
   uint32_t struct_size;
   // Whether the current configuration allocates it.
-  bool allocated;
+  HrtsBool allocated;
   // Width in texels.
   uint32_t width;
   // Height in texels.

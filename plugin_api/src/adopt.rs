@@ -20,7 +20,7 @@ pub(crate) fn device(info: &HrtsContextCreateInfo) -> ApiResult<Device> {
             )
         };
         return Ok(Device::new_headless(&rhi::DeviceDesc {
-            validation: info.enable_validation,
+            validation: info.enable_validation != 0,
             device_filter: filter,
         })?);
     }
@@ -48,12 +48,12 @@ pub(crate) fn device(info: &HrtsContextCreateInfo) -> ApiResult<Device> {
         queue_index: v.queue_index,
         enabled_extensions: extension_names(v)?,
         enabled_features: rhi::EnabledFeatures {
-            geometry_shader: v.geometry_shader,
-            fragment_stores_and_atomics: v.fragment_stores_and_atomics,
-            depth_clamp: v.depth_clamp,
+            geometry_shader: v.geometry_shader != 0,
+            fragment_stores_and_atomics: v.fragment_stores_and_atomics != 0,
+            depth_clamp: v.depth_clamp != 0,
             shader_float64: false,
         },
-        debug_utils: v.debug_utils,
+        debug_utils: v.debug_utils != 0,
     };
     // SAFETY: the caller guarantees the handles are valid, belong together and outlive the context;
     // `adopt` checks the physical device for what the plugin needs and for what the engine claims.

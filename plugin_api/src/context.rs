@@ -128,6 +128,9 @@ pub(crate) struct Context {
     pub(crate) progress: FrameProgress,
     /// The index of the last frame begun.
     pub(crate) last_frame: Option<u64>,
+    /// A read-back recorded after frame `f` is submitted after that frame's commands, so it may still be
+    /// pending while frame `f + 1` is: it counts as a use in frame `f + 1` for what is retired after it.
+    pub(crate) readback_frame: Option<u64>,
     /// How many times each light's passes were built.
     pub(crate) light_builds: Vec<u32>,
     /// How many frusta each light was last given (its passes hold one pipeline per frustum).
@@ -172,6 +175,7 @@ impl Context {
             targets: None,
             progress: FrameProgress::default(),
             last_frame: None,
+            readback_frame: None,
             light_builds: vec![0],
             frusta: vec![1],
             last_error: None,
@@ -185,11 +189,11 @@ impl Context {
             .map_or(HrtsBinningPath::Compute, binning_path_to_c);
         out.conservative_raster_tier = caps.conservative_raster_tier as u32;
         out.default_binning_path = default_path as u32;
-        out.geometry_shader = caps.geometry_shader;
-        out.timestamps = caps.timestamps;
-        out.ray_query = caps.ray_query;
-        out.ray_tracing_pipeline = caps.ray_tracing_pipeline;
-        out.fragment_shader_interlock = caps.fragment_shader_interlock;
+        out.geometry_shader = caps.geometry_shader.into();
+        out.timestamps = caps.timestamps.into();
+        out.ray_query = caps.ray_query.into();
+        out.ray_tracing_pipeline = caps.ray_tracing_pipeline.into();
+        out.fragment_shader_interlock = caps.fragment_shader_interlock.into();
         out.max_map_size = caps.max_image_dimension_2d;
         out.max_map_entry_budget_kib =
             (caps.max_storage_buffer_range >> 10).min(u64::from(u32::MAX)) as u32;
@@ -350,7 +354,7 @@ impl Context {
 
     /// Holds `retired` until the frames recorded so far completed (drops it now if none was recorded).
     fn retire(&mut self, retired: Retired) {
-        if let Some(last) = self.last_frame {
+        if let Some(last) = self.last_frame.max(self.readback_frame) {
             self.retired.retire(last, retired);
         }
     }
@@ -608,7 +612,7 @@ impl Context {
         let pipeline = self.ensure_built()?.light(light)?.single(light)?;
         match (pipeline.image(id), pipeline.buffer(id)) {
             (Some(image), _) => {
-                out.allocated = true;
+                out.allocated = 1;
                 out.width = image.width();
                 out.height = image.height();
                 out.layers = image.layers();
@@ -616,7 +620,7 @@ impl Context {
                 out.bytes = image.byte_size();
             }
             (None, Some(buffer)) => {
-                out.allocated = true;
+                out.allocated = 1;
                 out.width = (buffer.size() / 4).min(u64::from(u32::MAX)) as u32;
                 out.height = 1;
                 out.layers = 1;
@@ -624,7 +628,7 @@ impl Context {
                 out.bytes = buffer.size();
             }
             (None, None) => {
-                out.allocated = false;
+                out.allocated = 0;
                 (out.width, out.height, out.layers, out.format, out.bytes) = (0, 0, 0, 0, 0);
             }
         }

@@ -350,17 +350,17 @@ pub(crate) fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
         .fold(ResourceSet::EMPTY, |set, (_, &r)| set.with(r));
     let mut config = ShadowConfig {
         mode,
-        antialiasing: c.antialiasing,
-        static_light: c.static_light,
-        static_geometry: !c.dynamic_geometry,
+        antialiasing: c.antialiasing != 0,
+        static_light: c.static_light != 0,
+        static_geometry: c.dynamic_geometry == 0,
         extra_outputs,
         map: PrimitiveMapConfig {
             size: c.map_size,
             faces,
             binning,
             entry_budget: u64::from(c.map_entry_budget_kib) << 10,
-            guard: c.guard_entries,
-            receiver_culling: !c.debug_bin_all_texels,
+            guard: c.guard_entries != 0,
+            receiver_culling: c.debug_bin_all_texels == 0,
             initial_entries: c.map_initial_entries,
         },
         ..ShadowConfig::default()
@@ -402,8 +402,8 @@ pub(crate) fn config_to_c(config: &ShadowConfig) -> ApiResult<HrtsConfig> {
     Ok(HrtsConfig {
         struct_size: std::mem::size_of::<HrtsConfig>() as u32,
         mode: c_value(config.mode, &MODES),
-        antialiasing: config.antialiasing,
-        static_light: config.static_light,
+        antialiasing: config.antialiasing.into(),
+        static_light: config.static_light.into(),
         map_size: config.map.size,
         map_entry_budget_kib: (config.map.entry_budget >> 10).min(u64::from(u32::MAX)) as u32,
         faces: c_value(config.map.faces, &FACES),
@@ -421,10 +421,10 @@ pub(crate) fn config_to_c(config: &ShadowConfig) -> ApiResult<HrtsConfig> {
         pcss_max_filter_radius: config.pcss.max_filter_radius,
         shadow_map_constant_bias: config.shadow_map.constant_bias,
         shadow_map_slope_bias: config.shadow_map.slope_bias,
-        dynamic_geometry: !config.static_geometry,
+        dynamic_geometry: (!config.static_geometry).into(),
         extra_outputs,
-        guard_entries: config.map.guard,
-        debug_bin_all_texels: !config.map.receiver_culling,
+        guard_entries: config.map.guard.into(),
+        debug_bin_all_texels: (!config.map.receiver_culling).into(),
         map_initial_entries: config.map.initial_entries,
     })
 }

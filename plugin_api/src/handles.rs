@@ -14,6 +14,17 @@ struct Slot {
 
 static SLOTS: Mutex<Vec<Slot>> = Mutex::new(Vec::new());
 
+// A handle carries a 32-bit generation and a 32-bit slot number in one pointer-sized value.
+const _: () = assert!(usize::BITS >= 64, "handles need 64-bit pointers");
+
+/// The first slot free for a new context: empty, with a generation left. A slot whose generation is
+/// exhausted is retired, never reused, so that no handle ever names two contexts.
+fn free_slot(slots: &[Slot]) -> Option<usize> {
+    slots
+        .iter()
+        .position(|s| s.context.is_none() && s.generation < u32::MAX)
+}
+
 /// The handle of slot `index` at `generation`: `generation << 32 | (index + 1)`, never NULL and never
 /// dereferenced.
 fn handle(index: usize, generation: u32) -> *mut HrtsContext {
@@ -37,10 +48,10 @@ fn slots() -> std::sync::MutexGuard<'static, Vec<Slot>> {
 pub(crate) fn register(context: Context) -> *mut HrtsContext {
     let mut slots = slots();
     let context = Some(Arc::new(Mutex::new(context)));
-    match slots.iter().position(|s| s.context.is_none()) {
+    match free_slot(&slots) {
         Some(i) => {
             let slot = &mut slots[i];
-            slot.generation = slot.generation.wrapping_add(1);
+            slot.generation += 1;
             slot.context = context;
             handle(i, slot.generation)
         }
@@ -85,5 +96,16 @@ mod tests {
         }
         assert_eq!(parts(std::ptr::null()), None);
         assert_eq!(parts(0x1_0000_0000usize as *const HrtsContext), None);
+    }
+
+    #[test]
+    fn a_slot_whose_generation_is_exhausted_is_never_reused() {
+        let empty = |generation| Slot {
+            generation,
+            context: None,
+        };
+        assert_eq!(free_slot(&[empty(u32::MAX), empty(7)]), Some(1));
+        assert_eq!(free_slot(&[empty(u32::MAX - 1)]), Some(0));
+        assert_eq!(free_slot(&[empty(u32::MAX)]), None);
     }
 }

@@ -103,16 +103,58 @@ fn with_context(
     })
 }
 
-fn deref<'a, T>(p: *const T, name: &str) -> ApiResult<&'a T> {
-    // SAFETY: a non-NULL pointer passed to the C ABI points at a valid `T` (documented contract).
-    unsafe { p.as_ref() }
-        .ok_or_else(|| ApiError::new(HrtsResult::ErrorNullPointer, format!("{name} is NULL")))
+/// The C structs whose first field is `u32 struct_size`: the `sizeof` of the struct the caller was built
+/// with, checked before the plugin makes a reference to the whole struct.
+///
+/// # Safety
+/// Implementors are `#[repr(C)]` and start with a `u32` `struct_size` field.
+unsafe trait Versioned {}
+
+macro_rules! versioned {
+    ($($t:ty)*) => {$(
+        // SAFETY: `#[repr(C)]`, first field `struct_size: u32` (types.rs).
+        unsafe impl Versioned for $t {}
+    )*};
+}
+versioned!(HrtsAllocationCallbacks HrtsMemoryStats HrtsContextCreateInfo HrtsCapabilities HrtsConfig
+    HrtsCpuGeometry HrtsVulkanGeometry HrtsTargets HrtsFrame HrtsResourceInfo HrtsResourceReadback
+    HrtsFrameReport);
+
+/// Checks a caller's versioned struct before it is read as a whole: not NULL, aligned, and of this
+/// library's size (a struct of an older, smaller version is refused without reading past its end).
+fn check_versioned<T: Versioned>(p: *const T, name: &str) -> ApiResult<()> {
+    if p.is_null() {
+        return Err(ApiError::new(
+            HrtsResult::ErrorNullPointer,
+            format!("{name} is NULL"),
+        ));
+    }
+    if !p.is_aligned() {
+        return Err(error::invalid(format!(
+            "{name} is not aligned to {} bytes",
+            std::mem::align_of::<T>()
+        )));
+    }
+    // SAFETY: a non-NULL pointer passed to the C ABI points at a struct of this family whatever its
+    // version (documented contract), and every version starts with the `u32` size; it is aligned.
+    let size = unsafe { p.cast::<u32>().read() };
+    let type_name = std::any::type_name::<T>()
+        .rsplit("::")
+        .next()
+        .unwrap_or(name);
+    error::check_size::<T>(size, type_name)
 }
 
-fn deref_mut<'a, T>(p: *mut T, name: &str) -> ApiResult<&'a mut T> {
-    // SAFETY: as for `deref`.
-    unsafe { p.as_mut() }
-        .ok_or_else(|| ApiError::new(HrtsResult::ErrorNullPointer, format!("{name} is NULL")))
+fn deref<'a, T: Versioned>(p: *const T, name: &str) -> ApiResult<&'a T> {
+    check_versioned(p, name)?;
+    // SAFETY: checked non-NULL, aligned and of this version's size; valid per the documented contract.
+    Ok(unsafe { &*p })
+}
+
+fn deref_mut<'a, T: Versioned>(p: *mut T, name: &str) -> ApiResult<&'a mut T> {
+    check_versioned(p, name)?;
+    // SAFETY: as for `deref`; the caller gives the plugin exclusive use of `*p` during the call.
+    Ok(unsafe { &mut *p })
 }
 
 /// For Rust hosts linking the rlib: the pipeline resource an `HrtsResource` value names.
@@ -188,8 +230,8 @@ pub unsafe extern "C" fn hrts_get_memory_stats(out: *mut HrtsMemoryStats) -> Hrt
     boundary(None, || {
         let out = deref_mut(out, "out")?;
         error::check_size::<HrtsMemoryStats>(out.struct_size, "HrtsMemoryStats")?;
-        out.host_bytes_counted = memory::is_global_allocator();
-        out.host_bytes = if out.host_bytes_counted {
+        out.host_bytes_counted = memory::is_global_allocator().into();
+        out.host_bytes = if out.host_bytes_counted != 0 {
             memory::live_host_bytes()
         } else {
             0
@@ -243,7 +285,14 @@ pub unsafe extern "C" fn hrts_context_create(
     out_context: *mut *mut HrtsContext,
 ) -> HrtsResult {
     boundary(None, || {
-        let out = deref_mut(out_context, "out_context")?;
+        if out_context.is_null() || !out_context.is_aligned() {
+            return Err(ApiError::new(
+                HrtsResult::ErrorNullPointer,
+                "out_context is NULL or misaligned",
+            ));
+        }
+        // SAFETY: checked non-NULL and aligned; the caller gives a writable pointer (contract).
+        let out = unsafe { &mut *out_context };
         *out = std::ptr::null_mut();
         let info = deref(info, "info")?;
         error::check_size::<HrtsContextCreateInfo>(info.struct_size, "HrtsContextCreateInfo")?;

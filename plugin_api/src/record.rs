@@ -175,7 +175,7 @@ impl Context {
         Ok(())
     }
 
-    pub(crate) fn record_readback(&self, r: &HrtsResourceReadback) -> ApiResult<()> {
+    pub(crate) fn record_readback(&mut self, r: &HrtsResourceReadback) -> ApiResult<()> {
         check_size::<HrtsResourceReadback>(r.struct_size, "HrtsResourceReadback")?;
         if r.command_buffer == 0 || r.buffer == 0 {
             return Err(ApiError::new(
@@ -258,6 +258,7 @@ impl Context {
                 after: S::HostRead,
             },
         ]);
+        self.readback_frame = self.last_frame.map(|f| f + 1);
         Ok(())
     }
 }

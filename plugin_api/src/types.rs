@@ -8,6 +8,10 @@ use std::ffi::c_char;
 /// version differs.
 pub const HRTS_API_VERSION: u32 = 4 << 22;
 
+/// A flag in the C structs: 0 is false, any other value true. (A Rust `bool` would make any byte but 0
+/// and 1 undefined behaviour when the engine writes it.)
+pub type HrtsBool = u32;
+
 /// The most lights one context shades (`hrts_configure_lights`); a point light counts once.
 pub const HRTS_MAX_LIGHTS: u32 = 64;
 
@@ -289,13 +293,13 @@ pub struct HrtsVulkanDevice {
     /// Number of entries in `enabled_extensions`.
     pub enabled_extension_count: u32,
     /// Whether `geometryShader` is enabled (needed by the software conservative-raster path).
-    pub geometry_shader: bool,
+    pub geometry_shader: HrtsBool,
     /// Whether `fragmentStoresAndAtomics` is enabled (required).
-    pub fragment_stores_and_atomics: bool,
+    pub fragment_stores_and_atomics: HrtsBool,
     /// Whether `depthClamp` is enabled.
-    pub depth_clamp: bool,
+    pub depth_clamp: HrtsBool,
     /// Whether the instance enabled `VK_EXT_debug_utils` (per-pass debug labels).
-    pub debug_utils: bool,
+    pub debug_utils: HrtsBool,
 }
 
 /// How to create a context.
@@ -311,7 +315,7 @@ pub struct HrtsContextCreateInfo {
     /// Own device only: pick the device whose name contains this (NULL: best GPU, else lavapipe).
     pub device_name_filter: *const c_char,
     /// Own device only: enable the Khronos validation layer.
-    pub enable_validation: bool,
+    pub enable_validation: HrtsBool,
     /// The most frames the engine records before waiting for the oldest to complete, 1..=
     /// `HRTS_MAX_FRAMES_IN_FLIGHT` (0: 3). Recording frame `frame_index` states that every frame up to
     /// `frame_index - frames_in_flight` has completed on the GPU.
@@ -328,15 +332,15 @@ pub struct HrtsCapabilities {
     /// Binning path `HRTS_BINNING_PATH_AUTO` resolves to (`HrtsBinningPath`).
     pub default_binning_path: u32,
     /// Geometry shaders available (software path possible).
-    pub geometry_shader: bool,
+    pub geometry_shader: HrtsBool,
     /// Timestamp queries available (per-pass GPU times in the report).
-    pub timestamps: bool,
+    pub timestamps: HrtsBool,
     /// `VK_KHR_ray_query` present.
-    pub ray_query: bool,
+    pub ray_query: HrtsBool,
     /// `VK_KHR_ray_tracing_pipeline` present.
-    pub ray_tracing_pipeline: bool,
+    pub ray_tracing_pipeline: HrtsBool,
     /// `VK_EXT_fragment_shader_interlock` present.
-    pub fragment_shader_interlock: bool,
+    pub fragment_shader_interlock: HrtsBool,
     /// Largest primitive map size N.
     pub max_map_size: u32,
     /// Largest primitive-map entry budget in KiB (the device's largest storage buffer).
@@ -356,10 +360,10 @@ pub struct HrtsConfig {
     /// `HrtsShadowMode` (default hybrid).
     pub mode: u32,
     /// FXAA over the ray-traced shadow (default true).
-    pub antialiasing: bool,
+    pub antialiasing: HrtsBool,
     /// The light does not move between frames: the shadow map is kept (default false). The primitive map
     /// follows the camera and is rebuilt every frame.
-    pub static_light: bool,
+    pub static_light: HrtsBool,
     /// Primitive map N: texels per side of the light-space grid fitted to the receivers each frame,
     /// 1..=max_map_size (default 1024). It moves cost, never exactness.
     pub map_size: u32,
@@ -400,16 +404,16 @@ pub struct HrtsConfig {
     pub shadow_map_slope_bias: f32,
     /// The geometry changes every frame: the prim buffer is rebuilt each frame (default false: built once
     /// per `hrts_set_geometry_*`).
-    pub dynamic_geometry: bool,
+    pub dynamic_geometry: HrtsBool,
     /// Resources to produce besides those the mode needs, for `hrts_record_resource_readback` (bit
     /// `1 << HrtsResource`; default 0). E.g. the shadow-map visibility for comparisons.
     pub extra_outputs: u32,
     /// Debug: 4096 words after the list entries, filled with `0xFFFFFFFF` and never written: a read-back of
     /// `HRTS_RESOURCE_PRIM_LIST_ENTRIES` shows any write past the capacity (default false).
-    pub guard_entries: bool,
+    pub guard_entries: HrtsBool,
     /// Debug: bin every texel of the fitted grid, not only those holding ray origins, and keep triangles
     /// behind every ray origin: lists comparable with exact conservative binning (default false).
-    pub debug_bin_all_texels: bool,
+    pub debug_bin_all_texels: HrtsBool,
     /// Entries the primitive map's lists start with (default 0: estimated from map_size and the
     /// triangles). An engine that knows its scene can size them and avoid the frame of a growth.
     pub map_initial_entries: u32,
@@ -601,7 +605,7 @@ pub struct HrtsMemoryStats {
     pub host_bytes: u64,
     /// Whether the plugin counts its host memory: true in its shared and static libraries, whose global
     /// allocator counts it; false when a Rust program links the plugin's rlib and keeps its own allocator.
-    pub host_bytes_counted: bool,
+    pub host_bytes_counted: HrtsBool,
     /// GPU bytes allocated by the plugin and not freed (excludes what the Vulkan driver keeps internally).
     pub gpu_bytes: u64,
 }
@@ -696,7 +700,7 @@ pub struct HrtsResourceInfo {
     /// `sizeof(HrtsResourceInfo)`, set by the caller.
     pub struct_size: u32,
     /// Whether the current configuration allocates it.
-    pub allocated: bool,
+    pub allocated: HrtsBool,
     /// Width in texels.
     pub width: u32,
     /// Height in texels.

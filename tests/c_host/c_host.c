@@ -813,7 +813,7 @@ enum {
     CREATE_NULL_INFO, CREATE_NULL_OUT, CREATE_STRUCT_SIZE, CREATE_VERSION, CREATE_NULL_DEVICE, CREATE_NULL_GIPA,
     CREATE_DEVICE_STRUCT_SIZE, CREATE_FRAMES_IN_FLIGHT, CREATE_UNSUPPORTED_EXTENSION, CREATE_NO_SUCH_QUEUE_FAMILY,
     CREATE_NO_SUCH_QUEUE, CAPS_NULL_CONTEXT, CAPS_NULL_OUT, CAPS_STRUCT_SIZE, CONFIG_N_ZERO, CONFIG_N_ABSURD,
-    CONFIG_BUDGET_ZERO, CONFIG_BUDGET_SMALL, CONFIG_FACES, CONFIG_BINNING, CONFIG_STRUCT_SIZE, CONFIG_MODE,
+    CONFIG_BUDGET_ZERO, CONFIG_BUDGET_SMALL, CONFIG_FACES, CONFIG_BINNING, CONFIG_STRUCT_SIZE, CONFIG_OLDER_SMALLER, CONFIG_MISALIGNED, CONFIG_MODE,
     CONFIG_NAN_LIGHT_SIZE, CONFIG_NEGATIVE_WSS, CONFIG_PCF_TAPS, CONFIG_SHADOW_MAP_ZERO, CONFIG_DEFAULTS_NULL,
     CONFIG_FILTER, CONFIG_EXTRA_OUTPUT, CONFIG_FILTER_RADII, CONFIG_SLOPE_BIAS, LIGHTS_ZERO, LIGHTS_TOO_MANY,
     LIGHTS_NULL, LIGHTS_SECOND_INVALID, GEOMETRY_NULL_POSITIONS, GEOMETRY_STRIDE, GEOMETRY_NAN, GEOMETRY_INDEX,
@@ -853,6 +853,8 @@ static const struct {
     [CONFIG_FACES] = {"configure(unknown faces)", HRTS_RESULT_ERROR_INVALID_ENUM},
     [CONFIG_BINNING] = {"configure(unknown binning path)", HRTS_RESULT_ERROR_INVALID_ENUM},
     [CONFIG_STRUCT_SIZE] = {"configure(wrong size)", HRTS_RESULT_ERROR_STRUCT_SIZE},
+    [CONFIG_OLDER_SMALLER] = {"configure(an older, 8-byte HrtsConfig)", HRTS_RESULT_ERROR_STRUCT_SIZE},
+    [CONFIG_MISALIGNED] = {"configure(misaligned HrtsConfig)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [CONFIG_MODE] = {"configure(unknown mode)", HRTS_RESULT_ERROR_INVALID_ENUM},
     [CONFIG_NAN_LIGHT_SIZE] = {"configure(NaN light size)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [CONFIG_NEGATIVE_WSS] = {"configure(negative WSS)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
@@ -977,6 +979,22 @@ static HrtsResult misuse_call(int id, Misuse *m) {
     case CONFIG_FACES: c.faces = 7; return hrts_configure(ctx, &c);
     case CONFIG_BINNING: c.binning_path = 99; return hrts_configure(ctx, &c);
     case CONFIG_STRUCT_SIZE: c.struct_size = 3; return hrts_configure(ctx, &c);
+    case CONFIG_OLDER_SMALLER: {
+        /* a caller built against a version whose HrtsConfig was 8 bytes: only those bytes exist */
+        uint32_t *older = malloc(8);
+        older[0] = 8;
+        older[1] = HRTS_SHADOW_MODE_HARD;
+        HrtsResult r = hrts_configure(ctx, (const HrtsConfig *)(void *)older);
+        free(older);
+        return r;
+    }
+    case CONFIG_MISALIGNED: {
+        static unsigned char bytes[sizeof(HrtsConfig) + 16];
+        unsigned char *at = bytes + 1;
+        while (((uintptr_t)at % sizeof(uint32_t)) == 0) at++; /* HrtsConfig holds 4-byte fields */
+        memcpy(at, &c, sizeof c);
+        return hrts_configure(ctx, (const HrtsConfig *)(void *)at);
+    }
     case CONFIG_MODE: c.mode = 9; return hrts_configure(ctx, &c);
     case CONFIG_NAN_LIGHT_SIZE: c.pcss_angular_radius = NAN; return hrts_configure(ctx, &c);
     case CONFIG_NEGATIVE_WSS: c.hybrid_world_space_scale = -1.0f; return hrts_configure(ctx, &c);
