@@ -467,13 +467,17 @@ static void create_device(void) {
     VkPhysicalDeviceVulkan13Features f13 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
     f13.dynamicRendering = VK_TRUE;
     f13.synchronization2 = VK_TRUE;
+    /* the engine's own: a timeline semaphore holds the first frame in flight (frames_in_flight) */
+    VkPhysicalDeviceVulkan12Features f12 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+    f12.timelineSemaphore = VK_TRUE;
+    f12.pNext = &f13;
     VkPhysicalDeviceFeatures feats;
     memset(&feats, 0, sizeof feats);
     feats.geometryShader = VK_TRUE;
     feats.fragmentStoresAndAtomics = VK_TRUE;
     feats.depthClamp = VK_TRUE;
     VkDeviceCreateInfo di = {.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
-    di.pNext = &f13;
+    di.pNext = &f12;
     di.queueCreateInfoCount = 1;
     di.pQueueCreateInfos = &qi;
     di.pEnabledFeatures = &feats;
@@ -1387,7 +1391,16 @@ static void frames_in_flight(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *
         back[s] = make_host_buffer(sizeof(float) * LIGHTS * PX, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
         pending[s] = -1;
     }
-    int errors_before = validation_errors, recorded = 0, max_pending = 0;
+    /* the first frame waits on a timeline semaphore the host signals once IN_FLIGHT frames were submitted:
+     * the frames after it are ordered after it (the plugin's barrier at each frame's start), so exactly
+     * IN_FLIGHT frames are pending then, whatever the device's pace */
+    VkSemaphoreTypeCreateInfo sti = {.sType = VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
+    sti.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
+    VkSemaphoreCreateInfo sci = {.sType = VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+    sci.pNext = &sti;
+    VkSemaphore hold;
+    VK(vkCreateSemaphore(device, &sci, NULL, &hold));
+    int errors_before = validation_errors, recorded = 0, max_pending = 0, held_pending = 0;
     for (int i = 0; i < MOVING_FRAMES + IN_FLIGHT; i++) {
         int s = i % IN_FLIGHT;
         if (pending[s] >= 0) {
@@ -1412,12 +1425,36 @@ static void frames_in_flight(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *
         HrtsResult r = hrts_record_frame(ctx, &f);
         CHECK(r == HRTS_RESULT_OK, "in flight: frame %d: %s", i, hrts_last_error(ctx));
         record_output_readback(cmds[s], back[s], LIGHTS);
-        submit(cmds[s], fences[s]);
+        if (i == 0) {
+            VK(vkEndCommandBuffer(cmds[s]));
+            uint64_t wait_value = 1;
+            VkTimelineSemaphoreSubmitInfo ts = {.sType = VK_STRUCTURE_TYPE_TIMELINE_SEMAPHORE_SUBMIT_INFO};
+            ts.waitSemaphoreValueCount = 1;
+            ts.pWaitSemaphoreValues = &wait_value;
+            VkPipelineStageFlags stage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
+            VkSubmitInfo si = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO};
+            si.pNext = &ts;
+            si.waitSemaphoreCount = 1;
+            si.pWaitSemaphores = &hold;
+            si.pWaitDstStageMask = &stage;
+            si.commandBufferCount = 1;
+            si.pCommandBuffers = &cmds[s];
+            VK(vkQueueSubmit(queue, 1, &si, fences[s]));
+        } else {
+            submit(cmds[s], fences[s]);
+        }
         pending[s] = i;
         recorded++;
         int now = 0;
         for (int k = 0; k < IN_FLIGHT; k++) now += pending[k] >= 0 && vkGetFenceStatus(device, fences[k]) == VK_NOT_READY;
         if (now > max_pending) max_pending = now;
+        if (i == IN_FLIGHT - 1) {
+            held_pending = now;
+            VkSemaphoreSignalInfo release = {.sType = VK_STRUCTURE_TYPE_SEMAPHORE_SIGNAL_INFO};
+            release.semaphore = hold;
+            release.value = 1;
+            VK(vkSignalSemaphore(device, &release));
+        }
     }
     int in_flight_errors = validation_errors - errors_before;
     /* the reports of the last IN_FLIGHT frames are kept; older ones are not */
@@ -1458,10 +1495,12 @@ static void frames_in_flight(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *
            recorded, max_pending, RECONFIGURE_AT, RETARGET_AT, differ, differing_frames, hard_layers, mismatches,
            in_flight_errors);
     CHECK(recorded == MOVING_FRAMES, "in flight: %d frames recorded", recorded);
+    CHECK(held_pending == IN_FLIGHT, "in flight: %d of %d frames were pending together", held_pending, IN_FLIGHT);
     CHECK(differ == 0, "in flight: %d px in %d frames differ from the single-frame results", differ, differing_frames);
     CHECK(mismatches == 0, "in flight: %d px differ from the exact shadows", mismatches);
     CHECK(in_flight_errors == 0, "in flight: %d validation errors", in_flight_errors);
     VK(vkDeviceWaitIdle(device));
+    vkDestroySemaphore(device, hold, NULL);
     for (int s = 0; s < IN_FLIGHT; s++) {
         vkDestroyFence(device, fences[s], NULL);
         free_buffer(depth[s]);

@@ -11,20 +11,26 @@ use passes::{choose_binning_path, BinningRequest, FaceMode, PrimitiveMapConfig};
 use reference::{FaceSelection, RefScene};
 
 fn check(view: &View, size: u32, faces: FaceMode) {
+    check_paths(
+        view,
+        size,
+        faces,
+        &[BinningRequest::Compute, BinningRequest::Software],
+    );
+}
+
+/// Checks `view` with each binning path of `paths`; a path the device lacks fails the test (the hardware
+/// path has its own test, ignored unless run with `--ignored` on a device that has it).
+fn check_paths(view: &View, size: u32, faces: FaceMode, paths: &[BinningRequest]) {
     let device = device();
     let rs = RefScene::new(&view.scene);
     let selection = match faces {
         FaceMode::Both => FaceSelection::Both,
         FaceMode::FrontOnly => FaceSelection::FrontOnly,
     };
-    for binning in [
-        BinningRequest::Compute,
-        BinningRequest::Software,
-        BinningRequest::Hardware,
-    ] {
-        if choose_binning_path(device.capabilities(), binning).is_err() {
-            println!("{binning:?}: not on this device");
-            continue;
+    for &binning in paths {
+        if let Err(e) = choose_binning_path(device.capabilities(), binning) {
+            panic!("{binning:?} binning is not on this device: {e}");
         }
         for receiver_culling in [false, true] {
             let config = PrimitiveMapConfig {
@@ -63,6 +69,14 @@ fn check(view: &View, size: u32, faces: FaceMode) {
         }
     }
     assert_no_validation_errors(&device);
+}
+
+/// Hardware conservative rasterization: lavapipe has none, so this runs with `--ignored` on a GPU.
+#[test]
+#[ignore = "needs hardware conservative rasterization: run with --ignored on a GPU that has it"]
+fn hardware_binning_lists_are_exact() {
+    let view = View::framed(scene::procedural_default(), 64, 64);
+    check_paths(&view, 128, FaceMode::Both, &[BinningRequest::Hardware]);
 }
 
 #[test]

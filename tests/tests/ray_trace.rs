@@ -8,17 +8,14 @@ use host_demo::View;
 use passes::{choose_binning_path, BinningRequest, PrimitiveMapConfig};
 use reference::RefScene;
 
-fn check(view: &View, size: u32, max_near_edge_fraction: f64) {
+/// Checks `view` with each binning path of `paths`; a path the device lacks fails the test (the hardware
+/// path has its own test, ignored unless run with `--ignored` on a device that has it).
+fn check_paths(view: &View, size: u32, max_near_edge_fraction: f64, paths: &[BinningRequest]) {
     let device = device();
     let rs = RefScene::new(&view.scene);
-    for binning in [
-        BinningRequest::Compute,
-        BinningRequest::Software,
-        BinningRequest::Hardware,
-    ] {
-        if choose_binning_path(device.capabilities(), binning).is_err() {
-            println!("{binning:?} binning: not on this device");
-            continue;
+    for &binning in paths {
+        if let Err(e) = choose_binning_path(device.capabilities(), binning) {
+            panic!("{binning:?} binning is not on this device: {e}");
         }
         let config = PrimitiveMapConfig {
             size,
@@ -51,6 +48,23 @@ fn check_config(
         c.max_blocker_error
     );
     assert_no_validation_errors(device);
+}
+
+fn check(view: &View, size: u32, max_near_edge_fraction: f64) {
+    check_paths(
+        view,
+        size,
+        max_near_edge_fraction,
+        &[BinningRequest::Compute, BinningRequest::Software],
+    );
+}
+
+/// Hardware conservative rasterization: lavapipe has none, so this runs with `--ignored` on a GPU.
+#[test]
+#[ignore = "needs hardware conservative rasterization: run with --ignored on a GPU that has it"]
+fn hardware_binning_matches_exact_visibility() {
+    let view = View::framed(scene::procedural_default(), 240, 160);
+    check_paths(&view, 256, 0.02, &[BinningRequest::Hardware]);
 }
 
 #[test]
