@@ -24,6 +24,11 @@ static LIVE_HOST_BYTES: AtomicU64 = AtomicU64::new(0);
 static LIVE_ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
 static TOTAL_ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
 static CALLBACKS: OnceLock<Callbacks> = OnceLock::new();
+/// The allocator's state: [`INSTALLED`] once the engine's callbacks serve every allocation, else the
+/// number of live allocations `System` serves. Installing succeeds only from 0 (compare-and-swap), so no
+/// allocation can slip in between the check and the switch.
+static STATE: AtomicU64 = AtomicU64::new(0);
+const INSTALLED: u64 = 1 << 63;
 
 /// Whether [`CountingAllocator`] is the process's global allocator (the plugin's shared or static
 /// library), rather than this crate being linked as an rlib into a program with its own.
@@ -35,21 +40,55 @@ pub(crate) fn is_global_allocator() -> bool {
 
 /// Installs the engine's callbacks; false if the plugin holds memory (or callbacks are installed).
 pub(crate) fn install(callbacks: Callbacks) -> bool {
-    LIVE_ALLOCATIONS.load(Ordering::SeqCst) == 0 && CALLBACKS.set(callbacks).is_ok()
+    if STATE
+        .compare_exchange(0, INSTALLED, Ordering::SeqCst, Ordering::SeqCst)
+        .is_err()
+    {
+        return false;
+    }
+    // Allocations wait for this (see `callbacks`). The set cannot fail: only this winner gets here.
+    CALLBACKS.set(callbacks).is_ok()
 }
 
-// SAFETY: every method returns memory from one allocator for the whole process (callbacks can only be
-// installed before the first allocation) with the requested layout, and frees it with the same one.
+/// The engine's callbacks if they serve allocations, else `None` with one more live `System` allocation
+/// reserved (released by [`System`]'s deallocation, or at once by a failed allocation).
+fn callbacks_or_reserve_system() -> Option<&'static Callbacks> {
+    loop {
+        let state = STATE.load(Ordering::SeqCst);
+        if state & INSTALLED != 0 {
+            // Installed: the callbacks are set right after the switch.
+            if let Some(c) = CALLBACKS.get() {
+                return Some(c);
+            }
+            std::hint::spin_loop();
+        } else if STATE
+            .compare_exchange(state, state + 1, Ordering::SeqCst, Ordering::SeqCst)
+            .is_ok()
+        {
+            return None;
+        }
+    }
+}
+
+// SAFETY: every method returns memory with the requested layout and frees it with the allocator that
+// served it: callbacks are installed only while no `System` allocation is live (STATE), and serve every
+// allocation after that.
 unsafe impl GlobalAlloc for CountingAllocator {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         TOTAL_ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        let p = match CALLBACKS.get() {
+        let p = match callbacks_or_reserve_system() {
             // SAFETY: the engine's allocate returns `size` bytes aligned to `align`, or NULL.
             Some(c) => unsafe {
                 (c.allocate)(c.user_data as *mut c_void, layout.size(), layout.align()) as *mut u8
             },
-            // SAFETY: forwarded unchanged.
-            None => unsafe { System.alloc(layout) },
+            None => {
+                // SAFETY: forwarded unchanged.
+                let p = unsafe { System.alloc(layout) };
+                if p.is_null() {
+                    STATE.fetch_sub(1, Ordering::SeqCst);
+                }
+                p
+            }
         };
         if !p.is_null() {
             LIVE_HOST_BYTES.fetch_add(layout.size() as u64, Ordering::Relaxed);
@@ -69,8 +108,11 @@ unsafe impl GlobalAlloc for CountingAllocator {
                     layout.align(),
                 )
             },
-            // SAFETY: forwarded unchanged.
-            None => unsafe { System.dealloc(ptr, layout) },
+            None => {
+                // SAFETY: `ptr` came from `System` with this layout (no callbacks were installed then).
+                unsafe { System.dealloc(ptr, layout) };
+                STATE.fetch_sub(1, Ordering::SeqCst);
+            }
         }
         LIVE_HOST_BYTES.fetch_sub(layout.size() as u64, Ordering::Relaxed);
         LIVE_ALLOCATIONS.fetch_sub(1, Ordering::SeqCst);
