@@ -12,6 +12,13 @@ use std::mem::ManuallyDrop;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 
+// `adopt` and `adopt_desc` transmute between `vkGetInstanceProcAddr` function-pointer types whose ABI is
+// the same only where Vulkan's calling convention is C and pointers are 64-bit: fail the build elsewhere.
+const _: () = assert!(
+    usize::BITS == 64,
+    "the adoption of an engine's Vulkan objects assumes a 64-bit target"
+);
+
 /// What to do when no Vulkan driver or device is found.
 const NO_DRIVER_ADVICE: &str = "Run scripts/setup.sh from the checkout (it installs Mesa's lavapipe, a CPU Vulkan \
      driver, with the Vulkan loader and validation layers), or install your GPU's Vulkan driver; check that \

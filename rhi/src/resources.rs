@@ -563,15 +563,18 @@ impl Buffer {
             .ok_or_else(|| RhiError::InvalidArgument("buffer is not host-visible".into()))?
             .as_ptr()
             .cast::<u8>();
-        if !offset.is_multiple_of(8) || offset.checked_add(8).is_none_or(|end| end > self.size) {
+        let address = (ptr as usize).checked_add(offset as usize);
+        if address.is_none_or(|a| !a.is_multiple_of(8))
+            || offset.checked_add(8).is_none_or(|end| end > self.size)
+        {
             return Err(RhiError::InvalidArgument(format!(
                 "u64 read at offset {offset} of a {}-byte buffer",
                 self.size
             )));
         }
-        // SAFETY: the mapping covers `size` bytes and stays valid while `self` lives; the offset is in
-        // bounds and 8-aligned (mappings are at least 8-aligned); a volatile load of a plain integer
-        // tolerates concurrent device writes (it may see the old or the new value).
+        // SAFETY: the mapping covers `size` bytes and stays valid while `self` lives; the read is in
+        // bounds and its address checked 8-aligned; a volatile load of a plain integer tolerates
+        // concurrent device writes (it may see the old or the new value).
         Ok(unsafe { std::ptr::read_volatile(ptr.add(offset as usize).cast::<u64>()) })
     }
 
