@@ -795,6 +795,24 @@ impl ShadowPipeline {
         self.record_passes(enc, PassId::ALL)
     }
 
+    /// Makes the allocations the frame's recording of `passes` needs (the primitive map's lists growing
+    /// to what earlier frames needed), so that [`ShadowPipeline::record_passes`] allocates nothing: a
+    /// host that records several pipelines into one command buffer can fail before any of them records.
+    pub fn prepare_record(&mut self, device: &Device, passes: &[PassId]) -> Result<(), PassError> {
+        let index = match &self.frame {
+            Some(frame) => frame.index,
+            None => {
+                return Err(PassError::InvalidConfig(
+                    "no frame: call begin_frame first".into(),
+                ))
+            }
+        };
+        if passes.contains(&PassId::PrimitiveMap) && self.plan.runs(PassId::PrimitiveMap) {
+            self.grow_map(device, index)?;
+        }
+        Ok(())
+    }
+
     /// Whether [`ShadowPipeline::record_passes`] would accept `passes` now (without recording anything).
     pub fn check_record(&self, passes: &[PassId]) -> Result<(), PassError> {
         let frame = self

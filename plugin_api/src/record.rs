@@ -133,6 +133,23 @@ impl Context {
                 ApiError::new(HrtsResult::ErrorInvalidState, format!("light {i}: {e}"))
             })?;
         }
+        // Every light allocates what its recording needs before any records: an allocation failure leaves
+        // the command buffer untouched.
+        for (i, pipeline) in built
+            .lights
+            .iter_mut()
+            .enumerate()
+            .filter_map(|(i, l)| l.as_mut().map(|l| (i, l)))
+            .flat_map(|(i, l)| l.frusta.iter_mut().map(move |p| (i, p)))
+        {
+            pipeline.prepare_record(device, &passes).map_err(|e| {
+                let e = ApiError::from(e);
+                ApiError {
+                    message: format!("light {i}: {}", e.message),
+                    ..e
+                }
+            })?;
+        }
         // SAFETY: the engine guarantees the command buffer is recording, outside a render pass, on this
         // device and used by no other thread during the call (documented contract).
         let mut enc = unsafe { Encoder::from_raw_handle(device, f.command_buffer) };
