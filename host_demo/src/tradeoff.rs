@@ -178,28 +178,25 @@ pub fn methods(angular_radius: f32, wss: f32) -> Vec<Method> {
             passes: TRACED_PASSES,
         });
     }
-    for (filter, wss_scale, phs) in [
-        (PenumbraFilter::Shrinking, 1.0, 4.0),
-        (PenumbraFilter::Shrinking, 1.0, 1.0),
-        (PenumbraFilter::Shrinking, 1.0, 16.0),
-        (PenumbraFilter::Shrinking, 0.25, 4.0),
-        (PenumbraFilter::Shrinking, 4.0, 4.0),
-        (PenumbraFilter::Standard, 1.0, 4.0),
-        (PenumbraFilter::Standard, 0.25, 4.0),
+    // L = saturate(BD / WSS * PHS) depends on PHS / WSS alone: one row per ratio and filter, WSS fixed.
+    for (filter, phs) in [
+        (PenumbraFilter::Shrinking, 0.25),
+        (PenumbraFilter::Shrinking, 1.0),
+        (PenumbraFilter::Shrinking, 4.0),
+        (PenumbraFilter::Shrinking, 16.0),
+        (PenumbraFilter::Shrinking, 64.0),
+        (PenumbraFilter::Standard, 4.0),
+        (PenumbraFilter::Standard, 16.0),
     ] {
         out.push(Method {
             family: "hybrid",
-            name: format!(
-                "{}, WSS {:.3}, PHS {phs}",
-                filter_name(filter),
-                wss * wss_scale
-            ),
+            name: format!("{}, WSS {:.3}, PHS {phs}", filter_name(filter), wss),
             config: ShadowConfig {
                 mode: ShadowMode::Hybrid,
                 antialiasing: true,
                 pcss: pcss(filter, 16, 32),
                 hybrid: HybridConfig {
-                    world_space_scale: wss * wss_scale,
+                    world_space_scale: wss,
                     hard_shadow_percentage: phs,
                 },
                 ..base
@@ -693,5 +690,29 @@ impl Sweep {
     /// Rows of the sweep.
     pub fn rows(&self) -> &[Row] {
         &self.rows
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The hybrid's lerp factor depends on PHS / WSS alone: no two hybrid rows share it with one filter.
+    #[test]
+    fn hybrid_rows_are_distinct() {
+        let rows: Vec<(String, u32)> = methods(0.02, 0.8)
+            .iter()
+            .filter(|m| m.family == "hybrid")
+            .map(|m| {
+                let h = m.config.hybrid;
+                let ratio = h.hard_shadow_percentage / h.world_space_scale;
+                (
+                    filter_name(m.config.pcss.filter).to_owned(),
+                    ratio.to_bits(),
+                )
+            })
+            .collect();
+        let distinct: std::collections::BTreeSet<_> = rows.iter().collect();
+        assert_eq!(distinct.len(), rows.len(), "{rows:?}");
     }
 }
