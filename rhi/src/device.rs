@@ -4,7 +4,7 @@ use crate::caps::{
     device_extensions, device_type_name, has_extension, read_capabilities, Capabilities,
 };
 use crate::error::{Result, RhiError, VkResultExt};
-use crate::raytracing::{ray_tracing_missing, RayTracingDevice, RayTracingFeatures};
+use crate::rt_device::{ray_tracing_missing, RayTracingDevice, RayTracingFeatures};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use std::ffi::{c_void, CStr};
@@ -157,7 +157,7 @@ pub struct Device {
     pub(crate) shared: Arc<Shared>,
     /// The pool of `submit_and_wait`'s command buffers; its lock also serialises this device's own queue
     /// submissions, so `Device` may be shared between threads.
-    command_pool: Mutex<vk::CommandPool>,
+    pub(crate) command_pool: Mutex<vk::CommandPool>,
 }
 
 /// `vkGetInstanceProcAddr` as a plain C function pointer (`VkInstance` is a pointer-sized handle).
@@ -579,59 +579,7 @@ impl Device {
         &self.shared.validation
     }
 
-    /// Records commands with `record`, submits them and waits for completion. Only on a device of the RHI's
-    /// own: an adopted device's queue belongs to the engine, which synchronises its use.
-    pub fn submit_and_wait<R>(
-        &self,
-        record: impl FnOnce(&mut crate::Encoder<'_>) -> Result<R>,
-    ) -> Result<R> {
-        self.require_owned("submit_and_wait")?;
-        let pool = self
-            .command_pool
-            .lock()
-            .map_err(|_| RhiError::InvalidArgument("command pool lock poisoned".into()))?;
-        let d = &self.shared.device;
-        let alloc = vk::CommandBufferAllocateInfo::default()
-            .command_pool(*pool)
-            .level(vk::CommandBufferLevel::PRIMARY)
-            .command_buffer_count(1);
-        // SAFETY: the pool and the queue are used only under the pool's lock, held until this returns; the
-        // command buffer is freed below on every path.
-        unsafe {
-            let cmd = d
-                .allocate_command_buffers(&alloc)
-                .call("vkAllocateCommandBuffers")?[0];
-            let result = (|| {
-                d.begin_command_buffer(
-                    cmd,
-                    &vk::CommandBufferBeginInfo::default()
-                        .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-                )
-                .call("vkBeginCommandBuffer")?;
-                let mut enc = crate::Encoder::new(self, cmd);
-                let r = record(&mut enc)?;
-                d.end_command_buffer(cmd).call("vkEndCommandBuffer")?;
-                let fence = d
-                    .create_fence(&vk::FenceCreateInfo::default(), None)
-                    .call("vkCreateFence")?;
-                let cmds = [cmd];
-                let submit = vk::SubmitInfo::default().command_buffers(&cmds);
-                let submitted = d
-                    .queue_submit(self.shared.queue, &[submit], fence)
-                    .call("vkQueueSubmit");
-                let waited = submitted.and_then(|_| {
-                    d.wait_for_fences(&[fence], true, u64::MAX)
-                        .call("vkWaitForFences")
-                });
-                d.destroy_fence(fence, None);
-                waited.map(|_| r)
-            })();
-            d.free_command_buffers(*pool, &[cmd]);
-            result
-        }
-    }
-
-    /// Waits until the GPU is idle. Only on a device of the RHI's own (see [`Device::submit_and_wait`]).
+    /// Waits until the GPU is idle. Only on a device of the RHI's own (see `Device::submit_and_wait`).
     pub fn wait_idle(&self) -> Result<()> {
         self.require_owned("wait_idle")?;
         let _queue = self
@@ -647,7 +595,7 @@ impl Device {
         self.shared.owned
     }
 
-    fn require_owned(&self, what: &str) -> Result<()> {
+    pub(crate) fn require_owned(&self, what: &str) -> Result<()> {
         if self.shared.owned {
             Ok(())
         } else {

@@ -737,3 +737,58 @@ pub(crate) fn check_push(push: &[u8], declared: u32) -> Result<()> {
     }
     Ok(())
 }
+
+/// One-off submissions on a device of the RHI's own (they need an [`Encoder`]; a layer above the device).
+impl Device {
+    /// Records commands with `record`, submits them and waits for completion. Only on a device of the RHI's
+    /// own: an adopted device's queue belongs to the engine, which synchronises its use.
+    pub fn submit_and_wait<R>(
+        &self,
+        record: impl FnOnce(&mut Encoder<'_>) -> Result<R>,
+    ) -> Result<R> {
+        self.require_owned("submit_and_wait")?;
+        let pool = self
+            .command_pool
+            .lock()
+            .map_err(|_| RhiError::InvalidArgument("command pool lock poisoned".into()))?;
+        let d = &self.shared.device;
+        let alloc = vk::CommandBufferAllocateInfo::default()
+            .command_pool(*pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        // SAFETY: the pool and the queue are used only under the pool's lock, held until this returns; the
+        // command buffer is freed below on every path.
+        unsafe {
+            let cmd = d
+                .allocate_command_buffers(&alloc)
+                .call("vkAllocateCommandBuffers")?[0];
+            let result = (|| {
+                d.begin_command_buffer(
+                    cmd,
+                    &vk::CommandBufferBeginInfo::default()
+                        .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+                )
+                .call("vkBeginCommandBuffer")?;
+                let mut enc = Encoder::new(self, cmd);
+                let r = record(&mut enc)?;
+                d.end_command_buffer(cmd).call("vkEndCommandBuffer")?;
+                let fence = d
+                    .create_fence(&vk::FenceCreateInfo::default(), None)
+                    .call("vkCreateFence")?;
+                let cmds = [cmd];
+                let submit = vk::SubmitInfo::default().command_buffers(&cmds);
+                let submitted = d
+                    .queue_submit(self.shared.queue, &[submit], fence)
+                    .call("vkQueueSubmit");
+                let waited = submitted.and_then(|_| {
+                    d.wait_for_fences(&[fence], true, u64::MAX)
+                        .call("vkWaitForFences")
+                });
+                d.destroy_fence(fence, None);
+                waited.map(|_| r)
+            })();
+            d.free_command_buffers(*pool, &[cmd]);
+            result
+        }
+    }
+}

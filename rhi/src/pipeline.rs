@@ -1,9 +1,9 @@
 //! Compute and graphics pipelines from SPIR-V, their layouts, and bind groups (descriptor sets).
 
+use crate::accel::TopLevel;
 use crate::conv::Format;
 use crate::device::{Device, Shared};
 use crate::error::{Result, RhiError, VkResultExt};
-use crate::raytracing::TopLevel;
 use crate::resources::{Buffer, Image};
 use ash::vk;
 use std::sync::Arc;

@@ -3,115 +3,14 @@
 //! (`VK_KHR_ray_tracing_pipeline`). Available only on a device the RHI created where the device supports
 //! them; elsewhere every entry point fails with [`RhiError::MissingFeature`] naming what is missing.
 
-use crate::device::{Device, Shared};
+use crate::accel::{triangles, AccelerationStructure, BottomLevel, TopLevel};
+use crate::device::Device;
 use crate::encoder::{Barrier, Encoder};
 use crate::error::{Result, RhiError, VkResultExt};
 use crate::pipeline::{BindGroup, BindingKind, PipelineLayout};
 use crate::resources::{Buffer, MemoryLocation};
+use crate::rt_device::{align_up, RayTracingDevice, RayTracingLimits};
 use ash::vk;
-use std::ffi::CStr;
-use std::sync::Arc;
-
-/// Which of the features ray tracing needs a physical device supports.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub(crate) struct RayTracingFeatures {
-    /// `bufferDeviceAddress` (Vulkan 1.2).
-    pub buffer_device_address: bool,
-    /// `accelerationStructure`.
-    pub acceleration_structure: bool,
-    /// `rayTracingPipeline`.
-    pub ray_tracing_pipeline: bool,
-}
-
-/// Names of the extensions and features ray tracing needs that a device lacks (empty: it has them all).
-pub(crate) fn ray_tracing_missing(
-    has_extension: impl Fn(&CStr) -> bool,
-    features: RayTracingFeatures,
-) -> Vec<&'static str> {
-    let extensions = RayTracingDevice::EXTENSIONS
-        .iter()
-        .filter(|&&name| !has_extension(name))
-        .map(|name| name.to_str().unwrap_or("(unnamed extension)"));
-    let features = [
-        (features.buffer_device_address, "bufferDeviceAddress"),
-        (features.acceleration_structure, "accelerationStructure"),
-        (features.ray_tracing_pipeline, "rayTracingPipeline"),
-    ]
-    .into_iter()
-    .filter(|(present, _)| !present)
-    .map(|(_, name)| name);
-    extensions.chain(features).collect()
-}
-
-/// The ray-tracing limits the RHI honours.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct RayTracingLimits {
-    /// `shaderGroupHandleSize`.
-    pub handle_size: u32,
-    /// `shaderGroupHandleAlignment`: SBT record strides are multiples of it.
-    pub handle_alignment: u32,
-    /// `shaderGroupBaseAlignment`: every SBT region starts at a multiple of it.
-    pub base_alignment: u32,
-    /// `maxShaderGroupStride`.
-    pub max_stride: u32,
-    /// `maxRayDispatchInvocationCount`.
-    pub max_invocations: u32,
-    /// `minAccelerationStructureScratchOffsetAlignment`.
-    pub scratch_alignment: u32,
-}
-
-/// The ray-tracing entry points and limits of a device created with ray tracing enabled.
-pub(crate) struct RayTracingDevice {
-    accel: ash::khr::acceleration_structure::Device,
-    pipeline: ash::khr::ray_tracing_pipeline::Device,
-    limits: RayTracingLimits,
-}
-
-impl RayTracingDevice {
-    /// The device extensions ray tracing enables.
-    pub(crate) const EXTENSIONS: [&'static CStr; 3] = [
-        ash::khr::acceleration_structure::NAME,
-        ash::khr::ray_tracing_pipeline::NAME,
-        ash::khr::deferred_host_operations::NAME,
-    ];
-
-    /// Loads the entry points of `device`, which was created from `pd` with [`Self::EXTENSIONS`] and the
-    /// features of [`RayTracingFeatures`] enabled, and reads the limits.
-    pub(crate) fn new(
-        instance: &ash::Instance,
-        device: &ash::Device,
-        pd: vk::PhysicalDevice,
-    ) -> Self {
-        let mut pipeline_props = vk::PhysicalDeviceRayTracingPipelinePropertiesKHR::default();
-        let mut accel_props = vk::PhysicalDeviceAccelerationStructurePropertiesKHR::default();
-        let mut props = vk::PhysicalDeviceProperties2::default()
-            .push_next(&mut pipeline_props)
-            .push_next(&mut accel_props);
-        // SAFETY: `pd` belongs to `instance` and has both extensions; the chain outlives the call.
-        unsafe { instance.get_physical_device_properties2(pd, &mut props) };
-        Self {
-            accel: ash::khr::acceleration_structure::Device::new(instance, device),
-            pipeline: ash::khr::ray_tracing_pipeline::Device::new(instance, device),
-            limits: RayTracingLimits {
-                handle_size: pipeline_props.shader_group_handle_size,
-                handle_alignment: pipeline_props.shader_group_handle_alignment,
-                base_alignment: pipeline_props.shader_group_base_alignment,
-                max_stride: pipeline_props.max_shader_group_stride,
-                max_invocations: pipeline_props.max_ray_dispatch_invocation_count,
-                scratch_alignment: accel_props.min_acceleration_structure_scratch_offset_alignment,
-            },
-        }
-    }
-}
-
-/// `value` rounded up to a multiple of `alignment` (a power of two, or 0/1 for none).
-pub(crate) fn align_up(value: u64, alignment: u64) -> u64 {
-    if alignment <= 1 {
-        value
-    } else {
-        value.div_ceil(alignment) * alignment
-    }
-}
 
 /// Every shader stage mask that contains a shader stage also gets the ray-tracing shader stage, so that a
 /// D3D12-style state covers ray-tracing shaders too.
@@ -212,28 +111,6 @@ fn after_build() -> vk::MemoryBarrier2<'static> {
         .dst_access_mask(vk::AccessFlags2::ACCELERATION_STRUCTURE_READ_KHR)
 }
 
-/// An acceleration structure with its storage and its own build scratch memory.
-pub(crate) struct AccelerationStructure {
-    shared: Arc<Shared>,
-    pub(crate) raw: vk::AccelerationStructureKHR,
-    /// Device address of the structure (what a top-level instance references).
-    address: u64,
-    /// Device address of the scratch memory, aligned as the device requires.
-    scratch_address: u64,
-    // Keep the memory alive until the structure is destroyed (Drop runs before the fields drop).
-    _storage: Buffer,
-    _scratch: Buffer,
-}
-
-impl Drop for AccelerationStructure {
-    fn drop(&mut self) {
-        if let Ok(rt) = &self.shared.ray_tracing {
-            // SAFETY: created by this device; GPU work using it has completed before the owner drops it.
-            unsafe { rt.accel.destroy_acceleration_structure(self.raw, None) };
-        }
-    }
-}
-
 /// Device address of `buffer` rounded up to `alignment`, and that address's offset in the buffer.
 fn aligned_address(buffer: &Buffer, alignment: u64) -> (u64, u64) {
     let address = buffer.device_address();
@@ -254,39 +131,6 @@ pub struct TriangleGeometry<'a> {
     pub triangle_count: u32,
 }
 
-/// A bottom-level acceleration structure over one [`TriangleGeometry`], built for fast tracing.
-pub struct BottomLevel {
-    inner: AccelerationStructure,
-    vertices: u64,
-    stride: u64,
-    triangle_count: u32,
-}
-
-impl BottomLevel {
-    fn geometry(&self) -> vk::AccelerationStructureGeometryKHR<'static> {
-        triangles(self.vertices, self.stride, self.triangle_count)
-    }
-}
-
-fn triangles(
-    vertices: u64,
-    stride: u64,
-    triangle_count: u32,
-) -> vk::AccelerationStructureGeometryKHR<'static> {
-    let data = vk::AccelerationStructureGeometryTrianglesDataKHR::default()
-        .vertex_format(vk::Format::R32G32B32_SFLOAT)
-        .vertex_data(vk::DeviceOrHostAddressConstKHR {
-            device_address: vertices,
-        })
-        .vertex_stride(stride)
-        .max_vertex((triangle_count * 3).saturating_sub(1))
-        .index_type(vk::IndexType::NONE_KHR);
-    vk::AccelerationStructureGeometryKHR::default()
-        .geometry_type(vk::GeometryTypeKHR::TRIANGLES)
-        .geometry(vk::AccelerationStructureGeometryDataKHR { triangles: data })
-        .flags(vk::GeometryFlagsKHR::OPAQUE)
-}
-
 fn instances(address: u64) -> vk::AccelerationStructureGeometryKHR<'static> {
     let data = vk::AccelerationStructureGeometryInstancesDataKHR::default()
         .array_of_pointers(false)
@@ -296,22 +140,6 @@ fn instances(address: u64) -> vk::AccelerationStructureGeometryKHR<'static> {
     vk::AccelerationStructureGeometryKHR::default()
         .geometry_type(vk::GeometryTypeKHR::INSTANCES)
         .geometry(vk::AccelerationStructureGeometryDataKHR { instances: data })
-}
-
-/// A top-level acceleration structure with one instance (identity transform) of the bottom level it owns.
-pub struct TopLevel {
-    pub(crate) inner: AccelerationStructure,
-    // Holds the instance record the builds read.
-    _instances: Buffer,
-    instances_address: u64,
-    bottom: BottomLevel,
-}
-
-impl TopLevel {
-    /// The instanced bottom level.
-    pub fn bottom_level(&self) -> &BottomLevel {
-        &self.bottom
-    }
 }
 
 /// Description of a ray-tracing pipeline: one ray-generation shader, one miss shader, and one empty
@@ -741,51 +569,6 @@ impl Encoder<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn all_features() -> RayTracingFeatures {
-        RayTracingFeatures {
-            buffer_device_address: true,
-            acceleration_structure: true,
-            ray_tracing_pipeline: true,
-        }
-    }
-
-    #[test]
-    fn nothing_missing_with_every_extension_and_feature() {
-        assert!(ray_tracing_missing(|_| true, all_features()).is_empty());
-    }
-
-    #[test]
-    fn mesa_22_lavapipe_lacks_everything() {
-        // Mesa 22.3's lavapipe: bufferDeviceAddress (core 1.2) but no ray-tracing extensions.
-        let features = RayTracingFeatures {
-            buffer_device_address: true,
-            ..RayTracingFeatures::default()
-        };
-        assert_eq!(
-            ray_tracing_missing(|_| false, features),
-            [
-                "VK_KHR_acceleration_structure",
-                "VK_KHR_ray_tracing_pipeline",
-                "VK_KHR_deferred_host_operations",
-                "accelerationStructure",
-                "rayTracingPipeline",
-            ]
-        );
-    }
-
-    #[test]
-    fn missing_names_only_what_is_absent() {
-        let features = RayTracingFeatures {
-            ray_tracing_pipeline: false,
-            ..all_features()
-        };
-        let has = |n: &CStr| n != ash::khr::ray_tracing_pipeline::NAME;
-        assert_eq!(
-            ray_tracing_missing(has, features),
-            ["VK_KHR_ray_tracing_pipeline", "rayTracingPipeline"]
-        );
-    }
 
     #[test]
     fn align_up_rounds_to_multiples() {
