@@ -208,6 +208,25 @@ pub fn methods(angular_radius: f32, wss: f32) -> Vec<Method> {
     out
 }
 
+/// Ticks of a log axis from `lo` to `hi`: 1, 2 and 5 times the powers of ten in range, each once (the
+/// plotting crate's own log ticks can repeat a decade, printing its label over itself).
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    if !(lo > 0.0 && hi > lo) {
+        return Vec::new();
+    }
+    let mut ticks = Vec::new();
+    for exponent in (lo.log10().floor() as i32)..=(hi.log10().ceil() as i32) {
+        for m in [1.0, 2.0, 5.0] {
+            // Parsed from text so that 0.2 is 0.2, not 2 * 0.1 rounded.
+            let tick: f64 = format!("{m}e{exponent}").parse().unwrap_or(0.0);
+            if (lo..=hi).contains(&tick) {
+                ticks.push(tick);
+            }
+        }
+    }
+    ticks
+}
+
 fn filter_name(filter: PenumbraFilter) -> &'static str {
     match filter {
         PenumbraFilter::Standard => "standard",
@@ -516,11 +535,14 @@ impl Sweep {
             .x_label_area_size(44)
             .y_label_area_size(64)
             .build_cartesian_2d(
-                ((lo_ms * 0.7)..(hi_ms * 1.4)).log_scale(),
+                ((lo_ms * 0.7)..(hi_ms * 1.4))
+                    .log_scale()
+                    .with_key_points(log_ticks(lo_ms * 0.7, hi_ms * 1.4)),
                 0.0..(hi_err * 1.1),
             )?;
         chart
             .configure_mesh()
+            .x_label_formatter(&|ms| format!("{ms}"))
             .x_desc("GPU ms (log scale)")
             .y_desc("mean absolute error of visibility")
             .draw()?;
@@ -696,6 +718,16 @@ impl Sweep {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn log_ticks_are_distinct_and_in_range() {
+        assert_eq!(
+            log_ticks(0.15, 140.0),
+            [0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0]
+        );
+        assert_eq!(log_ticks(3.0, 4.0), Vec::<f64>::new());
+        assert!(log_ticks(0.0, 1.0).is_empty());
+    }
 
     /// The hybrid's lerp factor depends on PHS / WSS alone: no two hybrid rows share it with one filter.
     #[test]
