@@ -109,7 +109,8 @@ bool clipped_box(vec3 l[3], vec3 slack, float orientation, out vec2 lo, out vec2
 // triangle's. When |D| is within its error bound the light lies in the triangle's plane (up to rounding)
 // and both signs are accepted: the projection is then a band around one line. The bounding box clips the
 // map square to the three half-planes with one more texel of slack and grows by one texel, which absorbs
-// the rounding of the clip.
+// the rounding of the clip. With a known orientation, each edge's error bound is folded into that edge
+// (its constant term), and the edges are stored oriented.
 uint clipped_setup(HPoint h[3], float min_depth, float margin_base, inout BinTri bt) {
     Line lines[3] = Line[3](edge_line(h[1], h[2]), edge_line(h[2], h[0]), edge_line(h[0], h[1]));
     precise float d = dot(h[0].h, lines[0].l);
@@ -119,6 +120,7 @@ uint clipped_setup(HPoint h[3], float min_depth, float margin_base, inout BinTri
     // Any texel centre, grown by the base margin, lies within this distance of the map's origin per axis.
     float reach = ms.fit.y + 1.0 + margin_base;
     vec3 l[3];
+    float slack_of[3] = float[3](0.0, 0.0, 0.0);
     float extra = 0.0;
     for (int i = 0; i < 3; ++i) {
         vec3 c = lines[i].l, e = lines[i].e;
@@ -137,10 +139,27 @@ uint clipped_setup(HPoint h[3], float min_depth, float margin_base, inout BinTri
             l[i] = vec3(0.0);   // no usable edge: it accepts every texel (conservative)
         } else {
             l[i] = c;
+            slack_of[i] = slack;
             extra = max(extra, grow);
         }
     }
-    float margin = margin_base + extra;
+    float margin = margin_base;
+    if (orientation != 0.0) {
+        // A known orientation: each edge keeps its own error bound, folded into its constant term (with
+        // the addition's rounding), so that an ill-conditioned edge (one pointing at the light projects to
+        // almost a point) does not widen the other two.
+        for (int i = 0; i < 3; ++i) {
+            if (l[i] != vec3(0.0)) {
+                vec3 o = orientation * l[i];
+                float grown = slack_of[i] * ROUND_UP;
+                o.z = (o.z + grown) + 2.0 * U * (abs(o.z) + grown);
+                l[i] = o;
+            }
+        }
+        orientation = 1.0;
+    } else {
+        margin += extra;    // either orientation: one margin for the three edges, tested both ways
+    }
     float g = 1.5 + margin;    // half a texel, the margin, and the clip's one texel of slack
     vec3 slack = g * vec3(abs(l[0].x) + abs(l[0].y), abs(l[1].x) + abs(l[1].y), abs(l[2].x) + abs(l[2].y));
     vec2 lo = vec2(1.0 / 0.0), hi = vec2(-1.0 / 0.0);
