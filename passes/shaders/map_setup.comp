@@ -230,7 +230,11 @@ uint setup(uint index, out BinTri bt) {
     uint mode = MODE_COVER;
     float err = max(max(max(p[0].xy_err.x, p[0].xy_err.y), max(p[1].xy_err.x, p[1].xy_err.y)),
                     max(p[2].xy_err.x, p[2].xy_err.y));
-    margin += err;
+    // The per-texel edge functions (map_bin.glsl) are products of differences of coordinates up to R
+    // texels: their rounding, in texels, is within 8u R (doubled here), beyond ACCEPT_MARGIN once R
+    // reaches tens of thousands of texels.
+    vec2 reach = max(max(abs(p[0].xy), abs(p[1].xy)), max(abs(p[2].xy), vec2(ms.fit.y)));
+    margin += err + 16.0 * U * max(reach.x, reach.y);
     vec2 lo = min(min(p[0].xy, p[1].xy), p[2].xy) - margin;
     vec2 hi = max(max(p[0].xy, p[1].xy), p[2].xy) + margin;
     bool far = any(greaterThan(abs(vec4(lo, hi)), vec4(FAR_TEXELS)));
