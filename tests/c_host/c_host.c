@@ -803,6 +803,27 @@ static HrtsConfig config(uint32_t mode) {
     return cfg;
 }
 
+/* Engine geometry for misuse cases that fail before any buffer is touched: well-formed but for what the
+ * case changes, with handles that are never used (1) and the draws of `g`. */
+static HrtsVulkanGeometry fake_vulkan_geometry(const HrtsCpuGeometry *g) {
+    HrtsVulkanGeometry vg;
+    memset(&vg, 0, sizeof vg);
+    vg.struct_size = sizeof vg;
+    vg.vertex_buffer = 1;
+    vg.vertex_buffer_size = 1024;
+    vg.vertex_stride = 12;
+    vg.vertex_count = 12;
+    vg.index_buffer = 1;
+    vg.index_buffer_size = 1024;
+    vg.index_type = HRTS_INDEX_TYPE_UINT32;
+    vg.index_count = 42;
+    vg.draws = g->draws;
+    vg.draw_count = g->draw_count;
+    const float bounds[6] = {-4.0f, 0.0f, -4.0f, 4.0f, 1.6f, 4.0f};
+    memcpy(vg.bounds, bounds, sizeof bounds);
+    return vg;
+}
+
 static HrtsResult configure_all(HrtsContext *ctx, uint32_t count, uint32_t mode) {
     HrtsConfig cfgs[HRTS_MAX_LIGHTS];
     for (uint32_t i = 0; i < count; i++) cfgs[i] = config(mode);
@@ -1031,32 +1052,14 @@ static HrtsResult misuse_call(int id, Misuse *m) {
     }
     case GEOMETRY_NO_DRAWS: g.draw_count = 0; return hrts_set_geometry_cpu(ctx, &g);
     case VULKAN_GEOMETRY_INDEX_TYPE: {
-        HrtsVulkanGeometry vg;
-        memset(&vg, 0, sizeof vg);
-        vg.struct_size = sizeof vg;
-        vg.vertex_buffer = 1;
-        vg.index_buffer = 1;
+        HrtsVulkanGeometry vg = fake_vulkan_geometry(&g);
         vg.index_type = 5;
         return hrts_set_geometry_vulkan(ctx, &vg);
     }
     case VULKAN_GEOMETRY_VERTEX_OFFSET_WRAP:
     case VULKAN_GEOMETRY_INDEX_OFFSET_WRAP: {
-        /* offsets whose end wraps past 2^64 must fail the bounds check, not pass it (handles never used) */
-        HrtsVulkanGeometry vg;
-        memset(&vg, 0, sizeof vg);
-        vg.struct_size = sizeof vg;
-        vg.vertex_buffer = 1;
-        vg.vertex_buffer_size = 1024;
-        vg.vertex_stride = 12;
-        vg.vertex_count = 12;
-        vg.index_buffer = 1;
-        vg.index_buffer_size = 1024;
-        vg.index_type = HRTS_INDEX_TYPE_UINT32;
-        vg.index_count = 42;
-        vg.draws = g.draws;
-        vg.draw_count = g.draw_count;
-        const float bounds[6] = {-4.0f, 0.0f, -4.0f, 4.0f, 1.6f, 4.0f};
-        memcpy(vg.bounds, bounds, sizeof bounds);
+        /* offsets whose end wraps past 2^64 must fail the bounds check, not pass it */
+        HrtsVulkanGeometry vg = fake_vulkan_geometry(&g);
         if (id == VULKAN_GEOMETRY_VERTEX_OFFSET_WRAP)
             vg.vertex_offset = UINT64_MAX - 3;
         else
