@@ -1203,6 +1203,19 @@ static void misuse(HrtsContext *ctx, const HrtsVulkanDevice *vk) {
     CHECK(matched == MISUSE_CASES, "%d misuse cases did not fail as they must", MISUSE_CASES - matched);
 }
 
+/* A context of two frames in flight with `n` hard lights, the CPU geometry `g` and the targets, its lights
+ * those of the frames recorded next. */
+static HrtsContext *hard_lights_context(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g, const Emitter *lights,
+                                       uint32_t n) {
+    set_lights(lights, n);
+    HrtsContext *ctx = create_context(vk, 2);
+    CHECK(configure_all(ctx, n, HRTS_SHADOW_MODE_HARD) == HRTS_RESULT_OK, "configure %u lights: %s", n, hrts_last_error(ctx));
+    HrtsTargets t = targets();
+    CHECK(hrts_set_geometry_cpu(ctx, g) == HRTS_RESULT_OK && hrts_set_targets(ctx, &t) == HRTS_RESULT_OK,
+          "geometry and targets: %s", hrts_last_error(ctx));
+    return ctx;
+}
+
 /* ---------- several lights in one context ---------- */
 /* Eight lights, four directional and four spot, hard shadows, in one context sharing the prim buffer:
  * each light's layer of the output matches the exact shadow of that light; the prim buffer is built once,
@@ -1219,12 +1232,7 @@ static void several_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g)
         spot(v3(0.3, 5.0, 2.5), v3(0, 0, 0), 1.9),
         spot(v3(-1.5, 3.0, 2.0), v3(0, 0.5, 0), 2.2),
     };
-    set_lights(lights, N);
-    HrtsContext *ctx = create_context(vk, 2);
-    CHECK(configure_all(ctx, N, HRTS_SHADOW_MODE_HARD) == HRTS_RESULT_OK, "configure 8 lights: %s", hrts_last_error(ctx));
-    HrtsTargets t = targets();
-    CHECK(hrts_set_geometry_cpu(ctx, g) == HRTS_RESULT_OK && hrts_set_targets(ctx, &t) == HRTS_RESULT_OK,
-          "geometry and targets: %s", hrts_last_error(ctx));
+    HrtsContext *ctx = hard_lights_context(vk, g, lights, N);
     static float vis[N * W * H];
     uint64_t first = next_frame;
     CHECK(run_frame(ctx, vis) == HRTS_RESULT_OK, "8 lights: %s", hrts_last_error(ctx));
@@ -1283,15 +1291,11 @@ static void several_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g)
 static void native_local_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
     enum { N = 2 };
     Emitter lights[N] = {point(v3(0.9, 2.3, 0.7)), fitted_spot(v3(-1.5, 3.2, 1.8), v3(0, 0, 0), 1.35)};
-    set_lights(lights, N);
-    HrtsContext *ctx = create_context(vk, 2);
+    HrtsContext *ctx = hard_lights_context(vk, g, lights, N);
     /* a context takes HRTS_MAX_LIGHTS lights, a point light counting once */
     CHECK(HRTS_MAX_LIGHTS >= 64 && configure_all(ctx, HRTS_MAX_LIGHTS, HRTS_SHADOW_MODE_HARD) == HRTS_RESULT_OK,
           "configure %d lights: %s", HRTS_MAX_LIGHTS, hrts_last_error(ctx));
     CHECK(configure_all(ctx, N, HRTS_SHADOW_MODE_HARD) == HRTS_RESULT_OK, "configure: %s", hrts_last_error(ctx));
-    HrtsTargets t = targets();
-    CHECK(hrts_set_geometry_cpu(ctx, g) == HRTS_RESULT_OK && hrts_set_targets(ctx, &t) == HRTS_RESULT_OK,
-          "geometry and targets: %s", hrts_last_error(ctx));
     static float vis[N * W * H];
     uint64_t first = next_frame;
     CHECK(run_frame(ctx, vis) == HRTS_RESULT_OK, "point and fitted spot: %s", hrts_last_error(ctx));
