@@ -412,6 +412,43 @@ static void submit_and_wait(VkCommandBuffer cmd) {
     vkFreeCommandBuffers(device, pool, 1, &cmd);
 }
 
+/* A timeline semaphore at 0 that submissions held by the test wait on (value 1). */
+static VkSemaphore held_semaphore(void) {
+    VkSemaphoreTypeCreateInfo sti = {.sType = VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
+    sti.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
+    VkSemaphoreCreateInfo sci = {.sType = VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+    sci.pNext = &sti;
+    VkSemaphore hold;
+    VK(vkCreateSemaphore(device, &sci, NULL, &hold));
+    return hold;
+}
+
+/* Submits `cmd` to run once the test releases `hold` (it stays pending until then), signalling `fence`. */
+static void submit_held(VkCommandBuffer cmd, VkSemaphore hold, VkFence fence) {
+    VK(vkEndCommandBuffer(cmd));
+    uint64_t wait_value = 1;
+    VkTimelineSemaphoreSubmitInfo ts = {.sType = VK_STRUCTURE_TYPE_TIMELINE_SEMAPHORE_SUBMIT_INFO};
+    ts.waitSemaphoreValueCount = 1;
+    ts.pWaitSemaphoreValues = &wait_value;
+    VkPipelineStageFlags stage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
+    VkSubmitInfo si = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    si.pNext = &ts;
+    si.waitSemaphoreCount = 1;
+    si.pWaitSemaphores = &hold;
+    si.pWaitDstStageMask = &stage;
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &cmd;
+    VK(vkQueueSubmit(queue, 1, &si, fence));
+}
+
+/* Lets the submissions waiting on `hold` run. */
+static void release_held(VkSemaphore hold) {
+    VkSemaphoreSignalInfo release = {.sType = VK_STRUCTURE_TYPE_SEMAPHORE_SIGNAL_INFO};
+    release.semaphore = hold;
+    release.value = 1;
+    VK(vkSignalSemaphore(device, &release));
+}
+
 static void create_device(void) {
     const char *layers[] = {"VK_LAYER_KHRONOS_validation"};
     const char *inst_ext[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME, VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME};
@@ -704,10 +741,9 @@ static HrtsResult run_frame_in_parts(HrtsContext *ctx, float *vis, int one_by_on
     return finish_frame(cmd, r, vis);
 }
 
-/* Reads a plugin resource of the last complete frame back through hrts_record_resource_readback. */
-static HrtsResult read_resource(HrtsContext *ctx, uint32_t light, uint32_t resource, float *out, size_t bytes) {
-    Buf back = make_host_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-    VkCommandBuffer cmd = begin();
+/* Records the copy of light `light`'s `resource` into `back` (`bytes` long) into `cmd`. */
+static HrtsResult record_resource_readback(HrtsContext *ctx, VkCommandBuffer cmd, uint32_t light, uint32_t resource,
+                                           Buf back, size_t bytes) {
     HrtsResourceReadback rb;
     memset(&rb, 0, sizeof rb);
     rb.struct_size = sizeof rb;
@@ -716,7 +752,14 @@ static HrtsResult read_resource(HrtsContext *ctx, uint32_t light, uint32_t resou
     rb.light = light;
     rb.buffer = (uint64_t)(uintptr_t)back.buffer;
     rb.buffer_size = bytes;
-    HrtsResult r = hrts_record_resource_readback(ctx, &rb);
+    return hrts_record_resource_readback(ctx, &rb);
+}
+
+/* Reads a plugin resource of the last complete frame back through hrts_record_resource_readback. */
+static HrtsResult read_resource(HrtsContext *ctx, uint32_t light, uint32_t resource, float *out, size_t bytes) {
+    Buf back = make_host_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    VkCommandBuffer cmd = begin();
+    HrtsResult r = record_resource_readback(ctx, cmd, light, resource, back, bytes);
     submit_and_wait(cmd);
     if (r == HRTS_RESULT_OK) memcpy(out, back.map, bytes);
     free_buffer(back);
@@ -828,6 +871,110 @@ static HrtsResult configure_all(HrtsContext *ctx, uint32_t count, uint32_t mode)
     HrtsConfig cfgs[HRTS_MAX_LIGHTS];
     for (uint32_t i = 0; i < count; i++) cfgs[i] = config(mode);
     return hrts_configure_lights(ctx, count, cfgs);
+}
+
+/* A read-back recorded after frame N counts as a use of frame N+1: what a reconfigure retires after it is
+ * held until frame N+1 has completed. The read-back's submission waits on a semaphore the test holds, so it
+ * is surely pending when frame N+1 is recorded; with one frame in flight, recording frame N+1 frees what
+ * only frames up to N used. Freeing the image the read-back reads then is an error the validation layer
+ * reports (an object in use by a pending command buffer), and the read-back would read freed memory. */
+static void readback_retire(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
+    enum { PX = W * H };
+    setup_camera(0.0);
+    Emitter sun = directional(v3(0.45, -1.0, 0.2));
+    set_lights(&sun, 1);
+    upload_gbuffer();
+    HrtsContext *ctx = create_context(vk, 1);
+    HrtsTargets t = targets();
+    CHECK(configure_all(ctx, 1, HRTS_SHADOW_MODE_HARD) == HRTS_RESULT_OK && hrts_set_geometry_cpu(ctx, g) == HRTS_RESULT_OK &&
+              hrts_set_targets(ctx, &t) == HRTS_RESULT_OK,
+          "read-back retire: setup: %s", hrts_last_error(ctx));
+    static float vis[PX];
+    CHECK(run_frame(ctx, vis) == HRTS_RESULT_OK, "read-back retire: frame: %s", hrts_last_error(ctx));
+    Buf back = make_host_buffer(sizeof(float) * PX, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    memset(back.map, 0xff, sizeof(float) * PX);
+    VkCommandBuffer readback_cmd = begin();
+    CHECK(record_resource_readback(ctx, readback_cmd, 0, HRTS_RESOURCE_RT_VISIBILITY, back, sizeof(float) * PX) == HRTS_RESULT_OK,
+          "read-back retire: read-back: %s", hrts_last_error(ctx));
+    VkSemaphore hold = held_semaphore();
+    VkFenceCreateInfo fi = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    VkFence readback_done;
+    VK(vkCreateFence(device, &fi, NULL, &readback_done));
+    submit_held(readback_cmd, hold, readback_done);
+    int errors_before = validation_errors;
+    CHECK(configure_all(ctx, 1, HRTS_SHADOW_MODE_HYBRID) == HRTS_RESULT_OK, "read-back retire: reconfigure: %s", hrts_last_error(ctx));
+    VkCommandBuffer cmd = begin();
+    HrtsFrame f = frame(cmd, next_frame++);
+    CHECK(hrts_record_frame(ctx, &f) == HRTS_RESULT_OK, "read-back retire: next frame: %s", hrts_last_error(ctx));
+    int still_pending = vkGetFenceStatus(device, readback_done) == VK_NOT_READY;
+    int in_use_errors = validation_errors - errors_before;
+    release_held(hold);
+    VK(vkWaitForFences(device, 1, &readback_done, VK_TRUE, UINT64_MAX));
+    submit_and_wait(cmd);
+    int differ = differing(back.map, vis, PX);
+    printf("read-back retire: the read-back was %s when frame N+1 was recorded after a reconfigure; %d validation "
+           "errors then; the read-back differs from frame N's output in %d px\n",
+           still_pending ? "pending" : "NOT pending", in_use_errors, differ);
+    CHECK(still_pending, "read-back retire: the held read-back had completed: the case was not tested");
+    CHECK(in_use_errors == 0, "read-back retire: %d validation errors (objects freed under a pending read-back)", in_use_errors);
+    CHECK(differ == 0, "read-back retire: the read-back differs from the frame's output in %d px", differ);
+    vkDestroyFence(device, readback_done, NULL);
+    vkDestroySemaphore(device, hold, NULL);
+    vkFreeCommandBuffers(device, pool, 1, &readback_cmd);
+    free_buffer(back);
+    CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "read-back retire: destroy");
+}
+
+/* A failed call records nothing. Light 0 is hard (no shadow map), light 1 hybrid (its shadow map is
+ * rendered every frame), so a call of the passes up to the ray trace without the shadow map suits light 0
+ * and leaves out a pass light 1 runs: the call fails, and light 0's passes must not be in the command
+ * buffer either. The camera moves in that same command buffer: had light 0's ray trace been recorded, its
+ * visibility (read back after the submission) would show the new view. */
+static void partial_record(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
+    enum { PX = W * H };
+    setup_camera(0.0);
+    Emitter suns[2] = {directional(v3(0.45, -1.0, 0.2)), directional(v3(-0.3, -1.0, 0.35))};
+    set_lights(suns, 2);
+    upload_gbuffer();
+    HrtsContext *ctx = create_context(vk, 1);
+    HrtsTargets t = targets();
+    HrtsConfig cfgs[2] = {config(HRTS_SHADOW_MODE_HARD), config(HRTS_SHADOW_MODE_HYBRID)};
+    CHECK(hrts_configure_lights(ctx, 2, cfgs) == HRTS_RESULT_OK && hrts_set_geometry_cpu(ctx, g) == HRTS_RESULT_OK &&
+              hrts_set_targets(ctx, &t) == HRTS_RESULT_OK,
+          "partial record: setup: %s", hrts_last_error(ctx));
+    for (int i = 0; i < 2; i++) CHECK(run_frame(ctx, NULL) == HRTS_RESULT_OK, "partial record: frame: %s", hrts_last_error(ctx));
+    static float before[PX], after[PX], moved[PX];
+    CHECK(read_resource(ctx, 0, HRTS_RESOURCE_RT_VISIBILITY, before, sizeof before) == HRTS_RESULT_OK,
+          "partial record: read-back: %s", hrts_last_error(ctx));
+    setup_camera(0.5);
+    Buf depth = make_host_buffer(sizeof(float) * PX, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    Buf normal = make_host_buffer(sizeof(float) * 4 * PX, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    draw_gbuffer(depth.map, normal.map);
+    VkCommandBuffer cmd = begin();
+    record_gbuffer_upload(cmd, depth, normal, 0);
+    uint64_t index = next_frame++;
+    HrtsFrame f = frame(cmd, index);
+    uint32_t mask = 1u << HRTS_PASS_PRIM_BUFFER | 1u << HRTS_PASS_PRIMITIVE_MAP | 1u << HRTS_PASS_OCCUPANCY | 1u << HRTS_PASS_RAY_TRACE;
+    HrtsResult r = hrts_record_passes(ctx, &f, mask);
+    printf("partial record: the passes up to the ray trace without light 1's shadow map: %s (%s)\n", hrts_result_name(r), hrts_last_error(ctx));
+    CHECK(r == HRTS_RESULT_ERROR_INVALID_STATE && strstr(hrts_last_error(ctx), "light 1"),
+          "partial record: the call should fail for light 1: %s", hrts_result_name(r));
+    submit_and_wait(cmd);
+    free_buffer(depth);
+    free_buffer(normal);
+    CHECK(read_resource(ctx, 0, HRTS_RESOURCE_RT_VISIBILITY, after, sizeof after) == HRTS_RESULT_OK,
+          "partial record: read-back after the failed call: %s", hrts_last_error(ctx));
+    CHECK(run_frame(ctx, NULL) == HRTS_RESULT_OK, "partial record: the frame after: %s", hrts_last_error(ctx));
+    CHECK(read_resource(ctx, 0, HRTS_RESOURCE_RT_VISIBILITY, moved, sizeof moved) == HRTS_RESULT_OK,
+          "partial record: read-back of the moved view: %s", hrts_last_error(ctx));
+    int changed = differing(after, before, PX), view_changes = differing(moved, before, PX);
+    printf("partial record: light 0's visibility changed in %d px after the failed call (the moved view changes %d px)\n",
+           changed, view_changes);
+    CHECK(view_changes > 0, "partial record: the moved view changes nothing: the case was not tested");
+    CHECK(changed == 0, "partial record: the failed call recorded light 0's ray trace (%d px changed)", changed);
+    CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "partial record: destroy");
+    setup_camera(0.0);
+    upload_gbuffer();
 }
 
 /* ---------- misuse: a table of calls that must fail with a given result and a message ---------- */
@@ -1401,12 +1548,7 @@ static void frames_in_flight(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *
     /* the first frame waits on a timeline semaphore the host signals once IN_FLIGHT frames were submitted:
      * the frames after it are ordered after it (the plugin's barrier at each frame's start), so exactly
      * IN_FLIGHT frames are pending then, whatever the device's pace */
-    VkSemaphoreTypeCreateInfo sti = {.sType = VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
-    sti.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
-    VkSemaphoreCreateInfo sci = {.sType = VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-    sci.pNext = &sti;
-    VkSemaphore hold;
-    VK(vkCreateSemaphore(device, &sci, NULL, &hold));
+    VkSemaphore hold = held_semaphore();
     int errors_before = validation_errors, recorded = 0, max_pending = 0, held_pending = 0;
     for (int i = 0; i < MOVING_FRAMES + IN_FLIGHT; i++) {
         int s = i % IN_FLIGHT;
@@ -1433,20 +1575,7 @@ static void frames_in_flight(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *
         CHECK(r == HRTS_RESULT_OK, "in flight: frame %d: %s", i, hrts_last_error(ctx));
         record_output_readback(cmds[s], back[s], LIGHTS);
         if (i == 0) {
-            VK(vkEndCommandBuffer(cmds[s]));
-            uint64_t wait_value = 1;
-            VkTimelineSemaphoreSubmitInfo ts = {.sType = VK_STRUCTURE_TYPE_TIMELINE_SEMAPHORE_SUBMIT_INFO};
-            ts.waitSemaphoreValueCount = 1;
-            ts.pWaitSemaphoreValues = &wait_value;
-            VkPipelineStageFlags stage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
-            VkSubmitInfo si = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO};
-            si.pNext = &ts;
-            si.waitSemaphoreCount = 1;
-            si.pWaitSemaphores = &hold;
-            si.pWaitDstStageMask = &stage;
-            si.commandBufferCount = 1;
-            si.pCommandBuffers = &cmds[s];
-            VK(vkQueueSubmit(queue, 1, &si, fences[s]));
+            submit_held(cmds[s], hold, fences[s]);
         } else {
             submit(cmds[s], fences[s]);
         }
@@ -1457,10 +1586,7 @@ static void frames_in_flight(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *
         if (now > max_pending) max_pending = now;
         if (i == IN_FLIGHT - 1) {
             held_pending = now;
-            VkSemaphoreSignalInfo release = {.sType = VK_STRUCTURE_TYPE_SEMAPHORE_SIGNAL_INFO};
-            release.semaphore = hold;
-            release.value = 1;
-            VK(vkSignalSemaphore(device, &release));
+            release_held(hold);
         }
     }
     int in_flight_errors = validation_errors - errors_before;
@@ -1686,6 +1812,10 @@ int main(void) {
     native_local_lights(&vk, &g);
     phase = "frames in flight";
     frames_in_flight(&vk, &g);
+    phase = "read-back retire";
+    readback_retire(&vk, &g);
+    phase = "partial record";
+    partial_record(&vk, &g);
     phase = "create/destroy cycles";
     setup_camera(0.0);
     set_lights(&sun, 1);

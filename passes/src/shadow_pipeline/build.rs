@@ -1,0 +1,237 @@
+//! Creating a pipeline: the passes and resources its frame plan needs.
+
+use super::{FrameSlot, ShadowConfig, ShadowInputs, ShadowPipeline, MAX_FRAMES_IN_FLIGHT};
+use crate::frame_plan::{FramePlan, HardEdge, PassId, PenumbraFilter, ResourceId, ResourceSet};
+use crate::fxaa::FxaaPass;
+use crate::gpu_types::MapState;
+use crate::hybrid::{BlendPass, LerpFactorPass};
+use crate::pcss::{PcssInputs, PcssKind, PcssPass};
+use crate::prim_buffer::{Geometry, SharedGeometry};
+use crate::primitive_map::{choose_binning_path, BinningPath, PrimitiveMap, PrimitiveMapInputs};
+use crate::ray_trace::{RayTraceInputs, RayTracePass};
+use crate::retire::RetireQueue;
+use crate::screen_pass::visibility_image;
+use crate::shadow_map::ShadowMapPass;
+use crate::PassError;
+use rhi::{BufferUsage, Device, MemoryLocation};
+use std::sync::Arc;
+
+impl ShadowPipeline {
+    /// Creates the passes the plan of `config` needs over `geometry`, for the size of `inputs.depth`.
+    /// `config` may be a [`ShadowConfig`] or, for ray-traced hard shadows alone, a
+    /// [`PrimitiveMapConfig`].
+    pub fn new(
+        device: &Device,
+        geometry: Geometry,
+        inputs: &ShadowInputs<'_>,
+        config: impl Into<ShadowConfig>,
+    ) -> Result<Self, PassError> {
+        let config = config.into();
+        let shared = SharedGeometry::new(device, geometry, !config.static_geometry)?;
+        Self::with_shared_geometry(device, shared, inputs, config)
+    }
+
+    /// Creates the passes of one light over geometry that other lights' pipelines share: the prim buffer is
+    /// built by the first pipeline that begins a frame needing it, and `shared`'s dynamic flag (not
+    /// `config.static_geometry`) decides whether it is rebuilt every frame. Begin and record the lights'
+    /// frames in the same order, frame after frame.
+    pub fn with_shared_geometry(
+        device: &Device,
+        shared: Arc<SharedGeometry>,
+        inputs: &ShadowInputs<'_>,
+        config: impl Into<ShadowConfig>,
+    ) -> Result<Self, PassError> {
+        let config = config.into();
+        if !(1..=MAX_FRAMES_IN_FLIGHT).contains(&config.frames_in_flight) {
+            return Err(PassError::InvalidConfig(format!(
+                "frames_in_flight {} must be within 1..={MAX_FRAMES_IN_FLIGHT}",
+                config.frames_in_flight
+            )));
+        }
+        let geometry = shared.geometry();
+        let (width, height) = (inputs.depth.width(), inputs.depth.height());
+        if (inputs.normal.width(), inputs.normal.height()) != (width, height) {
+            return Err(PassError::InvalidConfig(
+                "depth and normal images differ in size".into(),
+            ));
+        }
+        let caps = device.capabilities();
+        config.map.validate(caps)?;
+        config.shadow_map.validate(caps)?;
+        config.pcss.validate()?;
+        config.hybrid.validate()?;
+        let plan = FramePlan::derive(config.plan_request());
+        let runs = |p| plan.runs(p);
+
+        let prims = runs(PassId::PrimBuffer).then(|| shared.prims());
+        let need_prims = || {
+            prims.ok_or_else(|| PassError::InvalidConfig("the plan lacks the prim buffer".into()))
+        };
+        let shadow_map = if runs(PassId::ShadowMap) {
+            Some(ShadowMapPass::new(
+                device,
+                need_prims()?,
+                config.shadow_map.size,
+            )?)
+        } else {
+            None
+        };
+        let map = if runs(PassId::PrimitiveMap) {
+            let map_inputs = PrimitiveMapInputs {
+                prims: need_prims()?,
+                triangles: geometry.triangle_count(),
+                depth: inputs.depth,
+                normal: inputs.normal,
+                occupancy_view: plan.resources().contains(ResourceId::Occupancy),
+            };
+            Some(PrimitiveMap::new(device, &map_inputs, config.map)?)
+        } else {
+            None
+        };
+        let binning_path = match &map {
+            Some(m) => m.path(),
+            None => choose_binning_path(caps, config.map.binning).unwrap_or(BinningPath::Compute),
+        };
+        let ray = match (&map, runs(PassId::RayTrace)) {
+            (Some(m), true) => Some(RayTracePass::new(
+                device,
+                &RayTraceInputs {
+                    depth: inputs.depth,
+                    normal: inputs.normal,
+                    map: m,
+                    prims: need_prims()?,
+                },
+                width,
+                height,
+            )?),
+            _ => None,
+        };
+        let pcss_pass = |kind| -> Result<Option<PcssPass>, PassError> {
+            let Some(sm) = &shadow_map else {
+                return Ok(None);
+            };
+            let pcss_inputs = PcssInputs {
+                depth: inputs.depth,
+                normal: inputs.normal,
+                shadow_map: &sm.depth,
+                rt_visibility: ray.as_ref().map(|r| &r.visibility),
+            };
+            PcssPass::new(
+                device,
+                &pcss_inputs,
+                kind,
+                config.pcss.filter,
+                width,
+                height,
+            )
+            .map(Some)
+        };
+        let shadow_map_test = if runs(PassId::ShadowMapTest) {
+            pcss_pass(PcssKind::ClassicTest)?
+        } else {
+            None
+        };
+        let edge = match (config.pcss.filter, plan.hard_edge()) {
+            (PenumbraFilter::Shrinking, HardEdge::RayTrace) => HardEdge::RayTrace,
+            _ => HardEdge::ShadowMap,
+        };
+        let pcss = if runs(PassId::Pcss) {
+            pcss_pass(PcssKind::Pcss(edge))?
+        } else {
+            None
+        };
+        let fxaa = match (&ray, runs(PassId::Fxaa)) {
+            (Some(r), true) => Some(FxaaPass::new(device, &r.visibility)?),
+            _ => None,
+        };
+        let lerp = match (&ray, runs(PassId::LerpFactor)) {
+            (Some(r), true) => Some(LerpFactorPass::new(device, &r.blocker_distance)?),
+            _ => None,
+        };
+        let blend = if runs(PassId::Blend) {
+            let rts = if config.antialiasing {
+                fxaa.as_ref().map(|f| &f.output)
+            } else {
+                ray.as_ref().map(|r| &r.visibility)
+            };
+            match (rts, &pcss, &lerp) {
+                (Some(rts), Some(p), Some(l)) => {
+                    Some(BlendPass::new(device, rts, &p.output, &l.output)?)
+                }
+                _ => None,
+            }
+        } else {
+            None
+        };
+        let lit = if runs(PassId::FillLit) {
+            Some(visibility_image(device, "lit", width, height)?)
+        } else {
+            None
+        };
+        let slots = (0..config.frames_in_flight)
+            .map(|_| {
+                Ok(FrameSlot {
+                    frame: None,
+                    timer: device.create_timer(48)?,
+                    stats_readback: device.create_buffer(
+                        "map state read-back",
+                        std::mem::size_of::<MapState>() as u64,
+                        BufferUsage::COPY_DST,
+                        MemoryLocation::GpuToCpu,
+                    )?,
+                    map_state_recorded: false,
+                    statuses: Vec::new(),
+                    completion: {
+                        let mut b = device.create_buffer(
+                            "frame completion",
+                            8,
+                            BufferUsage::COPY_DST,
+                            MemoryLocation::GpuToCpu,
+                        )?;
+                        b.write(0, &0u64.to_le_bytes())?;
+                        b
+                    },
+                })
+            })
+            .collect::<Result<Vec<_>, PassError>>()?;
+        let pipeline = Self {
+            config,
+            plan,
+            shared,
+            shadow_map,
+            map,
+            ray,
+            shadow_map_test,
+            pcss,
+            fxaa,
+            lerp,
+            blend,
+            lit,
+            slots,
+            binning_path,
+            valid: ResourceSet::EMPTY,
+            maps_light: None,
+            frame: None,
+            last_frame: None,
+            needed_entries: 0,
+            retired: RetireQueue::default(),
+            pending_uav: None,
+            statuses: Vec::new(),
+            width,
+            height,
+        };
+        // Every resource of the plan exists (a missing one would be a bug in the wiring above).
+        if let Some(r) = pipeline
+            .plan
+            .resources()
+            .iter()
+            .find(|&r| pipeline.resource_bytes(r).is_none())
+        {
+            return Err(PassError::InvalidConfig(format!(
+                "the plan needs {} but it was not created",
+                r.name()
+            )));
+        }
+        Ok(pipeline)
+    }
+}

@@ -1,0 +1,109 @@
+//! What a pipeline is asked to compute ([`ShadowConfig`]), for which camera and light ([`FrameInputs`]),
+//! from which engine images ([`ShadowInputs`]).
+
+use crate::frame_plan::{PlanRequest, ResourceSet, ShadowMode};
+use crate::hybrid::HybridConfig;
+use crate::light::Light;
+use crate::pcss::PcssConfig;
+use crate::primitive_map::PrimitiveMapConfig;
+use crate::shadow_map::ShadowMapConfig;
+use glam::{Mat4, Vec3};
+use rhi::Image;
+
+/// Camera and light of one frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameInputs {
+    /// World to view.
+    pub view: Mat4,
+    /// View to clip: reversed Z (depth 1 at the near plane, 0 at infinity), Vulkan conventions.
+    pub proj: Mat4,
+    /// Camera position in world space.
+    pub camera_position: Vec3,
+    /// The light.
+    pub light: Light,
+}
+
+/// What the pipeline computes and how: the requested outputs (per light: none, hard, soft or hybrid;
+/// antialiasing), what may be cached across frames, and the settings of each technique.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadowConfig {
+    /// The light's shadow mode (default hybrid).
+    pub mode: ShadowMode,
+    /// FXAA over the ray-traced visibility (default on; no effect without a ray-traced shadow).
+    pub antialiasing: bool,
+    /// The vertex and index buffers do not change between frames: the prim buffer is built once
+    /// (default true). When false it is rebuilt every frame, and everything downstream with it.
+    pub static_geometry: bool,
+    /// The light does not move: with static geometry, the shadow map and the primitive map are kept from
+    /// the frame that built them for as long as the frame's light equals that frame's (default false).
+    pub static_light: bool,
+    /// The deep primitive map.
+    pub map: PrimitiveMapConfig,
+    /// The shadow map.
+    pub shadow_map: ShadowMapConfig,
+    /// PCSS.
+    pub pcss: PcssConfig,
+    /// The hybrid blend.
+    pub hybrid: HybridConfig,
+    /// Resources to produce besides the final output (comparison views, debug images, a host G-buffer
+    /// drawing the prim buffer). Empty by default.
+    pub extra_outputs: ResourceSet,
+    /// The most frames recorded and not yet completed on the GPU (1..=[`MAX_FRAMES_IN_FLIGHT`], default 3):
+    /// when frame `f` is begun, every frame up to `f - frames_in_flight` has completed. Per-frame
+    /// read-backs and timers are ring-buffered this deep, and replaced GPU objects are held as long.
+    pub frames_in_flight: u32,
+}
+
+/// The most frames in flight a pipeline supports.
+pub const MAX_FRAMES_IN_FLIGHT: u32 = 8;
+
+impl Default for ShadowConfig {
+    /// The talk's full technique: hybrid with FXAA, 1K×1K×32 primitive map, 3K shadow map, shrinking PCSS.
+    fn default() -> Self {
+        Self {
+            mode: ShadowMode::Hybrid,
+            antialiasing: true,
+            static_geometry: true,
+            static_light: false,
+            map: PrimitiveMapConfig::default(),
+            shadow_map: ShadowMapConfig::default(),
+            pcss: PcssConfig::default(),
+            hybrid: HybridConfig::default(),
+            extra_outputs: ResourceSet::EMPTY,
+            frames_in_flight: 3,
+        }
+    }
+}
+
+impl From<PrimitiveMapConfig> for ShadowConfig {
+    /// A primitive-map configuration alone asks for ray-traced hard shadows without antialiasing: the
+    /// output is the exact ray-traced visibility.
+    fn from(map: PrimitiveMapConfig) -> Self {
+        Self {
+            mode: ShadowMode::Hard,
+            antialiasing: false,
+            map,
+            ..Self::default()
+        }
+    }
+}
+
+impl ShadowConfig {
+    /// The frame-plan request of this configuration.
+    pub fn plan_request(&self) -> PlanRequest {
+        PlanRequest {
+            mode: self.mode,
+            antialiasing: self.antialiasing,
+            filter: self.pcss.filter,
+            extra_outputs: self.extra_outputs,
+        }
+    }
+}
+
+/// The engine's images the pipeline reads, bound at creation.
+pub struct ShadowInputs<'a> {
+    /// Reversed-Z depth (`D32_SFLOAT`, sampled), `ShaderResource` state when the passes run.
+    pub depth: &'a Image,
+    /// World-space geometric normal facing the camera (xyz), w = 0 on background, `ShaderResource` state.
+    pub normal: &'a Image,
+}
