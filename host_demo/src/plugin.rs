@@ -86,8 +86,14 @@ pub struct LightFrameReport {
     /// How many times the plugin built the light's passes since the context was created
     /// (`HrtsFrameReport::light_builds`).
     pub light_builds: u32,
-    /// Frusta the plugin shadowed the light through (`HrtsFrameReport::frusta`: 6 for a point light).
+    /// Frusta the plugin shadowed the light through this frame (`HrtsFrameReport::frusta`: up to 6 for a
+    /// point light).
     pub frusta: u32,
+    /// Frusta of the light the plugin skipped this frame, holding no receiver in view within range
+    /// (`HrtsFrameReport::frusta_culled`).
+    pub frusta_culled: u32,
+    /// The plugin's decision for the light, in words (`HrtsFrameReport::decision_reason`).
+    pub decision: String,
     /// GPU milliseconds of all of the light's passes (`HrtsFrameReport::gpu_milliseconds`).
     pub gpu_ms: f64,
 }
@@ -420,6 +426,9 @@ impl PluginRenderer {
                     s if s == HrtsPassStatus::Shared as u32 => {
                         PassStatus::Skipped(SkipReason::Shared)
                     }
+                    s if s == HrtsPassStatus::Culled as u32 => {
+                        PassStatus::Skipped(SkipReason::Culled)
+                    }
                     _ => PassStatus::Skipped(SkipReason::NotRequested),
                 };
                 (p, status)
@@ -467,6 +476,11 @@ impl PluginRenderer {
             report,
             light_builds: r.light_builds,
             frusta: r.frusta,
+            frusta_culled: r.frusta_culled,
+            // SAFETY: the plugin NUL-terminates the reason within the array.
+            decision: unsafe { CStr::from_ptr(r.decision_reason.as_ptr()) }
+                .to_string_lossy()
+                .into_owned(),
             gpu_ms: r.gpu_milliseconds,
         })
     }

@@ -94,13 +94,14 @@ impl SceneRenderer {
     }
 }
 
-/// The C name of a pass status in the report: `RAN`, `UP_TO_DATE`, `SHARED` or `NOT_IN_PLAN`.
+/// The C name of a pass status in the report: `RAN`, `UP_TO_DATE`, `SHARED`, `NOT_IN_PLAN` or `CULLED`.
 pub fn status_name(status: PassStatus) -> &'static str {
     match status {
         PassStatus::Ran => "RAN",
         PassStatus::Skipped(SkipReason::UpToDate) => "UP_TO_DATE",
         PassStatus::Skipped(SkipReason::Shared) => "SHARED",
         PassStatus::Skipped(SkipReason::NotRequested) => "NOT_IN_PLAN",
+        PassStatus::Skipped(SkipReason::Culled) => "CULLED",
     }
 }
 
@@ -111,6 +112,9 @@ fn light_space_reason(
     static_light: bool,
     dynamic_geometry: bool,
 ) -> String {
+    if report.frusta == 0 {
+        return format!("nothing recorded: {}", report.decision);
+    }
     if built_now {
         return format!(
             "passes built this frame (build {}): everything in the plan ran",
@@ -133,7 +137,11 @@ fn light_space_reason(
         }
         _ => "no shadow map in the plan",
     };
-    format!("{prims}; {shadow_map}; the primitive map is refitted to the view every frame")
+    let culled = match report.frusta_culled {
+        0 => String::new(),
+        _ => format!("; {}", report.decision),
+    };
+    format!("{prims}; {shadow_map}; the primitive map is refitted to the view every frame{culled}")
 }
 
 /// `bytes` in KiB or MiB.
@@ -187,7 +195,7 @@ pub fn describe_frame(
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "frame {}: per light (pass statuses RAN / UP_TO_DATE / SHARED / NOT_IN_PLAN)",
+        "frame {}: per light (pass statuses RAN / UP_TO_DATE / SHARED / NOT_IN_PLAN / CULLED)",
         frame.frame_index
     );
     let plugin_lights = plan.plugin_lights();
@@ -247,7 +255,7 @@ pub fn describe_frame(
             }
             // The output copy (a pass of the C ABI only) ends every frame of a light.
             by_status.entry("RAN").or_default().push("output copy");
-            for name in ["RAN", "UP_TO_DATE", "SHARED", "NOT_IN_PLAN"] {
+            for name in ["RAN", "UP_TO_DATE", "SHARED", "NOT_IN_PLAN", "CULLED"] {
                 if let Some(passes) = by_status.get(name) {
                     let _ = writeln!(s, "      {name:<11} {}", passes.join(", "));
                 }
@@ -530,6 +538,10 @@ mod tests {
         assert_eq!(
             status_name(PassStatus::Skipped(SkipReason::NotRequested)),
             "NOT_IN_PLAN"
+        );
+        assert_eq!(
+            status_name(PassStatus::Skipped(SkipReason::Culled)),
+            "CULLED"
         );
     }
 }

@@ -443,6 +443,9 @@ pub enum SkipReason {
     UpToDate,
     /// Shared with other lights' pipelines (the prim buffer), and built this frame by another of them.
     Shared,
+    /// The frustum holds no receiver in view within the light's range this frame: nothing of it is
+    /// recorded (a host that culls frusta, as the plugin does with [`crate::ViewVolume`], reports it).
+    Culled,
 }
 
 impl SkipReason {
@@ -452,6 +455,7 @@ impl SkipReason {
             Self::NotRequested => "culled: no requested output depends on it",
             Self::UpToDate => "inputs unchanged since it last ran: earlier output reused",
             Self::Shared => "shared by the lights: built this frame by another light's passes",
+            Self::Culled => "the frustum holds no receiver in view within the light's range",
         }
     }
 }

@@ -21,6 +21,7 @@ pub mod scan;
 mod screen_pass;
 pub mod shadow_map;
 pub mod shadow_pipeline;
+pub mod view_cull;
 
 pub use error::PassError;
 pub use frame_plan::{
@@ -42,6 +43,7 @@ pub use shadow_pipeline::{
     camera_in_frame, FrameInputs, FrameReport, ResourceReport, ShadowConfig, ShadowInputs,
     ShadowPipeline, MAX_FRAMES_IN_FLIGHT,
 };
+pub use view_cull::ViewVolume;
 
 mod shaders {
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));

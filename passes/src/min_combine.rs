@@ -47,20 +47,38 @@ impl MinCombine {
         self.output.byte_size()
     }
 
-    /// Records the minimum over the frusta's outputs (in `UnorderedAccess` state); the output's former
-    /// contents are discarded and it is left in `UnorderedAccess` state.
-    pub fn record(&self, enc: &mut Encoder<'_>) -> Result<(), PassError> {
+    /// Records the minimum over the outputs of the frusta marked in `recorded` (in `UnorderedAccess`
+    /// state; the others were not recorded this frame and count as lit everywhere), or 1 if none is. The
+    /// output's former contents are discarded and it is left in `UnorderedAccess` state.
+    pub fn record(&self, enc: &mut Encoder<'_>, recorded: &[bool]) -> Result<(), PassError> {
+        if recorded.len() != self.steps.len() {
+            return Err(PassError::InvalidConfig(format!(
+                "{} frusta flagged for a light of {}",
+                recorded.len(),
+                self.steps.len()
+            )));
+        }
         let (width, height) = (self.output.width(), self.output.height());
         enc.barriers(&[Barrier::Image {
             image: &self.output,
             before: S::Undefined,
             after: S::UnorderedAccess,
         }]);
-        for (i, step) in self.steps.iter().enumerate() {
-            let push: [u32; 3] = [width, height, u32::from(i > 0)];
+        let mut folded = 0;
+        for (step, _) in self.steps.iter().zip(recorded).filter(|(_, &r)| r) {
+            let push: [u32; 3] = [width, height, u32::from(folded > 0)];
             step.record(enc, bytemuck::bytes_of(&push), width, height)?;
+            enc.barriers(&[Barrier::Uav]);
+            folded += 1;
+        }
+        if folded == 0 {
+            let push: [u32; 3] = [width, height, MODE_LIT];
+            self.steps[0].record(enc, bytemuck::bytes_of(&push), width, height)?;
             enc.barriers(&[Barrier::Uav]);
         }
         Ok(())
     }
 }
+
+/// Push-constant mode of `min_combine.comp` that writes 1 (no frustum recorded).
+const MODE_LIT: u32 = 2;

@@ -9,7 +9,7 @@
 
 // Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 // version differs.
-#define HRTS_API_VERSION (4 << 22)
+#define HRTS_API_VERSION (5 << 22)
 
 // The most lights one context shades (`hrts_configure_lights`); a point light counts once.
 #define HRTS_MAX_LIGHTS 64
@@ -252,12 +252,37 @@ enum HrtsPassStatus
   HRTS_PASS_STATUS_UP_TO_DATE = 2,
   // Shared by the context's lights (the prim buffer) and recorded this frame by an earlier light.
   HRTS_PASS_STATUS_SHARED = 3,
+  // Not recorded: no frustum of the light holds a receiver in view within its range this frame (see
+  // `HrtsLightDecision`).
+  HRTS_PASS_STATUS_CULLED = 4,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
 typedef enum HrtsPassStatus HrtsPassStatus;
 #else
 typedef uint32_t HrtsPassStatus;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+// What the plugin decided for a light in a frame (`HrtsFrameReport::decision`), from the camera, the
+// geometry's bounds (CPU geometry, or static Vulkan geometry) and the light's frusta and range.
+enum HrtsLightDecision
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  // Shadowed through the frusta that may hold a receiver in view within the light's range (all, or
+  // some of a point light's or wide spot light's faces: `frusta_culled` says how many were skipped).
+  HRTS_LIGHT_DECISION_SHADOWED = 0,
+  // No frustum of the light may hold a receiver in view within its range: no pass ran and its output
+  // layer is 1.
+  HRTS_LIGHT_DECISION_OUT_OF_VIEW = 1,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum HrtsLightDecision HrtsLightDecision;
+#else
+typedef uint32_t HrtsLightDecision;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
@@ -589,7 +614,10 @@ typedef struct HrtsLight {
   // frustum has its near plane at `range / 1024` (0.01 without a range) and its far plane at infinity.
   float view_proj[16];
   // Spot and point lights: distance beyond which the light has no effect, or 0 for unlimited. It sets
-  // the near plane of the frusta the plugin fits; shadows stay exact at every distance.
+  // the near plane of the frusta the plugin fits. A frustum holding no receiver in view within the
+  // range is not recorded, and a pixel it alone would shade is lit (1): beyond the range the
+  // visibility may be 1 where geometry blocks the light, since the light does not reach there.
+  // Within the range shadows are exact.
   float range;
   // Spot lights whose frusta the plugin fits: half-angle of the cone in radians, in (0, π/2]. Up to
   // π/3 one frustum covers it; wider cones use the five cube faces around the axis. Ignored otherwise.
@@ -712,10 +740,17 @@ typedef struct HrtsFrameReport {
   // How many times this light's passes were built since the context was created: a configuration,
   // geometry or targets call that changed nothing of this light leaves it as it was.
   uint32_t light_builds;
-  // Frusta the light is shadowed through: 1, or the cube faces of a point light (6) or of a wide spot
-  // light (5). Statistics, pass times and memory above are summed over them (the longest list is the
-  // longest of any; `map_to_texels` is the first frustum's).
+  // Frusta the light was shadowed through this frame: those of its frusta (1, or the cube faces of a
+  // point light (6) or of a wide spot light (5)) that may hold a receiver in view within its range.
+  // Statistics and pass times above are summed over them, memory over every frustum (the longest
+  // list is the longest of any; `map_to_texels` is the first recorded frustum's).
   uint32_t frusta;
+  // Frusta of the light skipped this frame: they hold no receiver in view within its range.
+  uint32_t frusta_culled;
+  // `HrtsLightDecision` of the light this frame.
+  uint32_t decision;
+  // Why, in words (NUL-terminated, truncated to fit): the frusta recorded and those culled, by name.
+  char decision_reason[128];
   // GPU milliseconds of all of this light's passes in the frame (every frustum, the minimum over
   // them, and the light's share of nothing else).
   double gpu_milliseconds;

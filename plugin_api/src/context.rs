@@ -2,15 +2,16 @@
 //! them, and what reconfiguration retired while frames in flight may still use it.
 
 use crate::convert::{
-    binning_path_to_c, require_usage, resource_id, resource_index, shadow_config, RESOURCES,
+    binning_path_to_c, require_usage, resource_id, resource_index, shadow_config, FrameLight,
+    RESOURCES,
 };
 use crate::error::{check_size, invalid, ApiError, ApiResult};
 use crate::geometry::{cpu_geometry, geometry_from, vulkan_geometry, GeometrySource};
 use crate::types::*;
 use passes::retire::{completed_before, RetireQueue};
 use passes::{
-    BinningRequest, FrameInputs, FrameReport, MinCombine, PassStatus, ResourceId, ShadowConfig,
-    ShadowInputs, ShadowPipeline, SharedGeometry, SkipReason,
+    BinningRequest, FrameReport, MinCombine, PassStatus, ResourceId, ShadowConfig, ShadowInputs,
+    ShadowPipeline, SharedGeometry, SkipReason, ViewVolume,
 };
 use rhi::{Device, Format, Image, ImageDesc, ImageUsage};
 use std::sync::Arc;
@@ -68,13 +69,42 @@ pub(crate) struct Built {
 }
 
 impl Built {
-    /// Every built pipeline, one per frustum, with the index of its light.
-    pub(crate) fn pipelines(&self) -> impl Iterator<Item = (usize, &ShadowPipeline)> {
+    /// The built pipelines of the frusta `recorded[light][frustum]` marks, with the index of their light.
+    pub(crate) fn scheduled<'a>(
+        &'a self,
+        recorded: &'a [Vec<bool>],
+    ) -> impl Iterator<Item = (usize, &'a ShadowPipeline)> {
         self.lights
             .iter()
+            .zip(recorded)
             .enumerate()
-            .filter_map(|(i, l)| l.as_ref().map(|l| (i, l)))
-            .flat_map(|(i, l)| l.frusta.iter().map(move |p| (i, p)))
+            .filter_map(|(i, (l, r))| l.as_ref().map(|l| (i, l, r)))
+            .flat_map(|(i, l, r)| {
+                l.frusta
+                    .iter()
+                    .zip(r)
+                    .filter(|(_, &on)| on)
+                    .map(move |(p, _)| (i, p))
+            })
+    }
+
+    /// [`Built::scheduled`], mutable.
+    pub(crate) fn scheduled_mut<'a>(
+        &'a mut self,
+        recorded: &'a [Vec<bool>],
+    ) -> impl Iterator<Item = (usize, &'a mut ShadowPipeline)> {
+        self.lights
+            .iter_mut()
+            .zip(recorded)
+            .enumerate()
+            .filter_map(|(i, (l, r))| l.as_mut().map(|l| (i, l, r)))
+            .flat_map(|(i, l, r)| {
+                l.frusta
+                    .iter_mut()
+                    .zip(r)
+                    .filter(|(_, &on)| on)
+                    .map(move |(p, _)| (i, p))
+            })
     }
 
     /// The passes of `light`, once built.
@@ -111,8 +141,62 @@ pub(crate) struct FrameProgress {
 /// A frame recorded pass by pass and not finished yet.
 pub(crate) struct OpenFrame {
     pub(crate) index: u64,
-    pub(crate) inputs: Vec<Vec<FrameInputs>>,
+    pub(crate) inputs: Vec<FrameLight>,
     pub(crate) last_pass: u32,
+}
+
+/// Which frusta of each light a frame recorded: those that may hold a receiver in view within the light's
+/// range ([`passes::ViewVolume`]).
+pub(crate) struct FrameSchedule {
+    pub(crate) index: u64,
+    pub(crate) lights: Vec<LightSchedule>,
+}
+
+/// One light's frusta in a frame: recorded or culled, with their names for the report.
+pub(crate) struct LightSchedule {
+    pub(crate) kind: HrtsLightType,
+    pub(crate) recorded: Vec<bool>,
+    pub(crate) names: Vec<&'static str>,
+}
+
+impl LightSchedule {
+    /// The light's decision and its reason in words.
+    pub(crate) fn decision(&self) -> (HrtsLightDecision, String) {
+        let kind = match self.kind {
+            HrtsLightType::Directional => "directional light",
+            HrtsLightType::Spot => "spot light",
+            HrtsLightType::Point => "point light",
+        };
+        let recorded = self.recorded.iter().filter(|&&r| r).count();
+        let culled: Vec<&str> = self
+            .names
+            .iter()
+            .zip(&self.recorded)
+            .filter(|(_, &r)| !r)
+            .map(|(&n, _)| n)
+            .collect();
+        match (recorded, self.recorded.len()) {
+            (0, _) => (
+                HrtsLightDecision::OutOfView,
+                format!("{kind}: no frustum holds a receiver in view within range; lit"),
+            ),
+            (_, 1) => (
+                HrtsLightDecision::Shadowed,
+                format!("{kind}: its frustum holds receivers in view"),
+            ),
+            (_, n) if culled.is_empty() => (
+                HrtsLightDecision::Shadowed,
+                format!("{kind}: all {n} frusta hold receivers in view within range"),
+            ),
+            (r, n) => (
+                HrtsLightDecision::Shadowed,
+                format!(
+                    "{kind}: {r} of {n} frusta hold receivers in view within range; culled {}",
+                    culled.join(" ")
+                ),
+            ),
+        }
+    }
 }
 
 /// State of one plugin context.
@@ -135,6 +219,8 @@ pub(crate) struct Context {
     pub(crate) light_builds: Vec<u32>,
     /// How many frusta each light was last given (its passes hold one pipeline per frustum).
     pub(crate) frusta: Vec<usize>,
+    /// Which frusta the last `frames_in_flight` frames recorded, oldest first.
+    pub(crate) schedules: std::collections::VecDeque<FrameSchedule>,
     /// The message of the last call if it failed.
     pub(crate) last_error: Option<std::ffi::CString>,
 }
@@ -178,6 +264,7 @@ impl Context {
             readback_frame: None,
             light_builds: vec![0],
             frusta: vec![1],
+            schedules: Default::default(),
             last_error: None,
         })
     }
@@ -256,6 +343,42 @@ impl Context {
 
     /// Takes each light's number of frusta this frame: a light whose number changed (a spot light turned
     /// point light, say) has its passes rebuilt.
+    /// Which frusta of each light may hold a receiver in view within the light's range this frame.
+    pub(crate) fn schedule(&self, lights: &[FrameLight]) -> Vec<LightSchedule> {
+        let dynamic = self.lights.iter().any(|c| !c.static_geometry);
+        let bounds = self.geometry.as_ref().and_then(|g| g.cull_bounds(dynamic));
+        let camera = lights
+            .first()
+            .and_then(|l| l.frusta.first())
+            .map(|f| ViewVolume::new(f.proj.as_dmat4() * f.view.as_dmat4(), bounds));
+        lights
+            .iter()
+            .map(|light| LightSchedule {
+                kind: light.kind,
+                recorded: light
+                    .frusta
+                    .iter()
+                    .map(|f| {
+                        camera
+                            .as_ref()
+                            .is_none_or(|c| c.meets(&f.light, light.range))
+                    })
+                    .collect(),
+                names: (0..light.frusta.len())
+                    .map(|k| light.frustum_name(k))
+                    .collect(),
+            })
+            .collect()
+    }
+
+    /// Keeps the schedule of frame `index` for its reports, with those of the frames in flight before it.
+    pub(crate) fn keep_schedule(&mut self, index: u64, lights: Vec<LightSchedule>) {
+        while self.schedules.len() >= self.frames_in_flight as usize {
+            self.schedules.pop_front();
+        }
+        self.schedules.push_back(FrameSchedule { index, lights });
+    }
+
     pub(crate) fn set_frusta(&mut self, frusta: &[usize]) {
         let mut replaced = Vec::new();
         for (i, (&new, old)) in frusta.iter().zip(&mut self.frusta).enumerate() {
@@ -525,10 +648,24 @@ impl Context {
             )
         })?;
         let passes = built.light(light)?;
+        let schedule = self
+            .schedules
+            .iter()
+            .find(|s| s.index == frame_index)
+            .and_then(|s| s.lights.get(light as usize))
+            .filter(|s| s.recorded.len() == passes.frusta.len())
+            .ok_or_else(|| {
+                invalid(format!(
+                    "frame {frame_index} is not among the last {} frames recorded with light {light}'s passes as they are",
+                    self.frames_in_flight
+                ))
+            })?;
         let reports = passes
             .frusta
             .iter()
-            .map(|p| {
+            .zip(&schedule.recorded)
+            .filter(|(_, &r)| r)
+            .map(|(p, _)| {
                 p.try_report_frame(frame_index)
                     .map_err(|e| ApiError::new(HrtsResult::ErrorInvalidArgument, e.to_string()))?
                     .ok_or_else(|| {
@@ -539,9 +676,9 @@ impl Context {
                     })
             })
             .collect::<ApiResult<Vec<FrameReport>>>()?;
-        let first = &reports[0];
-        out.binning_path = binning_path_to_c(first.binning_path) as u32;
-        out.tier = first.binning_path.tier() as u32;
+        let first_pipeline = &passes.frusta[0];
+        out.binning_path = binning_path_to_c(first_pipeline.binning_path()) as u32;
+        out.tier = first_pipeline.binning_path().tier() as u32;
         let sum = |f: fn(&FrameReport) -> u32| {
             reports.iter().map(f).fold(0u32, |a, b| a.saturating_add(b))
         };
@@ -557,7 +694,9 @@ impl Context {
         out.receiver_pixels = sum(|r| r.stats.receiver_pixels);
         out.receiver_texels = sum(|r| r.stats.receiver_texels);
         out.triangles_binned = sum(|r| r.stats.triangles_binned);
-        out.map_to_texels = first.map_to_texels.to_cols_array();
+        out.map_to_texels = reports
+            .first()
+            .map_or([0.0; 16], |r| r.map_to_texels.to_cols_array());
         let timings: Vec<_> = reports.iter().flat_map(|r| &r.timings).collect();
         out.pass_count = timings.len().min(HRTS_MAX_REPORTED_PASSES) as u32;
         for (slot, t) in out.passes.iter_mut().zip(&timings) {
@@ -567,37 +706,49 @@ impl Context {
             }
             slot.milliseconds = t.ms;
         }
-        out.gpu_milliseconds = timings.iter().map(|t| t.ms).sum();
+        out.gpu_milliseconds = timings.iter().fold(0.0, |sum, t| sum + t.ms);
         out.pass_status = [HrtsPassStatus::NotInPlan as u32; HRTS_PASS_COUNT];
-        for (i, &(_, status)) in first.passes.iter().enumerate() {
-            let ran = reports.iter().any(|r| r.passes[i].1 == PassStatus::Ran);
-            out.pass_status[i] = match status {
-                _ if ran => HrtsPassStatus::Ran,
-                PassStatus::Ran => HrtsPassStatus::Ran,
-                PassStatus::Skipped(SkipReason::UpToDate) => HrtsPassStatus::UpToDate,
-                PassStatus::Skipped(SkipReason::NotRequested) => HrtsPassStatus::NotInPlan,
-                PassStatus::Skipped(SkipReason::Shared) => HrtsPassStatus::Shared,
+        let planned = first_pipeline.plan();
+        for (i, &pass) in passes::PassId::ALL.iter().enumerate() {
+            let statuses: Vec<PassStatus> = reports.iter().map(|r| r.passes[i].1).collect();
+            out.pass_status[i] = match statuses.first() {
+                _ if statuses.contains(&PassStatus::Ran) => HrtsPassStatus::Ran,
+                None if planned.runs(pass) => HrtsPassStatus::Culled,
+                None => HrtsPassStatus::NotInPlan,
+                Some(PassStatus::Ran) => HrtsPassStatus::Ran,
+                Some(PassStatus::Skipped(SkipReason::UpToDate)) => HrtsPassStatus::UpToDate,
+                Some(PassStatus::Skipped(SkipReason::NotRequested)) => HrtsPassStatus::NotInPlan,
+                Some(PassStatus::Skipped(SkipReason::Shared)) => HrtsPassStatus::Shared,
+                Some(PassStatus::Skipped(SkipReason::Culled)) => HrtsPassStatus::Culled,
             } as u32;
         }
         out.pass_status[HrtsPass::OutputCopy as usize] = HrtsPassStatus::Ran as u32;
         out.resource_bytes = [0; HRTS_RESOURCE_COUNT];
         out.prim_buffer_bytes = 0;
-        for r in reports.iter().flat_map(|r| &r.resources) {
+        for r in passes.frusta.iter().flat_map(|p| p.resources()) {
             if let Some(i) = RESOURCES.iter().position(|&id| id == r.resource) {
                 out.resource_bytes[i] += r.bytes;
             } else if r.resource == ResourceId::PrimBuffer {
                 out.prim_buffer_bytes = r.bytes;
             }
         }
+        let output = planned.final_output();
         if let (Some(combine), Some(i)) = (
             &passes.combine,
-            RESOURCES.iter().position(|&id| id == first.output),
+            RESOURCES.iter().position(|&id| id == output),
         ) {
             out.resource_bytes[i] += combine.bytes();
         }
-        out.output_resource = resource_index(first.output)?;
+        out.output_resource = resource_index(output)?;
         out.light_builds = self.light_builds.get(light as usize).copied().unwrap_or(0);
         out.frusta = reports.len() as u32;
+        out.frusta_culled = (schedule.recorded.len() - reports.len()) as u32;
+        let (decision, reason) = schedule.decision();
+        out.decision = decision as u32;
+        out.decision_reason = [0; 128];
+        for (dst, src) in out.decision_reason.iter_mut().zip(reason.bytes().take(127)) {
+            *dst = src as std::ffi::c_char;
+        }
         Ok(())
     }
 

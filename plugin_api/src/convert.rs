@@ -105,7 +105,7 @@ pub(crate) fn resource_index(id: ResourceId) -> ApiResult<u32> {
 
 /// The camera and each light of a frame (every field checked): per light, one `FrameInputs` per frustum
 /// it is shadowed through.
-pub(crate) fn frame_inputs(f: &HrtsFrame) -> ApiResult<Vec<Vec<FrameInputs>>> {
+pub(crate) fn frame_inputs(f: &HrtsFrame) -> ApiResult<Vec<FrameLight>> {
     finite(&f.view, "view")?;
     finite(&f.proj, "proj")?;
     finite(&f.camera_position, "camera_position")?;
@@ -127,22 +127,53 @@ pub(crate) fn frame_inputs(f: &HrtsFrame) -> ApiResult<Vec<Vec<FrameInputs>>> {
         .iter()
         .enumerate()
         .map(|(i, l)| {
-            Ok(light_frusta(l, i)?
-                .into_iter()
-                .map(|light| FrameInputs {
-                    view: mat4(&f.view),
-                    proj: mat4(&f.proj),
-                    camera_position: Vec3::from_array(f.camera_position),
-                    light,
-                })
-                .collect())
+            let (kind, range, frusta) = light_frusta(l, i)?;
+            Ok(FrameLight {
+                frusta: frusta
+                    .into_iter()
+                    .map(|light| FrameInputs {
+                        view: mat4(&f.view),
+                        proj: mat4(&f.proj),
+                        camera_position: Vec3::from_array(f.camera_position),
+                        light,
+                    })
+                    .collect(),
+                kind,
+                range,
+            })
         })
         .collect()
 }
 
-/// The frusta of `lights[index]` (every field checked): the light as given, or the frusta the plugin
-/// fits to a point light or to a spot light without a `view_proj`.
-fn light_frusta(l: &HrtsLight, index: usize) -> ApiResult<Vec<Light>> {
+/// One light of a frame: the frusta it is shadowed through (the camera in each), its type and range.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct FrameLight {
+    pub(crate) frusta: Vec<FrameInputs>,
+    pub(crate) kind: HrtsLightType,
+    /// The range of a spot or point light (`None`: unlimited, or a directional light).
+    pub(crate) range: Option<f32>,
+}
+
+impl FrameLight {
+    /// The names of the frusta in reports: a point light's cube faces, a wide spot light's faces.
+    pub(crate) fn frustum_name(&self, frustum: usize) -> &'static str {
+        const POINT: [&str; 6] = ["+X", "-X", "+Y", "-Y", "+Z", "-Z"];
+        const SPOT: [&str; 5] = ["front", "right", "left", "up", "down"];
+        let names: &[&str] = match (self.kind, self.frusta.len()) {
+            (HrtsLightType::Point, 6) => &POINT,
+            (HrtsLightType::Spot, 5) => &SPOT,
+            _ => &[],
+        };
+        names.get(frustum).copied().unwrap_or("frustum")
+    }
+}
+
+/// The type, range and frusta of `lights[index]` (every field checked): the light as given, or the
+/// frusta the plugin fits to a point light or to a spot light without a `view_proj`.
+fn light_frusta(
+    l: &HrtsLight,
+    index: usize,
+) -> ApiResult<(HrtsLightType, Option<f32>, Vec<Light>)> {
     let field = |name: &str| format!("lights[{index}].{name}");
     finite(&l.direction, &field("direction"))?;
     finite(&l.view_proj, &field("view_proj"))?;
@@ -168,9 +199,13 @@ fn light_frusta(l: &HrtsLight, index: usize) -> ApiResult<Vec<Light>> {
             l.range
         )));
     }
-    let range = (l.range > 0.0).then_some(l.range);
+    let range = (l.range > 0.0 && kind != HrtsLightType::Directional).then_some(l.range);
     if kind == HrtsLightType::Point {
-        return Ok(passes::point_light_faces(position, range).to_vec());
+        return Ok((
+            kind,
+            range,
+            passes::point_light_faces(position, range).to_vec(),
+        ));
     }
     let direction = Vec3::from_array(l.direction);
     if direction.length_squared() == 0.0 {
@@ -185,16 +220,15 @@ fn light_frusta(l: &HrtsLight, index: usize) -> ApiResult<Vec<Light>> {
                 l.outer_cone
             )));
         }
-        return Ok(passes::spot_light_frusta(
-            position,
-            direction,
-            l.outer_cone,
+        return Ok((
+            kind,
             range,
+            passes::spot_light_frusta(position, direction, l.outer_cone, range),
         ));
     }
     let view_proj = mat4(&l.view_proj);
     // Passed on as given: the passes normalise in f64 (normalising here in f32 would round twice).
-    Ok(vec![if kind == HrtsLightType::Spot {
+    let light = if kind == HrtsLightType::Spot {
         Light::Spot {
             position,
             direction,
@@ -205,7 +239,8 @@ fn light_frusta(l: &HrtsLight, index: usize) -> ApiResult<Vec<Light>> {
             direction,
             view_proj,
         }
-    }])
+    };
+    Ok((kind, range, vec![light]))
 }
 
 pub(crate) fn enum_value<T>(

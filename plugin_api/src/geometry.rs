@@ -21,6 +21,7 @@ pub(crate) enum GeometrySource {
         indices: Vec<u32>,
         draws: Vec<Draw>,
         origin: DVec3,
+        bounds: [DVec3; 2],
     },
     Vulkan {
         vertices: (u64, u64),
@@ -29,7 +30,20 @@ pub(crate) enum GeometrySource {
         index: IndexLayout,
         draws: Vec<Draw>,
         origin: DVec3,
+        bounds: [DVec3; 2],
     },
+}
+
+impl GeometrySource {
+    /// World-space bounds (min, max) of every triangle in every frame, for culling: always for CPU
+    /// geometry (copied once), for the engine's buffers only while they do not change (`dynamic` false:
+    /// the engine's `bounds` describe what it gave).
+    pub(crate) fn cull_bounds(&self, dynamic: bool) -> Option<[DVec3; 2]> {
+        match self {
+            Self::Cpu { bounds, .. } => Some(*bounds),
+            Self::Vulkan { bounds, .. } => (!dynamic).then_some(*bounds),
+        }
+    }
 }
 
 fn draws_from(ptr: *const HrtsDraw, count: u32) -> ApiResult<Vec<Draw>> {
@@ -122,6 +136,7 @@ pub(crate) fn cpu_geometry(g: &HrtsCpuGeometry) -> ApiResult<GeometrySource> {
         indices,
         draws,
         origin: frame_origin(lo, hi),
+        bounds: [lo, hi],
     })
 }
 
@@ -170,6 +185,7 @@ pub(crate) fn vulkan_geometry(
         index,
         draws,
         origin: frame_origin(lo, hi),
+        bounds: [lo, hi],
     };
     geometry_from(device, &source)?;
     Ok(source)
@@ -182,6 +198,7 @@ pub(crate) fn geometry_from(device: &Device, source: &GeometrySource) -> ApiResu
             indices,
             draws,
             origin,
+            ..
         } => Geometry::upload(device, positions, indices, draws, *origin)?,
         GeometrySource::Vulkan {
             vertices,
@@ -190,6 +207,7 @@ pub(crate) fn geometry_from(device: &Device, source: &GeometrySource) -> ApiResu
             index,
             draws,
             origin,
+            ..
         } => {
             // SAFETY: the engine guarantees its buffers are live and of the stated sizes (contract).
             let (vb, ib) = unsafe {

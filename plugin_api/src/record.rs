@@ -6,7 +6,7 @@ use crate::convert::{frame_inputs, pass_from_index, resource_id};
 use crate::error::{check_size, invalid, ApiError, ApiResult};
 use crate::types::*;
 use passes::{PassError, PassId, ResourceId};
-use rhi::{Barrier, BufferUsage, Encoder, ResourceState as S};
+use rhi::{Barrier, BufferUsage, Encoder, Image, ResourceState as S};
 
 /// Pass-mask bits of the passes that read the engine's depth and normal images (the primitive map fits
 /// itself to the receivers).
@@ -90,7 +90,9 @@ impl Context {
         if !continues {
             self.begin_frame(f.frame_index)?;
         }
-        self.set_frusta(&inputs.iter().map(Vec::len).collect::<Vec<_>>());
+        self.set_frusta(&inputs.iter().map(|l| l.frusta.len()).collect::<Vec<_>>());
+        let schedule = self.schedule(&inputs);
+        let recorded: Vec<Vec<bool>> = schedule.iter().map(|l| l.recorded.clone()).collect();
         self.ensure_built()?;
         let frame_index = f.frame_index;
         let (device, built) = match self.built.as_mut() {
@@ -100,8 +102,20 @@ impl Context {
         if !continues {
             self.progress.open = None;
             self.last_frame = Some(frame_index);
-            for (passes, light_inputs) in built.lights.iter_mut().flatten().zip(&inputs) {
-                for (pipeline, frustum_inputs) in passes.frusta.iter_mut().zip(light_inputs) {
+            for ((passes, light), recorded) in built
+                .lights
+                .iter_mut()
+                .flatten()
+                .zip(&inputs)
+                .zip(&recorded)
+            {
+                for ((pipeline, frustum_inputs), _) in passes
+                    .frusta
+                    .iter_mut()
+                    .zip(&light.frusta)
+                    .zip(recorded)
+                    .filter(|(_, &r)| r)
+                {
                     pipeline.begin_frame_at(frustum_inputs, frame_index)?;
                 }
             }
@@ -111,7 +125,7 @@ impl Context {
             .filter_map(pass_from_index)
             .collect();
         if copy_output {
-            for (i, pipeline) in built.pipelines() {
+            for (i, pipeline) in built.scheduled(&recorded) {
                 if let Some(missing) = pipeline
                     .passes_to_record()
                     .into_iter()
@@ -128,20 +142,14 @@ impl Context {
             }
         }
         // Every light accepts the passes before anything is recorded: a failed call records nothing.
-        for (i, pipeline) in built.pipelines() {
+        for (i, pipeline) in built.scheduled(&recorded) {
             pipeline.check_record(&passes).map_err(|e| {
                 ApiError::new(HrtsResult::ErrorInvalidState, format!("light {i}: {e}"))
             })?;
         }
         // Every light allocates what its recording needs before any records: an allocation failure leaves
         // the command buffer untouched.
-        for (i, pipeline) in built
-            .lights
-            .iter_mut()
-            .enumerate()
-            .filter_map(|(i, l)| l.as_mut().map(|l| (i, l)))
-            .flat_map(|(i, l)| l.frusta.iter_mut().map(move |p| (i, p)))
-        {
+        for (i, pipeline) in built.scheduled_mut(&recorded) {
             pipeline.prepare_record(device, &passes).map_err(|e| {
                 let e = ApiError::from(e);
                 ApiError {
@@ -157,27 +165,22 @@ impl Context {
         if reads_depth {
             engine_inputs(&mut enc, built, f, true);
         }
-        let mut recorded = Ok(());
-        for pipeline in built
-            .lights
-            .iter_mut()
-            .flatten()
-            .flat_map(|l| l.frusta.iter_mut())
-        {
-            recorded = pipeline.record_passes(&mut enc, &passes);
-            if recorded.is_err() {
+        let mut outcome = Ok(());
+        for (_, pipeline) in built.scheduled_mut(&recorded) {
+            outcome = pipeline.record_passes(&mut enc, &passes);
+            if outcome.is_err() {
                 break;
             }
         }
         if reads_depth {
             engine_inputs(&mut enc, built, f, false);
         }
-        recorded.map_err(|e| match e {
+        outcome.map_err(|e| match e {
             PassError::InvalidConfig(m) => ApiError::new(HrtsResult::ErrorInvalidState, m),
             other => other.into(),
         })?;
         if copy_output {
-            record_output_copy(&mut enc, built, f)?;
+            record_output_copy(&mut enc, built, f, &recorded)?;
             self.progress = FrameProgress {
                 open: None,
                 completed: Some(frame_index),
@@ -188,6 +191,9 @@ impl Context {
                 inputs,
                 last_pass: highest,
             });
+        }
+        if !continues {
+            self.keep_schedule(frame_index, schedule);
         }
         Ok(())
     }
@@ -302,21 +308,39 @@ fn engine_inputs(enc: &mut Encoder<'_>, b: &Built, f: &HrtsFrame, to_shader: boo
 }
 
 /// Copies each light's final visibility into its layer of the engine's output image: for a light of
-/// several frusta, first the minimum over them.
-fn record_output_copy(enc: &mut Encoder<'_>, b: &Built, f: &HrtsFrame) -> ApiResult<()> {
+/// several frusta, first the minimum over those recorded (`recorded[light][frustum]`); a light of one
+/// frustum that was not recorded gets 1 in its layer.
+fn record_output_copy(
+    enc: &mut Encoder<'_>,
+    b: &Built,
+    f: &HrtsFrame,
+    recorded: &[Vec<bool>],
+) -> ApiResult<()> {
     let combines: Vec<_> = b
         .lights
         .iter()
         .flatten()
-        .filter_map(|l| l.combine.as_ref())
+        .zip(recorded)
+        .filter_map(|(l, r)| l.combine.as_ref().map(|c| (c, r)))
         .collect();
     if !combines.is_empty() {
         enc.barriers(&[Barrier::Uav]);
-        for combine in combines {
-            combine.record(enc)?;
+        for (combine, recorded) in combines {
+            combine.record(enc, recorded)?;
         }
     }
-    let outputs: Vec<_> = b.lights.iter().flatten().map(|l| l.output()).collect();
+    let lit =
+        |l: &crate::context::LightPasses, r: &[bool]| l.combine.is_none() && !r.contains(&true);
+    // The layer of each light, and the visibility to copy into it (none: fill with 1).
+    let layers: Vec<(u32, Option<&Image>)> = b
+        .lights
+        .iter()
+        .flatten()
+        .zip(recorded)
+        .enumerate()
+        .map(|(layer, (l, r))| (layer as u32, (!lit(l, r)).then(|| l.output())))
+        .collect();
+    let outputs: Vec<&Image> = layers.iter().filter_map(|&(_, image)| image).collect();
     let each = |before, after| -> Vec<Barrier<'_>> {
         outputs
             .iter()
@@ -335,8 +359,11 @@ fn record_output_copy(enc: &mut Encoder<'_>, b: &Built, f: &HrtsFrame) -> ApiRes
         after: S::CopyDest,
     });
     enc.barriers(&to_copy);
-    for (layer, vis) in outputs.iter().enumerate() {
-        enc.copy_image_into_layer(vis, &b.output, layer as u32)?;
+    for &(layer, vis) in &layers {
+        match vis {
+            Some(vis) => enc.copy_image_into_layer(vis, &b.output, layer)?,
+            None => enc.clear_uint_layer(&b.output, layer, 1.0f32.to_bits())?,
+        }
     }
     let mut back = each(S::CopySource, S::UnorderedAccess);
     back.push(Barrier::Image {

@@ -6,7 +6,7 @@ use std::ffi::c_char;
 
 /// Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 /// version differs.
-pub const HRTS_API_VERSION: u32 = 4 << 22;
+pub const HRTS_API_VERSION: u32 = 5 << 22;
 
 /// A flag in the C structs: 0 is false, any other value true. (A Rust `bool` would make any byte but 0
 /// and 1 undefined behaviour when the engine writes it.)
@@ -171,6 +171,22 @@ pub enum HrtsPassStatus {
     UpToDate = 2,
     /// Shared by the context's lights (the prim buffer) and recorded this frame by an earlier light.
     Shared = 3,
+    /// Not recorded: no frustum of the light holds a receiver in view within its range this frame (see
+    /// `HrtsLightDecision`).
+    Culled = 4,
+}
+
+/// What the plugin decided for a light in a frame (`HrtsFrameReport::decision`), from the camera, the
+/// geometry's bounds (CPU geometry, or static Vulkan geometry) and the light's frusta and range.
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HrtsLightDecision {
+    /// Shadowed through the frusta that may hold a receiver in view within the light's range (all, or
+    /// some of a point light's or wide spot light's faces: `frusta_culled` says how many were skipped).
+    Shadowed = 0,
+    /// No frustum of the light may hold a receiver in view within its range: no pass ran and its output
+    /// layer is 1.
+    OutOfView = 1,
 }
 
 /// A resource the plugin allocates (for the report, `hrts_get_resource_info` and
@@ -531,7 +547,10 @@ pub struct HrtsLight {
     /// frustum has its near plane at `range / 1024` (0.01 without a range) and its far plane at infinity.
     pub view_proj: [f32; 16],
     /// Spot and point lights: distance beyond which the light has no effect, or 0 for unlimited. It sets
-    /// the near plane of the frusta the plugin fits; shadows stay exact at every distance.
+    /// the near plane of the frusta the plugin fits. A frustum holding no receiver in view within the
+    /// range is not recorded, and a pixel it alone would shade is lit (1): beyond the range the
+    /// visibility may be 1 where geometry blocks the light, since the light does not reach there.
+    /// Within the range shadows are exact.
     pub range: f32,
     /// Spot lights whose frusta the plugin fits: half-angle of the cone in radians, in (0, π/2]. Up to
     /// π/3 one frustum covers it; wider cones use the five cube faces around the axis. Ignored otherwise.
@@ -666,10 +685,17 @@ pub struct HrtsFrameReport {
     /// How many times this light's passes were built since the context was created: a configuration,
     /// geometry or targets call that changed nothing of this light leaves it as it was.
     pub light_builds: u32,
-    /// Frusta the light is shadowed through: 1, or the cube faces of a point light (6) or of a wide spot
-    /// light (5). Statistics, pass times and memory above are summed over them (the longest list is the
-    /// longest of any; `map_to_texels` is the first frustum's).
+    /// Frusta the light was shadowed through this frame: those of its frusta (1, or the cube faces of a
+    /// point light (6) or of a wide spot light (5)) that may hold a receiver in view within its range.
+    /// Statistics and pass times above are summed over them, memory over every frustum (the longest
+    /// list is the longest of any; `map_to_texels` is the first recorded frustum's).
     pub frusta: u32,
+    /// Frusta of the light skipped this frame: they hold no receiver in view within its range.
+    pub frusta_culled: u32,
+    /// `HrtsLightDecision` of the light this frame.
+    pub decision: u32,
+    /// Why, in words (NUL-terminated, truncated to fit): the frusta recorded and those culled, by name.
+    pub decision_reason: [c_char; 128],
     /// GPU milliseconds of all of this light's passes in the frame (every frustum, the minimum over
     /// them, and the light's share of nothing else).
     pub gpu_milliseconds: f64,

@@ -348,11 +348,29 @@ impl<'a> Encoder<'a> {
         unsafe { self.d().cmd_pipeline_barrier2(self.cmd, &dep) };
     }
 
-    /// Clears all layers of an integer colour image (in `CopyDest` state) to `value`.
+    /// Clears all layers of a colour image (in `CopyDest` state) to `value` in every channel: integer
+    /// formats take it as it is, float formats as the bits of an `f32`.
     pub fn clear_uint(&mut self, image: &Image, value: u32) {
+        self.clear_uint_layer_range(image, 0, image.layers(), value);
+    }
+
+    /// Clears layer `layer` of a colour image (in `CopyDest` state) to `value`, as
+    /// [`Encoder::clear_uint`] does.
+    pub fn clear_uint_layer(&mut self, image: &Image, layer: u32, value: u32) -> Result<()> {
+        if layer >= image.layers() {
+            return Err(RhiError::InvalidArgument(format!(
+                "layer {layer} of an image of {} layers",
+                image.layers()
+            )));
+        }
+        self.clear_uint_layer_range(image, layer, 1, value);
+        Ok(())
+    }
+
+    fn clear_uint_layer_range(&mut self, image: &Image, first: u32, count: u32, value: u32) {
         let clear = vk::ClearColorValue { uint32: [value; 4] };
-        let range = subresource_range(image.format(), image.layers());
-        // SAFETY: the image is in TRANSFER_DST_OPTIMAL (CopyDest) by contract.
+        let range = subresource_range(image.format(), count).base_array_layer(first);
+        // SAFETY: the image is in TRANSFER_DST_OPTIMAL (CopyDest) by contract; the layers exist.
         unsafe {
             self.d().cmd_clear_color_image(
                 self.cmd,

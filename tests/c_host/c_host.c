@@ -1453,15 +1453,39 @@ static void native_local_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometr
         int mismatches = count_mismatches(vis + i * W * H, tol, &lights[i], &near_edge, &shadowed, &lit);
         HrtsFrameReport rep;
         CHECK(report(ctx, first, (uint32_t)i, &rep) == HRTS_RESULT_OK, "report %d: %s", i, hrts_last_error(ctx));
-        printf("%s: %u frusta, %.3f GPU ms, %u entries (longest list %u); %d lit, %d shadowed, %d near-edge, %d mismatches\n",
-               i == 0 ? "point light" : "fitted spot light", rep.frusta, rep.gpu_milliseconds, rep.entries,
-               rep.longest_list, lit, shadowed, near_edge, mismatches);
-        CHECK(rep.frusta == want_frusta[i], "light %d: %u frusta", i, rep.frusta);
+        printf("%s: %u frusta recorded, %u culled (%s), %.3f GPU ms, %u entries (longest list %u); %d lit, %d shadowed, "
+               "%d near-edge, %d mismatches\n",
+               i == 0 ? "point light" : "fitted spot light", rep.frusta, rep.frusta_culled, rep.decision_reason,
+               rep.gpu_milliseconds, rep.entries, rep.longest_list, lit, shadowed, near_edge, mismatches);
+        CHECK(rep.frusta + rep.frusta_culled == want_frusta[i] && rep.decision == HRTS_LIGHT_DECISION_SHADOWED,
+              "light %d: %u frusta recorded, %u culled, decision %u", i, rep.frusta, rep.frusta_culled, rep.decision);
         CHECK(rep.gpu_milliseconds > 0.0 && rep.texels_past_capacity == 0, "light %d: report", i);
         CHECK(mismatches == 0, "light %d: %d pixels differ from the exact shadow", i, mismatches);
         CHECK(shadowed > 100 && lit > 1000 && near_edge * 100 <= 4 * W * H, "light %d: %d shadowed, %d lit, %d near-edge px",
               i, shadowed, lit, near_edge);
     }
+    /* the point light sits above the geometry's bounds (y 0..1.6): its +Y face holds no receiver */
+    HrtsFrameReport point_rep;
+    CHECK(report(ctx, first, 0, &point_rep) == HRTS_RESULT_OK && point_rep.frusta_culled >= 1 &&
+              strstr(point_rep.decision_reason, "+Y") && point_rep.pass_status[HRTS_PASS_RAY_TRACE] == HRTS_PASS_STATUS_RAN,
+          "the point light's +Y face is culled: %s", point_rep.decision_reason);
+    /* a point light whose range reaches no receiver: nothing is recorded for it and its layer is lit */
+    Emitter out_of_view = point(v3(0.0, 6.0, 0.0));
+    out_of_view.c.range = 2.0f;
+    Emitter pair[N] = {out_of_view, lights[1]};
+    set_lights(pair, N);
+    CHECK(run_frame(ctx, vis) == HRTS_RESULT_OK, "out-of-view point light: %s", hrts_last_error(ctx));
+    HrtsFrameReport culled;
+    CHECK(report(ctx, next_frame - 1, 0, &culled) == HRTS_RESULT_OK, "out-of-view report: %s", hrts_last_error(ctx));
+    int not_lit = 0;
+    for (int p = 0; p < W * H; p++) not_lit += vis[p] != 1.0f;
+    printf("out-of-view point light: decision %u (%s), %u frusta recorded, %u culled, %.3f GPU ms, %d px not lit\n",
+           culled.decision, culled.decision_reason, culled.frusta, culled.frusta_culled, culled.gpu_milliseconds, not_lit);
+    CHECK(culled.decision == HRTS_LIGHT_DECISION_OUT_OF_VIEW && culled.frusta == 0 && culled.frusta_culled == 6 &&
+              culled.pass_count == 0 && culled.pass_status[HRTS_PASS_RAY_TRACE] == HRTS_PASS_STATUS_CULLED &&
+              culled.pass_status[HRTS_PASS_OUTPUT_COPY] == HRTS_PASS_STATUS_RAN && not_lit == 0,
+          "an out-of-view point light records nothing and is lit: %d px not lit", not_lit);
+    set_lights(lights, N);
     float one[W * H];
     CHECK(read_resource(ctx, 0, HRTS_RESOURCE_RT_VISIBILITY, one, sizeof one) == HRTS_RESULT_ERROR_INVALID_STATE &&
               strlen(hrts_last_error(ctx)) > 0,

@@ -61,6 +61,23 @@ impl FrameReport {
 }
 
 impl ShadowPipeline {
+    /// Every resource the pipeline allocated, with its size (what a frame report lists).
+    pub fn resources(&self) -> Vec<ResourceReport> {
+        self.plan
+            .resources()
+            .iter()
+            .filter_map(|r| {
+                self.resource_bytes(r)
+                    .map(|bytes| ResourceReport { resource: r, bytes })
+            })
+            .collect()
+    }
+
+    /// The binning path of the primitive map (what the device would use when the plan has none).
+    pub fn binning_path(&self) -> BinningPath {
+        self.binning_path
+    }
+
     /// Timings and statistics of the last frame begun, waiting for its GPU timestamps; call after its
     /// submission was made.
     pub fn report(&self) -> Result<FrameReport, PassError> {
@@ -144,15 +161,7 @@ impl ShadowPipeline {
             true => bytemuck::pod_read_unaligned(slot.stats_readback.read()?),
             false => MapState::zeroed(),
         };
-        let resources = self
-            .plan
-            .resources()
-            .iter()
-            .filter_map(|r| {
-                self.resource_bytes(r)
-                    .map(|bytes| ResourceReport { resource: r, bytes })
-            })
-            .collect();
+        let resources = self.resources();
         Ok(FrameReport {
             timings,
             binning_path: self.binning_path,
