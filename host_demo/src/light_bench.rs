@@ -1,9 +1,11 @@
 //! `host_demo bench --lights`: what each kind of light costs inside whole scenes. The shared Sponza and
 //! Conference models, seen from inside, each with one light at a time: the sun, a spot light inside and a
-//! point light at three positions inside, planned as `render --scene` plans a glTF scene (a point light
-//! through the cube faces that hold receivers in view) and drawn through the plugin's C ABI. Per light:
-//! frusta, GPU ms of its passes (the median over the frames after the first of the per-frame sum over its
-//! frusta), memory, and its lists (entries, mean and longest list, texels past capacity).
+//! point light at three positions inside, planned as `render --scene` plans a glTF scene and drawn through
+//! the plugin's C ABI (a point light given as a point light: the plugin records the cube faces that may
+//! hold a receiver in view); with `--point-lights N`, N point lights in one context. Per light: frusta
+//! recorded of those built, GPU ms of its passes (the median over the frames after the first of the
+//! per-frame sum over its frusta), memory, and its lists (entries, mean and longest list, texels past
+//! capacity).
 
 use crate::bench::BenchArgs;
 use crate::plugin::{c_point_light, LightsFrame, PluginRenderer};
@@ -107,7 +109,8 @@ fn lights(scene: &LightScene, bounds: &Aabb) -> Vec<(String, SceneLight)> {
 /// What one light cost.
 struct LightCost {
     name: String,
-    frusta: usize,
+    /// Frusta recorded in the last frame, and built.
+    frusta: (u32, u32),
     gpu_ms: f64,
     map_ms: f64,
     trace_ms: f64,
@@ -181,7 +184,7 @@ fn measure_light(
         .sum();
     Ok(LightCost {
         name: name.to_owned(),
-        frusta: reports.len(),
+        frusta: frusta_of(last),
         gpu_ms,
         map_ms,
         trace_ms,
@@ -209,9 +212,17 @@ fn measure_light(
     })
 }
 
+/// Frusta of `frame`'s lights: recorded, and built (recorded or culled).
+fn frusta_of(frame: &LightsFrame) -> (u32, u32) {
+    frame.lights.iter().fold((0, 0), |(r, b), l| {
+        (r + l.frusta, b + l.frusta + l.frusta_culled)
+    })
+}
+
 /// The cost of point lights at `positions` given to the plugin as point lights (the C ABI's
-/// `HRTS_LIGHT_TYPE_POINT`) in one context: the plugin fits and records all six cube faces of each, and
-/// combines them. Statistics are those of the first light; time and memory are the sum over all.
+/// `HRTS_LIGHT_TYPE_POINT`) in one context: the plugin fits six cube faces to each, records those that may
+/// hold a receiver in view, and combines them. Statistics are those of the first light; time and memory
+/// are the sum over all.
 fn measure_native_points(
     device: &Device,
     file: &SceneFile,
@@ -246,7 +257,7 @@ fn measure_native_points(
     let st = &light.report.stats;
     Ok(LightCost {
         name,
-        frusta: last.lights.iter().map(|l| l.frusta as usize).sum(),
+        frusta: frusta_of(last),
         gpu_ms,
         map_ms,
         trace_ms,
@@ -270,7 +281,8 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
     let mut out = format!(
         "Device: {} ({}); {}×{}, hard shadows (zero-size lights), no FXAA; one light at a time, planned as \
          `render --scene` plans it; GPU ms = median over {} frames after the first of the light's passes \
-         summed over its frusta (the shared prim buffer excluded); memory = the light's own resources.\n\n\
+         summed over its frusta (the shared prim buffer excluded); memory = the light's own resources; frusta = \
+         recorded / built (the plugin skips those holding no receiver in view).\n\n\
          | scene | light | frusta | GPU ms | × sun | map ms | ray trace ms | MiB | entries | mean list | longest | past capacity |\n\
          |---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         caps.device_name,
@@ -285,7 +297,7 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
         .collect();
     let total: usize = chosen
         .iter()
-        .map(|s| 3 + s.points.len() + usize::from(args.point_lights > 0))
+        .map(|s| 2 + s.points.len() + usize::from(args.point_lights > 0))
         .sum();
     let bar = crate::progress(total as u64, "bench --lights");
     for scene_case in chosen {
@@ -319,17 +331,6 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
             )?);
             bar.inc(1);
         }
-        bar.set_message(format!("{} native point light", scene_case.file));
-        let first_point = at(&bounds, scene_case.points[0]);
-        costs.push(measure_native_points(
-            device,
-            &file_with(Vec::new()),
-            &camera,
-            &[first_point],
-            "point 1, native (6 faces)".to_owned(),
-            args,
-        )?);
-        bar.inc(1);
         if args.point_lights > 0 {
             bar.set_message(format!(
                 "{} {} point lights",
@@ -361,10 +362,11 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
         for c in &costs {
             let _ = writeln!(
                 out,
-                "| {} | {} | {} | {:.3} | {:.1} | {:.3} | {:.3} | {:.1} | {} | {:.1} | {} | {} |",
+                "| {} | {} | {} / {} | {:.3} | {:.1} | {:.3} | {:.3} | {:.1} | {} | {:.1} | {} | {} |",
                 scene_case.file.trim_end_matches(".obj"),
                 c.name,
-                c.frusta,
+                c.frusta.0,
+                c.frusta.1,
                 c.gpu_ms,
                 if sun > 0.0 { c.gpu_ms / sun } else { 0.0 },
                 c.map_ms,

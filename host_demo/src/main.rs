@@ -38,7 +38,7 @@ enum Command {
     /// With --scene, every light of a glTF scene as the scene's plan says (see `plan`).
     Render(RenderArgs),
     /// Print the plan of a glTF scene without rendering (no GPU): per light the shadow it gets (none, hard or
-    /// hybrid) and why, its shadow frusta, configuration, passes and resources.
+    /// hybrid) and why, the light as the plugin takes it (its frusta), configuration, passes and resources.
     Plan(PlanArgs),
     /// Write the example glTF scene (ground, boxes, a moving cart; a sized sun, a zero-size rim light, a
     /// sized spot light, a moving point lamp and a fill light that casts no shadows): binary glTF if FILE

@@ -708,25 +708,30 @@ fn set_geometry(context: &Context, geometry: &Geometry, bounds: &Aabb) -> Result
 
 /// The C light of `light`.
 fn c_light(light: &Light) -> HrtsLight {
-    let (light_type, position, direction, view_proj) = match *light {
+    match *light {
         Light::Directional {
             direction,
             view_proj,
-        } => (HrtsLightType::Directional, [0.0; 3], direction, view_proj),
+        } => c_directional_light(direction, view_proj),
         Light::Spot {
             position,
             direction,
             view_proj,
-        } => (
-            HrtsLightType::Spot,
-            position.to_array(),
-            direction,
-            view_proj,
-        ),
-    };
+        } => HrtsLight {
+            light_type: HrtsLightType::Spot as u32,
+            view_proj: view_proj.to_cols_array(),
+            direction: direction.to_array(),
+            ..c_point_light(position, 0.0)
+        },
+    }
+}
+
+/// The C directional light travelling along `direction`, with the orthographic `view_proj` enclosing the
+/// scene.
+pub fn c_directional_light(direction: glam::Vec3, view_proj: glam::Mat4) -> HrtsLight {
     HrtsLight {
-        light_type: light_type as u32,
-        position,
+        light_type: HrtsLightType::Directional as u32,
+        position: [0.0; 3],
         direction: direction.to_array(),
         view_proj: view_proj.to_cols_array(),
         range: 0.0,
@@ -744,6 +749,22 @@ pub fn c_point_light(position: glam::Vec3, range: f32) -> HrtsLight {
         view_proj: [0.0; 16],
         range,
         outer_cone: 0.0,
+    }
+}
+
+/// The C spot light at `position` along `direction` with a cone of half-angle `outer_cone` within `range`
+/// (0: unlimited), without a matrix: the plugin fits its frusta.
+pub fn c_fitted_spot_light(
+    position: glam::Vec3,
+    direction: glam::Vec3,
+    outer_cone: f32,
+    range: f32,
+) -> HrtsLight {
+    HrtsLight {
+        light_type: HrtsLightType::Spot as u32,
+        direction: direction.to_array(),
+        outer_cone,
+        ..c_point_light(position, range)
     }
 }
 

@@ -1,5 +1,7 @@
 //! The plan of a glTF scene: which shadow each light gets, derived from what the scene declares (its
-//! lights' kinds, sizes and flags, which objects move) and from what the camera sees. Pure: no GPU.
+//! lights' kinds, sizes and flags, which objects move) and from what the camera sees. Pure: no GPU. The
+//! plan hands each shadowed light to the plugin as the C ABI takes it (`HrtsLight`), so the demo is a
+//! thin caller of what the plugin does for every engine.
 //!
 //! Per light, in this order:
 //! - a light that casts no shadow, emits nothing (zero colour or intensity), or whose influence (its cone
@@ -10,47 +12,38 @@
 //! - a **sized** light gets the hybrid: its angular radius (directional) becomes
 //!   `pcss_angular_radius`, its radius (spot, point) `pcss_spot_radius`.
 //!
-//! A shadowed light is one or more *shadow frusta*, each one light of the plugin:
-//! - a directional light: one orthographic frustum enclosing the scene ([`DirectionalLight::view_proj`]);
-//! - a spot light whose cone is at most [`MAX_SPOT_FRUSTUM_HALF_ANGLE`] wide: one perspective frustum
-//!   around its cone;
-//! - a point light, or a wider spot light: the faces of a cube around it (each a 90° perspective
-//!   frustum) that hold a receiver in view within the light's reach; the others are not built. A spot
-//!   light's cube is turned to its axis and has no back face.
+//! A shadowed light is one light of the plugin:
+//! - a directional light, with one orthographic frustum enclosing the scene
+//!   ([`DirectionalLight::view_proj`]);
+//! - a spot light by its position, axis, cone and range (`HRTS_LIGHT_TYPE_SPOT` with no matrix): the
+//!   plugin fits one perspective frustum to a cone up to 60°, the five cube faces around its axis to a
+//!   wider one;
+//! - a point light by its position and range (`HRTS_LIGHT_TYPE_POINT`): the plugin shadows it through
+//!   the six faces of a cube around it.
 //!
-//! The plugin counts pixels outside a frustum as lit, so a light's visibility is the minimum of its
-//! frusta's visibilities. Frusta are widened by 1% beyond the cone or the cube face, so that neighbouring
-//! faces overlap instead of leaving a crack to rounding.
+//! Every frame the plugin records only the frusta that may hold a receiver in view within the light's
+//! range, and writes the minimum over them to the light's layer; its frame report says which it culled
+//! and why.
 //!
 //! "Receivers in view" are the scene's triangles that are not entirely outside one plane of the camera
 //! frustum (occlusion is not considered), and a triangle is within a light's reach when its bounding
-//! sphere meets the light's range and cone: the tests keep every light and face that may light a visible
-//! pixel, and may keep a few that do not.
+//! sphere meets the light's range and cone: the test keeps every light that may light a visible pixel,
+//! and may keep a few that do not.
 //!
 //! Caching: a light marked static sets `static_light`; any object that is not static makes the geometry
 //! dynamic for every light (the plugin shares one prim buffer between its lights).
 
+use crate::plugin::{c_directional_light, c_fitted_spot_light, c_point_light};
 use anyhow::{bail, Result};
-use glam::{DVec3, DVec4, Mat4, Vec3};
-use hrts_plugin::HRTS_MAX_LIGHTS;
-use passes::{FaceMode, FramePlan, Light, ResourceId, ShadowConfig, ShadowMode};
+use glam::{DVec3, DVec4, Vec3};
+use hrts_plugin::{HrtsLight, HRTS_MAX_LIGHTS};
+use passes::{FaceMode, FramePlan, ResourceId, ShadowConfig, ShadowMode};
 use scene::{Aabb, Camera, DirectionalLight, LightKind, LightSize, SceneFile, SceneLight};
 use std::f64::consts::FRAC_PI_2;
 use std::fmt::Write as _;
 
-/// Widest half-angle of a spot light's cone shadowed through one perspective frustum (60°); a wider
-/// spot light is shadowed through the faces of a cube, like a point light.
-pub const MAX_SPOT_FRUSTUM_HALF_ANGLE: f32 = std::f32::consts::FRAC_PI_3;
-
-/// Each frustum's half-width (as the tangent of its half-angle) is this much wider than the cone or cube
-/// face it covers.
-const FRUSTUM_WIDENING: f32 = 1.01;
-
-/// The far plane of a spot or point frustum is this much beyond the farthest receiver.
-const FAR_MARGIN: f32 = 1.01;
-
-/// The near plane of a spot or point frustum is at least this fraction of the far plane's distance.
-const MIN_NEAR_FRACTION: f32 = 1e-3;
+/// The pyramid enclosing a spot light's cone in the reach test is this much wider than the cone.
+const CONE_WIDENING: f32 = 1.01;
 
 /// What the plan needs besides the scene and the camera.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -90,28 +83,18 @@ impl NoPassReason {
     }
 }
 
-/// One frustum of a shadowed light: one light of the plugin.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ShadowFrustum {
-    /// Which part of the light it covers: "whole" for a directional light or a single spot frustum, else
-    /// the cube face ("+X" ... "-Z" for a point light; "front", "right", "left", "up", "down" around a
-    /// spot light's axis).
-    pub label: String,
-    /// The light as the plugin takes it: direction, position and view-projection.
-    pub light: Light,
-}
-
 /// The passes of a light the plugin shadows.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ShadowedLight {
-    /// The configuration of each of its frusta.
+    /// The light's configuration.
     pub config: ShadowConfig,
     /// The passes and resources the plugin derives from the configuration.
     pub frame_plan: FramePlan,
-    /// Its frusta, in a fixed order (cube faces in the order of their labels above).
-    pub frusta: Vec<ShadowFrustum>,
-    /// The cube faces left out because no receiver in view within the light's reach lies in them.
-    pub culled_faces: Vec<String>,
+    /// The light as the plugin takes it.
+    pub light: HrtsLight,
+    /// The frusta the plugin shadows it through, by name: "whole" for one, else cube faces ("+X" ...
+    /// "-Z" for a point light; "front", "right", "left", "up", "down" around a wide spot light's axis).
+    pub frusta: &'static [&'static str],
 }
 
 /// What the plan does with a light.
@@ -162,15 +145,13 @@ impl LightPlan {
     }
 }
 
-/// One light of the plugin: a frustum of a shadowed scene light.
+/// One light of the plugin: a shadowed scene light.
 #[derive(Debug, Clone, Copy)]
 pub struct PluginLight<'a> {
     /// Index of the scene light.
     pub scene_light: usize,
-    /// The frustum.
-    pub frustum: &'a ShadowFrustum,
-    /// Its configuration.
-    pub config: &'a ShadowConfig,
+    /// The light as the plugin takes it, its configuration and frusta.
+    pub shadowed: &'a ShadowedLight,
 }
 
 /// The plan of a scene seen by a camera.
@@ -189,17 +170,15 @@ pub struct ScenePlan {
 }
 
 impl ScenePlan {
-    /// The plugin's lights: every frustum of every shadowed light, in scene order.
+    /// The plugin's lights: every shadowed light, in scene order.
     pub fn plugin_lights(&self) -> Vec<PluginLight<'_>> {
         self.lights
             .iter()
             .enumerate()
-            .filter_map(|(i, l)| l.shadowed().map(|s| (i, s)))
-            .flat_map(|(scene_light, s)| {
-                s.frusta.iter().map(move |frustum| PluginLight {
+            .filter_map(|(scene_light, l)| {
+                l.shadowed().map(|shadowed| PluginLight {
                     scene_light,
-                    frustum,
-                    config: &s.config,
+                    shadowed,
                 })
             })
             .collect()
@@ -207,14 +186,17 @@ impl ScenePlan {
 
     /// The configuration of each plugin light ([`ScenePlan::plugin_lights`] order).
     pub fn plugin_configs(&self) -> Vec<ShadowConfig> {
-        self.plugin_lights().iter().map(|l| *l.config).collect()
-    }
-
-    /// The light of each plugin light for a frame ([`ScenePlan::plugin_lights`] order).
-    pub fn plugin_frame_lights(&self) -> Vec<Light> {
         self.plugin_lights()
             .iter()
-            .map(|l| l.frustum.light)
+            .map(|l| l.shadowed.config)
+            .collect()
+    }
+
+    /// The C light of each plugin light for a frame ([`ScenePlan::plugin_lights`] order).
+    pub fn plugin_frame_lights(&self) -> Vec<HrtsLight> {
+        self.plugin_lights()
+            .iter()
+            .map(|l| l.shadowed.light)
             .collect()
     }
 
@@ -242,10 +224,9 @@ impl ScenePlan {
         let plugin_lights = self.plugin_lights();
         let _ = writeln!(
             s,
-            "lights: {}, shadowed through {} plugin light{} (shadow frusta)",
+            "lights: {}, {} shadowed by the plugin",
             self.lights.len(),
             plugin_lights.len(),
-            if plugin_lights.len() == 1 { "" } else { "s" }
         );
         for (i, plan) in self.lights.iter().enumerate() {
             let _ = writeln!(
@@ -258,25 +239,19 @@ impl ScenePlan {
             let Some(shadowed) = plan.shadowed() else {
                 continue;
             };
-            let first = plugin_lights
+            let index = plugin_lights
                 .iter()
                 .position(|l| l.scene_light == i)
                 .unwrap_or_default();
-            let frusta: Vec<String> = shadowed
-                .frusta
-                .iter()
-                .enumerate()
-                .map(|(k, f)| format!("{} (plugin light {})", f.label, first + k))
-                .collect();
-            let _ = write!(s, "      frusta: {}", frusta.join(", "));
-            if !shadowed.culled_faces.is_empty() {
-                let _ = write!(
+            let _ = match shadowed.frusta {
+                [_] => writeln!(s, "      plugin light {index}: one frustum"),
+                faces => writeln!(
                     s,
-                    "; faces not built (no receiver in view within reach): {}",
-                    shadowed.culled_faces.join(", ")
-                );
-            }
-            let _ = writeln!(s);
+                    "      plugin light {index}: {} frusta fitted by the plugin ({}); each frame it records those holding a receiver in view within range",
+                    faces.len(),
+                    faces.join(", ")
+                ),
+            };
             let c = &shadowed.config;
             let _ = writeln!(
                 s,
@@ -369,7 +344,7 @@ pub fn scene_camera(file: &SceneFile, aspect: f32) -> Camera {
 ///
 /// # Errors
 ///
-/// A frame size of zero, `static_objects` not matching the objects, or more shadow frusta than the
+/// A frame size of zero, `static_objects` not matching the objects, or more shadowed lights than the
 /// plugin shades ([`HRTS_MAX_LIGHTS`]).
 pub fn plan_scene(file: &SceneFile, camera: &Camera, settings: &PlanSettings) -> Result<ScenePlan> {
     if settings.width == 0 || settings.height == 0 {
@@ -409,19 +384,10 @@ pub fn plan_scene(file: &SceneFile, camera: &Camera, settings: &PlanSettings) ->
         triangles: file.scene.triangle_count(),
         lights,
     };
-    let frusta = plan.plugin_lights().len();
-    if frusta > HRTS_MAX_LIGHTS as usize {
-        let per_light: Vec<String> = plan
-            .lights
-            .iter()
-            .filter_map(|l| {
-                l.shadowed()
-                    .map(|s| format!("{} {}", l.light.name, s.frusta.len()))
-            })
-            .collect();
+    let shadowed = plan.plugin_lights().len();
+    if shadowed > HRTS_MAX_LIGHTS as usize {
         bail!(
-            "the scene needs {frusta} shadow frusta ({}), but the plugin shades at most {HRTS_MAX_LIGHTS} lights per context",
-            per_light.join(", ")
+            "the scene has {shadowed} shadowed lights, but the plugin shades at most {HRTS_MAX_LIGHTS} lights per context"
         );
     }
     Ok(plan)
@@ -593,73 +559,12 @@ impl Pyramid {
     }
 }
 
-/// The perspective frustum of a light at `position` looking along `forward` (unit), `tan_half` wide on
-/// both axes, with `up_hint` (not parallel to `forward`) giving its up; and its pyramid.
-fn perspective_frustum(
-    position: Vec3,
-    forward: Vec3,
-    up_hint: Vec3,
-    tan_half: f32,
-    (near, far): (f32, f32),
-) -> (Light, Pyramid) {
-    let view = Mat4::look_to_rh(position, forward, up_hint);
-    let proj = Mat4::perspective_rh(2.0 * tan_half.atan(), 1.0, near, far);
-    let pyramid = Pyramid::new(position, forward, up_hint, tan_half);
-    let light = Light::Spot {
-        position,
-        direction: forward,
-        view_proj: proj * view,
-    };
-    (light, pyramid)
-}
-
 /// An up direction for a view along `forward`: +Y unless `forward` is within about 1° of ±Y, then +Z.
 fn up_hint(forward: Vec3) -> Vec3 {
     if forward.y.abs() > 1f32.to_radians().cos() {
         Vec3::Z
     } else {
         Vec3::Y
-    }
-}
-
-/// Near and far planes of a perspective frustum at `position`: far just beyond the farthest corner of the
-/// scene's bounds (or the range, if nearer); near at half the distance to the bounds, at least
-/// [`MIN_NEAR_FRACTION`] of far.
-fn depth_range(position: Vec3, bounds: &Aabb, range: Option<f32>) -> (f32, f32) {
-    let farthest = bounds
-        .corners()
-        .iter()
-        .map(|c| c.distance(position))
-        .fold(0.0, f32::max);
-    let far = (range.map_or(farthest, |r| r.min(farthest)) * FAR_MARGIN).max(f32::MIN_POSITIVE);
-    let nearest = (position.clamp(bounds.min, bounds.max) - position).length();
-    let near = (nearest * 0.5).max(far * MIN_NEAR_FRACTION);
-    (near, far.max(near * 2.0))
-}
-
-/// The cube faces around a light as (label, forward, up hint): world axes for a point light; the spot's
-/// axis and the four directions across it (no back face) for a spot light.
-fn cube_faces(axis: Option<Vec3>) -> Vec<(&'static str, Vec3, Vec3)> {
-    match axis {
-        None => vec![
-            ("+X", Vec3::X, Vec3::Y),
-            ("-X", Vec3::NEG_X, Vec3::Y),
-            ("+Y", Vec3::Y, Vec3::Z),
-            ("-Y", Vec3::NEG_Y, Vec3::Z),
-            ("+Z", Vec3::Z, Vec3::Y),
-            ("-Z", Vec3::NEG_Z, Vec3::Y),
-        ],
-        Some(axis) => {
-            let right = axis.cross(up_hint(axis)).normalize();
-            let up = right.cross(axis);
-            vec![
-                ("front", axis, up),
-                ("right", right, up),
-                ("left", -right, up),
-                ("up", up, axis),
-                ("down", -up, axis),
-            ]
-        }
     }
 }
 
@@ -681,17 +586,11 @@ fn decide(
     if receivers.is_empty() {
         return NoPass(NoPassReason::NothingInView);
     }
-    let (position, range, cone) = match light.kind {
+    let (position, range, cone, c_light) = match light.kind {
         LightKind::Directional { direction } => {
             let view_proj = DirectionalLight { direction }.view_proj(bounds);
-            let frustum = ShadowFrustum {
-                label: "whole".into(),
-                light: Light::Directional {
-                    direction,
-                    view_proj,
-                },
-            };
-            return shadowed(light, settings, dynamic_geometry, vec![frustum], Vec::new());
+            let c_light = c_directional_light(direction, view_proj);
+            return shadowed(light, settings, dynamic_geometry, c_light, 1);
         }
         LightKind::Spot {
             position,
@@ -699,8 +598,18 @@ fn decide(
             outer_cone,
             range,
             ..
-        } => (position, range, Some((direction, outer_cone))),
-        LightKind::Point { position, range } => (position, range, None),
+        } => (
+            position,
+            range,
+            Some((direction, outer_cone)),
+            c_fitted_spot_light(position, direction, outer_cone, range.unwrap_or(0.0)),
+        ),
+        LightKind::Point { position, range } => (
+            position,
+            range,
+            None,
+            c_point_light(position, range.unwrap_or(0.0)),
+        ),
     };
     let reach = Reach {
         position: position.as_dvec3(),
@@ -708,48 +617,20 @@ fn decide(
         cone: cone.map(|(axis, angle)| Cone {
             axis: axis.as_dvec3(),
             half_angle: f64::from(angle),
-            enclosing: (angle < std::f32::consts::FRAC_PI_2).then(|| {
-                Pyramid::new(
-                    position,
-                    axis,
-                    up_hint(axis),
-                    angle.tan() * FRUSTUM_WIDENING,
-                )
-            }),
+            enclosing: (angle < std::f32::consts::FRAC_PI_2)
+                .then(|| Pyramid::new(position, axis, up_hint(axis), angle.tan() * CONE_WIDENING)),
         }),
     };
-    let reached: Vec<&[DVec3; 3]> = receivers.iter().filter(|t| reach.touches(t)).collect();
-    if reached.is_empty() {
+    if !receivers.iter().any(|t| reach.touches(t)) {
         return NoPass(NoPassReason::OutOfReach);
     }
-    let depths = depth_range(position, bounds, range);
-    if let Some((axis, outer_cone)) = cone.filter(|&(_, a)| a <= MAX_SPOT_FRUSTUM_HALF_ANGLE) {
-        let tan_half = outer_cone.tan() * FRUSTUM_WIDENING;
-        let (frustum, _) = perspective_frustum(position, axis, up_hint(axis), tan_half, depths);
-        let whole = ShadowFrustum {
-            label: "whole".into(),
-            light: frustum,
-        };
-        return shadowed(light, settings, dynamic_geometry, vec![whole], Vec::new());
-    }
-    let mut frusta = Vec::new();
-    let mut culled_faces = Vec::new();
-    for (label, forward, up) in cube_faces(cone.map(|(axis, _)| axis)) {
-        let (frustum, pyramid) =
-            perspective_frustum(position, forward, up, FRUSTUM_WIDENING, depths);
-        if reached.iter().any(|t| pyramid.touches(t)) {
-            frusta.push(ShadowFrustum {
-                label: label.into(),
-                light: frustum,
-            });
-        } else {
-            culled_faces.push(label.to_owned());
+    let frusta = match cone {
+        Some((axis, outer_cone)) => {
+            passes::spot_light_frusta(position, axis, outer_cone, range).len()
         }
-    }
-    if frusta.is_empty() {
-        return NoPass(NoPassReason::OutOfReach);
-    }
-    shadowed(light, settings, dynamic_geometry, frusta, culled_faces)
+        None => passes::point_light_faces(position, range).len(),
+    };
+    shadowed(light, settings, dynamic_geometry, c_light, frusta)
 }
 
 /// A shadowed light: its configuration from the settings' base and the light's size and flags.
@@ -757,8 +638,8 @@ fn shadowed(
     light: &SceneLight,
     settings: &PlanSettings,
     dynamic_geometry: bool,
-    frusta: Vec<ShadowFrustum>,
-    culled_faces: Vec<String>,
+    c_light: HrtsLight,
+    frusta: usize,
 ) -> LightDecision {
     let mut config = settings.base;
     config.static_geometry = !dynamic_geometry;
@@ -781,14 +662,15 @@ fn shadowed(
     LightDecision::Shadowed(Box::new(ShadowedLight {
         config,
         frame_plan: FramePlan::derive(config.plan_request()),
-        frusta,
-        culled_faces,
+        light: c_light,
+        frusta: passes::frustum_names(frusta),
     }))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hrts_plugin::HrtsLightType;
     use passes::PassId;
     use scene::Scene;
 
@@ -880,8 +762,8 @@ mod tests {
         let p = only(ground_and_box(vec![sun(LightSize::Zero)]));
         let s = p.shadowed().expect("shadowed");
         assert_eq!(s.config.mode, ShadowMode::Hard);
-        assert_eq!(s.frusta.len(), 1);
-        assert!(matches!(s.frusta[0].light, Light::Directional { .. }));
+        assert_eq!(s.frusta, ["whole"]);
+        assert_eq!(s.light.light_type, HrtsLightType::Directional as u32);
         for r in [ResourceId::ShadowMap, ResourceId::Pcss] {
             assert!(!s.frame_plan.resources().contains(r), "{r:?}");
         }
@@ -907,22 +789,13 @@ mod tests {
         assert_eq!(s.config.mode, ShadowMode::Hybrid);
         assert_eq!(s.config.pcss.spot_radius, 0.05);
         assert_eq!(s.config.map.faces, FaceMode::Both);
-        assert_eq!(s.frusta.len(), 1);
-        let Light::Spot {
-            position,
-            direction,
-            view_proj,
-        } = s.frusta[0].light
-        else {
-            panic!("a spot frustum")
-        };
-        assert_eq!(position, Vec3::new(0.0, 4.0, 0.0));
-        assert_eq!(direction, Vec3::NEG_Y);
-        // The frustum holds the cone: a point on the cone's edge projects inside, just.
-        let edge = position + Vec3::new(0.5f32.tan(), -1.0, 0.0) * 2.0;
-        let ndc = view_proj.project_point3(edge);
-        assert!(ndc.x.abs().max(ndc.y.abs()) < 1.0 && ndc.x.abs().max(ndc.y.abs()) > 0.98);
-        assert!((0.0..1.0).contains(&ndc.z));
+        // A fitted spot light: no matrix; the plugin fits one frustum to its cone and range.
+        assert_eq!(s.frusta, ["whole"]);
+        assert_eq!(s.light.light_type, HrtsLightType::Spot as u32);
+        assert_eq!(s.light.position, [0.0, 4.0, 0.0]);
+        assert_eq!(s.light.direction, [0.0, -1.0, 0.0]);
+        assert_eq!((s.light.outer_cone, s.light.range), (0.5, 10.0));
+        assert!(s.light.view_proj.iter().all(|&x| x == 0.0));
     }
 
     #[test]
@@ -994,7 +867,7 @@ mod tests {
     }
 
     #[test]
-    fn a_point_light_is_shadowed_through_the_faces_its_receivers_need() {
+    fn a_point_light_is_given_to_the_plugin_as_a_point_light() {
         let lamp = light(
             "lamp",
             LightKind::Point {
@@ -1005,66 +878,29 @@ mod tests {
         );
         let p = only(ground_and_box(vec![lamp]));
         let s = p.shadowed().expect("shadowed");
-        let labels: Vec<&str> = s.frusta.iter().map(|f| f.label.as_str()).collect();
-        // Nothing lies above the lamp: no +Y face.
-        assert_eq!(labels, ["+X", "-X", "-Y", "+Z", "-Z"]);
-        assert_eq!(s.culled_faces, ["+Y"]);
+        assert_eq!(s.light.light_type, HrtsLightType::Point as u32);
+        assert_eq!((s.light.position, s.light.range), ([2.0, 1.5, 2.0], 20.0));
+        assert_eq!(s.frusta, ["+X", "-X", "+Y", "-Y", "+Z", "-Z"]);
         assert_eq!(s.config.mode, ShadowMode::Hybrid);
         assert_eq!(s.config.pcss.spot_radius, 0.1);
-        // A short range keeps only the faces that reach the ground and box within it.
-        let near_lamp = light(
-            "lamp",
-            LightKind::Point {
-                position: Vec3::new(0.0, 1.6, 0.0),
-                range: Some(0.7),
-            },
-            LightSize::Zero,
-        );
-        let p = only(ground_and_box(vec![near_lamp]));
-        let s = p.shadowed().expect("shadowed");
-        let labels: Vec<&str> = s.frusta.iter().map(|f| f.label.as_str()).collect();
-        assert_eq!(labels, ["-Y"]);
-        assert_eq!(s.config.mode, ShadowMode::Hard);
-    }
-
-    #[test]
-    fn cube_faces_cover_every_direction_inside_their_frusta() {
-        let lamp = light(
-            "lamp",
-            LightKind::Point {
-                position: Vec3::new(0.3, 2.0, -0.2),
-                range: None,
-            },
-            LightSize::Zero,
-        );
-        let bounds = ground_and_box(Vec::new()).scene.bounds();
-        let position = lamp.kind.position().expect("position");
-        let depths = depth_range(position, &bounds, None);
-        let faces: Vec<Light> = cube_faces(None)
-            .into_iter()
-            .map(|(_, f, up)| perspective_frustum(position, f, up, FRUSTUM_WIDENING, depths).0)
-            .collect();
-        let mut rng = scene::SplitMix64::new(7);
-        for _ in 0..2000 {
-            let d = Vec3::new(
-                rng.uniform_f32(-1.0, 1.0),
-                rng.uniform_f32(-1.0, 1.0),
-                rng.uniform_f32(-1.0, 1.0),
-            );
-            let Some(d) = d.try_normalize() else { continue };
-            let p = position + d * 1.5;
-            let inside = faces.iter().filter(|f| {
-                let c = f.view_proj() * p.extend(1.0);
-                c.w > 0.0 && c.x.abs() < c.w * 0.999 && c.y.abs() < c.w * 0.999
-            });
-            assert!(inside.count() >= 1, "direction {d} is in no face");
-        }
+        assert!(p.describe_decision().contains("per cube face"));
         // A wide spot light: the front face and the four across its axis, no back face.
         let wide = spot(Vec3::new(0.0, 3.0, 0.0), Vec3::NEG_Y, 1.3, None);
         let p = only(ground_and_box(vec![wide]));
         let s = p.shadowed().expect("shadowed");
-        let labels: Vec<&str> = s.frusta.iter().map(|f| f.label.as_str()).collect();
-        assert_eq!(labels, ["front", "right", "left", "up", "down"]);
+        assert_eq!(s.frusta, ["front", "right", "left", "up", "down"]);
+        assert_eq!(s.light.range, 0.0);
+        // A lamp whose range reaches no receiver in view gets no pass.
+        let far_lamp = light(
+            "lamp",
+            LightKind::Point {
+                position: Vec3::new(0.0, 4.0, 0.0),
+                range: Some(2.0),
+            },
+            LightSize::Zero,
+        );
+        let p = only(ground_and_box(vec![far_lamp]));
+        assert_eq!(p.decision, LightDecision::NoPass(NoPassReason::OutOfReach));
     }
 
     #[test]
@@ -1120,11 +956,11 @@ mod tests {
                 ("rim", Some(ShadowMode::Hard), 1),
                 ("spot", Some(ShadowMode::Hybrid), 1),
                 ("fill", None, 0),
-                ("cart_lamp", Some(ShadowMode::Hybrid), 5),
+                ("cart_lamp", Some(ShadowMode::Hybrid), 6),
             ]
         );
         assert!(p.dynamic_geometry);
-        assert_eq!(p.plugin_lights().len(), 8);
+        assert_eq!(p.plugin_lights().len(), 4);
         let text = p.describe();
         assert!(text.contains("fill: point"), "{text}");
         assert!(text.contains("no pass (casts no shadows)"), "{text}");
@@ -1176,14 +1012,14 @@ mod tests {
     }
 
     #[test]
-    fn more_frusta_than_the_plugin_shades_is_an_error() {
-        // Each lamp needs at least 5 cube faces in view: more lamps than a fifth of the limit overflow it.
-        let lamps: Vec<SceneLight> = (0..=HRTS_MAX_LIGHTS / 5)
+    fn more_lights_than_the_plugin_shades_is_an_error() {
+        // A point light counts once.
+        let lamps: Vec<SceneLight> = (0..=HRTS_MAX_LIGHTS)
             .map(|i| {
                 light(
                     &format!("lamp{i}"),
                     LightKind::Point {
-                        position: Vec3::new(i as f32 * 0.2 - 1.5, 0.5, 1.5),
+                        position: Vec3::new(i as f32 * 0.04 - 1.5, 0.5, 1.5),
                         range: None,
                     },
                     LightSize::Zero,
@@ -1192,7 +1028,7 @@ mod tests {
             .collect();
         let file = ground_and_box(lamps);
         let error = plan_scene(&file, &file.camera.expect("camera"), &settings())
-            .expect_err("too many frusta")
+            .expect_err("too many lights")
             .to_string();
         assert!(
             error.contains(&format!("at most {HRTS_MAX_LIGHTS}")),

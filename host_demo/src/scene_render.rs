@@ -1,6 +1,7 @@
 //! `host_demo render --scene`: a glTF scene's lights through the plugin's C ABI as the scene's plan
-//! ([`crate::scene_plan`]) says, each frustum one light of the plugin, the shaded image and every light's
-//! visibility, and per frame and light what ran, what was reused and why, and the memory it holds.
+//! ([`crate::scene_plan`]) says, each shadowed light one light of the plugin, the shaded image and every
+//! light's visibility, and per frame and light what ran, what was culled or reused and why, and the
+//! memory it holds.
 
 use crate::output::{write_exr_rgba, write_exr_scalar, write_png};
 use crate::plugin::{LightFrameReport, LightsFrame, PluginRenderer};
@@ -32,11 +33,11 @@ pub struct SceneRenderer {
 pub struct SceneImages {
     /// The demo's G-buffer (position, normal, depth).
     pub gbuffer: FrameImages,
-    /// Per scene light: the minimum over its frusta's visibilities, or 1 everywhere for a light without
+    /// Per scene light: its layer of the plugin's visibility image, or 1 everywhere for a light without
     /// a pass.
     pub visibility: Vec<Vec<f32>>,
-    /// Per plugin light (frustum): its layer of the visibility image.
-    pub frusta: Vec<Vec<f32>>,
+    /// Per plugin light: its layer of the visibility image.
+    pub layers: Vec<Vec<f32>>,
 }
 
 impl SceneRenderer {
@@ -58,8 +59,8 @@ impl SceneRenderer {
         &self.plugin
     }
 
-    /// Renders one frame of `plan` seen through `camera`: configures the plugin with the plan's frusta
-    /// (unchanged lights keep their passes) and records them. Returns the plugin's report per frustum.
+    /// Renders one frame of `plan` seen through `camera`: configures the plugin with the plan's lights
+    /// (unchanged lights keep their passes) and records them. Returns the plugin's report per light.
     pub fn render(
         &mut self,
         device: &Device,
@@ -68,28 +69,26 @@ impl SceneRenderer {
     ) -> Result<LightsFrame> {
         self.plugin
             .configure_lights(device, &plan.plugin_configs())?;
-        self.plugin.render_lights(
+        self.plugin.render_c_lights(
             device,
             &CameraMatrices::of_camera(camera, self.width, self.height),
-            &plan.plugin_frame_lights(),
+            plan.plugin_frame_lights(),
         )
     }
 
-    /// Reads back the last frame: the G-buffer, every frustum's visibility and every scene light's
-    /// visibility (the minimum over its frusta: the plugin counts pixels outside a frustum as lit).
+    /// Reads back the last frame: the G-buffer, every plugin light's layer and every scene light's
+    /// visibility.
     pub fn read_back(&self, device: &Device, plan: &ScenePlan) -> Result<SceneImages> {
-        let (gbuffer, frusta) = self.plugin.read_frame(device)?;
+        let (gbuffer, layers) = self.plugin.read_frame(device)?;
         let pixels = self.width as usize * self.height as usize;
         let mut visibility = vec![vec![1.0f32; pixels]; plan.lights.len()];
-        for (light, layer) in plan.plugin_lights().iter().zip(&frusta) {
-            for (v, &f) in visibility[light.scene_light].iter_mut().zip(layer) {
-                *v = v.min(f);
-            }
+        for (light, layer) in plan.plugin_lights().iter().zip(&layers) {
+            visibility[light.scene_light].clone_from(layer);
         }
         Ok(SceneImages {
             gbuffer,
             visibility,
-            frusta,
+            layers,
         })
     }
 }
@@ -209,13 +208,11 @@ pub fn describe_frame(
             .sum()
     };
     for (i, light) in plan.lights.iter().enumerate() {
-        let mine: Vec<(usize, &LightFrameReport)> = frame
-            .lights
+        let mine = plugin_lights
             .iter()
-            .enumerate()
-            .filter(|&(k, _)| plugin_lights.get(k).is_some_and(|l| l.scene_light == i))
-            .collect();
-        let Some(shadowed) = light.shadowed() else {
+            .position(|l| l.scene_light == i)
+            .and_then(|k| frame.lights.get(k).map(|r| (k, r)));
+        let (Some(shadowed), Some((k, report))) = (light.shadowed(), mine) else {
             let _ = writeln!(
                 s,
                 "  {}: {}; holds nothing",
@@ -224,67 +221,59 @@ pub fn describe_frame(
             );
             continue;
         };
-        let total: u64 = mine.iter().map(|(_, r)| own_bytes(r)).sum();
+        let built_now = previous
+            .and_then(|p| p.lights.get(k))
+            .is_none_or(|p| p.light_builds != report.light_builds);
         let _ = writeln!(
             s,
-            "  {}: {}, {} frust{}, holds {}",
+            "  {} (plugin light {k}): {}, {} of {} frust{} recorded, holds {}; passes built {} time{}",
             light.light.name,
             shadowed.config.mode.name(),
-            mine.len(),
-            if mine.len() == 1 { "um" } else { "a" },
-            size(total)
+            report.frusta,
+            shadowed.frusta.len(),
+            if shadowed.frusta.len() == 1 { "um" } else { "a" },
+            size(own_bytes(report)),
+            report.light_builds,
+            if report.light_builds == 1 { "" } else { "s" }
         );
-        for (k, report) in mine {
-            let pl = &plugin_lights[k];
-            let built_now = previous
-                .and_then(|p| p.lights.get(k))
-                .is_none_or(|p| p.light_builds != report.light_builds);
-            let _ = writeln!(
-                s,
-                "    {} (plugin light {k}): passes built {} time{}",
-                pl.frustum.label,
-                report.light_builds,
-                if report.light_builds == 1 { "" } else { "s" }
-            );
-            let mut by_status: BTreeMap<&str, Vec<&str>> = BTreeMap::new();
-            for &(pass, status) in &report.report.passes {
-                by_status
-                    .entry(status_name(status))
-                    .or_default()
-                    .push(pass.name());
-            }
-            // The output copy (a pass of the C ABI only) ends every frame of a light.
-            by_status.entry("RAN").or_default().push("output copy");
-            for name in ["RAN", "UP_TO_DATE", "SHARED", "NOT_IN_PLAN", "CULLED"] {
-                if let Some(passes) = by_status.get(name) {
-                    let _ = writeln!(s, "      {name:<11} {}", passes.join(", "));
-                }
-            }
-            let _ = writeln!(
-                s,
-                "      why: {}",
-                light_space_reason(
-                    report,
-                    built_now,
-                    pl.config.static_light,
-                    !pl.config.static_geometry
-                )
-            );
-            let resources: Vec<String> = report
-                .report
-                .resources
-                .iter()
-                .filter(|r| r.resource != ResourceId::PrimBuffer)
-                .map(|r| format!("{} {}", r.resource.name(), size(r.bytes)))
-                .collect();
-            let _ = writeln!(
-                s,
-                "      memory {}: {}",
-                size(own_bytes(report)),
-                resources.join(", ")
-            );
-            let _ = writeln!(s, "      cost {}", describe_cost(&report.report));
+        let mut by_status: BTreeMap<&str, Vec<&str>> = BTreeMap::new();
+        for &(pass, status) in &report.report.passes {
+            by_status
+                .entry(status_name(status))
+                .or_default()
+                .push(pass.name());
         }
+        // The output copy (a pass of the C ABI only) ends every frame of a light.
+        by_status.entry("RAN").or_default().push("output copy");
+        for name in ["RAN", "UP_TO_DATE", "SHARED", "NOT_IN_PLAN", "CULLED"] {
+            if let Some(passes) = by_status.get(name) {
+                let _ = writeln!(s, "      {name:<11} {}", passes.join(", "));
+            }
+        }
+        let _ = writeln!(
+            s,
+            "      why: {}",
+            light_space_reason(
+                report,
+                built_now,
+                shadowed.config.static_light,
+                !shadowed.config.static_geometry
+            )
+        );
+        let resources: Vec<String> = report
+            .report
+            .resources
+            .iter()
+            .filter(|r| r.resource != ResourceId::PrimBuffer)
+            .map(|r| format!("{} {}", r.resource.name(), size(r.bytes)))
+            .collect();
+        let _ = writeln!(
+            s,
+            "      memory {}: {}",
+            size(own_bytes(report)),
+            resources.join(", ")
+        );
+        let _ = writeln!(s, "      cost {}", describe_cost(&report.report));
     }
     let shared = frame.lights.iter().find_map(|r| {
         r.report
@@ -312,11 +301,13 @@ struct LightJson {
 }
 
 #[derive(Serialize)]
-struct FrustumReportJson {
+struct LightReportJson {
     scene_light: String,
-    frustum: String,
     mode: &'static str,
     light_builds: u32,
+    frusta_recorded: u32,
+    frusta_culled: u32,
+    decision: String,
     pass_status: BTreeMap<&'static str, &'static str>,
     resource_bytes: BTreeMap<&'static str, u64>,
     gpu_ms: f64,
@@ -353,7 +344,7 @@ impl From<&MapStats> for ListsJson {
 #[derive(Serialize)]
 struct FrameReportJson {
     frame_index: u64,
-    lights: Vec<FrustumReportJson>,
+    lights: Vec<LightReportJson>,
 }
 
 #[derive(Serialize)]
@@ -451,7 +442,7 @@ pub fn render_scene_to_folder(
             decision: light.describe_decision(),
             frusta: light
                 .shadowed()
-                .map(|s| s.frusta.iter().map(|f| f.label.clone()).collect())
+                .map(|s| s.frusta.iter().map(|&f| f.to_owned()).collect())
                 .unwrap_or_default(),
             visibility_png: png_name,
             visibility_exr: exr_name,
@@ -466,11 +457,13 @@ pub fn render_scene_to_folder(
                 .lights
                 .iter()
                 .zip(&plugin_lights)
-                .map(|(report, pl)| FrustumReportJson {
+                .map(|(report, pl)| LightReportJson {
                     scene_light: plan.lights[pl.scene_light].light.name.clone(),
-                    frustum: pl.frustum.label.clone(),
-                    mode: pl.config.mode.name(),
+                    mode: pl.shadowed.config.mode.name(),
                     light_builds: report.light_builds,
+                    frusta_recorded: report.frusta,
+                    frusta_culled: report.frusta_culled,
+                    decision: report.decision.clone(),
                     pass_status: report
                         .report
                         .passes

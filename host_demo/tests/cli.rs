@@ -239,7 +239,7 @@ fn plan_prints_every_light_without_a_device() {
         String::from_utf8_lossy(&output.stderr)
     );
     for expected in [
-        "shadowed through 8 plugin lights",
+        "lights: 5, 4 shadowed by the plugin",
         "[0] sun: directional",
         "-> hybrid (sized light: PCSS with pcss_angular_radius 0.01 rad",
         "[1] rim: directional",
@@ -248,7 +248,7 @@ fn plan_prints_every_light_without_a_device() {
         "[3] fill: point",
         "-> no pass (casts no shadows): visibility 1",
         "[4] cart_lamp: point",
-        "faces not built (no receiver in view within reach): +Y",
+        "plugin light 3: 6 frusta fitted by the plugin (+X, -X, +Y, -Y, +Z, -Z)",
         "dynamic (not static: cart_body, cart_load)",
     ] {
         assert!(
@@ -320,11 +320,26 @@ fn scene_render_reports_what_each_light_ran_and_kept() {
         stdout.contains("fill: no pass (casts no shadows)"),
         "{stdout}"
     );
-    assert_eq!(json["plugin_lights"], 8);
+    assert_eq!(json["plugin_lights"], 4);
     let frames = json["frames"].as_array().expect("frames");
     assert_eq!(frames.len(), 2);
     let second = frames[1]["lights"].as_array().expect("lights");
-    assert_eq!(second.len(), 8);
+    assert_eq!(second.len(), 4);
+    // The lamp is one plugin light: the plugin fits six faces and says which it recorded.
+    let lamp = &second[3];
+    assert_eq!(lamp["scene_light"], "cart_lamp");
+    assert_eq!(
+        lamp["frusta_recorded"].as_u64().unwrap() + lamp["frusta_culled"].as_u64().unwrap(),
+        6,
+        "{lamp}"
+    );
+    assert!(
+        lamp["decision"]
+            .as_str()
+            .unwrap()
+            .starts_with("point light: "),
+        "{lamp}"
+    );
     for light in second {
         assert_eq!(light["light_builds"], 1, "{light}");
         assert_eq!(light["pass_status"]["prim buffer"], "UP_TO_DATE", "{light}");

@@ -102,6 +102,23 @@ fn perspective(position: Vec3, forward: Vec3, up: Vec3, tan_half: f32, near: f32
     }
 }
 
+/// Names of a point light's cube faces, in the order of [`point_light_faces`].
+pub const POINT_FACE_NAMES: [&str; 6] = ["+X", "-X", "+Y", "-Y", "+Z", "-Z"];
+
+/// Names of the faces of a spot light wider than [`MAX_SINGLE_FRUSTUM_CONE`], in the order of
+/// [`spot_light_frusta`]: its axis, then the four directions across it.
+pub const SPOT_FACE_NAMES: [&str; 5] = ["front", "right", "left", "up", "down"];
+
+/// The names of a light's frusta in reports: its cube faces (`count` 6: a point light's; 5: a wide spot
+/// light's), else "whole" for its one frustum.
+pub fn frustum_names(count: usize) -> &'static [&'static str] {
+    match count {
+        6 => &POINT_FACE_NAMES,
+        5 => &SPOT_FACE_NAMES,
+        _ => &["whole"],
+    }
+}
+
 /// The frusta that shadow a point light at `position` of `range` (`None`: unlimited): the six cube faces
 /// along ±X, ±Y, ±Z, each [`CUBE_FACE_TAN_HALF`] wide, so that every direction lies inside one. A pixel
 /// outside a face's frustum is lit in that face's visibility: the light's visibility is the minimum over

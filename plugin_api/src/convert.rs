@@ -155,16 +155,12 @@ pub(crate) struct FrameLight {
 }
 
 impl FrameLight {
-    /// The names of the frusta in reports: a point light's cube faces, a wide spot light's faces.
+    /// The name of frustum `frustum` in reports: a point light's cube face, a wide spot light's face.
     pub(crate) fn frustum_name(&self, frustum: usize) -> &'static str {
-        const POINT: [&str; 6] = ["+X", "-X", "+Y", "-Y", "+Z", "-Z"];
-        const SPOT: [&str; 5] = ["front", "right", "left", "up", "down"];
-        let names: &[&str] = match (self.kind, self.frusta.len()) {
-            (HrtsLightType::Point, 6) => &POINT,
-            (HrtsLightType::Spot, 5) => &SPOT,
-            _ => &[],
-        };
-        names.get(frustum).copied().unwrap_or("frustum")
+        passes::frustum_names(self.frusta.len())
+            .get(frustum)
+            .copied()
+            .unwrap_or("whole")
     }
 }
 

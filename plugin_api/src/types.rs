@@ -532,7 +532,7 @@ pub struct HrtsTargets {
 
 /// One light of a frame.
 #[repr(C)]
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HrtsLight {
     /// `HrtsLightType`.
     pub light_type: u32,
