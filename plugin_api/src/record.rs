@@ -321,11 +321,17 @@ fn record_output_copy(
         .iter()
         .flatten()
         .zip(recorded)
-        .filter_map(|(l, r)| l.combine.as_ref().map(|c| (c, r)))
+        .filter_map(|(l, r)| l.combine.as_ref().map(|c| (l, c, r)))
         .collect();
     if !combines.is_empty() {
         enc.barriers(&[Barrier::Uav]);
-        for (combine, recorded) in combines {
+        for (light, combine, recorded) in combines {
+            // Timed with the light's last frustum recorded this frame, so that the light's report holds
+            // its whole cost; a light with none recorded only fills its layer with 1, untimed.
+            match light.frusta.iter().zip(recorded).rev().find(|(_, &r)| r) {
+                Some((timed, _)) => timed.continue_timing(enc),
+                None => enc.stop_timing(),
+            }
             combine.record(enc, recorded)?;
         }
     }

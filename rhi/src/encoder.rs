@@ -219,6 +219,11 @@ impl<'a> Encoder<'a> {
         self.timer = Some(timer.clone());
     }
 
+    /// Records the next passes without timestamps, until a timer is attached or continued.
+    pub fn stop_timing(&mut self) {
+        self.timer = None;
+    }
+
     /// Opens a named pass: a debug label and a begin timestamp (when a timer is attached).
     pub fn begin_pass(&mut self, name: &str) {
         if let Some(utils) = &self.device.shared.debug_utils {

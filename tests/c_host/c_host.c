@@ -1460,6 +1460,11 @@ static void native_local_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometr
         CHECK(rep.frusta + rep.frusta_culled == want_frusta[i] && rep.decision == HRTS_LIGHT_DECISION_SHADOWED,
               "light %d: %u frusta recorded, %u culled, decision %u", i, rep.frusta, rep.frusta_culled, rep.decision);
         CHECK(rep.gpu_milliseconds > 0.0 && rep.texels_past_capacity == 0, "light %d: report", i);
+        /* the minimum over the light's frusta (one step per frustum recorded) is timed in its own report */
+        uint32_t combine_timed = 0;
+        for (uint32_t p = 0; p < rep.pass_count; p++) combine_timed += strcmp(rep.passes[p].name, "min over frusta") == 0;
+        CHECK(combine_timed == rep.frusta, "light %d: 'min over frusta' timed %u times in its report for %u frusta", i,
+              combine_timed, rep.frusta);
         CHECK(mismatches == 0, "light %d: %d pixels differ from the exact shadow", i, mismatches);
         CHECK(shadowed > 100 && lit > 1000 && near_edge * 100 <= 4 * W * H, "light %d: %d shadowed, %d lit, %d near-edge px",
               i, shadowed, lit, near_edge);

@@ -71,6 +71,15 @@ impl ShadowPipeline {
         Ok(())
     }
 
+    /// Times the next passes recorded into `enc` in the current frame's GPU timer, as part of this
+    /// pipeline's frame report (work a host records for it after its passes, such as combining a light's
+    /// frusta). Does nothing before a frame was begun.
+    pub fn continue_timing(&self, enc: &mut Encoder<'_>) {
+        if let Some(frame) = &self.frame {
+            enc.continue_timer(&self.slots[frame.slot].timer);
+        }
+    }
+
     /// Whether [`ShadowPipeline::record_passes`] would accept `passes` now (without recording anything).
     pub fn check_record(&self, passes: &[PassId]) -> Result<(), PassError> {
         let frame = self
