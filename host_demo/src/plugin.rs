@@ -471,6 +471,7 @@ impl PluginRenderer {
             passes,
             resources,
             output,
+            map_scratch_bytes: r.map_scratch_bytes,
         };
         Ok(LightFrameReport {
             report,

@@ -281,11 +281,18 @@ pub fn describe_frame(
             .iter()
             .find(|r| r.resource == ResourceId::PrimBuffer)
     });
+    let scratch = frame
+        .lights
+        .iter()
+        .map(|r| r.report.map_scratch_bytes)
+        .max()
+        .unwrap_or(0);
     if let Some(prims) = shared {
         let _ = writeln!(
             s,
-            "  shared by the lights: prim buffer {}",
-            size(prims.bytes)
+            "  shared by the lights: prim buffer {}, primitive-map build scratch {}",
+            size(prims.bytes),
+            size(scratch)
         );
     }
     s

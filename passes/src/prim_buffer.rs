@@ -4,6 +4,7 @@
 //! Reads: vertex buffer, index buffer. Writes: prim buffer.
 
 use crate::gpu_types::{GpuTriangle, PrimBufferPush};
+use crate::primitive_map::MapScratchPool;
 use crate::{shader, PassError};
 use glam::{DMat4, DVec3, Mat4};
 use rhi::{
@@ -342,6 +343,7 @@ pub struct SharedGeometry {
     geometry: Geometry,
     pass: PrimBufferPass,
     state: Mutex<PrimBufferState>,
+    map_scratch: MapScratchPool,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -364,6 +366,7 @@ impl SharedGeometry {
                 built: false,
                 claimed: None,
             }),
+            map_scratch: MapScratchPool::default(),
         }))
     }
 
@@ -375,6 +378,11 @@ impl SharedGeometry {
     /// The prim buffer (triangles in frame coordinates).
     pub fn prims(&self) -> &Buffer {
         self.pass.prims()
+    }
+
+    /// The build scratch the primitive maps over this geometry share (one light's map is built at a time).
+    pub fn map_scratch(&self) -> &MapScratchPool {
+        &self.map_scratch
     }
 
     /// Whether the prim buffer is rebuilt every frame.

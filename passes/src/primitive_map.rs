@@ -270,6 +270,91 @@ pub struct PrimitiveMapInputs<'a> {
     /// Whether the occupancy pass draws the N×N occupancy view, besides the statistics it always
     /// gathers.
     pub occupancy_view: bool,
+    /// Where the map takes its build scratch from (one pool per geometry).
+    pub scratch: &'a MapScratchPool,
+}
+
+/// The buffers a map uses only while it is built (per-triangle bin items and tile offsets, per-texel
+/// counts), shared by every map over the same geometry: the builds are recorded one after another with
+/// barriers between them (each clears the counts first), so one set serves every light and frustum.
+pub struct MapScratch {
+    bin_tris: Buffer,
+    tile_offsets: Buffer,
+    counts: Buffer,
+    /// The largest map size N the counts hold.
+    size: u32,
+}
+
+impl MapScratch {
+    /// GPU bytes of the scratch.
+    pub fn bytes(&self) -> u64 {
+        [&self.bin_tris, &self.tile_offsets, &self.counts]
+            .iter()
+            .map(|b| b.size())
+            .sum()
+    }
+}
+
+/// The scratch shared by the maps over one geometry: it grows to the largest map size asked for; a map
+/// keeps the scratch it was created with (the pool's newer, larger one serves the maps created after).
+#[derive(Default)]
+pub struct MapScratchPool {
+    current: std::sync::Mutex<Option<std::sync::Arc<MapScratch>>>,
+}
+
+impl MapScratchPool {
+    /// The scratch for a map of size `size` over `triangles` triangles: the pool's, or a new one as large
+    /// as the largest asked for so far.
+    pub fn get(
+        &self,
+        device: &Device,
+        size: u32,
+        triangles: u32,
+    ) -> Result<std::sync::Arc<MapScratch>, PassError> {
+        let mut current = self
+            .current
+            .lock()
+            .map_err(|_| PassError::InvalidConfig("map scratch pool poisoned".into()))?;
+        if let Some(s) = current.as_ref().filter(|s| s.size >= size) {
+            return Ok(s.clone());
+        }
+        let size = current.as_ref().map_or(size, |s| s.size.max(size));
+        let n2 = u64::from(size) * u64::from(size);
+        let tris = u64::from(triangles);
+        let storage = |name, bytes: u64, usage| {
+            device.create_buffer(
+                name,
+                bytes.max(4),
+                BufferUsage::STORAGE | usage,
+                MemoryLocation::GpuOnly,
+            )
+        };
+        let scratch = std::sync::Arc::new(MapScratch {
+            bin_tris: storage("primitive map triangles", tris * 64, BufferUsage::default())?,
+            tile_offsets: storage(
+                "primitive map tile offsets",
+                (tris + 1) * 4,
+                BufferUsage::default(),
+            )?,
+            counts: storage(
+                "primitive map counts",
+                (n2 + 1) * 4,
+                BufferUsage::COPY_DST | BufferUsage::COPY_SRC,
+            )?,
+            size,
+        });
+        *current = Some(scratch.clone());
+        Ok(scratch)
+    }
+
+    /// GPU bytes of the pool's current scratch (0 before any map asked for one).
+    pub fn bytes(&self) -> u64 {
+        self.current
+            .lock()
+            .ok()
+            .and_then(|c| c.as_ref().map(|s| s.bytes()))
+            .unwrap_or(0)
+    }
 }
 
 /// The binning pipelines of the path in use.
@@ -299,16 +384,13 @@ pub struct PrimitiveMap {
     tile_scan: PrefixScan,
     offset_scan: PrefixScan,
     constants: Buffer,
-    bin_tris: Buffer,
-    tile_offsets: Buffer,
+    scratch: std::sync::Arc<MapScratch>,
     /// The map's per-frame state ([`MapState`]): fitted transform, totals, statistics.
     pub state: Buffer,
     /// N² `u32`: 0 where no ray origin lies, else the ordered largest depth key of the texel's origins.
     pub receivers: Buffer,
     /// One `u32` per screen pixel: the texel of its ray origin (or a no-ray / outside marker).
     pub pixel_texels: Buffer,
-    /// N² + 1 `u32` per-texel counts during the build (zero between frames).
-    counts: Buffer,
     /// N² + 1 `u32`: texel t's list is `entries[offsets[t] .. offsets[t + 1]]`.
     pub offsets: Buffer,
     /// The lists' triangle indices (capacity `u32`, plus the guard words in guard mode).
@@ -340,7 +422,6 @@ impl PrimitiveMap {
             )
         };
         let copy = BufferUsage::COPY_DST | BufferUsage::COPY_SRC;
-        let tris = u64::from(inputs.triangles);
         let constants = constant_buffer::<RayTraceConstants>(device, "primitive map constants")?;
         let state = storage(
             "primitive map state",
@@ -353,13 +434,9 @@ impl PrimitiveMap {
             u64::from(width) * u64::from(height) * 4,
             copy,
         )?;
-        let bin_tris = storage("primitive map triangles", tris * 64, BufferUsage::default())?;
-        let tile_offsets = storage(
-            "primitive map tile offsets",
-            (tris + 1) * 4,
-            BufferUsage::default(),
-        )?;
-        let counts = storage("primitive map counts", (n2 + 1) * 4, copy)?;
+        let scratch = inputs.scratch.get(device, n, inputs.triangles)?;
+        let (bin_tris, tile_offsets, counts) =
+            (&scratch.bin_tris, &scratch.tile_offsets, &scratch.counts);
         let offsets = storage("primitive map list offsets", (n2 + 1) * 4, copy)?;
         let capacity = config.starting_entries(caps, inputs.triangles);
         let entries = Self::create_entries(device, &config, capacity)?;
@@ -437,20 +514,11 @@ impl PrimitiveMap {
             &[
                 Resource::Buffer(inputs.prims),
                 Resource::Buffer(&state),
-                Resource::Buffer(&bin_tris),
-                Resource::Buffer(&tile_offsets),
+                Resource::Buffer(bin_tris),
+                Resource::Buffer(tile_offsets),
             ],
         )?;
-        let bin_group = Self::bin_group(
-            device,
-            &binner,
-            &bin_tris,
-            &tile_offsets,
-            &receivers,
-            &counts,
-            &offsets,
-            &entries,
-        )?;
+        let bin_group = Self::bin_group(device, &binner, &scratch, &receivers, &offsets, &entries)?;
         let occupancy_group = device.create_bind_group(
             occupancy_pipeline.layout(),
             &[
@@ -463,11 +531,11 @@ impl PrimitiveMap {
         let tile_scan = PrefixScan::new(
             device,
             &scan,
-            &tile_offsets,
-            &tile_offsets,
+            tile_offsets,
+            tile_offsets,
             inputs.triangles + 1,
         )?;
-        let offset_scan = PrefixScan::new(device, &scan, &counts, &offsets, (n2 + 1) as u32)?;
+        let offset_scan = PrefixScan::new(device, &scan, counts, &offsets, (n2 + 1) as u32)?;
         Ok(Self {
             config,
             path,
@@ -488,12 +556,10 @@ impl PrimitiveMap {
             tile_scan,
             offset_scan,
             constants,
-            bin_tris,
-            tile_offsets,
+            scratch,
             state,
             receivers,
             pixel_texels,
-            counts,
             offsets,
             entries,
             occupancy,
@@ -540,18 +606,17 @@ impl PrimitiveMap {
         })?)
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn bin_group(
         device: &Device,
         binner: &Binner,
-        bin_tris: &Buffer,
-        tile_offsets: &Buffer,
+        scratch: &MapScratch,
         receivers: &Buffer,
-        counts: &Buffer,
         offsets: &Buffer,
         entries: &Buffer,
     ) -> Result<BindGroup, PassError> {
         let b = Resource::Buffer;
+        let (bin_tris, tile_offsets, counts) =
+            (&scratch.bin_tris, &scratch.tile_offsets, &scratch.counts);
         Ok(match binner {
             Binner::Compute(p) => device.create_bind_group(
                 p.layout(),
@@ -586,15 +651,13 @@ impl PrimitiveMap {
         self.capacity
     }
 
-    /// Bytes the map holds on the GPU.
+    /// Bytes the map holds on the GPU (its share of the build scratch aside: see
+    /// [`PrimitiveMap::scratch`]).
     pub fn bytes(&self) -> u64 {
         [
             &self.state,
             &self.receivers,
             &self.pixel_texels,
-            &self.bin_tris,
-            &self.tile_offsets,
-            &self.counts,
             &self.offsets,
             &self.entries,
         ]
@@ -602,6 +665,11 @@ impl PrimitiveMap {
         .map(|b| b.size())
         .sum::<u64>()
             + self.occupancy_view().map_or(0, Image::byte_size)
+    }
+
+    /// The build scratch the map shares with the other maps over its geometry.
+    pub fn scratch(&self) -> &MapScratch {
+        &self.scratch
     }
 
     /// The occupancy view, when the map draws one.
@@ -670,7 +738,7 @@ impl PrimitiveMap {
             after: S::CopyDest,
         }]);
         enc.fill_buffer(&self.receivers, 0);
-        enc.fill_buffer(&self.counts, 0);
+        enc.fill_buffer(&self.scratch.counts, 0);
         if self.config.guard {
             enc.fill_buffer(&self.entries, GUARD_VALUE);
         }

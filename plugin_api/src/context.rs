@@ -725,6 +725,12 @@ impl Context {
         out.pass_status[HrtsPass::OutputCopy as usize] = HrtsPassStatus::Ran as u32;
         out.resource_bytes = [0; HRTS_RESOURCE_COUNT];
         out.prim_buffer_bytes = 0;
+        out.map_scratch_bytes = passes
+            .frusta
+            .iter()
+            .map(ShadowPipeline::map_scratch_bytes)
+            .max()
+            .unwrap_or(0);
         for r in passes.frusta.iter().flat_map(|p| p.resources()) {
             if let Some(i) = RESOURCES.iter().position(|&id| id == r.resource) {
                 out.resource_bytes[i] += r.bytes;

@@ -669,8 +669,12 @@ pub struct HrtsFrameReport {
     pub resource_bytes: [u64; HRTS_RESOURCE_COUNT],
     /// The `HrtsResource` copied into the output image.
     pub output_resource: u32,
-    /// Bytes of the prim buffer (triangles in frame coordinates; 0 if the plan has none).
+    /// Bytes of the prim buffer (triangles in frame coordinates; 0 if the plan has none), shared by the
+    /// context's lights.
     pub prim_buffer_bytes: u64,
+    /// Bytes of the primitive map's build scratch (per-triangle bin items, per-texel counts), shared by the
+    /// maps of the context's lights and frusta (0 if the light has no primitive map).
+    pub map_scratch_bytes: u64,
     /// Entries the lists could hold this frame (they grow to fit from the next frame on).
     pub entry_capacity: u32,
     /// Pixels that traced a shadow ray.

@@ -1385,11 +1385,16 @@ static void several_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g)
     CHECK(run_frame(ctx, vis) == HRTS_RESULT_OK, "8 lights: %s", hrts_last_error(ctx));
     double tol = edge_tolerance();
     int total_mismatches = 0, total_shadowed = 0;
+    uint64_t scratch = 0;
     for (int i = 0; i < N; i++) {
         int near_edge, shadowed, lit;
         int mismatches = count_mismatches(vis + i * W * H, tol, &lights[i], &near_edge, &shadowed, &lit);
         HrtsFrameReport rep;
         HrtsResult r = report(ctx, first, (uint32_t)i, &rep);
+        /* one primitive-map build scratch serves every light: the same bytes in every report */
+        if (i == 0) scratch = rep.map_scratch_bytes;
+        CHECK(rep.map_scratch_bytes > 0 && rep.map_scratch_bytes == scratch, "light %d: map scratch %llu bytes, light 0's %llu",
+              i, (unsigned long long)rep.map_scratch_bytes, (unsigned long long)scratch);
         printf("light %d (%s): %d lit, %d shadowed, %d near-edge, %d mismatches; prim buffer %s\n", i,
                lights[i].spot ? "spot" : "directional", lit, shadowed, near_edge, mismatches,
                rep.pass_status[HRTS_PASS_PRIM_BUFFER] == HRTS_PASS_STATUS_RAN ? "built" : "shared");

@@ -83,6 +83,7 @@ impl ShadowPipeline {
                 depth: inputs.depth,
                 normal: inputs.normal,
                 occupancy_view: plan.resources().contains(ResourceId::Occupancy),
+                scratch: shared.map_scratch(),
             };
             Some(PrimitiveMap::new(device, &map_inputs, config.map)?)
         } else {

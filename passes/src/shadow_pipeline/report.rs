@@ -38,6 +38,9 @@ pub struct FrameReport {
     pub resources: Vec<ResourceReport>,
     /// The resource [`ShadowPipeline::output`] holds.
     pub output: ResourceId,
+    /// GPU bytes of the primitive map's build scratch, shared by the maps of every light over the same
+    /// geometry (not in `resources`; 0 without a primitive map).
+    pub map_scratch_bytes: u64,
 }
 
 impl FrameReport {
@@ -71,6 +74,12 @@ impl ShadowPipeline {
                     .map(|bytes| ResourceReport { resource: r, bytes })
             })
             .collect()
+    }
+
+    /// GPU bytes of the primitive-map build scratch this pipeline shares with the other lights' (0 without
+    /// a primitive map).
+    pub fn map_scratch_bytes(&self) -> u64 {
+        self.map.as_ref().map_or(0, |m| m.scratch().bytes())
     }
 
     /// The binning path of the primitive map (what the device would use when the plan has none).
@@ -170,6 +179,7 @@ impl ShadowPipeline {
             passes: slot.statuses.clone(),
             resources,
             output: self.plan.final_output(),
+            map_scratch_bytes: self.map_scratch_bytes(),
         })
     }
 }
