@@ -15,6 +15,7 @@ pub mod compare;
 pub mod gbuffer;
 pub mod hardcases;
 pub mod images;
+pub mod interior;
 
 /// Limits of the command line's options, checked before any GPU work.
 pub mod limits {

@@ -3,6 +3,7 @@
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 use glam::Vec3;
+use host_demo::interior::Enclosure;
 use host_demo::render::{
     parse_binning, parse_faces, render_to_folder, world_space_scale_of, RenderOptions,
     SoftShadowArgs,
@@ -10,9 +11,10 @@ use host_demo::render::{
 use host_demo::scene_plan::{held_still, plan_scene, scene_camera, PlanSettings};
 use host_demo::scene_render::render_scene_to_folder;
 use host_demo::{parse_vec3, View};
-use passes::{BinningRequest, FaceMode, PrimitiveMapConfig};
+use passes::{BinningRequest, FaceMode, PrimitiveMapConfig, ShadowMode};
+use reference::RefScene;
 use rhi::Device;
-use scene::{Aabb, Camera, DirectionalLight, SceneFile};
+use scene::{Aabb, Camera, DirectionalLight, LightSize, Scene, SceneFile, SceneLight};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -89,10 +91,11 @@ struct RenderArgs {
     /// prints the plan and each frame's per-light report.
     #[arg(long, conflicts_with_all = ["obj", "no_ground", "light_dir", "dump_rays", "mode", "angular_radius"])]
     scene: Option<PathBuf>,
-    /// OBJ file to load (default: the built-in procedural scene).
+    /// OBJ file to load (default: the built-in procedural scene). A closed model (a room) is seen from
+    /// inside and lit by a point light below its ceiling, rendered as --scene renders a scene's lights.
     #[arg(long)]
     obj: Option<PathBuf>,
-    /// Do not add a ground plane under an OBJ model.
+    /// Do not add a ground plane under an OBJ model (a closed model never gets one).
     #[arg(long)]
     no_ground: bool,
     /// Output folder.
@@ -104,7 +107,8 @@ struct RenderArgs {
     /// Frame height in pixels.
     #[arg(long, default_value_t = 720, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
     height: u32,
-    /// Direction the light travels, "x,y,z" (default: slanted, about 34° from vertical).
+    /// Direction the light travels, "x,y,z" (default: slanted, about 34° from vertical; inside a closed
+    /// model, a point light below its ceiling).
     #[arg(long, value_parser = parse_vec3)]
     light_dir: Option<Vec3>,
     #[command(flatten)]
@@ -147,7 +151,8 @@ struct RenderArgs {
 /// Where the camera is, when not framed automatically (or, with `--scene`, taken from the file).
 #[derive(clap::Args)]
 struct CameraArgs {
-    /// Camera position "x,y,z" (default: the scene file's camera, else framed automatically).
+    /// Camera position "x,y,z" (default: the scene file's camera, else framed automatically: from
+    /// outside, or inside a closed model, in a corner at eye height looking across the room).
     #[arg(long, value_parser = parse_vec3)]
     camera_pos: Option<Vec3>,
     /// Camera target "x,y,z" (default: the scene file's camera's, else the scene centre).
@@ -304,18 +309,11 @@ fn render_scene(cli: &Cli, args: &RenderArgs, path: &Path) -> Result<()> {
         bail!("--frames must be at least 2 with --scene: the second frame's report shows what was kept");
     }
     let file = load_scene(path, args.still)?;
-    let map = PrimitiveMapConfig {
-        size: args.map_size,
-        faces: args.faces,
-        binning: args.binning,
-        entry_budget: u64::from(args.map_budget_mb) << 20,
-        ..PrimitiveMapConfig::default()
-    };
     let (camera, settings) = scene_setup(
         &file,
         (args.width, args.height),
         (args.camera.camera_pos, args.camera.camera_target),
-        map,
+        map_config(args),
         &args.soft,
     )?;
     let device = device(cli)?;
@@ -341,18 +339,34 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
     if let Some(path) = &args.scene {
         return render_scene(cli, args, path);
     }
+    let explicit_camera = args.camera.camera_pos.is_some() || args.camera.camera_target.is_some();
+    let mut interior_camera = None;
     let scene = match &args.obj {
         Some(path) => {
-            let s = scene::load_obj(path)?;
-            if args.no_ground {
-                s
+            let model = scene::load_obj(path)?;
+            let closed = if explicit_camera && args.light_dir.is_some() {
+                None
             } else {
-                s.with_ground_plane()
+                closed_interior(&model, args)?
+            };
+            match closed {
+                Some(interior) if args.light_dir.is_none() => {
+                    return render_closed(cli, args, path, model, interior);
+                }
+                Some(interior) => {
+                    interior_camera = Some(interior.camera);
+                    model
+                }
+                None if args.no_ground => model,
+                None => model.with_ground_plane(),
             }
         }
         None => scene::procedural_default(),
     };
     let mut view = View::framed(scene, args.width, args.height);
+    if let Some(camera) = interior_camera {
+        view.camera = camera;
+    }
     if let Some(d) = args.light_dir {
         view.light =
             DirectionalLight::new(d).context("--light-dir must be a non-zero finite vector")?;
@@ -365,13 +379,7 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
     )?;
     let device = device(cli)?;
     let options = RenderOptions {
-        map: PrimitiveMapConfig {
-            size: args.map_size,
-            faces: args.faces,
-            binning: args.binning,
-            entry_budget: u64::from(args.map_budget_mb) << 20,
-            ..PrimitiveMapConfig::default()
-        },
+        map: map_config(args),
         frames: args.frames,
         soft: args.soft.clone(),
         occupancy_view: !args.no_occupancy,
@@ -382,6 +390,122 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
         println!("ray dump: {dump:?}");
     }
     host_demo::check_validation(&device)
+}
+
+/// The camera and light inside a closed model, as `render --obj` places them by default.
+struct Interior {
+    camera: Camera,
+    light: SceneLight,
+}
+
+/// Whether `model` is a closed scene (see [`host_demo::interior`]), printed with what follows from it;
+/// if it is, the camera and light inside it. `args` says which of them the command line sets.
+fn closed_interior(model: &Scene, args: &RenderArgs) -> Result<Option<Interior>> {
+    let reference = RefScene::new(model);
+    let enclosure = Enclosure::probe(&reference, &model.bounds());
+    let angular_radius = match args.soft.mode {
+        ShadowMode::Hybrid => args.soft.angular_radius,
+        _ => 0.0,
+    };
+    let aspect = args.width as f32 / args.height as f32;
+    let inside = (
+        enclosure.interior_camera(&reference, aspect),
+        enclosure.interior_light(&reference, angular_radius),
+    );
+    let (true, (Some(camera), Some(mut light))) = (enclosure.is_closed(), inside) else {
+        println!(
+            "{}; the default view is from outside, lit by the sun",
+            enclosure.describe()
+        );
+        return Ok(None);
+    };
+    let camera_text = if args.camera.camera_pos.is_some() || args.camera.camera_target.is_some() {
+        "camera from the command line".to_owned()
+    } else {
+        format!(
+            "camera inside at ({}) looking at ({})",
+            xyz(camera.position),
+            xyz(camera.target)
+        )
+    };
+    let light_text = match (args.light_dir, light.kind.position()) {
+        (None, Some(position)) => {
+            match args.soft.mode {
+                ShadowMode::Soft => bail!(
+                    "--mode soft: the point light inside a closed scene is shadowed hard or hybrid; pass \
+                     --light-dir for a sun with soft shadows"
+                ),
+                ShadowMode::None => light.casts_shadows = false,
+                ShadowMode::Hard | ShadowMode::Hybrid => {}
+            }
+            if args.dump_rays {
+                bail!(
+                    "--dump-rays writes a sun's shadow rays: pass --light-dir to light the closed scene \
+                     with a sun"
+                );
+            }
+            let size = match light.size {
+                LightSize::Radius(r) => format!("a sphere of radius {r:.3}"),
+                _ => "zero size".to_owned(),
+            };
+            format!(
+                "point light at ({}) below the ceiling, {size}",
+                xyz(position)
+            )
+        }
+        _ => "the sun of --light-dir".to_owned(),
+    };
+    println!(
+        "{}; {camera_text}, {light_text}; no ground plane",
+        enclosure.describe()
+    );
+    Ok(Some(Interior { camera, light }))
+}
+
+/// "x, y, z" with three decimals.
+fn xyz(v: Vec3) -> String {
+    format!("{:.3}, {:.3}, {:.3}", v.x, v.y, v.z)
+}
+
+/// Renders a closed model as a scene of one interior point light (see `render --scene`), seen from
+/// the interior camera unless the command line places it.
+fn render_closed(
+    cli: &Cli,
+    args: &RenderArgs,
+    path: &Path,
+    model: Scene,
+    interior: Interior,
+) -> Result<()> {
+    let file = host_demo::interior::scene_file(model, interior.light, interior.camera);
+    let (camera, settings) = scene_setup(
+        &file,
+        (args.width, args.height),
+        (args.camera.camera_pos, args.camera.camera_target),
+        map_config(args),
+        &args.soft,
+    )?;
+    let device = device(cli)?;
+    render_scene_to_folder(
+        &device,
+        &file,
+        path,
+        &camera,
+        &settings,
+        args.frames,
+        &args.out,
+    )?;
+    host_demo::check_validation(&device)
+}
+
+/// The primitive map the command line asks for.
+fn map_config(args: &RenderArgs) -> PrimitiveMapConfig {
+    PrimitiveMapConfig {
+        size: args.map_size,
+        faces: args.faces,
+        binning: args.binning,
+        entry_budget: u64::from(args.map_budget_mb) << 20,
+        ..PrimitiveMapConfig::default()
+    }
 }
 
 /// The device chosen by the global options.

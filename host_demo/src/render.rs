@@ -32,7 +32,8 @@ pub struct SoftShadowArgs {
     /// PCSS penumbra filter: shrinking or standard.
     #[arg(long, default_value = "shrinking", value_parser = parse_filter)]
     pub filter: PenumbraFilter,
-    /// Angular radius of the directional light in radians (PCSS light size).
+    /// Angular radius of the directional light in radians (PCSS light size); inside a closed model, the
+    /// point light is a sphere this wide seen from the floor below it.
     #[arg(long, default_value_t = 0.02)]
     pub angular_radius: f32,
     /// PCSS blocker-search taps.

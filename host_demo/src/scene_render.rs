@@ -354,11 +354,20 @@ struct FrameReportJson {
     lights: Vec<LightReportJson>,
 }
 
+/// The camera of the frames in `scene_report.json`.
+#[derive(Serialize)]
+struct CameraJson {
+    position: [f32; 3],
+    target: [f32; 3],
+    fov_y_radians: f32,
+}
+
 #[derive(Serialize)]
 struct SceneJson {
     scene: String,
     width: u32,
     height: u32,
+    camera: CameraJson,
     dynamic_geometry: bool,
     plugin_lights: usize,
     lights: Vec<LightJson>,
@@ -494,6 +503,11 @@ pub fn render_scene_to_folder(
         scene: source.display().to_string(),
         width: w,
         height: h,
+        camera: CameraJson {
+            position: camera.position.to_array(),
+            target: camera.target.to_array(),
+            fov_y_radians: camera.fov_y_radians,
+        },
         dynamic_geometry: plan.dynamic_geometry,
         plugin_lights: plugin_lights.len(),
         lights: lights_json,

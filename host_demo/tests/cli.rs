@@ -451,3 +451,230 @@ fn long_runs_print_a_line_per_step_off_a_terminal() {
     assert!(lines[1].starts_with("bench [2/2] 07_veach"), "{stderr}");
     assert!(lines[1].contains("s elapsed, about"), "{stderr}");
 }
+
+/// Reads an 8-bit PNG (grey or RGBA) into its first channel per pixel.
+fn png_first_channel(path: &Path) -> Vec<u8> {
+    let decoder = png::Decoder::new(std::fs::File::open(path).expect("png exists"));
+    let mut reader = decoder.read_info().expect("png header");
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).expect("png frame");
+    let channels = info.color_type.samples();
+    buf[..info.buffer_size()]
+        .chunks_exact(channels)
+        .map(|p| p[0])
+        .collect()
+}
+
+/// The shared conference room is closed: by default `render` looks at it from inside, in free space,
+/// and lights it with a point light inside, so the frame shows lit floor and walls and the shadows of
+/// the furniture (it used to show the outside of the box, and a sun cannot light it).
+#[test]
+fn a_closed_model_is_seen_and_lit_from_inside_by_default() {
+    let models = scene::models_dir().unwrap_or_else(|e| panic!("{e}"));
+    let obj = models.join("05_conference_clean_277k.obj");
+    let bounds = scene::load_obj(&obj)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .bounds();
+    let dir = temp_dir("closed-conference");
+    let out = dir.join("out");
+    let output = host_demo(&[
+        "--validation",
+        "render",
+        "--obj",
+        obj.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--width",
+        "160",
+        "--height",
+        "90",
+        "--frames",
+        "2",
+        "--map-size",
+        "128",
+        "--shadow-map-size",
+        "256",
+    ]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "stdout: {stdout}\nstderr: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let first = stdout.lines().next().unwrap_or_default();
+    for said in [
+        "closed scene: ",
+        "% of the ",
+        "camera inside at (",
+        "point light at (",
+    ] {
+        assert!(first.contains(said), "'{said}' missing from: {first}");
+    }
+    let json: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("scene_report.json")).expect("scene_report.json"),
+    )
+    .expect("scene_report.json parses");
+    for point in ["position", "target"] {
+        let p: Vec<f32> = json["camera"][point]
+            .as_array()
+            .unwrap_or_else(|| panic!("camera {point} missing: {json}"))
+            .iter()
+            .map(|v| v.as_f64().unwrap() as f32)
+            .collect();
+        let p = glam::Vec3::from_slice(&p);
+        assert!(
+            p.cmpgt(bounds.min).all() && p.cmplt(bounds.max).all(),
+            "camera {point} {p} is outside the model's bounds {bounds:?}"
+        );
+    }
+    let visibility = png_first_channel(&out.join("visibility_0_interior.png"));
+    assert_eq!(visibility.len(), 160 * 90);
+    let share = |keep: fn(u8) -> bool| {
+        visibility.iter().filter(|&&v| keep(v)).count() as f64 / visibility.len() as f64
+    };
+    let (lit, shadowed) = (share(|v| v >= 250), share(|v| v <= 5));
+    assert!(lit > 0.2, "only {lit:.3} of the frame is lit");
+    assert!(
+        shadowed > 0.02,
+        "only {shadowed:.3} of the frame is in shadow"
+    );
+    let shaded = png_first_channel(&out.join("shaded.png"));
+    assert!(shaded.iter().any(|&v| v > 128), "the shaded frame is dark");
+}
+
+/// A generated room (its walls facing in, a table inside), as an OBJ file.
+fn room_obj(dir: &Path) -> PathBuf {
+    let mut text = String::new();
+    let boxes = [
+        ([-3.0, 0.0, -2.0], [5.0, 3.0, 4.0], true),
+        ([-0.5, 0.0, 0.0], [2.5, 0.8, 2.0], false),
+    ];
+    for (k, (lo, hi, inward)) in boxes.iter().enumerate() {
+        for i in 0..8 {
+            let pick = |axis: usize| {
+                if i >> axis & 1 == 1 {
+                    hi[axis]
+                } else {
+                    lo[axis]
+                }
+            };
+            text += &format!("v {} {} {}\n", pick(0), pick(1), pick(2));
+        }
+        // Corner i is at max along x, y, z where bit 0, 1, 2 of i is set; faces wound outwards.
+        let faces = [
+            [1, 3, 7, 5],
+            [0, 4, 6, 2],
+            [2, 6, 7, 3],
+            [0, 1, 5, 4],
+            [4, 5, 7, 6],
+            [0, 2, 3, 1],
+        ];
+        for face in faces {
+            let mut f: Vec<usize> = face.iter().map(|v| v + 1 + 8 * k).collect();
+            if *inward {
+                f.reverse();
+            }
+            text += &format!("f {} {} {} {}\n", f[0], f[1], f[2], f[3]);
+        }
+    }
+    let path = dir.join("room.obj");
+    std::fs::write(&path, text).expect("write room.obj");
+    path
+}
+
+/// On a closed model, `--light-dir` keeps the sun (with the camera inside), and the options only a sun
+/// has fail clearly with the interior light; an open model says why it is framed from outside.
+#[test]
+fn closed_model_options_and_open_models() {
+    let dir = temp_dir("closed-options");
+    let room = room_obj(&dir);
+    let run = |extra: &[&str], out: &str| {
+        let out = dir.join(out);
+        let mut args = vec![
+            "render",
+            "--obj",
+            room.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--frames",
+            "1",
+            "--map-size",
+            "64",
+            "--shadow-map-size",
+            "64",
+        ];
+        args.extend_from_slice(extra);
+        let output = host_demo(&args);
+        let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
+        let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+        (output, stdout, stderr, out)
+    };
+    let (output, stdout, stderr, out) = run(&["--mode", "hard"], "point");
+    assert!(output.status.success(), "{stdout}\n{stderr}");
+    assert!(
+        stdout.starts_with("closed scene: 100.0% of the "),
+        "{stdout}"
+    );
+    assert!(stdout.contains("zero size"), "{stdout}");
+    assert!(out.join("shaded.png").is_file());
+
+    let (output, stdout, stderr, out) = run(&["--light-dir", "0,-1,0"], "sun");
+    assert!(output.status.success(), "{stdout}\n{stderr}");
+    assert!(stdout.contains("the sun of --light-dir"), "{stdout}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("frame.json")).unwrap()).unwrap();
+    let position: Vec<f64> = json["camera"]["position"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert!(
+        (-3.0..5.0).contains(&position[0])
+            && (0.0..3.0).contains(&position[1])
+            && (-2.0..4.0).contains(&position[2]),
+        "camera at {position:?} is not in the room"
+    );
+
+    for (option, expect) in [
+        (&["--mode", "soft"][..], "--mode soft"),
+        (&["--dump-rays"][..], "--dump-rays"),
+    ] {
+        let (output, _, stderr, _) = run(option, "refused");
+        assert_clean_failure(&output, &stderr, expect);
+    }
+
+    let cube = dir.join("cube.obj");
+    std::fs::write(
+        &cube,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n\
+         f 2 4 8 6\nf 1 5 7 3\nf 3 7 8 4\nf 1 2 6 5\nf 5 6 8 7\nf 1 3 4 2\n",
+    )
+    .unwrap();
+    let out = dir.join("cube");
+    let output = host_demo(&[
+        "render",
+        "--obj",
+        cube.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--frames",
+        "1",
+        "--map-size",
+        "64",
+        "--shadow-map-size",
+        "64",
+    ]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{stdout}");
+    assert!(stdout.starts_with("open scene: "), "{stdout}");
+    assert!(out.join("preview.png").is_file());
+}

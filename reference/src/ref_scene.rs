@@ -3,6 +3,7 @@
 use glam::DVec3;
 
 use crate::exact::has_zero_area;
+use crate::intersect_watertight;
 
 /// Largest number of triangles in a leaf that the SAH may choose to keep unsplit.
 const MAX_LEAF: usize = 8;
@@ -158,6 +159,22 @@ impl RefScene {
     /// All triangles, indexed like [`RefScene::triangle`].
     pub(crate) fn triangles(&self) -> &[[DVec3; 3]] {
         &self.triangles
+    }
+
+    /// The nearest usable triangle that the ray `origin + t * dir` crosses at `t > 0`, as `(t, triangle
+    /// index)`, by [`intersect_watertight`] over the hierarchy (two-sided; `dir` need not be a unit
+    /// vector, `t` is in units of it). `None` when the ray hits nothing.
+    pub fn nearest_hit(&self, origin: DVec3, dir: DVec3) -> Option<(f64, usize)> {
+        let mut best = None;
+        self.traverse(origin, dir, 0.0, f64::INFINITY, 0.0, |i, t_max| {
+            if let Some((t, _)) = intersect_watertight(origin, dir, &self.triangles[i]) {
+                if t > 0.0 && t < *t_max {
+                    *t_max = t;
+                    best = Some((t, i));
+                }
+            }
+        });
+        best
     }
 
     /// Whether triangle `i` is finite and has non-zero area in 3D.

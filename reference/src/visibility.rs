@@ -241,7 +241,7 @@ fn shade_pixel(
     let edge_tolerance = CameraEdgeTolerance {
         per_t: dir_length * camera.pixel_angle * params.pixel_tolerance.max(0.0),
     };
-    let Some((t_hit, receiver)) = nearest_hit(scene, origin, dir) else {
+    let Some((t_hit, receiver)) = scene.nearest_hit(origin, dir) else {
         let ambiguous = scene_exit(scene, origin, dir).is_some_and(|t_exit| {
             camera_ambiguous(scene, origin, dir, None, t_exit, edge_tolerance, 0.0)
         });
@@ -299,20 +299,6 @@ fn shade_pixel(
     };
     (pixel.class, pixel.blocker_distance) = shadow.classify(scene);
     pixel
-}
-
-/// Nearest hit with `t > 0`: `(t, triangle)`.
-fn nearest_hit(scene: &RefScene, origin: DVec3, dir: DVec3) -> Option<(f64, usize)> {
-    let mut best = None;
-    scene.traverse(origin, dir, 0.0, f64::INFINITY, 0.0, |i, t_max| {
-        if let Some((t, _)) = intersect_watertight(origin, dir, &scene.triangle(i)) {
-            if t > 0.0 && t < *t_max {
-                *t_max = t;
-                best = Some((t, i));
-            }
-        }
-    });
-    best
 }
 
 /// Parameter at which the ray leaves the bounds of the scene's usable triangles

@@ -170,6 +170,28 @@ fn lines_through_closed_meshes_hit_on_both_sides() {
 }
 
 #[test]
+fn nearest_hit_is_the_smallest_positive_crossing() {
+    let mut rng = SplitMix64::new(5);
+    let mut mesh = cube(3);
+    mesh.add_sphere(Vec3::new(0.2, -0.1, 0.3), 0.4, 8, 12);
+    let scene = RefScene::new(&mesh.into_scene("mesh"));
+    for _ in 0..500 {
+        let origin = in_cube(&mut rng, 0.9);
+        let dir = random_direction(&mut rng) * rng.uniform_f64(0.5, 2.0);
+        let (t, triangle) = scene.nearest_hit(origin, dir).expect("a closed cube");
+        let nearest = hits(&scene, origin, dir)
+            .into_iter()
+            .filter(|&t| t > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        assert_eq!(t, nearest, "from {origin} along {dir}");
+        let crossing = intersect_watertight(origin, dir, &scene.triangle(triangle));
+        assert_eq!(crossing.map(|(t, _)| t), Some(nearest));
+    }
+    // Outside, pointing away: nothing.
+    assert_eq!(scene.nearest_hit(DVec3::new(0.0, 3.0, 0.0), DVec3::Y), None);
+}
+
+#[test]
 fn cube_corners_and_seams_are_watertight_along_axes_and_diagonals() {
     let scene = RefScene::new(&cube(3).into_scene("mesh"));
     // Rays from the centre straight at corners and along seams.
