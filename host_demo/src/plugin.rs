@@ -134,9 +134,10 @@ pub struct PluginRenderer {
 
 impl PluginRenderer {
     /// Uploads `view`'s scene into the demo's buffers, creates the G-buffer and the visibility image for
-    /// its size, and a plugin context on `device` configured with `config` (one light).
+    /// its size, and a plugin context on `device` configured with `config` (one light), asking for the
+    /// blocker distance when it traces rays (the demo compares it with the exact reference).
     pub fn new(device: &Device, view: &View, config: impl Into<ShadowConfig>) -> Result<Self> {
-        let config = config.into();
+        let config = crate::renderer::with_blocker_distance(config.into());
         let mut renderer = Self::for_scene(
             device,
             &view.scene,

@@ -6,7 +6,7 @@ use crate::CameraMatrices;
 use glam::DVec3;
 use passes::{
     FrameInputs, FrameReport, Geometry, PassError, PassId, ResourceId, ShadowConfig, ShadowInputs,
-    ShadowPipeline,
+    ShadowMode, ShadowPipeline,
 };
 use rhi::{Barrier, Buffer, BufferUsage, Device, Image, MemoryLocation, ResourceState as S};
 
@@ -66,7 +66,7 @@ impl ShadowRenderer {
                 "frame size must be non-zero".into(),
             ));
         }
-        let mut config = config.into();
+        let mut config = with_blocker_distance(config.into());
         config.extra_outputs = config.extra_outputs.with(ResourceId::PrimBuffer);
         let targets = GBufferTargets::new(device, width, height)?;
         let inputs = ShadowInputs {
@@ -271,6 +271,16 @@ fn read_buffers(device: &Device, buffers: &[&Buffer]) -> Result<Vec<Vec<u8>>, Pa
         Ok(())
     })?;
     staging.iter().map(|b| Ok(b.read()?.to_vec())).collect()
+}
+
+/// `config` asking for the ray trace's blocker distance when its mode traces rays (hard, hybrid): the
+/// demo compares blocker distances with the exact reference, and the plugin allocates them only when
+/// asked (or for the hybrid).
+pub fn with_blocker_distance(mut config: ShadowConfig) -> ShadowConfig {
+    if matches!(config.mode, ShadowMode::Hard | ShadowMode::Hybrid) {
+        config.extra_outputs = config.extra_outputs.with(ResourceId::BlockerDistance);
+    }
+    config
 }
 
 /// Where a read-back image goes in [`FrameImages`].

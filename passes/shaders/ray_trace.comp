@@ -123,7 +123,9 @@ void consider(uint index, inout float nearest) {
 
 void write(ivec2 px, float vis, float bd) {
     imageStore(visibility, px, vec4(vis));
-    imageStore(blocker, px, vec4(bd));
+    if (k.misc.z != 0u) {
+        imageStore(blocker, px, vec4(bd));
+    }
 }
 
 void main() {

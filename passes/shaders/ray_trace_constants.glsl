@@ -7,6 +7,7 @@ struct RayTraceConstants {
     vec4 light_dir;             // xyz: direction the light travels (unit)
     uvec4 dims;                 // screen width, height, primitive map N, unused
     vec4 offset;                // x: radians per pixel, y: offset in pixels, z: relative float bound of |P|
-    uvec4 misc;                 // x: 1 = front-only map, y: triangles in the prim buffer, zw unused
+    uvec4 misc;                 // x: 1 = front-only map, y: triangles in the prim buffer,
+                                // z: 1 = store the blocker distance (ray trace), w unused
     vec4 light_pos;             // spot light: xyz position in frame coordinates, w = 1; directional: w = 0
 };

@@ -248,6 +248,15 @@ fn outputs(request: &PlanRequest) -> ResourceSet {
     request.extra_outputs.with(request.final_output())
 }
 
+/// Whether the ray trace writes the blocker distance: the hybrid's lerp factor reads it, or the caller asked
+/// for it (or for the lerp factor). Otherwise it is not allocated (a screen-size image saved per light).
+fn writes_blocker_distance(request: &PlanRequest) -> bool {
+    let outputs = outputs(request);
+    request.mode == ShadowMode::Hybrid
+        || outputs.contains(ResourceId::BlockerDistance)
+        || outputs.contains(ResourceId::LerpFactor)
+}
+
 /// What a live pass reads and writes under a request.
 fn io(pass: PassId, request: &PlanRequest, hard_edge: HardEdge) -> (ResourceSet, ResourceSet) {
     use ResourceId as R;
@@ -279,7 +288,11 @@ fn io(pass: PassId, request: &PlanRequest, hard_edge: HardEdge) -> (ResourceSet,
                 ],
             ]
             .concat(),
-            vec![R::RtVisibility, R::BlockerDistance],
+            if writes_blocker_distance(request) {
+                vec![R::RtVisibility, R::BlockerDistance]
+            } else {
+                vec![R::RtVisibility]
+            },
         ),
         PassId::ShadowMapTest => (
             [&screen[..], &[R::ShadowMap, R::Light]].concat(),
@@ -520,6 +533,22 @@ mod tests {
         let aa = plan(ShadowMode::Hard, true);
         assert_eq!(aa.final_output(), R::RtAntialiased);
         assert!(aa.runs(P::Fxaa));
+    }
+
+    #[test]
+    fn the_blocker_distance_exists_for_the_hybrid_or_when_asked_for() {
+        let hard = plan(ShadowMode::Hard, true);
+        assert!(!hard.resources().contains(R::BlockerDistance));
+        assert!(!hard.writes(P::RayTrace).contains(R::BlockerDistance));
+        assert!(plan(ShadowMode::Hybrid, true)
+            .resources()
+            .contains(R::BlockerDistance));
+        let asked = FramePlan::derive(PlanRequest {
+            extra_outputs: ResourceSet::of(&[R::BlockerDistance]),
+            ..hard.request
+        });
+        assert_eq!(asked.passes(), hard.passes());
+        assert!(asked.writes(P::RayTrace).contains(R::BlockerDistance));
     }
 
     #[test]

@@ -7,8 +7,8 @@ use crate::gpu_types::{constant_buffer, RayTraceConstants};
 use crate::primitive_map::PrimitiveMap;
 use crate::{shader, PassError};
 use rhi::{
-    BindGroup, BindingKind, Buffer, ComputePipeline, Device, Encoder, Format, Image, ImageDesc,
-    ImageUsage, Resource,
+    Barrier, BindGroup, BindingKind, Buffer, ComputePipeline, Device, Encoder, Format, Image,
+    ImageDesc, ImageUsage, Resource, ResourceState as S,
 };
 
 /// Ray-origin offset along the receiver's normal, in pixels of footprint at the receiver's distance.
@@ -43,17 +43,20 @@ pub struct RayTracePass {
     /// `R32_SFLOAT` visibility, 1 = lit.
     pub visibility: Image,
     /// `R32_SFLOAT` distance from the ray origin to the nearest blocker; 0 where the receiver faces away
-    /// from the light, -1 where lit or background.
-    pub blocker_distance: Image,
+    /// from the light, -1 where lit or background. `None` when not asked for (the pass then stores none).
+    pub blocker_distance: Option<Image>,
+    /// A 1×1 image bound in place of the blocker distance when there is none (never written).
+    unused_blocker: Option<Image>,
 }
 
 impl RayTracePass {
-    /// Creates `width` x `height` outputs.
+    /// Creates `width` x `height` outputs: the visibility, and the blocker distance if `blocker_distance`.
     pub fn new(
         device: &Device,
         inputs: &RayTraceInputs<'_>,
         width: u32,
         height: u32,
+        blocker_distance: bool,
     ) -> Result<Self, PassError> {
         let out = |name| ImageDesc {
             name,
@@ -64,7 +67,23 @@ impl RayTracePass {
             usage: ImageUsage::STORAGE | ImageUsage::SAMPLED | ImageUsage::COPY_SRC,
         };
         let visibility = device.create_image(&out("rt visibility"))?;
-        let blocker_distance = device.create_image(&out("rt blocker distance"))?;
+        let (blocker_distance, unused_blocker) = if blocker_distance {
+            (
+                Some(device.create_image(&out("rt blocker distance"))?),
+                None,
+            )
+        } else {
+            let unused = ImageDesc {
+                width: 1,
+                height: 1,
+                ..out("rt blocker distance (not stored)")
+            };
+            (None, Some(device.create_image(&unused)?))
+        };
+        let blocker_binding = blocker_distance
+            .as_ref()
+            .or(unused_blocker.as_ref())
+            .ok_or_else(|| PassError::InvalidConfig("no blocker image".into()))?;
         let constants = constant_buffer::<RayTraceConstants>(device, "ray trace constants")?;
         let pipeline = device.create_compute_pipeline(
             "ray trace",
@@ -96,7 +115,7 @@ impl RayTracePass {
                 b(&inputs.map.entries),
                 b(inputs.prims),
                 Resource::Image(&visibility),
-                Resource::Image(&blocker_distance),
+                Resource::Image(blocker_binding),
             ],
         )?;
         Ok(Self {
@@ -105,6 +124,7 @@ impl RayTracePass {
             constants,
             visibility,
             blocker_distance,
+            unused_blocker,
         })
     }
 
@@ -130,8 +150,18 @@ impl RayTracePass {
         enc: &mut Encoder<'_>,
         constants: &RayTraceConstants,
     ) -> Result<(), PassError> {
-        enc.update_buffer(&self.constants, 0, bytemuck::bytes_of(constants))?;
+        let mut constants = *constants;
+        constants.misc.z = u32::from(self.blocker_distance.is_some());
+        enc.update_buffer(&self.constants, 0, bytemuck::bytes_of(&constants))?;
         enc.begin_pass("ray trace");
+        if let Some(unused) = &self.unused_blocker {
+            // Bound as a storage image, so in the storage layout, though never written.
+            enc.barriers(&[Barrier::Image {
+                image: unused,
+                before: S::Undefined,
+                after: S::UnorderedAccess,
+            }]);
+        }
         let groups = [
             constants.dims.x.div_ceil(8),
             constants.dims.y.div_ceil(8),

@@ -304,7 +304,8 @@ enum HrtsResource
   HRTS_RESOURCE_OCCUPANCY = 3,
   // Ray-traced visibility, `R32_SFLOAT`, 1 = lit.
   HRTS_RESOURCE_RT_VISIBILITY = 4,
-  // Ray-traced blocker distance, `R32_SFLOAT`.
+  // Ray-traced blocker distance, `R32_SFLOAT`: allocated for the hybrid (its lerp factor reads it) or
+  // when `extra_outputs` asks for it (or for the lerp factor).
   HRTS_RESOURCE_BLOCKER_DISTANCE = 5,
   // Classic shadow-map visibility, `R32_SFLOAT`.
   HRTS_RESOURCE_SHADOW_MAP_VISIBILITY = 6,

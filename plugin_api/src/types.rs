@@ -205,7 +205,8 @@ pub enum HrtsResource {
     Occupancy = 3,
     /// Ray-traced visibility, `R32_SFLOAT`, 1 = lit.
     RtVisibility = 4,
-    /// Ray-traced blocker distance, `R32_SFLOAT`.
+    /// Ray-traced blocker distance, `R32_SFLOAT`: allocated for the hybrid (its lerp factor reads it) or
+    /// when `extra_outputs` asks for it (or for the lerp factor).
     BlockerDistance = 5,
     /// Classic shadow-map visibility, `R32_SFLOAT`.
     ShadowMapVisibility = 6,

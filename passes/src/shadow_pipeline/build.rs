@@ -104,6 +104,8 @@ impl ShadowPipeline {
                 },
                 width,
                 height,
+                plan.writes(PassId::RayTrace)
+                    .contains(ResourceId::BlockerDistance),
             )?),
             _ => None,
         };
@@ -146,7 +148,13 @@ impl ShadowPipeline {
             _ => None,
         };
         let lerp = match (&ray, runs(PassId::LerpFactor)) {
-            (Some(r), true) => Some(LerpFactorPass::new(device, &r.blocker_distance)?),
+            (
+                Some(RayTracePass {
+                    blocker_distance: Some(blocker),
+                    ..
+                }),
+                true,
+            ) => Some(LerpFactorPass::new(device, blocker)?),
             _ => None,
         };
         let blend = if runs(PassId::Blend) {

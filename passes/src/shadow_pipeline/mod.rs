@@ -145,7 +145,7 @@ impl ShadowPipeline {
             R::ShadowMap => self.shadow_map.as_ref().map(|s| &s.depth),
             R::Occupancy => self.map.as_ref().and_then(PrimitiveMap::occupancy_view),
             R::RtVisibility => self.ray.as_ref().map(|r| &r.visibility),
-            R::BlockerDistance => self.ray.as_ref().map(|r| &r.blocker_distance),
+            R::BlockerDistance => self.ray.as_ref().and_then(|r| r.blocker_distance.as_ref()),
             R::ShadowMapVisibility => self.shadow_map_test.as_ref().map(|p| &p.output),
             R::Pcss => self.pcss.as_ref().map(|p| &p.output),
             R::RtAntialiased => self.fxaa.as_ref().map(|f| &f.output),
