@@ -309,8 +309,13 @@ fn render_scene(cli: &Cli, args: &RenderArgs, path: &Path) -> Result<()> {
         bail!("--frames must be at least 2 with --scene: the second frame's report shows what was kept");
     }
     let file = load_scene(path, args.still)?;
+    render_scene_file(cli, args, &file, path)
+}
+
+/// Renders `file` (read from `path`) as `render --scene` does, with the command line's view and settings.
+fn render_scene_file(cli: &Cli, args: &RenderArgs, file: &SceneFile, path: &Path) -> Result<()> {
     let (camera, settings) = scene_setup(
-        &file,
+        file,
         (args.width, args.height),
         (args.camera.camera_pos, args.camera.camera_target),
         map_config(args),
@@ -319,7 +324,7 @@ fn render_scene(cli: &Cli, args: &RenderArgs, path: &Path) -> Result<()> {
     let device = device(cli)?;
     render_scene_to_folder(
         &device,
-        &file,
+        file,
         path,
         &camera,
         &settings,
@@ -477,24 +482,7 @@ fn render_closed(
     interior: Interior,
 ) -> Result<()> {
     let file = host_demo::interior::scene_file(model, interior.light, interior.camera);
-    let (camera, settings) = scene_setup(
-        &file,
-        (args.width, args.height),
-        (args.camera.camera_pos, args.camera.camera_target),
-        map_config(args),
-        &args.soft,
-    )?;
-    let device = device(cli)?;
-    render_scene_to_folder(
-        &device,
-        &file,
-        path,
-        &camera,
-        &settings,
-        args.frames,
-        &args.out,
-    )?;
-    host_demo::check_validation(&device)
+    render_scene_file(cli, args, &file, path)
 }
 
 /// The primitive map the command line asks for.

@@ -588,12 +588,12 @@ fn room_obj(dir: &Path) -> PathBuf {
 fn closed_model_options_and_open_models() {
     let dir = temp_dir("closed-options");
     let room = room_obj(&dir);
-    let run = |extra: &[&str], out: &str| {
+    let run_obj = |obj: &Path, extra: &[&str], out: &str| {
         let out = dir.join(out);
         let mut args = vec![
             "render",
             "--obj",
-            room.to_str().unwrap(),
+            obj.to_str().unwrap(),
             "--out",
             out.to_str().unwrap(),
             "--width",
@@ -613,6 +613,7 @@ fn closed_model_options_and_open_models() {
         let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
         (output, stdout, stderr, out)
     };
+    let run = |extra: &[&str], out: &str| run_obj(&room, extra, out);
     let (output, stdout, stderr, out) = run(&["--mode", "hard"], "point");
     assert!(output.status.success(), "{stdout}\n{stderr}");
     assert!(
@@ -655,25 +656,7 @@ fn closed_model_options_and_open_models() {
          f 2 4 8 6\nf 1 5 7 3\nf 3 7 8 4\nf 1 2 6 5\nf 5 6 8 7\nf 1 3 4 2\n",
     )
     .unwrap();
-    let out = dir.join("cube");
-    let output = host_demo(&[
-        "render",
-        "--obj",
-        cube.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--width",
-        "32",
-        "--height",
-        "24",
-        "--frames",
-        "1",
-        "--map-size",
-        "64",
-        "--shadow-map-size",
-        "64",
-    ]);
-    let stdout = String::from_utf8_lossy(&output.stdout);
+    let (output, stdout, _, out) = run_obj(&cube, &[], "cube");
     assert!(output.status.success(), "{stdout}");
     assert!(stdout.starts_with("open scene: "), "{stdout}");
     assert!(out.join("preview.png").is_file());

@@ -274,6 +274,21 @@ pub struct PrimitiveMapInputs<'a> {
     pub scratch: &'a MapScratchPool,
 }
 
+/// A GPU-only storage buffer of `bytes` (at least 4) with `usage` besides storage.
+fn storage_buffer(
+    device: &Device,
+    name: &str,
+    bytes: u64,
+    usage: BufferUsage,
+) -> Result<Buffer, rhi::RhiError> {
+    device.create_buffer(
+        name,
+        bytes.max(4),
+        BufferUsage::STORAGE | usage,
+        MemoryLocation::GpuOnly,
+    )
+}
+
 /// The buffers a map uses only while it is built (per-triangle bin items and tile offsets, per-texel
 /// counts), shared by every map over the same geometry: the builds are recorded one after another with
 /// barriers between them (each clears the counts first), so one set serves every light and frustum.
@@ -321,14 +336,7 @@ impl MapScratchPool {
         let size = current.as_ref().map_or(size, |s| s.size.max(size));
         let n2 = u64::from(size) * u64::from(size);
         let tris = u64::from(triangles);
-        let storage = |name, bytes: u64, usage| {
-            device.create_buffer(
-                name,
-                bytes.max(4),
-                BufferUsage::STORAGE | usage,
-                MemoryLocation::GpuOnly,
-            )
-        };
+        let storage = |name, bytes, usage| storage_buffer(device, name, bytes, usage);
         let scratch = std::sync::Arc::new(MapScratch {
             bin_tris: storage("primitive map triangles", tris * 64, BufferUsage::default())?,
             tile_offsets: storage(
@@ -413,14 +421,7 @@ impl PrimitiveMap {
         let n = config.size;
         let n2 = u64::from(n) * u64::from(n);
         let (width, height) = (inputs.depth.width(), inputs.depth.height());
-        let storage = |name, bytes: u64, usage| {
-            device.create_buffer(
-                name,
-                bytes.max(4),
-                BufferUsage::STORAGE | usage,
-                MemoryLocation::GpuOnly,
-            )
-        };
+        let storage = |name, bytes, usage| storage_buffer(device, name, bytes, usage);
         let copy = BufferUsage::COPY_DST | BufferUsage::COPY_SRC;
         let constants = constant_buffer::<RayTraceConstants>(device, "primitive map constants")?;
         let state = storage(
