@@ -16,32 +16,34 @@
 //! The integration test `tests/tests/hard_cases.rs` calls [`run_cases`] too, so the table and the tests
 //! cannot drift apart.
 
-use crate::accuracy::{absolute_tolerance, compare_map, compare_visibility, fitted_light_matrix};
+use crate::accuracy::{compare_map, compare_visibility, fitted_light_matrix};
 use crate::output::write_png;
 use crate::plugin::PluginRenderer;
 use crate::{FrameImages, View};
 use anyhow::{anyhow, bail, Context, Result};
-use glam::{DMat4, DVec2, DVec3, Mat4};
+use glam::{DVec3, Mat4};
 use passes::{
     BinningRequest, FaceMode, FrameInputs, Light, PrimitiveMapConfig, DEFAULT_ENTRY_BUDGET,
     GUARD_VALUE, GUARD_WORDS,
 };
-use reference::{certainly_blocked, contact_shadow_start, FaceSelection, RefScene};
+use reference::{FaceSelection, RefScene};
 use rhi::Device;
-use scene::hard_cases::{Check, Expectation, Family, HardCase, Overflow, Solid};
-use scene::{Aabb, DirectionalLight, Scene};
+use scene::hard_cases::{Check, Expectation, HardCase, Overflow};
+use scene::{DirectionalLight, Scene};
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
+
+mod cli;
+mod probe;
+
+pub use cli::{run_cli, table, HardcasesArgs};
+use probe::Probe;
 
 /// Margin of the analytic checks, in pixel footprints at the receiver's distance from the camera: a
 /// receiver counts as certainly shadowed (or certainly in a contact shadow) only if its shadow ray passes
 /// this far inside the blocker.
 pub const MARGIN_PIXELS: f64 = 2.0;
-
-/// Light-facing threshold of the acne check: receivers whose normal makes a cosine above this with the
-/// direction to the light (89.99°) must be lit where nothing blocks them.
-const FACING_COSINE: f64 = 1.7e-4;
 
 /// What one case measured.
 #[derive(Debug, Clone, Default)]
@@ -501,299 +503,6 @@ fn slug(name: &str) -> String {
         }
     }
     s.trim_matches('-').to_owned()
-}
-
-/// A receiver seen by one pixel.
-struct Receiver {
-    index: usize,
-    position: DVec3,
-    /// Camera-facing geometric normal.
-    normal: DVec3,
-    lit: bool,
-    /// Margin of the analytic checks at this receiver (world units).
-    margin: f64,
-}
-
-/// Per-pixel access to a frame's receivers for the analytic checks.
-struct Probe<'a> {
-    images: &'a FrameImages,
-    camera: DVec3,
-    view_proj: DMat4,
-    to_light: DVec3,
-    pixel_angle: f64,
-    absolute_margin: f64,
-    width: f64,
-    height: f64,
-}
-
-impl<'a> Probe<'a> {
-    fn new(view: &View, inputs: &FrameInputs, images: &'a FrameImages) -> Self {
-        Self {
-            images,
-            camera: inputs.camera_position.as_dvec3(),
-            view_proj: inputs.proj.as_dmat4() * inputs.view.as_dmat4(),
-            to_light: -view.light.direction.as_dvec3().normalize(),
-            pixel_angle: 2.0 * (f64::from(view.camera.fov_y_radians) / 2.0).tan()
-                / f64::from(view.height),
-            absolute_margin: absolute_tolerance(view),
-            width: f64::from(view.width),
-            height: f64::from(view.height),
-        }
-    }
-
-    fn receivers(&self) -> impl Iterator<Item = Receiver> + '_ {
-        let images = self.images;
-        (0..images.visibility.len()).filter_map(move |index| {
-            let n = images.normal[index];
-            let p = images.position[index];
-            if n[3] == 0.0 {
-                return None;
-            }
-            let position = DVec3::new(p[0].into(), p[1].into(), p[2].into());
-            let normal = DVec3::new(n[0].into(), n[1].into(), n[2].into());
-            if !position.is_finite() || !normal.is_finite() {
-                return None;
-            }
-            let margin = MARGIN_PIXELS * position.distance(self.camera) * self.pixel_angle
-                + self.absolute_margin;
-            Some(Receiver {
-                index,
-                position,
-                normal,
-                lit: images.visibility[index] > 0.5,
-                margin,
-            })
-        })
-    }
-
-    /// Receivers whose shadow ray passes through `solid` shrunk by the margin, and the lit ones among them.
-    fn leaks(&self, solid: &Solid, flagged: &mut [bool]) -> (usize, usize) {
-        let (mut judged, mut leaks) = (0, 0);
-        for r in self.receivers() {
-            if certainly_blocked(solid, r.position, self.to_light, r.margin) {
-                judged += 1;
-                if r.lit {
-                    flagged[r.index] = true;
-                    leaks += 1;
-                }
-            }
-        }
-        (judged, leaks)
-    }
-
-    /// Light-facing receivers inside `region`, and the shadowed ones among them.
-    fn acne(&self, region: &Aabb, flagged: &mut [bool]) -> (usize, usize) {
-        let (min, max) = (region.min.as_dvec3(), region.max.as_dvec3());
-        let (mut judged, mut acne) = (0, 0);
-        for r in self.receivers() {
-            let inside = r.position.cmpge(min).all() && r.position.cmple(max).all();
-            if inside && r.normal.dot(self.to_light) > FACING_COSINE {
-                judged += 1;
-                if !r.lit {
-                    flagged[r.index] = true;
-                    acne += 1;
-                }
-            }
-        }
-        (judged, acne)
-    }
-
-    /// Receivers in the contact shadow of box `b` (standing on a horizontal receiver at `b.min.y`), and the
-    /// largest screen distance (pixels) between a lit one and the footprint edge its shadow ray enters
-    /// through.
-    fn contact_gap(&self, b: &Aabb, flagged: &mut [bool]) -> (usize, f64) {
-        let min_y = f64::from(b.min.y);
-        let (mut judged, mut gap) = (0, 0.0f64);
-        for r in self.receivers() {
-            let p = r.position;
-            let on_base = (p.y - min_y).abs() <= 1e-3 * r.margin + 1e-6 * (1.0 + min_y.abs());
-            if !on_base || r.normal.y < 0.999 {
-                continue;
-            }
-            let Some(contact) = contact_shadow_start(b, p, self.to_light, r.margin) else {
-                continue;
-            };
-            judged += 1;
-            if !r.lit {
-                continue;
-            }
-            let distance = self.screen(p).distance(self.screen(contact));
-            flagged[r.index] = true;
-            gap = gap.max(distance);
-        }
-        (judged, gap)
-    }
-
-    /// Continuous pixel coordinates of a world point.
-    fn screen(&self, p: DVec3) -> DVec2 {
-        let clip = self.view_proj * p.extend(1.0);
-        let ndc = clip.truncate().truncate() / clip.w;
-        (ndc * 0.5 + 0.5) * DVec2::new(self.width, self.height)
-    }
-}
-
-/// Arguments of `host_demo hardcases`.
-#[derive(Debug, clap::Args)]
-pub struct HardcasesArgs {
-    /// Print the table as Markdown (for the README).
-    #[arg(long)]
-    pub markdown: bool,
-    /// Run only these families (repeatable): shared-edges, grazing, contact, scale, small-triangles,
-    /// texel-boundaries, frustum-border, coplanar, thin-geometry, models, non-finite, overflow.
-    #[arg(long, value_parser = parse_family)]
-    pub family: Vec<Family>,
-    /// The models folder (default: `HRTS_MODELS`, else `../shared/models` beside the checkout).
-    #[arg(long)]
-    pub models: Option<PathBuf>,
-    /// Write a shaded preview PNG of every case into this folder (pixels failing an analytic check in red).
-    #[arg(long)]
-    pub previews: Option<PathBuf>,
-}
-
-fn parse_family(s: &str) -> Result<Family, String> {
-    Family::from_name(s).ok_or_else(|| {
-        let names: Vec<&str> = Family::ALL.iter().map(|f| f.name()).collect();
-        format!(
-            "unknown family '{s}' (expected one of {})",
-            names.join(", ")
-        )
-    })
-}
-
-/// Runs the subcommand: creates the device (`device_filter`, `validation` as for `render`), runs the
-/// cases, prints the table, and fails if any case failed.
-pub fn run_cli(
-    device_filter: Option<String>,
-    validation: bool,
-    args: &HardcasesArgs,
-) -> Result<()> {
-    let validation = validation || rhi::DeviceDesc::from_env().validation;
-    let device = crate::open_device(device_filter, validation)?;
-    let families = if args.family.is_empty() {
-        Family::ALL.to_vec()
-    } else {
-        args.family.clone()
-    };
-    let models = match &args.models {
-        Some(dir) => dir.clone(),
-        None => scene::models_dir().map_err(anyhow::Error::msg)?,
-    };
-    let cases: Vec<HardCase> = families
-        .iter()
-        .flat_map(|&f| scene::hard_cases::family(f, &models))
-        .collect();
-    let start = Instant::now();
-    let outcomes = run_cases(&device, &cases, args.previews.as_deref());
-    let caps = device.capabilities();
-    let path = outcomes
-        .iter()
-        .map(|o| o.binning_path)
-        .find(|p| !p.is_empty())
-        .unwrap_or("none");
-    println!(
-        "Hard cases on {} ({}), {} binning, validation {}: {:.1} s\n",
-        caps.device_name,
-        caps.driver,
-        path,
-        if validation { "on" } else { "off" },
-        start.elapsed().as_secs_f64()
-    );
-    print!("{}", table(&outcomes, args.markdown));
-    let failed = outcomes.iter().filter(|o| !o.passed()).count();
-    if failed > 0 {
-        bail!("{failed} of {} hard cases failed", outcomes.len());
-    }
-    println!("\nall {} hard cases pass", outcomes.len());
-    Ok(())
-}
-
-/// The outcome table: plain text with aligned columns, or Markdown.
-pub fn table(outcomes: &[Outcome], markdown: bool) -> String {
-    const HEADER: [&str; 12] = [
-        "case",
-        "pixels",
-        "near-edge",
-        "mismatches",
-        "leaks",
-        "acne",
-        "NaN/Inf",
-        "texels past capacity",
-        "map errors",
-        "measure",
-        "time",
-        "result",
-    ];
-    let rows: Vec<[String; 12]> = outcomes
-        .iter()
-        .map(|o| {
-            let rendered = o.rejected.is_none() && o.error.is_none();
-            let n = |v: usize| {
-                if rendered {
-                    v.to_string()
-                } else {
-                    "-".into()
-                }
-            };
-            [
-                o.name.to_owned(),
-                n(o.pixels),
-                n(o.near_edge),
-                n(o.mismatches),
-                n(o.leaks),
-                n(o.acne),
-                n(o.non_finite),
-                n(o.texels_past_capacity as usize),
-                n(o.map_missing + o.map_garbage),
-                o.measure(),
-                format!("{:.1} s", o.seconds),
-                o.result(),
-            ]
-        })
-        .collect();
-    let mut out = String::new();
-    if markdown {
-        let line = |cells: &[&str]| format!("| {} |\n", cells.join(" | "));
-        out += &line(&HEADER);
-        let align: Vec<&str> = HEADER
-            .iter()
-            .map(|h| match *h {
-                "case" | "measure" | "result" => "---",
-                _ => "---:",
-            })
-            .collect();
-        out += &line(&align);
-        for r in &rows {
-            let cells: Vec<String> = r.iter().map(|c| c.replace('|', "\\|")).collect();
-            out += &line(&cells.iter().map(String::as_str).collect::<Vec<_>>());
-        }
-    } else {
-        let mut widths = HEADER.map(|h| h.chars().count());
-        for r in &rows {
-            for (w, c) in widths.iter_mut().zip(r) {
-                *w = (*w).max(c.chars().count());
-            }
-        }
-        let line = |cells: &[&str]| {
-            let padded: Vec<String> = cells
-                .iter()
-                .zip(widths)
-                .enumerate()
-                .map(|(i, (c, w))| {
-                    if (1..9).contains(&i) || i == 10 {
-                        format!("{c:>w$}")
-                    } else {
-                        format!("{c:<w$}")
-                    }
-                })
-                .collect();
-            format!("{}\n", padded.join("  ").trim_end())
-        };
-        out += &line(&HEADER);
-        for r in &rows {
-            out += &line(&r.iter().map(String::as_str).collect::<Vec<_>>());
-        }
-    }
-    out
 }
 
 #[cfg(test)]
