@@ -212,6 +212,7 @@ impl PluginRenderer {
                 height: t.depth.height(),
                 depth_image: t.depth.raw_handle(),
                 depth_usage: t.depth.raw_usage(),
+                depth_format: t.depth.format().raw_vk() as u32,
                 normal_image: t.normal.raw_handle(),
                 normal_usage: t.normal.raw_usage(),
                 output_image: output.raw_handle(),

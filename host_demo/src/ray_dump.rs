@@ -229,8 +229,10 @@ fn shadow_rays(rs: &RefScene, view: &View, inputs: &FrameInputs, origin: DVec3) 
         if facing.is_nan() || facing <= 0.0 {
             continue; // facing away from the light
         }
-        let delta =
-            rel.length() * per_distance + p.abs().max_element() * f64::from(RAY_OFFSET_FLOAT_BOUND);
+        // As the GPU offsets its origins (shadow_ray.glsl), with the demo's reversed-Z float depth: its
+        // rounding moves the rebuilt point by at most 2^-23 of its distance.
+        let delta = rel.length() * (per_distance + f64::from(f32::EPSILON))
+            + p.abs().max_element() * f64::from(RAY_OFFSET_FLOAT_BOUND);
         let o = p + n * delta;
         let (dir, t_max) = match light_position {
             None => (to_light, f64::INFINITY),

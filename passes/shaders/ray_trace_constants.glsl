@@ -6,7 +6,8 @@ struct RayTraceConstants {
     vec4 camera_pos;            // xyz: camera in frame coordinates
     vec4 light_dir;             // xyz: direction the light travels (unit)
     uvec4 dims;                 // screen width, height, primitive map N, unused
-    vec4 offset;                // x: radians per pixel, y: offset in pixels, z: relative float bound of |P|
+    vec4 offset;                // x: radians per pixel, y: offset in pixels, z: relative float bound of |P|,
+                                // w: one step of a normalized depth format (0 for float depth)
     uvec4 misc;                 // x: 1 = front-only map, y: triangles in the prim buffer,
                                 // z: 1 = store the blocker distance (ray trace), w unused
     vec4 light_pos;             // spot light: xyz position in frame coordinates, w = 1; directional: w = 0

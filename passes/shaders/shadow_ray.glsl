@@ -3,8 +3,10 @@
 // exactly the same rays. The includer declares `k` (RayTraceConstants), `depth_tex` and `normal_tex`.
 //
 // The receiver point P is rebuilt from depth relative to the camera, then offset along its geometric
-// normal by a bound on its own error: a fraction of the pixel footprint plus a few ulps of |P|. No
-// world-space bias. Directional light: the ray runs along -light_dir without end. Spot light: the ray runs
+// normal by a bound on its own error: a fraction of the pixel footprint, a few ulps of |P|, and how far the
+// depth format's precision lets P move along its view ray. No world-space bias. Any depth convention works
+// (reversed or standard Z, finite or infinite far plane): P is rebuilt through the engine's own projection,
+// and the normal's w marks the pixels that hold geometry. Directional light: the ray runs along -light_dir without end. Spot light: the ray runs
 // from the offset origin to the light position and only hits before it count (t < t_max).
 
 const int SHADOW_RAY_TRACE = 0;     // trace o + t * dir, 0 < t < t_max
@@ -31,7 +33,16 @@ int shadow_ray(ivec2 px, out vec3 o, out vec3 dir, out float t_max) {
         return SHADOW_RAY_FACING_AWAY;
     }
     vec3 ap = abs(p);
-    float delta = length(rel) * k.offset.x * k.offset.y + max(max(ap.x, ap.y), ap.z) * k.offset.z;
+    // The depth buffer holds the depth within q of the surface's: one step of a D16 or D24 format
+    // (k.offset.w: rounded either way), or 2^-23 of the value for a float format (either rounding). P moves along
+    // its view ray by at most the distance from P to the points rebuilt from depth - q and depth + q (the
+    // first kept in front of the far plane: a normalized depth that close to it may lie anywhere behind).
+    float q = max(k.offset.w, depth * 1.1920929e-7);
+    vec4 h_near = k.inv_view_proj_rel * vec4(ndc, depth + q, 1.0);
+    vec4 h_far = k.inv_view_proj_rel * vec4(ndc, max(depth - q, 0.5 * depth), 1.0);
+    float depth_error = max(length(h_near.xyz / h_near.w - rel), length(h_far.xyz / h_far.w - rel));
+    float delta = length(rel) * k.offset.x * k.offset.y + max(max(ap.x, ap.y), ap.z) * k.offset.z
+        + depth_error;
     o = p + n * delta;
     dir = to_light;
     if (spot) {

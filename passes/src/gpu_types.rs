@@ -76,9 +76,11 @@ pub struct RayTraceConstants {
     pub light_dir: Vec4,
     /// Screen width, height, map N, unused.
     pub dims: UVec4,
-    /// x: radians per pixel, y: ray-origin offset in pixels, z: relative float bound of |P|.
+    /// x: radians per pixel, y: ray-origin offset in pixels, z: relative float bound of |P|, w: one step of
+    /// a normalized depth format (0 for float depth).
     pub offset: Vec4,
-    /// x: front-only map flag, y: triangles in the prim buffer.
+    /// x: front-only map flag, y: triangles in the prim buffer, z: 1 = the ray trace stores the blocker
+    /// distance.
     pub misc: UVec4,
     /// Spot light: position in frame coordinates (xyz), w = 1; directional light: w = 0.
     pub light_pos: Vec4,

@@ -263,7 +263,7 @@ pub struct PrimitiveMapInputs<'a> {
     pub prims: &'a Buffer,
     /// Triangles in the prim buffer.
     pub triangles: u32,
-    /// Reversed-Z depth (`ShaderResource` state when the map is built).
+    /// Depth (`ShaderResource` state when the map is built).
     pub depth: &'a Image,
     /// Camera-facing geometric normal, w = 0 on background (`ShaderResource` state).
     pub normal: &'a Image,

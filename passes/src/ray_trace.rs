@@ -25,7 +25,7 @@ const ENTRIES_BINDING: u32 = 6;
 
 /// Inputs of the ray trace.
 pub struct RayTraceInputs<'a> {
-    /// Reversed-Z depth (`ShaderResource` state).
+    /// Depth (`ShaderResource` state).
     pub depth: &'a Image,
     /// Camera-facing geometric normal, w = 0 on background (`ShaderResource` state).
     pub normal: &'a Image,

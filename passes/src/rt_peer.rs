@@ -159,8 +159,9 @@ impl RtPeerPass {
 
 /// The shadow-ray constants of a `width` x `height` frame of `inputs` over geometry whose frame origin is
 /// `origin`, as the shadow pipeline computes them: what a host that drives the pipeline through the C ABI
-/// (and so never sees its constants) passes to [`RtPeerPass::record_trace`]. The fields only the
-/// primitive-map passes read (map size, face mode, triangle count) are zero.
+/// (and so never sees its constants) passes to [`RtPeerPass::record_trace`], for a float depth buffer (no
+/// depth step in the offset). The fields only the primitive-map passes read (map size, face mode, triangle
+/// count) are zero.
 pub fn shadow_ray_constants(
     inputs: &FrameInputs,
     origin: DVec3,

@@ -581,11 +581,19 @@ typedef struct HrtsTargets {
   uint32_t width;
   // Height in pixels.
   uint32_t height;
-  // Reversed-Z depth `VkImage` (`VK_FORMAT_D32_SFLOAT`, usage includes SAMPLED): 1 at the near plane,
-  // 0 at the far plane / background.
+  // The engine's depth `VkImage` (`depth_format`, usage includes SAMPLED), as its projection writes it:
+  // reversed or standard Z, finite or infinite far plane (the plugin rebuilds positions through
+  // `HrtsFrame::proj`; the normal image's w says which pixels hold geometry).
   uint64_t depth_image;
   // Usage flags the depth image was created with (`VkImageUsageFlags`).
   uint32_t depth_usage;
+  // `VkFormat` of the depth image: `VK_FORMAT_D16_UNORM`, `VK_FORMAT_X8_D24_UNORM_PACK32`,
+  // `VK_FORMAT_D24_UNORM_S8_UINT`, `VK_FORMAT_D32_SFLOAT` or `VK_FORMAT_D32_SFLOAT_S8_UINT` (sampled
+  // through its depth aspect; its layouts are given for both aspects), or 0 for `VK_FORMAT_D32_SFLOAT`.
+  // The ray origins move off the surface by the format's depth error, so shadows stay exact at the
+  // points the depth describes; a coarse format (D16 with a near plane close to the camera) moves
+  // contact shadows' start by that error.
+  uint32_t depth_format;
   // World-space normal `VkImage` (`VK_FORMAT_R32G32B32A32_SFLOAT`, usage includes SAMPLED): xyz the
   // geometric normal facing the camera, w = 1 on geometry and 0 on background.
   uint64_t normal_image;
@@ -637,7 +645,8 @@ typedef struct HrtsFrame {
   uint64_t frame_index;
   // World-to-view matrix, column-major.
   float view[16];
-  // View-to-clip matrix, column-major, reversed Z, Vulkan clip conventions.
+  // View-to-clip matrix, column-major, Vulkan clip conventions (depth 0..1), the projection that wrote the
+  // depth image: reversed or standard Z, finite or infinite far plane.
   float proj[16];
   // Camera position in world space.
   float camera_position[3];

@@ -22,6 +22,7 @@ pub(crate) struct TargetSource {
     pub(crate) width: u32,
     pub(crate) height: u32,
     pub(crate) depth: u64,
+    pub(crate) depth_format: Format,
     pub(crate) normal: u64,
     pub(crate) output: u64,
     pub(crate) output_layers: u32,
@@ -450,6 +451,32 @@ impl Context {
                 t.output_layers, caps.max_image_array_layers
             )));
         }
+        let depth_format = match t.depth_format {
+            0 => Format::D32Float,
+            raw => i32::try_from(raw)
+                .ok()
+                .and_then(Format::depth_from_raw_vk)
+                .ok_or_else(|| {
+                    let accepted: Vec<String> =
+                        Format::DEPTH.iter().map(|f| f.raw_vk().to_string()).collect();
+                    ApiError::new(
+                        HrtsResult::ErrorInvalidEnum,
+                        format!(
+                            "depth_format {raw} is not a depth format the plugin reads: one of {} (D16_UNORM, X8_D24_UNORM_PACK32, D24_UNORM_S8_UINT, D32_SFLOAT, D32_SFLOAT_S8_UINT), or 0 for D32_SFLOAT",
+                            accepted.join(", ")
+                        ),
+                    )
+                })?,
+        };
+        if !self.device.can_sample(depth_format) {
+            return Err(ApiError::new(
+                HrtsResult::ErrorUnsupported,
+                format!(
+                    "the device cannot sample depth_format {} ({depth_format:?}) with optimal tiling",
+                    depth_format.raw_vk()
+                ),
+            ));
+        }
         require_usage(t.depth_usage, ImageUsage::SAMPLED, "depth_image", "SAMPLED")?;
         require_usage(
             t.normal_usage,
@@ -467,6 +494,7 @@ impl Context {
             width: t.width,
             height: t.height,
             depth: t.depth_image,
+            depth_format,
             normal: t.normal_image,
             output: t.output_image,
             output_layers: t.output_layers,
@@ -579,7 +607,7 @@ impl Context {
             depth: wrap(
                 "engine depth",
                 t.depth,
-                Format::D32Float,
+                t.depth_format,
                 ImageUsage::SAMPLED,
                 1,
             )?,

@@ -179,9 +179,26 @@ pub enum Format {
     Rgba8Unorm,
     /// DXGI_FORMAT_D32_FLOAT.
     D32Float,
+    /// DXGI_FORMAT_D16_UNORM.
+    D16Unorm,
+    /// DXGI_FORMAT_D24_UNORM_S8_UINT's depth alone (`VK_FORMAT_X8_D24_UNORM_PACK32`).
+    X8D24Unorm,
+    /// DXGI_FORMAT_D24_UNORM_S8_UINT.
+    D24UnormS8Uint,
+    /// DXGI_FORMAT_D32_FLOAT_S8X24_UINT.
+    D32FloatS8Uint,
 }
 
 impl Format {
+    /// The depth formats an engine's depth buffer may have, sampled through their depth aspect.
+    pub const DEPTH: [Format; 5] = [
+        Self::D16Unorm,
+        Self::X8D24Unorm,
+        Self::D24UnormS8Uint,
+        Self::D32Float,
+        Self::D32FloatS8Uint,
+    ];
+
     /// The Vulkan format.
     pub fn to_vk(self) -> vk::Format {
         match self {
@@ -190,29 +207,60 @@ impl Format {
             Self::Rgba32Float => vk::Format::R32G32B32A32_SFLOAT,
             Self::Rgba8Unorm => vk::Format::R8G8B8A8_UNORM,
             Self::D32Float => vk::Format::D32_SFLOAT,
+            Self::D16Unorm => vk::Format::D16_UNORM,
+            Self::X8D24Unorm => vk::Format::X8_D24_UNORM_PACK32,
+            Self::D24UnormS8Uint => vk::Format::D24_UNORM_S8_UINT,
+            Self::D32FloatS8Uint => vk::Format::D32_SFLOAT_S8_UINT,
         }
+    }
+    /// The depth format whose raw `VkFormat` value is `raw`, if it is one of [`Format::DEPTH`].
+    pub fn depth_from_raw_vk(raw: i32) -> Option<Format> {
+        Self::DEPTH.into_iter().find(|f| f.raw_vk() == raw)
     }
     /// The raw `VkFormat` value (what a C ABI exchanges).
     pub fn raw_vk(self) -> i32 {
         self.to_vk().as_raw()
     }
-    /// Bytes per texel.
+    /// Bytes per texel (of the depth aspect, for depth formats: what a copy of it moves).
     pub fn texel_size(self) -> u32 {
         match self {
             Self::Rgba32Float => 16,
+            Self::D16Unorm => 2,
             _ => 4,
         }
     }
     /// Whether this is a depth format.
     pub fn is_depth(self) -> bool {
-        self == Self::D32Float
+        Self::DEPTH.contains(&self)
     }
-    /// Image aspect of the format.
+    /// Whether the format has a stencil aspect besides its depth.
+    pub fn has_stencil(self) -> bool {
+        matches!(self, Self::D24UnormS8Uint | Self::D32FloatS8Uint)
+    }
+    /// Every aspect of the format: what a layout transition covers.
     pub fn aspect(self) -> vk::ImageAspectFlags {
+        if self.has_stencil() {
+            vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL
+        } else {
+            self.view_aspect()
+        }
+    }
+    /// The aspect a view samples and a copy moves: depth for depth formats (stencil aside), else colour.
+    pub fn view_aspect(self) -> vk::ImageAspectFlags {
         if self.is_depth() {
             vk::ImageAspectFlags::DEPTH
         } else {
             vk::ImageAspectFlags::COLOR
+        }
+    }
+    /// The largest error of a depth stored in this format, as a bound on |stored - exact| in depth units:
+    /// one step of a normalized format (D16, D24). 0 for float formats, whose error is relative (2⁻²⁴ of
+    /// the value, rounded to nearest).
+    pub fn depth_quantum(self) -> f32 {
+        match self {
+            Self::D16Unorm => 1.0 / 65535.0,
+            Self::X8D24Unorm | Self::D24UnormS8Uint => 1.0 / 16_777_215.0,
+            _ => 0.0,
         }
     }
 }
@@ -324,5 +372,64 @@ mod tests {
         assert!(Format::D32Float.is_depth());
         assert_eq!(Format::Rgba32Float.texel_size(), 16);
         assert_eq!(Format::R32Uint.aspect(), vk::ImageAspectFlags::COLOR);
+    }
+
+    #[test]
+    fn engine_depth_formats_map_with_their_aspects() {
+        let both = vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL;
+        for (format, vk_format, aspect, size, quantum) in [
+            (
+                Format::D16Unorm,
+                vk::Format::D16_UNORM,
+                vk::ImageAspectFlags::DEPTH,
+                2,
+                1.0 / 65535.0,
+            ),
+            (
+                Format::X8D24Unorm,
+                vk::Format::X8_D24_UNORM_PACK32,
+                vk::ImageAspectFlags::DEPTH,
+                4,
+                1.0 / 16_777_215.0,
+            ),
+            (
+                Format::D24UnormS8Uint,
+                vk::Format::D24_UNORM_S8_UINT,
+                both,
+                4,
+                1.0 / 16_777_215.0,
+            ),
+            (
+                Format::D32Float,
+                vk::Format::D32_SFLOAT,
+                vk::ImageAspectFlags::DEPTH,
+                4,
+                0.0,
+            ),
+            (
+                Format::D32FloatS8Uint,
+                vk::Format::D32_SFLOAT_S8_UINT,
+                both,
+                4,
+                0.0,
+            ),
+        ] {
+            assert_eq!(format.to_vk(), vk_format);
+            assert_eq!(Format::depth_from_raw_vk(vk_format.as_raw()), Some(format));
+            assert!(format.is_depth());
+            assert_eq!(format.aspect(), aspect, "{format:?}");
+            // Sampled and copied through the depth aspect alone.
+            assert_eq!(format.view_aspect(), vk::ImageAspectFlags::DEPTH);
+            assert_eq!(format.texel_size(), size);
+            assert_eq!(format.depth_quantum(), quantum);
+        }
+        assert_eq!(
+            Format::depth_from_raw_vk(vk::Format::R32_SFLOAT.as_raw()),
+            None
+        );
+        assert_eq!(
+            Format::depth_from_raw_vk(vk::Format::S8_UINT.as_raw()),
+            None
+        );
     }
 }

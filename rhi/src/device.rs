@@ -3,6 +3,7 @@
 use crate::caps::{
     device_extensions, device_type_name, has_extension, read_capabilities, Capabilities,
 };
+use crate::conv::Format;
 use crate::error::{Result, RhiError, VkResultExt};
 use crate::rt_device::{ray_tracing_missing, RayTracingDevice, RayTracingFeatures};
 use ash::vk;
@@ -572,6 +573,20 @@ impl Device {
     /// The device's capabilities.
     pub fn capabilities(&self) -> &Capabilities {
         &self.shared.caps
+    }
+
+    /// Whether optimally tiled images of `format` can be sampled (depth formats through their depth
+    /// aspect).
+    pub fn can_sample(&self, format: Format) -> bool {
+        // SAFETY: the physical device belongs to this instance.
+        let props = unsafe {
+            self.shared
+                .instance
+                .get_physical_device_format_properties(self.shared.physical, format.to_vk())
+        };
+        props
+            .optimal_tiling_features
+            .contains(vk::FormatFeatureFlags::SAMPLED_IMAGE)
     }
 
     /// Validation messages seen so far (empty unless validation is on).

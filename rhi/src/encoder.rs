@@ -639,7 +639,7 @@ impl<'a> Encoder<'a> {
             .buffer_offset(offset)
             .image_subresource(
                 vk::ImageSubresourceLayers::default()
-                    .aspect_mask(image.format().aspect())
+                    .aspect_mask(image.format().view_aspect())
                     .mip_level(0)
                     .base_array_layer(0)
                     .layer_count(image.layers()),
@@ -695,7 +695,7 @@ impl<'a> Encoder<'a> {
     fn record_image_copy(&mut self, src: &Image, dst: &Image, dst_layer: u32, layers: u32) {
         let subresource = |base| {
             vk::ImageSubresourceLayers::default()
-                .aspect_mask(src.format().aspect())
+                .aspect_mask(src.format().view_aspect())
                 .mip_level(0)
                 .base_array_layer(base)
                 .layer_count(layers)

@@ -453,7 +453,9 @@ impl Device {
             .image(raw)
             .view_type(view_type)
             .format(desc.format.to_vk())
-            .subresource_range(subresource_range(desc.format, desc.layers));
+            .subresource_range(
+                subresource_range(desc.format, desc.layers).aspect_mask(desc.format.view_aspect()),
+            );
         // SAFETY: guaranteed by the caller.
         unsafe { self.shared.device.create_image_view(&view_info, None) }.call("vkCreateImageView")
     }

@@ -977,6 +977,135 @@ static void partial_record(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g)
     upload_gbuffer();
 }
 
+/* ---------- the engine's depth as it is ---------- */
+/* Every depth format the plugin reads, written by a reversed-Z projection with an infinite far plane and by a
+ * standard-Z one with a finite far plane, gives the exact hard shadow (0 mismatches outside near-edge pixels):
+ * the plugin rebuilds positions through the frame's projection and offsets the ray origins by the format's
+ * depth error. A format it does not read is refused with a message. */
+static void engine_depth(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
+    enum { PX = W * H };
+    const struct {
+        VkFormat format;
+        const char *name;
+    } formats[] = {
+        {VK_FORMAT_D16_UNORM, "D16_UNORM"},
+        {VK_FORMAT_X8_D24_UNORM_PACK32, "X8_D24_UNORM_PACK32"},
+        {VK_FORMAT_D24_UNORM_S8_UINT, "D24_UNORM_S8_UINT"},
+        {VK_FORMAT_D32_SFLOAT, "D32_SFLOAT"},
+        {VK_FORMAT_D32_SFLOAT_S8_UINT, "D32_SFLOAT_S8_UINT"},
+    };
+    const double FAR = 50.0;
+    setup_camera(0.0);
+    Emitter sun = directional(v3(0.45, -1.0, 0.2));
+    set_lights(&sun, 1);
+    upload_gbuffer(); /* the normals of this view (and a depth the cases below replace) */
+    static double distance[PX];
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            V3 n;
+            double t;
+            distance[y * W + x] = cast(cam_pos, pixel_ray(x, y), 0, &t, &n) ? t : -1.0;
+        }
+    int cases = 0, failed_cases = 0;
+    char skipped[256] = "";
+    for (size_t k = 0; k < sizeof formats / sizeof formats[0]; k++) {
+        VkFormat format = formats[k].format;
+        VkFormatProperties props;
+        vkGetPhysicalDeviceFormatProperties(phys, format, &props);
+        VkFormatFeatureFlags need = VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT | VK_FORMAT_FEATURE_TRANSFER_DST_BIT |
+                                    VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT;
+        if ((props.optimalTilingFeatures & need) != need) {
+            strcat(skipped, " ");
+            strcat(skipped, formats[k].name);
+            continue;
+        }
+        int stencil = format == VK_FORMAT_D24_UNORM_S8_UINT || format == VK_FORMAT_D32_SFLOAT_S8_UINT;
+        VkImageAspectFlags all = VK_IMAGE_ASPECT_DEPTH_BIT | (stencil ? VK_IMAGE_ASPECT_STENCIL_BIT : 0);
+        VkImageLayout layout =
+            stencil ? VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL : VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL;
+        size_t texel = format == VK_FORMAT_D16_UNORM ? 2 : 4;
+        for (int forward = 0; forward < 2; forward++) {
+            /* the projection: reversed Z to infinity (the default view), or standard Z to FAR */
+            setup_camera(0.0);
+            if (forward) {
+                proj[10] = (float)(FAR / (NEAR - FAR));
+                proj[14] = (float)(NEAR * FAR / (NEAR - FAR));
+            }
+            /* an engine's depth buffer: a depth attachment it also samples */
+            VkImageUsageFlags usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                                      VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+            Img depth = make_image(format, usage, 1);
+            Buf staging = make_host_buffer(texel * PX, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+            for (int i = 0; i < PX; i++) {
+                double t = distance[i];
+                double d = t < 0 ? (forward ? 1.0 : 0.0) : forward ? FAR / (FAR - NEAR) * (1.0 - NEAR / t) : NEAR / t;
+                if (format == VK_FORMAT_D16_UNORM)
+                    ((uint16_t *)staging.map)[i] = (uint16_t)lround(d * 65535.0);
+                else if (format == VK_FORMAT_D32_SFLOAT || format == VK_FORMAT_D32_SFLOAT_S8_UINT)
+                    ((float *)staging.map)[i] = (float)d;
+                else
+                    ((uint32_t *)staging.map)[i] = (uint32_t)lround(d * 16777215.0);
+            }
+            VkCommandBuffer cmd = begin();
+            barrier(cmd, depth.image, all, 1, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+            VkBufferImageCopy region;
+            memset(&region, 0, sizeof region);
+            region.imageSubresource.aspectMask = VK_IMAGE_ASPECT_DEPTH_BIT;
+            region.imageSubresource.layerCount = 1;
+            region.imageExtent.width = W;
+            region.imageExtent.height = H;
+            region.imageExtent.depth = 1;
+            vkCmdCopyBufferToImage(cmd, staging.buffer, depth.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+            barrier(cmd, depth.image, all, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, layout);
+            submit_and_wait(cmd);
+            free_buffer(staging);
+
+            HrtsContext *ctx = create_context(vk, 1);
+            HrtsTargets t = targets();
+            t.depth_image = (uint64_t)(uintptr_t)depth.image;
+            t.depth_usage = usage;
+            t.depth_format = (uint32_t)format;
+            HrtsResult r = configure_all(ctx, 1, HRTS_SHADOW_MODE_HARD);
+            if (r == HRTS_RESULT_OK) r = hrts_set_geometry_cpu(ctx, g);
+            if (r == HRTS_RESULT_OK) r = hrts_set_targets(ctx, &t);
+            static float vis[PX];
+            if (r == HRTS_RESULT_OK) {
+                VkCommandBuffer frame_cmd = begin();
+                HrtsFrame f = frame(frame_cmd, next_frame++);
+                f.depth_layout = layout;
+                r = finish_frame(frame_cmd, hrts_record_frame(ctx, &f), vis);
+            }
+            int near_edge = 0, shadowed = 0, lit = 0, mismatches = -1;
+            if (r == HRTS_RESULT_OK) mismatches = count_mismatches(vis, edge_tolerance(), &sun, &near_edge, &shadowed, &lit);
+            printf("depth %s, %s: %d lit, %d shadowed, %d near-edge, %d mismatches\n", formats[k].name,
+                   forward ? "standard Z to a far plane" : "reversed Z to infinity", lit, shadowed, near_edge, mismatches);
+            CHECK(r == HRTS_RESULT_OK, "depth %s: %s", formats[k].name, hrts_last_error(ctx));
+            int ok = r == HRTS_RESULT_OK && mismatches == 0 && shadowed > 300 && near_edge * 100 <= 4 * PX;
+            CHECK(ok, "depth %s (%s): %d mismatches, %d shadowed, %d near-edge", formats[k].name,
+                  forward ? "standard Z" : "reversed Z", mismatches, shadowed, near_edge);
+            cases++;
+            failed_cases += !ok;
+            CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
+            free_image(depth);
+        }
+    }
+    setup_camera(0.0);
+    printf("engine depth: %d format and convention cases, %d failed; skipped (the device cannot sample them):%s\n",
+           cases, failed_cases, skipped[0] ? skipped : " none");
+    CHECK(cases >= 4, "only %d depth cases ran", cases);
+    /* a format the plugin does not read, and a colour format, are refused */
+    HrtsContext *ctx = create_context(vk, 1);
+    HrtsTargets t = targets();
+    const uint32_t refused[] = {VK_FORMAT_S8_UINT, VK_FORMAT_R32_SFLOAT};
+    for (int i = 0; i < 2; i++) {
+        t.depth_format = refused[i];
+        HrtsResult r = hrts_set_targets(ctx, &t);
+        CHECK(r == HRTS_RESULT_ERROR_INVALID_ENUM && strstr(hrts_last_error(ctx), "depth_format"),
+              "depth_format %u refused: %s", refused[i], hrts_last_error(ctx));
+    }
+    CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
+}
+
 /* ---------- misuse: a table of calls that must fail with a given result and a message ---------- */
 /* Each case runs in table order on one context (some build on the state left by the ones before); after
  * each, the context must still answer. A successful call clears the last error, so a case that fails with
@@ -1846,6 +1975,8 @@ int main(void) {
     native_local_lights(&vk, &g);
     phase = "frames in flight";
     frames_in_flight(&vk, &g);
+    phase = "engine depth";
+    engine_depth(&vk, &g);
     phase = "read-back retire";
     readback_retire(&vk, &g);
     phase = "partial record";

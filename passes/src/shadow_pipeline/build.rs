@@ -228,6 +228,7 @@ impl ShadowPipeline {
             statuses: Vec::new(),
             width,
             height,
+            depth_quantum: inputs.depth.format().depth_quantum(),
         };
         // Every resource of the plan exists (a missing one would be a bug in the wiring above).
         if let Some(r) = pipeline

@@ -15,7 +15,8 @@ use rhi::Image;
 pub struct FrameInputs {
     /// World to view.
     pub view: Mat4,
-    /// View to clip: reversed Z (depth 1 at the near plane, 0 at infinity), Vulkan conventions.
+    /// View to clip, Vulkan conventions (depth 0..1): the projection that wrote the depth image, reversed
+    /// or standard Z, finite or infinite far plane.
     pub proj: Mat4,
     /// Camera position in world space.
     pub camera_position: Vec3,
@@ -102,7 +103,8 @@ impl ShadowConfig {
 
 /// The engine's images the pipeline reads, bound at creation.
 pub struct ShadowInputs<'a> {
-    /// Reversed-Z depth (`D32_SFLOAT`, sampled), `ShaderResource` state when the passes run.
+    /// Depth as `FrameInputs::proj` writes it (any [`rhi::Format::DEPTH`] format, sampled through its depth
+    /// aspect), `ShaderResource` state when the passes run.
     pub depth: &'a Image,
     /// World-space geometric normal facing the camera (xyz), w = 0 on background, `ShaderResource` state.
     pub normal: &'a Image,

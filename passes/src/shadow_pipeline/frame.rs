@@ -56,7 +56,7 @@ impl ShadowPipeline {
                     radians_per_pixel,
                     RAY_OFFSET_PIXELS,
                     RAY_OFFSET_FLOAT_BOUND,
-                    0.0,
+                    self.depth_quantum,
                 ),
                 misc: UVec4::new(front_only, self.geometry().triangle_count(), 0, 0),
                 light_pos: light.position.map_or(Vec4::ZERO, |p| p.extend(1.0)),

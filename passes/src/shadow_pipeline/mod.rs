@@ -115,6 +115,8 @@ pub struct ShadowPipeline {
     statuses: Vec<(PassId, PassStatus)>,
     width: u32,
     height: u32,
+    /// One step of the engine's depth format (0 for float formats): part of the ray-origin offset.
+    depth_quantum: f32,
 }
 
 impl ShadowPipeline {
