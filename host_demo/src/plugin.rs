@@ -218,6 +218,7 @@ impl PluginRenderer {
                 output_image: output.raw_handle(),
                 output_usage: output.raw_usage(),
                 output_layers: layers,
+                output_format: output.format().raw_vk() as u32,
             };
             // SAFETY: live context; the images live as long as the renderer, which destroys the context
             // first.

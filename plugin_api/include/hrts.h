@@ -599,13 +599,17 @@ typedef struct HrtsTargets {
   uint64_t normal_image;
   // Usage flags of the normal image.
   uint32_t normal_usage;
-  // Visibility `VkImage` the plugin writes (`VK_FORMAT_R32_SFLOAT`, usage includes TRANSFER_DST): 1 = lit.
+  // Visibility `VkImage` the plugin writes (`output_format`, usage includes TRANSFER_DST): 1 = lit.
   // Light `i`'s visibility goes to array layer `i`.
   uint64_t output_image;
   // Usage flags of the output image.
   uint32_t output_usage;
   // Array layers of the output image: at least the number of lights when a frame is recorded.
   uint32_t output_layers;
+  // `VkFormat` of the output image: `VK_FORMAT_R32_SFLOAT` (or 0), written by a copy, or
+  // `VK_FORMAT_R8_UNORM` or `VK_FORMAT_R16_SFLOAT`, written by a converting blit (the device must
+  // support blits from `R32_SFLOAT` to it).
+  uint32_t output_format;
 } HrtsTargets;
 
 // One light of a frame.

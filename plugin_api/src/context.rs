@@ -23,6 +23,7 @@ pub(crate) struct TargetSource {
     pub(crate) height: u32,
     pub(crate) depth: u64,
     pub(crate) depth_format: Format,
+    pub(crate) output_format: Format,
     pub(crate) normal: u64,
     pub(crate) output: u64,
     pub(crate) output_layers: u32,
@@ -477,6 +478,31 @@ impl Context {
                 ),
             ));
         }
+        let output_format = match t.output_format {
+            0 => Format::R32Float,
+            raw => i32::try_from(raw)
+                .ok()
+                .and_then(Format::visibility_from_raw_vk)
+                .ok_or_else(|| {
+                    ApiError::new(
+                        HrtsResult::ErrorInvalidEnum,
+                        format!(
+                            "output_format {raw} is not a visibility format the plugin writes: R8_UNORM (9), R16_SFLOAT (76) or R32_SFLOAT (100), or 0 for R32_SFLOAT"
+                        ),
+                    )
+                })?,
+        };
+        if output_format != Format::R32Float
+            && !self.device.can_blit(Format::R32Float, output_format)
+        {
+            return Err(ApiError::new(
+                HrtsResult::ErrorUnsupported,
+                format!(
+                    "the device cannot blit R32_SFLOAT into output_format {} ({output_format:?})",
+                    output_format.raw_vk()
+                ),
+            ));
+        }
         require_usage(t.depth_usage, ImageUsage::SAMPLED, "depth_image", "SAMPLED")?;
         require_usage(
             t.normal_usage,
@@ -495,6 +521,7 @@ impl Context {
             height: t.height,
             depth: t.depth_image,
             depth_format,
+            output_format,
             normal: t.normal_image,
             output: t.output_image,
             output_layers: t.output_layers,
@@ -621,7 +648,7 @@ impl Context {
             output: wrap(
                 "engine visibility",
                 t.output,
-                Format::R32Float,
+                t.output_format,
                 ImageUsage::COPY_DST,
                 t.output_layers,
             )?,

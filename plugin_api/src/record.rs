@@ -6,7 +6,7 @@ use crate::convert::{frame_inputs, pass_from_index, resource_id};
 use crate::error::{check_size, invalid, ApiError, ApiResult};
 use crate::types::*;
 use passes::{PassError, PassId, ResourceId};
-use rhi::{Barrier, BufferUsage, Encoder, Image, ResourceState as S};
+use rhi::{Barrier, BufferUsage, Encoder, Format, Image, ResourceState as S};
 
 /// Pass-mask bits of the passes that read the engine's depth and normal images (the primitive map fits
 /// itself to the receivers).
@@ -365,9 +365,11 @@ fn record_output_copy(
         after: S::CopyDest,
     });
     enc.barriers(&to_copy);
+    let same_format = b.output.format() == Format::R32Float;
     for &(layer, vis) in &layers {
         match vis {
-            Some(vis) => enc.copy_image_into_layer(vis, &b.output, layer)?,
+            Some(vis) if same_format => enc.copy_image_into_layer(vis, &b.output, layer)?,
+            Some(vis) => enc.blit_into_layer(vis, &b.output, layer)?,
             None => enc.clear_uint_layer(&b.output, layer, 1.0f32.to_bits())?,
         }
     }

@@ -530,13 +530,17 @@ pub struct HrtsTargets {
     pub normal_image: u64,
     /// Usage flags of the normal image.
     pub normal_usage: u32,
-    /// Visibility `VkImage` the plugin writes (`VK_FORMAT_R32_SFLOAT`, usage includes TRANSFER_DST): 1 = lit.
+    /// Visibility `VkImage` the plugin writes (`output_format`, usage includes TRANSFER_DST): 1 = lit.
     /// Light `i`'s visibility goes to array layer `i`.
     pub output_image: u64,
     /// Usage flags of the output image.
     pub output_usage: u32,
     /// Array layers of the output image: at least the number of lights when a frame is recorded.
     pub output_layers: u32,
+    /// `VkFormat` of the output image: `VK_FORMAT_R32_SFLOAT` (or 0), written by a copy, or
+    /// `VK_FORMAT_R8_UNORM` or `VK_FORMAT_R16_SFLOAT`, written by a converting blit (the device must
+    /// support blits from `R32_SFLOAT` to it).
+    pub output_format: u32,
 }
 
 /// One light of a frame.

@@ -187,6 +187,10 @@ pub enum Format {
     D24UnormS8Uint,
     /// DXGI_FORMAT_D32_FLOAT_S8X24_UINT.
     D32FloatS8Uint,
+    /// DXGI_FORMAT_R8_UNORM.
+    R8Unorm,
+    /// DXGI_FORMAT_R16_FLOAT.
+    R16Float,
 }
 
 impl Format {
@@ -211,7 +215,18 @@ impl Format {
             Self::X8D24Unorm => vk::Format::X8_D24_UNORM_PACK32,
             Self::D24UnormS8Uint => vk::Format::D24_UNORM_S8_UINT,
             Self::D32FloatS8Uint => vk::Format::D32_SFLOAT_S8_UINT,
+            Self::R8Unorm => vk::Format::R8_UNORM,
+            Self::R16Float => vk::Format::R16_SFLOAT,
         }
+    }
+
+    /// The one-channel formats a visibility image may have: written by a copy (`R32_SFLOAT`) or a
+    /// converting blit.
+    pub const VISIBILITY: [Format; 3] = [Self::R8Unorm, Self::R16Float, Self::R32Float];
+
+    /// The visibility format whose raw `VkFormat` value is `raw`, if it is one of [`Format::VISIBILITY`].
+    pub fn visibility_from_raw_vk(raw: i32) -> Option<Format> {
+        Self::VISIBILITY.into_iter().find(|f| f.raw_vk() == raw)
     }
     /// The depth format whose raw `VkFormat` value is `raw`, if it is one of [`Format::DEPTH`].
     pub fn depth_from_raw_vk(raw: i32) -> Option<Format> {
@@ -225,7 +240,8 @@ impl Format {
     pub fn texel_size(self) -> u32 {
         match self {
             Self::Rgba32Float => 16,
-            Self::D16Unorm => 2,
+            Self::D16Unorm | Self::R16Float => 2,
+            Self::R8Unorm => 1,
             _ => 4,
         }
     }

@@ -578,15 +578,28 @@ impl Device {
     /// Whether optimally tiled images of `format` can be sampled (depth formats through their depth
     /// aspect).
     pub fn can_sample(&self, format: Format) -> bool {
+        self.optimal_features(format)
+            .contains(vk::FormatFeatureFlags::SAMPLED_IMAGE)
+    }
+
+    /// Whether [`crate::Encoder::blit_into_layer`] can write optimally tiled images of `dst` from images
+    /// of `src`.
+    pub fn can_blit(&self, src: Format, dst: Format) -> bool {
+        self.optimal_features(src)
+            .contains(vk::FormatFeatureFlags::BLIT_SRC)
+            && self
+                .optimal_features(dst)
+                .contains(vk::FormatFeatureFlags::BLIT_DST)
+    }
+
+    fn optimal_features(&self, format: Format) -> vk::FormatFeatureFlags {
         // SAFETY: the physical device belongs to this instance.
-        let props = unsafe {
+        unsafe {
             self.shared
                 .instance
                 .get_physical_device_format_properties(self.shared.physical, format.to_vk())
-        };
-        props
-            .optimal_tiling_features
-            .contains(vk::FormatFeatureFlags::SAMPLED_IMAGE)
+        }
+        .optimal_tiling_features
     }
 
     /// Validation messages seen so far (empty unless validation is on).

@@ -690,6 +690,54 @@ impl<'a> Encoder<'a> {
         Ok(())
     }
 
+    /// Writes one-layer `src` into layer `layer` of `dst` (same size, any formats the device blits between:
+    /// see [`crate::Device::can_blit`]), converting texels as a blit does; `src` in `CopySource`, `dst` in
+    /// `CopyDest` state.
+    pub fn blit_into_layer(&mut self, src: &Image, dst: &Image, layer: u32) -> Result<()> {
+        if (src.width(), src.height()) != (dst.width(), dst.height())
+            || src.layers() != 1
+            || layer >= dst.layers()
+            || src.format().is_depth()
+            || dst.format().is_depth()
+        {
+            return Err(RhiError::InvalidArgument(format!(
+                "blit into layer {layer} of {} needs one colour source layer of the same size",
+                dst.layers()
+            )));
+        }
+        let subresource = |base| {
+            vk::ImageSubresourceLayers::default()
+                .aspect_mask(vk::ImageAspectFlags::COLOR)
+                .mip_level(0)
+                .base_array_layer(base)
+                .layer_count(1)
+        };
+        let corner = vk::Offset3D {
+            x: src.width() as i32,
+            y: src.height() as i32,
+            z: 1,
+        };
+        let region = vk::ImageBlit::default()
+            .src_subresource(subresource(0))
+            .src_offsets([vk::Offset3D::default(), corner])
+            .dst_subresource(subresource(layer))
+            .dst_offsets([vk::Offset3D::default(), corner]);
+        // SAFETY: checked sizes, layers and aspects; the images are in the stated layouts by contract and
+        // the caller checked the formats' blit support.
+        unsafe {
+            self.d().cmd_blit_image(
+                self.cmd,
+                src.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                dst.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[region],
+                vk::Filter::NEAREST,
+            )
+        };
+        Ok(())
+    }
+
     /// Records the copy of `layers` layers of `src`, from its first, into `dst` from layer `dst_layer`
     /// (checked by the callers).
     fn record_image_copy(&mut self, src: &Image, dst: &Image, dst_layer: u32, layers: u32) {
