@@ -61,6 +61,24 @@ impl ViewVolume {
         let mut planes = box_planes(lo, hi);
         planes.extend(&self.camera);
         planes.extend(clip_planes(light.view_proj().as_dmat4()));
+        // Quick rejection: the whole box outside one plane.
+        let corners: Vec<DVec3> = (0..8)
+            .map(|i| {
+                DVec3::new(
+                    if i & 1 == 0 { lo.x } else { hi.x },
+                    if i & 2 == 0 { lo.y } else { hi.y },
+                    if i & 4 == 0 { lo.z } else { hi.z },
+                )
+            })
+            .collect();
+        let outside = |p: &DVec4| {
+            corners
+                .iter()
+                .all(|c| p.truncate().dot(*c) + p.w < -tolerance)
+        };
+        if planes[6..].iter().any(outside) {
+            return false;
+        }
         feasible(&planes, tolerance)
     }
 }

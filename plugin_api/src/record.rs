@@ -91,8 +91,20 @@ impl Context {
             self.begin_frame(f.frame_index)?;
         }
         self.set_frusta(&inputs.iter().map(|l| l.frusta.len()).collect::<Vec<_>>());
-        let schedule = self.schedule(&inputs);
-        let recorded: Vec<Vec<bool>> = schedule.iter().map(|l| l.recorded.clone()).collect();
+        // A frame's later calls (same camera and lights) record the frusta its first call chose.
+        let kept = self
+            .schedules
+            .back()
+            .filter(|s| continues && s.index == f.frame_index);
+        let schedule = match kept {
+            Some(_) => None,
+            None => Some(self.schedule(&inputs)),
+        };
+        let recorded: Vec<Vec<bool>> = schedule
+            .as_deref()
+            .or(kept.map(|s| s.lights.as_slice()))
+            .map(|lights| lights.iter().map(|l| l.recorded.clone()).collect())
+            .unwrap_or_default();
         self.ensure_built()?;
         let frame_index = f.frame_index;
         let (device, built) = match self.built.as_mut() {
@@ -192,7 +204,7 @@ impl Context {
                 last_pass: highest,
             });
         }
-        if !continues {
+        if let Some(schedule) = schedule.filter(|_| !continues) {
             self.keep_schedule(frame_index, schedule);
         }
         Ok(())
