@@ -127,6 +127,9 @@ pub struct PluginRenderer {
     configured: Vec<ShadowConfig>,
     timer: GpuTimer,
     dynamic_geometry: bool,
+    /// The scene's bounds, given with every frame: the demo does not animate its scenes, so they hold in
+    /// every frame even when the geometry counts as moving.
+    bounds: Aabb,
     frames: u64,
     frames_with_plugin_passes: u64,
     native_tier: ConservativeRasterTier,
@@ -180,6 +183,7 @@ impl PluginRenderer {
             configured: Vec::new(),
             timer: device.create_timer(4)?,
             dynamic_geometry,
+            bounds: scene.bounds(),
             frames: 0,
             frames_with_plugin_passes: 0,
             native_tier: device.capabilities().conservative_raster_tier,
@@ -319,7 +323,13 @@ impl PluginRenderer {
             }
             enc.attach_timer(&self.timer);
             if with_plugin {
-                let frame = c_frame(enc.raw_handle(), self.frames, camera, &c_lights);
+                let frame = c_frame(
+                    enc.raw_handle(),
+                    self.frames,
+                    camera,
+                    &c_lights,
+                    &self.bounds,
+                );
                 self.record_passes(&frame, HRTS_PASS_MASK_LIGHT_SPACE)?;
             }
             let undefined_to = |image, after| Barrier::Image {
@@ -354,7 +364,13 @@ impl PluginRenderer {
         if with_plugin {
             let start = std::time::Instant::now();
             device.submit_and_wait(|enc| {
-                let frame = c_frame(enc.raw_handle(), self.frames, camera, &c_lights);
+                let frame = c_frame(
+                    enc.raw_handle(),
+                    self.frames,
+                    camera,
+                    &c_lights,
+                    &self.bounds,
+                );
                 self.record_passes(&frame, HRTS_PASS_MASK_SCREEN_SPACE)
             })?;
             let wall = start.elapsed().as_secs_f64() * 1e3;
@@ -779,6 +795,7 @@ fn c_frame(
     frame_index: u64,
     camera: &CameraMatrices,
     lights: &[HrtsLight],
+    bounds: &Aabb,
 ) -> HrtsFrame {
     let sampled = S::ShaderResource.raw_layout();
     HrtsFrame {
@@ -794,5 +811,14 @@ fn c_frame(
         normal_layout: sampled,
         output_layout_before: S::Undefined.raw_layout(),
         output_layout_after: sampled,
+        bounds: [
+            bounds.min.x,
+            bounds.min.y,
+            bounds.min.z,
+            bounds.max.x,
+            bounds.max.y,
+            bounds.max.z,
+        ],
+        has_bounds: 1,
     }
 }

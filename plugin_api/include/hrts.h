@@ -666,6 +666,13 @@ typedef struct HrtsFrame {
   int32_t output_layout_before;
   // `VkImageLayout` the output image is left in.
   int32_t output_layout_after;
+  // World-space bounds (min xyz, max xyz) of every triangle of the geometry this frame, read when
+  // `has_bounds` is set. They let the plugin cull light frusta by the scene's extent when the geometry
+  // moves; without them it culls moving Vulkan geometry by the view and the lights' ranges alone
+  // (CPU geometry and static Vulkan geometry use the bounds they were given).
+  float bounds[6];
+  // Whether `bounds` holds this frame's bounds.
+  HrtsBool has_bounds;
 } HrtsFrame;
 
 // Shape of a plugin resource, for reading it back.

@@ -345,10 +345,16 @@ impl Context {
 
     /// Takes each light's number of frusta this frame: a light whose number changed (a spot light turned
     /// point light, say) has its passes rebuilt.
-    /// Which frusta of each light may hold a receiver in view within the light's range this frame.
-    pub(crate) fn schedule(&self, lights: &[FrameLight]) -> Vec<LightSchedule> {
+    /// Which frusta of each light may hold a receiver in view within the light's range this frame, within
+    /// `frame_bounds` when the engine gave them, else the geometry's own bounds when they hold.
+    pub(crate) fn schedule(
+        &self,
+        lights: &[FrameLight],
+        frame_bounds: Option<[glam::DVec3; 2]>,
+    ) -> Vec<LightSchedule> {
         let dynamic = self.lights.iter().any(|c| !c.static_geometry);
-        let bounds = self.geometry.as_ref().and_then(|g| g.cull_bounds(dynamic));
+        let bounds =
+            frame_bounds.or_else(|| self.geometry.as_ref().and_then(|g| g.cull_bounds(dynamic)));
         let camera = lights
             .first()
             .and_then(|l| l.frusta.first())

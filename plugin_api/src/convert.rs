@@ -145,6 +145,20 @@ pub(crate) fn frame_inputs(f: &HrtsFrame) -> ApiResult<Vec<FrameLight>> {
         .collect()
 }
 
+/// The frame's geometry bounds, when the engine gives them (`has_bounds`).
+pub(crate) fn frame_bounds(f: &HrtsFrame) -> ApiResult<Option<[glam::DVec3; 2]>> {
+    if f.has_bounds == 0 {
+        return Ok(None);
+    }
+    finite(&f.bounds, "bounds")?;
+    let lo = Vec3::from_slice(&f.bounds[..3]).as_dvec3();
+    let hi = Vec3::from_slice(&f.bounds[3..]).as_dvec3();
+    if lo.cmpgt(hi).any() {
+        return Err(invalid("bounds: min exceeds max"));
+    }
+    Ok(Some([lo, hi]))
+}
+
 /// One light of a frame: the frusta it is shadowed through (the camera in each), its type and range.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct FrameLight {

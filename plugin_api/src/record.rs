@@ -2,7 +2,7 @@
 //! the copy of each light's visibility into the engine's output, and resource read-backs.
 
 use crate::context::{Built, Context, FrameProgress, OpenFrame};
-use crate::convert::{frame_inputs, pass_from_index, resource_id};
+use crate::convert::{frame_bounds, frame_inputs, pass_from_index, resource_id};
 use crate::error::{check_size, invalid, ApiError, ApiResult};
 use crate::types::*;
 use passes::{PassError, PassId, ResourceId};
@@ -33,6 +33,7 @@ impl Context {
             return Err(invalid("frame_index UINT64_MAX is reserved"));
         }
         let inputs = frame_inputs(f)?;
+        let bounds = frame_bounds(f)?;
         if inputs.len() != self.lights.len() {
             return Err(invalid(format!(
                 "light_count {} differs from the {} lights configured",
@@ -98,7 +99,7 @@ impl Context {
             .filter(|s| continues && s.index == f.frame_index);
         let schedule = match kept {
             Some(_) => None,
-            None => Some(self.schedule(&inputs)),
+            None => Some(self.schedule(&inputs, bounds)),
         };
         let recorded: Vec<Vec<bool>> = schedule
             .as_deref()

@@ -600,6 +600,13 @@ pub struct HrtsFrame {
     pub output_layout_before: i32,
     /// `VkImageLayout` the output image is left in.
     pub output_layout_after: i32,
+    /// World-space bounds (min xyz, max xyz) of every triangle of the geometry this frame, read when
+    /// `has_bounds` is set. They let the plugin cull light frusta by the scene's extent when the geometry
+    /// moves; without them it culls moving Vulkan geometry by the view and the lights' ranges alone
+    /// (CPU geometry and static Vulkan geometry use the bounds they were given).
+    pub bounds: [f32; 6],
+    /// Whether `bounds` holds this frame's bounds.
+    pub has_bounds: HrtsBool,
 }
 
 /// The engine's host allocator. The plugin's host memory (not Vulkan's) goes through it for the whole

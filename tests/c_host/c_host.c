@@ -41,6 +41,8 @@ static int passed, failed;
 static const double BOX_MIN[3] = {-0.5, 0.6, -0.5};
 static const double BOX_MAX[3] = {0.5, 1.6, 0.5};
 static const double GROUND = 4.0;
+/* World-space bounds of the scene's triangles (min xyz, max xyz). */
+static const float SCENE_BOUNDS[6] = {-4.0f, 0.0f, -4.0f, 4.0f, 1.6f, 4.0f};
 
 static float positions[] = {
     -4, 0, -4, 4, 0, -4, 4, 0, 4, -4, 0, 4, /* ground 0..3 */
@@ -862,8 +864,7 @@ static HrtsVulkanGeometry fake_vulkan_geometry(const HrtsCpuGeometry *g) {
     vg.index_count = 42;
     vg.draws = g->draws;
     vg.draw_count = g->draw_count;
-    const float bounds[6] = {-4.0f, 0.0f, -4.0f, 4.0f, 1.6f, 4.0f};
-    memcpy(vg.bounds, bounds, sizeof bounds);
+    memcpy(vg.bounds, SCENE_BOUNDS, sizeof SCENE_BOUNDS);
     return vg;
 }
 
@@ -975,6 +976,98 @@ static void partial_record(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g)
     CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "partial record: destroy");
     setup_camera(0.0);
     upload_gbuffer();
+}
+
+/* The scene in the engine's own Vulkan buffers: float4 positions (stride 16) at byte offset 64, 16-bit
+ * indices at byte offset 8; the buffers go to `vb` and `ib`. */
+static HrtsVulkanGeometry engine_geometry(Buf *vb, Buf *ib) {
+    *vb = make_host_buffer(64 + 12 * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    *ib = make_host_buffer(8 + 44 * 2, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    float *vp = (float *)((char *)vb->map + 64);
+    uint16_t *ip = (uint16_t *)((char *)ib->map + 8);
+    for (int v = 0; v < 12; v++) {
+        vp[4 * v + 0] = positions[3 * v + 0];
+        vp[4 * v + 1] = positions[3 * v + 1];
+        vp[4 * v + 2] = positions[3 * v + 2];
+        vp[4 * v + 3] = 1.0f;
+    }
+    for (int k = 0; k < 42; k++) ip[k] = (uint16_t)indices[k];
+    HrtsVulkanGeometry vg;
+    memset(&vg, 0, sizeof vg);
+    vg.struct_size = sizeof vg;
+    vg.vertex_buffer = (uint64_t)(uintptr_t)vb->buffer;
+    vg.vertex_buffer_size = 64 + 12 * 16;
+    vg.vertex_offset = 64;
+    vg.vertex_stride = 16;
+    vg.vertex_count = 12;
+    vg.index_buffer = (uint64_t)(uintptr_t)ib->buffer;
+    vg.index_buffer_size = 8 + 44 * 2;
+    vg.index_offset = 8;
+    vg.index_type = HRTS_INDEX_TYPE_UINT16;
+    vg.index_count = 42;
+    vg.draws = draws;
+    vg.draw_count = 2;
+    memcpy(vg.bounds, SCENE_BOUNDS, sizeof SCENE_BOUNDS);
+    return vg;
+}
+
+/* ---------- moving geometry: bounds per frame ---------- */
+/* With Vulkan geometry that the engine changes every frame, the plugin cannot trust the bounds of the
+ * geometry call: it culls a point light's faces by the view and the range alone, and records all six of a
+ * light above the scene. Given this frame's bounds (`has_bounds`), it culls the face that looks above
+ * them. Both frames match the exact shadow. */
+static void moving_geometry_bounds(const HrtsVulkanDevice *vk) {
+    setup_camera(0.0);
+    Emitter lamp = point(v3(0.9, 2.3, 0.7));
+    set_lights(&lamp, 1);
+    upload_gbuffer();
+    HrtsContext *ctx = create_context(vk, 1);
+    HrtsConfig cfg = config(HRTS_SHADOW_MODE_HARD);
+    cfg.dynamic_geometry = true;
+    Buf vb, ib;
+    HrtsVulkanGeometry vg = engine_geometry(&vb, &ib);
+    HrtsTargets t = targets();
+    CHECK(hrts_configure(ctx, &cfg) == HRTS_RESULT_OK && hrts_set_geometry_vulkan(ctx, &vg) == HRTS_RESULT_OK &&
+              hrts_set_targets(ctx, &t) == HRTS_RESULT_OK,
+          "moving geometry: setup: %s", hrts_last_error(ctx));
+    static float vis[W * H];
+    uint32_t culled[2] = {99, 99};
+    int mismatches[2] = {-1, -1};
+    for (int with_bounds = 0; with_bounds < 2; with_bounds++) {
+        VkCommandBuffer cmd = begin();
+        uint64_t index = next_frame++;
+        HrtsFrame f = frame(cmd, index);
+        f.has_bounds = with_bounds;
+        memcpy(f.bounds, SCENE_BOUNDS, sizeof SCENE_BOUNDS);
+        HrtsResult r = finish_frame(cmd, hrts_record_frame(ctx, &f), vis);
+        HrtsFrameReport rep;
+        CHECK(r == HRTS_RESULT_OK && report(ctx, index, 0, &rep) == HRTS_RESULT_OK, "moving geometry: frame: %s",
+              hrts_last_error(ctx));
+        culled[with_bounds] = rep.frusta_culled;
+        int near_edge, shadowed, lit;
+        mismatches[with_bounds] = count_mismatches(vis, edge_tolerance(), &lamp, &near_edge, &shadowed, &lit);
+        printf("moving geometry, %s: %s; %d shadowed, %d mismatches\n",
+               with_bounds ? "with the frame's bounds" : "without bounds", rep.decision_reason, shadowed,
+               mismatches[with_bounds]);
+    }
+    CHECK(culled[0] == 0 && culled[1] >= 1, "moving geometry: %u faces culled without bounds, %u with", culled[0],
+          culled[1]);
+    CHECK(mismatches[0] == 0 && mismatches[1] == 0, "moving geometry: %d and %d mismatches", mismatches[0],
+          mismatches[1]);
+    /* bounds that are not finite, or inverted, are refused */
+    VkCommandBuffer cmd = begin();
+    HrtsFrame f = frame(cmd, next_frame++);
+    f.has_bounds = 1;
+    memcpy(f.bounds, SCENE_BOUNDS, sizeof SCENE_BOUNDS);
+    f.bounds[0] = 5.0f;
+    CHECK(hrts_record_frame(ctx, &f) == HRTS_RESULT_ERROR_INVALID_ARGUMENT && strstr(hrts_last_error(ctx), "bounds"),
+          "inverted bounds refused: %s", hrts_last_error(ctx));
+    submit_and_wait(cmd);
+    /* the engine's buffers may go once the frames that read them completed */
+    VK(vkDeviceWaitIdle(device));
+    CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
+    free_buffer(vb);
+    free_buffer(ib);
 }
 
 /* ---------- the engine's depth as it is ---------- */
@@ -2015,34 +2108,8 @@ int main(void) {
 
     /* the same scene from the engine's own Vulkan buffers: float4 positions (stride 16) at byte offset 64,
      * 16-bit indices at byte offset 8 */
-    Buf vb = make_host_buffer(64 + 12 * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    Buf ib = make_host_buffer(8 + 44 * 2, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    float *vp = (float *)((char *)vb.map + 64);
-    uint16_t *ip = (uint16_t *)((char *)ib.map + 8);
-    for (int v = 0; v < 12; v++) {
-        vp[4 * v + 0] = positions[3 * v + 0];
-        vp[4 * v + 1] = positions[3 * v + 1];
-        vp[4 * v + 2] = positions[3 * v + 2];
-        vp[4 * v + 3] = 1.0f;
-    }
-    for (int k = 0; k < 42; k++) ip[k] = (uint16_t)indices[k];
-    HrtsVulkanGeometry vg;
-    memset(&vg, 0, sizeof vg);
-    vg.struct_size = sizeof vg;
-    vg.vertex_buffer = (uint64_t)(uintptr_t)vb.buffer;
-    vg.vertex_buffer_size = 64 + 12 * 16;
-    vg.vertex_offset = 64;
-    vg.vertex_stride = 16;
-    vg.vertex_count = 12;
-    vg.index_buffer = (uint64_t)(uintptr_t)ib.buffer;
-    vg.index_buffer_size = 8 + 44 * 2;
-    vg.index_offset = 8;
-    vg.index_type = HRTS_INDEX_TYPE_UINT16;
-    vg.index_count = 42;
-    vg.draws = draws;
-    vg.draw_count = 2;
-    const float bounds[6] = {-4.0f, 0.0f, -4.0f, 4.0f, 1.6f, 4.0f};
-    memcpy(vg.bounds, bounds, sizeof bounds);
+    Buf vb, ib;
+    HrtsVulkanGeometry vg = engine_geometry(&vb, &ib);
     phase = "engine buffers";
     CHECK(hrts_set_geometry_vulkan(ctx, &vg) == HRTS_RESULT_OK, "vulkan geometry: %s", hrts_last_error(ctx));
     static float vis_engine[W * H];
@@ -2068,6 +2135,8 @@ int main(void) {
     native_local_lights(&vk, &g);
     phase = "frames in flight";
     frames_in_flight(&vk, &g);
+    phase = "moving geometry";
+    moving_geometry_bounds(&vk);
     phase = "engine depth";
     engine_depth(&vk, &g);
     phase = "output formats";
