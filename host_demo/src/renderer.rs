@@ -6,7 +6,7 @@ use crate::CameraMatrices;
 use glam::DVec3;
 use passes::{
     FrameInputs, FrameReport, Geometry, PassError, PassId, ResourceId, ShadowConfig, ShadowInputs,
-    ShadowMode, ShadowPipeline,
+    ShadowMode, ShadowPipeline, SurfaceInput,
 };
 use rhi::{Barrier, Buffer, BufferUsage, Device, Image, MemoryLocation, ResourceState as S};
 
@@ -72,6 +72,7 @@ impl ShadowRenderer {
         let inputs = ShadowInputs {
             depth: &targets.depth,
             normal: &targets.normal,
+            surface: SurfaceInput::default(),
         };
         let pipeline = ShadowPipeline::new(device, geometry, &inputs, config)?;
         let prims = pipeline.prims().ok_or_else(|| {

@@ -1,4 +1,4 @@
-// Mirrors passes::gpu_types::PcssConstants (352 bytes).
+// Mirrors passes::gpu_types::PcssConstants (448 bytes).
 #include "light.glsl"
 
 #define MODE_PCSS_STANDARD 0u
@@ -14,4 +14,7 @@ struct PcssConstants {
     vec4 bias;              // x, y: classic constant / slope bias (texels); z: receiver-plane tolerance
                             // (texels of slope); w: constant tolerance (texels of world size)
     GpuLight light;
+    mat4 view_to_world;     // the camera's rotation, view to world (for view-space normals)
+    uvec4 surface_mode;     // the engine's normal: see engine_surface.glsl
+    vec4 surface;           // x: the depth of background pixels
 };

@@ -4,7 +4,7 @@
 //
 // - Receiver: P is rebuilt from the engine's depth as in the ray trace, in frame coordinates. Receivers
 //   facing away from the light are 0, receivers outside the light's frustum 1, like the ray trace.
-// - Receiver-plane depth: the receiver's plane (exact geometric normal from the G-buffer) is a plane in the
+// - Receiver-plane depth: the receiver's plane (the engine's normal, decoded by engine_surface.glsl) is a plane in the
 //   light's NDC too (projective maps keep planes), so its depth at any shadow-map texel centre is
 //   d_r + g . (texel - uv). Every tap compares the stored depth with the receiver plane at that texel's
 //   centre, where the rasterizer computed the stored depth, so planar receivers need no depth bias beyond
@@ -24,6 +24,7 @@ layout(set = 0, binding = 0) uniform Constants { PcssConstants k; };
 layout(set = 0, binding = 1) uniform sampler2D depth_tex;
 layout(set = 0, binding = 2) uniform sampler2D normal_tex;
 layout(set = 0, binding = 3) uniform sampler2D shadow_map;
+#include "engine_surface.glsl"
 layout(set = 0, binding = 4, r32f) uniform writeonly image2D result;
 #ifdef HARD_EDGE_FROM_RAY_TRACE
 layout(set = 0, binding = 5, r32f) uniform readonly image2D rt_visibility;
@@ -104,16 +105,16 @@ void main() {
         return;
     }
     float depth = texelFetch(depth_tex, px, 0).r;
-    vec4 normal = texelFetch(normal_tex, px, 0);
-    if (depth <= 0.0 || normal.w == 0.0) {
-        store(px, 1.0);     // background
-        return;
-    }
     vec2 ndc = (vec2(px) + 0.5) / vec2(k.dims.xy) * 2.0 - 1.0;
     vec4 h = k.inv_view_proj_rel * vec4(ndc, depth, 1.0);
     vec3 rel = h.xyz / h.w;
+    vec3 n;
+    if (!engine_surface(px, depth, rel, k.inv_view_proj_rel, k.dims.xy, k.surface_mode, k.view_to_world,
+                        k.surface.x, n)) {
+        store(px, 1.0);     // background
+        return;
+    }
     vec3 p = k.camera_pos.xyz + rel;
-    vec3 n = normal.xyz;
     vec3 to_light = is_spot() ? normalize(k.light.position.xyz - p) : -k.light.direction.xyz;
     float cos_t = dot(n, to_light);
     if (!(cos_t > 0.0)) {

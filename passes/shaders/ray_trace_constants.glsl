@@ -1,4 +1,4 @@
-// Mirrors passes::gpu_types::RayTraceConstants (224 bytes). Positions are in frame coordinates
+// Mirrors passes::gpu_types::RayTraceConstants (320 bytes). Positions are in frame coordinates
 // (relative to the geometry's frame origin).
 struct RayTraceConstants {
     mat4 inv_view_proj_rel;     // inverse(proj * view) with the camera at the origin
@@ -11,4 +11,7 @@ struct RayTraceConstants {
     uvec4 misc;                 // x: 1 = front-only map, y: triangles in the prim buffer,
                                 // z: 1 = store the blocker distance (ray trace), w unused
     vec4 light_pos;             // spot light: xyz position in frame coordinates, w = 1; directional: w = 0
+    mat4 view_to_world;         // the camera's rotation, view to world (for view-space normals)
+    uvec4 surface_mode;         // the engine's normal: see engine_surface.glsl
+    vec4 surface;               // x: the depth of background pixels
 };

@@ -1,6 +1,8 @@
 // The shadow ray of a screen pixel, shared by every tracer of the frame (the primitive-map ray trace, the
 // receiver passes that fit and cull the map, and the ray-tracing-pipeline peer) so that all of them trace
 // exactly the same rays. The includer declares `k` (RayTraceConstants), `depth_tex` and `normal_tex`.
+
+#include "engine_surface.glsl"
 //
 // The receiver point P is rebuilt from depth relative to the camera, then offset along its geometric
 // normal by a bound on its own error: a fraction of the pixel footprint, a few ulps of |P|, and how far the
@@ -18,17 +20,17 @@ int shadow_ray(ivec2 px, out vec3 o, out vec3 dir, out float t_max) {
     dir = vec3(0.0, 0.0, 1.0);
     t_max = 1.0 / 0.0;
     float depth = texelFetch(depth_tex, px, 0).r;
-    vec4 normal = texelFetch(normal_tex, px, 0);
-    if (depth <= 0.0 || normal.w == 0.0) {
-        return SHADOW_RAY_LIT;
-    }
     vec2 ndc = (vec2(px) + 0.5) / vec2(k.dims.xy) * 2.0 - 1.0;
     vec4 h = k.inv_view_proj_rel * vec4(ndc, depth, 1.0);
     vec3 rel = h.xyz / h.w;
+    vec3 n;
+    if (!engine_surface(px, depth, rel, k.inv_view_proj_rel, k.dims.xy, k.surface_mode, k.view_to_world,
+                        k.surface.x, n)) {
+        return SHADOW_RAY_LIT;
+    }
     vec3 p = k.camera_pos.xyz + rel;
     bool spot = k.light_pos.w != 0.0;
     vec3 to_light = spot ? k.light_pos.xyz - p : -k.light_dir.xyz;
-    vec3 n = normal.xyz;
     if (dot(n, to_light) <= 0.0) {
         return SHADOW_RAY_FACING_AWAY;
     }

@@ -84,6 +84,12 @@ pub struct RayTraceConstants {
     pub misc: UVec4,
     /// Spot light: position in frame coordinates (xyz), w = 1; directional light: w = 0.
     pub light_pos: Vec4,
+    /// The camera's rotation, view to world (for view-space normals).
+    pub view_to_world: Mat4,
+    /// How the engine's normal image encodes the normal ([`crate::surface::SurfaceInput::mode`]).
+    pub surface_mode: UVec4,
+    /// x: the depth of background pixels ([`crate::surface::background_depth`]).
+    pub surface: Vec4,
 }
 
 /// The primitive map's per-frame GPU state (`map_state.glsl`), read back for the frame report.
@@ -202,6 +208,12 @@ pub struct PcssConstants {
     pub bias: Vec4,
     /// The light.
     pub light: GpuLight,
+    /// The camera's rotation, view to world (for view-space normals).
+    pub view_to_world: Mat4,
+    /// How the engine's normal image encodes the normal ([`crate::surface::SurfaceInput::mode`]).
+    pub surface_mode: UVec4,
+    /// x: the depth of background pixels ([`crate::surface::background_depth`]).
+    pub surface: Vec4,
 }
 
 /// Push constants of FXAA (`fxaa.comp`).
@@ -240,7 +252,7 @@ const _: () = {
     assert!(std::mem::offset_of!(PrimBufferPush, first_index) == 64);
     assert!(std::mem::size_of::<MapPush>() == 112);
     assert!(std::mem::offset_of!(MapPush, size) == 80);
-    assert!(std::mem::size_of::<RayTraceConstants>() == 224);
+    assert!(std::mem::size_of::<RayTraceConstants>() == 320);
     assert!(std::mem::offset_of!(RayTraceConstants, light_pos) == 208);
     assert!(std::mem::offset_of!(RayTraceConstants, dims) == 160);
     assert!(std::mem::offset_of!(RayTraceConstants, offset) == 176);
@@ -249,7 +261,7 @@ const _: () = {
     assert!(std::mem::size_of::<GpuLight>() == 208);
     assert!(std::mem::offset_of!(GpuLight, params) == 192);
     assert!(std::mem::size_of::<ShadowMapPush>() == 64);
-    assert!(std::mem::size_of::<PcssConstants>() == 352);
+    assert!(std::mem::size_of::<PcssConstants>() == 448);
     assert!(std::mem::offset_of!(PcssConstants, light) == 144);
     assert!(std::mem::size_of::<FxaaPush>() == 32);
     assert!(std::mem::size_of::<HybridPush>() == 16);

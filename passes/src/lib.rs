@@ -21,6 +21,7 @@ pub mod scan;
 mod screen_pass;
 pub mod shadow_map;
 pub mod shadow_pipeline;
+pub mod surface;
 pub mod view_cull;
 
 pub use error::PassError;
@@ -43,6 +44,7 @@ pub use shadow_pipeline::{
     camera_in_frame, FrameInputs, FrameReport, ResourceReport, ShadowConfig, ShadowInputs,
     ShadowPipeline, MAX_FRAMES_IN_FLIGHT,
 };
+pub use surface::{NormalEncoding, NormalSpace, SurfaceInput};
 pub use view_cull::ViewVolume;
 
 mod shaders {

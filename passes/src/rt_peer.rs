@@ -160,7 +160,7 @@ impl RtPeerPass {
 /// The shadow-ray constants of a `width` x `height` frame of `inputs` over geometry whose frame origin is
 /// `origin`, as the shadow pipeline computes them: what a host that drives the pipeline through the C ABI
 /// (and so never sees its constants) passes to [`RtPeerPass::record_trace`], for a float depth buffer (no
-/// depth step in the offset). The fields only the primitive-map passes read (map size, face mode, triangle
+/// depth step in the offset) and world-space normals with coverage in w (the demo's G-buffer). The fields only the primitive-map passes read (map size, face mode, triangle
 /// count) are zero.
 pub fn shadow_ray_constants(
     inputs: &FrameInputs,
@@ -193,5 +193,8 @@ pub fn shadow_ray_constants(
         ),
         misc: UVec4::ZERO,
         light_pos: light.position.map_or(Vec4::ZERO, |p| p.extend(1.0)),
+        view_to_world: crate::surface::view_to_world(inputs.view),
+        surface_mode: crate::surface::SurfaceInput::default().mode(rhi::Format::Rgba32Float),
+        surface: crate::surface::surface_vector(inputs.proj),
     })
 }

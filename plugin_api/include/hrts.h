@@ -286,6 +286,52 @@ typedef uint32_t HrtsLightDecision;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
+// How the engine's normal image encodes the surface normal (`HrtsTargets::normal_encoding`). The normal
+// may be a shading normal: a receiver whose normal faces away from the light is in its own shadow, as the
+// engine shades it, and the ray origin moves off the surface along it (a quantized encoding tilts it by
+// under 0.5°, inside the offset's margin).
+enum HrtsNormalEncoding
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  // xyz, w = 0 on background pixels and nonzero on geometry (the original contract).
+  HRTS_NORMAL_ENCODING_XYZ_COVERAGE = 0,
+  // xyz; background pixels are those whose depth is the projection's far value.
+  HRTS_NORMAL_ENCODING_XYZ = 1,
+  // Octahedral in the first two channels; background known by depth.
+  HRTS_NORMAL_ENCODING_OCTAHEDRAL = 2,
+  // No normal image: the plugin derives the normal from depth (the neighbouring pixels on the same
+  // surface); background known by depth.
+  HRTS_NORMAL_ENCODING_NONE = 3,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum HrtsNormalEncoding HrtsNormalEncoding;
+#else
+typedef uint32_t HrtsNormalEncoding;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+// The space of the engine's normals (`HrtsTargets::normal_space`).
+enum HrtsNormalSpace
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  // World space.
+  HRTS_NORMAL_SPACE_WORLD = 0,
+  // View space of `HrtsFrame::view`.
+  HRTS_NORMAL_SPACE_VIEW = 1,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum HrtsNormalSpace HrtsNormalSpace;
+#else
+typedef uint32_t HrtsNormalSpace;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
 // A resource the plugin allocates (for the report, `hrts_get_resource_info` and
 // `hrts_record_resource_readback`). Bit `1 << resource` in `HrtsConfig::extra_outputs`.
 enum HrtsResource
@@ -594,11 +640,20 @@ typedef struct HrtsTargets {
   // points the depth describes; a coarse format (D16 with a near plane close to the camera) moves
   // contact shadows' start by that error.
   uint32_t depth_format;
-  // World-space normal `VkImage` (`VK_FORMAT_R32G32B32A32_SFLOAT`, usage includes SAMPLED): xyz the
-  // geometric normal facing the camera, w = 1 on geometry and 0 on background.
+  // The engine's normal `VkImage` (`normal_format`, usage includes SAMPLED), encoded as
+  // `normal_encoding` says; ignored (may be 0) with `HRTS_NORMAL_ENCODING_NONE`.
   uint64_t normal_image;
   // Usage flags of the normal image.
   uint32_t normal_usage;
+  // `VkFormat` of the normal image, or 0 for `VK_FORMAT_R32G32B32A32_SFLOAT`. xyz encodings take
+  // `R32G32B32A32_SFLOAT`, `R16G16B16A16_SFLOAT`, `A2B10G10R10_UNORM_PACK32` or `R8G8B8A8_UNORM`;
+  // octahedral ones `R16G16_SNORM`, `R16G16_UNORM`, `R16G16_SFLOAT` or `A2B10G10R10_UNORM_PACK32`.
+  // Normalized (unorm) channels map [0, 1] to [-1, 1].
+  uint32_t normal_format;
+  // `HrtsNormalEncoding` of the normal image.
+  uint32_t normal_encoding;
+  // `HrtsNormalSpace` of the normals.
+  uint32_t normal_space;
   // Visibility `VkImage` the plugin writes (`output_format`, usage includes TRANSFER_DST): 1 = lit.
   // Light `i`'s visibility goes to array layer `i`.
   uint64_t output_image;

@@ -2,16 +2,16 @@
 //! them, and what reconfiguration retired while frames in flight may still use it.
 
 use crate::convert::{
-    binning_path_to_c, require_usage, resource_id, resource_index, shadow_config, FrameLight,
-    RESOURCES,
+    binning_path_to_c, require_usage, resource_id, resource_index, shadow_config, surface_input,
+    FrameLight, RESOURCES,
 };
 use crate::error::{check_size, invalid, ApiError, ApiResult};
 use crate::geometry::{cpu_geometry, geometry_from, vulkan_geometry, GeometrySource};
 use crate::types::*;
 use passes::retire::{completed_before, RetireQueue};
 use passes::{
-    BinningRequest, FrameReport, MinCombine, PassStatus, ResourceId, ShadowConfig, ShadowInputs,
-    ShadowPipeline, SharedGeometry, SkipReason, ViewVolume,
+    BinningRequest, FrameReport, MinCombine, NormalEncoding, PassStatus, ResourceId, ShadowConfig,
+    ShadowInputs, ShadowPipeline, SharedGeometry, SkipReason, SurfaceInput, ViewVolume,
 };
 use rhi::{Device, Format, Image, ImageDesc, ImageUsage};
 use std::sync::Arc;
@@ -24,7 +24,10 @@ pub(crate) struct TargetSource {
     pub(crate) depth: u64,
     pub(crate) depth_format: Format,
     pub(crate) output_format: Format,
-    pub(crate) normal: u64,
+    /// The engine's normal image (`None`: normals derived from depth).
+    pub(crate) normal: Option<u64>,
+    pub(crate) normal_format: Format,
+    pub(crate) surface: SurfaceInput,
     pub(crate) output: u64,
     pub(crate) output_layers: u32,
 }
@@ -66,7 +69,12 @@ pub(crate) struct Built {
     pub(crate) lights: Vec<Option<LightPasses>>,
     pub(crate) shared: Arc<SharedGeometry>,
     pub(crate) depth: Image,
+    /// The engine's normal image, or, with normals derived from depth, a 1×1 image of the plugin's own.
     pub(crate) normal: Image,
+    /// Whether `normal` is the engine's (its layouts are the engine's to give).
+    pub(crate) engine_normal: bool,
+    /// How the passes decode the normal.
+    pub(crate) surface: SurfaceInput,
     pub(crate) output: Image,
 }
 
@@ -438,10 +446,12 @@ impl Context {
 
     pub(crate) fn set_targets(&mut self, t: &HrtsTargets) -> ApiResult<()> {
         check_size::<HrtsTargets>(t.struct_size, "HrtsTargets")?;
-        if t.depth_image == 0 || t.normal_image == 0 || t.output_image == 0 {
+        let surface = surface_input(t)?;
+        let derived = surface.encoding == NormalEncoding::FromDepth;
+        if t.depth_image == 0 || (t.normal_image == 0 && !derived) || t.output_image == 0 {
             return Err(ApiError::new(
                 HrtsResult::ErrorNullPointer,
-                "depth_image, normal_image and output_image must be non-NULL",
+                "depth_image, normal_image (unless normal_encoding is NONE) and output_image must be non-NULL",
             ));
         }
         let caps = self.device.capabilities();
@@ -510,12 +520,45 @@ impl Context {
             ));
         }
         require_usage(t.depth_usage, ImageUsage::SAMPLED, "depth_image", "SAMPLED")?;
-        require_usage(
-            t.normal_usage,
-            ImageUsage::SAMPLED,
-            "normal_image",
-            "SAMPLED",
-        )?;
+        let normal_format = match t.normal_format {
+            0 => Format::Rgba32Float,
+            raw => i32::try_from(raw)
+                .ok()
+                .and_then(Format::normal_from_raw_vk)
+                .ok_or_else(|| {
+                    ApiError::new(
+                        HrtsResult::ErrorInvalidEnum,
+                        format!(
+                            "normal_format {raw} is not a normal format the plugin reads: R32G32B32A32_SFLOAT, R16G16B16A16_SFLOAT, A2B10G10R10_UNORM_PACK32, R8G8B8A8_UNORM, R16G16_SNORM, R16G16_UNORM or R16G16_SFLOAT, or 0 for R32G32B32A32_SFLOAT"
+                        ),
+                    )
+                })?,
+        };
+        if !derived {
+            if !surface.accepts(normal_format) {
+                return Err(invalid(format!(
+                    "normal_format {} ({normal_format:?}, {} channels) cannot hold {:?} normals: xyz needs four channels",
+                    normal_format.raw_vk(),
+                    normal_format.channels(),
+                    surface.encoding
+                )));
+            }
+            if !self.device.can_sample(normal_format) {
+                return Err(ApiError::new(
+                    HrtsResult::ErrorUnsupported,
+                    format!(
+                        "the device cannot sample normal_format {} ({normal_format:?})",
+                        normal_format.raw_vk()
+                    ),
+                ));
+            }
+            require_usage(
+                t.normal_usage,
+                ImageUsage::SAMPLED,
+                "normal_image",
+                "SAMPLED",
+            )?;
+        }
         require_usage(
             t.output_usage,
             ImageUsage::COPY_DST,
@@ -528,7 +571,9 @@ impl Context {
             depth: t.depth_image,
             depth_format,
             output_format,
-            normal: t.normal_image,
+            normal: (!derived).then_some(t.normal_image),
+            normal_format,
+            surface,
             output: t.output_image,
             output_layers: t.output_layers,
         });
@@ -576,6 +621,7 @@ impl Context {
                 let inputs = ShadowInputs {
                     depth: &built.depth,
                     normal: &built.normal,
+                    surface: built.surface,
                 };
                 let passes = (|| -> Result<LightPasses, passes::PassError> {
                     let frusta = (0..frusta)
@@ -644,13 +690,26 @@ impl Context {
                 ImageUsage::SAMPLED,
                 1,
             )?,
-            normal: wrap(
-                "engine normal",
-                t.normal,
-                Format::Rgba32Float,
-                ImageUsage::SAMPLED,
-                1,
-            )?,
+            normal: match t.normal {
+                Some(handle) => wrap(
+                    "engine normal",
+                    handle,
+                    t.normal_format,
+                    ImageUsage::SAMPLED,
+                    1,
+                )?,
+                // Normals derived from depth: an image of the plugin's own is bound, never read.
+                None => device.create_image(&ImageDesc {
+                    name: "normal (derived from depth; not read)",
+                    format: Format::Rgba32Float,
+                    width: 1,
+                    height: 1,
+                    layers: 1,
+                    usage: ImageUsage::SAMPLED,
+                })?,
+            },
+            engine_normal: t.normal.is_some(),
+            surface: t.surface,
             output: wrap(
                 "engine visibility",
                 t.output,

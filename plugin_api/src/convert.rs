@@ -4,8 +4,9 @@ use crate::error::{check_size, invalid, ApiError, ApiResult};
 use crate::types::*;
 use glam::{Mat4, Vec3};
 use passes::{
-    BinningPath, BinningRequest, FaceMode, FrameInputs, Light, PassId, PenumbraFilter,
-    PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig, ShadowMode,
+    BinningPath, BinningRequest, FaceMode, FrameInputs, Light, NormalEncoding, NormalSpace, PassId,
+    PenumbraFilter, PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig, ShadowMode,
+    SurfaceInput,
 };
 use rhi::ImageUsage;
 
@@ -143,6 +144,37 @@ pub(crate) fn frame_inputs(f: &HrtsFrame) -> ApiResult<Vec<FrameLight>> {
             })
         })
         .collect()
+}
+
+/// How the engine's normal image encodes the normal (`normal_encoding`, `normal_space`).
+pub(crate) fn surface_input(t: &HrtsTargets) -> ApiResult<SurfaceInput> {
+    let encoding = enum_value(
+        t.normal_encoding,
+        &[
+            (
+                HrtsNormalEncoding::XyzCoverage as u32,
+                NormalEncoding::XyzCoverage,
+            ),
+            (HrtsNormalEncoding::Xyz as u32, NormalEncoding::Xyz),
+            (
+                HrtsNormalEncoding::Octahedral as u32,
+                NormalEncoding::Octahedral,
+            ),
+            (HrtsNormalEncoding::None as u32, NormalEncoding::FromDepth),
+        ],
+        "normal_encoding",
+        "HrtsNormalEncoding",
+    )?;
+    let space = enum_value(
+        t.normal_space,
+        &[
+            (HrtsNormalSpace::World as u32, NormalSpace::World),
+            (HrtsNormalSpace::View as u32, NormalSpace::View),
+        ],
+        "normal_space",
+        "HrtsNormalSpace",
+    )?;
+    Ok(SurfaceInput { encoding, space })
 }
 
 /// The frame's geometry bounds, when the engine gives them (`has_bounds`).

@@ -43,10 +43,10 @@ impl Context {
         }
         let mut used_layouts = Vec::new();
         if mask & DEPTH_NORMAL_READERS != 0 {
-            used_layouts.extend([
-                ("depth_layout", f.depth_layout),
-                ("normal_layout", f.normal_layout),
-            ]);
+            used_layouts.push(("depth_layout", f.depth_layout));
+            if self.targets.is_none_or(|t| t.normal.is_some()) {
+                used_layouts.push(("normal_layout", f.normal_layout));
+            }
         }
         let copy_output = mask & 1 << HrtsPass::OutputCopy as u32 != 0;
         if copy_output {
@@ -314,10 +314,21 @@ fn engine_inputs(enc: &mut Encoder<'_>, b: &Built, f: &HrtsFrame, to_shader: boo
             after,
         }
     };
-    enc.barriers(&[
-        transition(&b.depth, f.depth_layout),
-        transition(&b.normal, f.normal_layout),
-    ]);
+    let normal = if b.engine_normal {
+        transition(&b.normal, f.normal_layout)
+    } else {
+        // The plugin's own stand-in, bound but never read: made readable, its contents undefined.
+        Barrier::Image {
+            image: &b.normal,
+            before: if to_shader {
+                S::Undefined
+            } else {
+                S::ShaderResource
+            },
+            after: S::ShaderResource,
+        }
+    };
+    enc.barriers(&[transition(&b.depth, f.depth_layout), normal]);
 }
 
 /// Copies each light's final visibility into its layer of the engine's output image: for a light of

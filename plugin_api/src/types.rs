@@ -263,6 +263,34 @@ pub enum HrtsLightType {
     Point = 2,
 }
 
+/// How the engine's normal image encodes the surface normal (`HrtsTargets::normal_encoding`). The normal
+/// may be a shading normal: a receiver whose normal faces away from the light is in its own shadow, as the
+/// engine shades it, and the ray origin moves off the surface along it (a quantized encoding tilts it by
+/// under 0.5°, inside the offset's margin).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HrtsNormalEncoding {
+    /// xyz, w = 0 on background pixels and nonzero on geometry (the original contract).
+    XyzCoverage = 0,
+    /// xyz; background pixels are those whose depth is the projection's far value.
+    Xyz = 1,
+    /// Octahedral in the first two channels; background known by depth.
+    Octahedral = 2,
+    /// No normal image: the plugin derives the normal from depth (the neighbouring pixels on the same
+    /// surface); background known by depth.
+    None = 3,
+}
+
+/// The space of the engine's normals (`HrtsTargets::normal_space`).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HrtsNormalSpace {
+    /// World space.
+    World = 0,
+    /// View space of `HrtsFrame::view`.
+    View = 1,
+}
+
 /// Index element type of engine geometry.
 #[repr(u32)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -525,11 +553,20 @@ pub struct HrtsTargets {
     /// points the depth describes; a coarse format (D16 with a near plane close to the camera) moves
     /// contact shadows' start by that error.
     pub depth_format: u32,
-    /// World-space normal `VkImage` (`VK_FORMAT_R32G32B32A32_SFLOAT`, usage includes SAMPLED): xyz the
-    /// geometric normal facing the camera, w = 1 on geometry and 0 on background.
+    /// The engine's normal `VkImage` (`normal_format`, usage includes SAMPLED), encoded as
+    /// `normal_encoding` says; ignored (may be 0) with `HRTS_NORMAL_ENCODING_NONE`.
     pub normal_image: u64,
     /// Usage flags of the normal image.
     pub normal_usage: u32,
+    /// `VkFormat` of the normal image, or 0 for `VK_FORMAT_R32G32B32A32_SFLOAT`. xyz encodings take
+    /// `R32G32B32A32_SFLOAT`, `R16G16B16A16_SFLOAT`, `A2B10G10R10_UNORM_PACK32` or `R8G8B8A8_UNORM`;
+    /// octahedral ones `R16G16_SNORM`, `R16G16_UNORM`, `R16G16_SFLOAT` or `A2B10G10R10_UNORM_PACK32`.
+    /// Normalized (unorm) channels map [0, 1] to [-1, 1].
+    pub normal_format: u32,
+    /// `HrtsNormalEncoding` of the normal image.
+    pub normal_encoding: u32,
+    /// `HrtsNormalSpace` of the normals.
+    pub normal_space: u32,
     /// Visibility `VkImage` the plugin writes (`output_format`, usage includes TRANSFER_DST): 1 = lit.
     /// Light `i`'s visibility goes to array layer `i`.
     pub output_image: u64,

@@ -191,6 +191,16 @@ pub enum Format {
     R8Unorm,
     /// DXGI_FORMAT_R16_FLOAT.
     R16Float,
+    /// DXGI_FORMAT_R16G16B16A16_FLOAT.
+    Rgba16Float,
+    /// DXGI_FORMAT_R10G10B10A2_UNORM (`VK_FORMAT_A2B10G10R10_UNORM_PACK32`).
+    Rgb10A2Unorm,
+    /// DXGI_FORMAT_R16G16_SNORM.
+    Rg16Snorm,
+    /// DXGI_FORMAT_R16G16_UNORM.
+    Rg16Unorm,
+    /// DXGI_FORMAT_R16G16_FLOAT.
+    Rg16Float,
 }
 
 impl Format {
@@ -217,6 +227,49 @@ impl Format {
             Self::D32FloatS8Uint => vk::Format::D32_SFLOAT_S8_UINT,
             Self::R8Unorm => vk::Format::R8_UNORM,
             Self::R16Float => vk::Format::R16_SFLOAT,
+            Self::Rgba16Float => vk::Format::R16G16B16A16_SFLOAT,
+            Self::Rgb10A2Unorm => vk::Format::A2B10G10R10_UNORM_PACK32,
+            Self::Rg16Snorm => vk::Format::R16G16_SNORM,
+            Self::Rg16Unorm => vk::Format::R16G16_UNORM,
+            Self::Rg16Float => vk::Format::R16G16_SFLOAT,
+        }
+    }
+
+    /// The formats an engine's normal image may have: four channels holding xyz (and w), or two holding
+    /// an octahedral encoding (an RGB10A2 image may hold either).
+    pub const NORMAL: [Format; 7] = [
+        Self::Rgba32Float,
+        Self::Rgba16Float,
+        Self::Rgb10A2Unorm,
+        Self::Rgba8Unorm,
+        Self::Rg16Snorm,
+        Self::Rg16Unorm,
+        Self::Rg16Float,
+    ];
+
+    /// The normal-image format whose raw `VkFormat` value is `raw`, if it is one of [`Format::NORMAL`].
+    pub fn normal_from_raw_vk(raw: i32) -> Option<Format> {
+        Self::NORMAL.into_iter().find(|f| f.raw_vk() == raw)
+    }
+
+    /// Whether the format's channels are normalized to [0, 1].
+    pub fn is_unorm(self) -> bool {
+        matches!(
+            self,
+            Self::Rgba8Unorm
+                | Self::Rgb10A2Unorm
+                | Self::Rg16Unorm
+                | Self::R8Unorm
+                | Self::D16Unorm
+        )
+    }
+
+    /// Channels the format holds (of its colour aspect; 1 for depth).
+    pub fn channels(self) -> u32 {
+        match self {
+            Self::Rgba32Float | Self::Rgba8Unorm | Self::Rgba16Float | Self::Rgb10A2Unorm => 4,
+            Self::Rg16Snorm | Self::Rg16Unorm | Self::Rg16Float => 2,
+            _ => 1,
         }
     }
 
@@ -240,6 +293,7 @@ impl Format {
     pub fn texel_size(self) -> u32 {
         match self {
             Self::Rgba32Float => 16,
+            Self::Rgba16Float => 8,
             Self::D16Unorm | Self::R16Float => 2,
             Self::R8Unorm => 1,
             _ => 4,

@@ -1292,6 +1292,176 @@ static void output_formats(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g)
     CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
 }
 
+/* ---------- the engine's normals as they are ---------- */
+/* Normals as engines keep them: xyz in half floats, RGB10A2 or RGBA8 (unorm: [0, 1] for [-1, 1]),
+ * octahedral in RG16 snorm, unorm or float or in RGB10A2, in world or view space, or no normal image at
+ * all (the plugin derives the normal from depth). Each gives the exact hard shadow of a sun and of a point
+ * light (0 mismatches outside near-edge pixels). */
+static uint16_t float_to_half(float f) {
+    uint32_t x;
+    memcpy(&x, &f, sizeof x);
+    uint32_t sign = (x >> 16) & 0x8000u;
+    int exponent = (int)((x >> 23) & 0xff) - 127 + 15;
+    uint32_t mantissa = x & 0x7fffffu;
+    if (exponent <= 0) {
+        if (exponent < -10) return (uint16_t)sign;
+        mantissa |= 0x800000u;
+        uint32_t shift = (uint32_t)(14 - exponent);
+        uint32_t half = mantissa >> shift;
+        if ((mantissa >> (shift - 1)) & 1u) half++;
+        return (uint16_t)(sign | half);
+    }
+    uint32_t half = sign | ((uint32_t)exponent << 10) | (mantissa >> 13);
+    if (mantissa & 0x1000u) half++;
+    return (uint16_t)half;
+}
+
+static void octahedral_encode(V3 n, double *ex, double *ey) {
+    double l1 = fabs(n.x) + fabs(n.y) + fabs(n.z);
+    double x = n.x / l1, y = n.y / l1;
+    if (n.z < 0) {
+        double ox = (1 - fabs(y)) * (x >= 0 ? 1 : -1), oy = (1 - fabs(x)) * (y >= 0 ? 1 : -1);
+        x = ox;
+        y = oy;
+    }
+    *ex = x;
+    *ey = y;
+}
+
+static uint32_t unorm(double v, double max) { return (uint32_t)lround((v * 0.5 + 0.5) * max); }
+
+enum { NORMAL_XYZ_RGBA16F, NORMAL_XYZ_RGB10A2, NORMAL_XYZ_RGBA8, NORMAL_OCT_RG16_SNORM, NORMAL_OCT_RG16_UNORM,
+       NORMAL_OCT_RG16F, NORMAL_OCT_RGB10A2, NORMAL_NONE, NORMAL_CASES };
+
+static void engine_normals(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
+    enum { PX = W * H };
+    const struct {
+        const char *name;
+        VkFormat format;
+        uint32_t encoding, space;
+        size_t texel;
+    } cases[NORMAL_CASES] = {
+        [NORMAL_XYZ_RGBA16F] = {"xyz RGBA16F world", VK_FORMAT_R16G16B16A16_SFLOAT, HRTS_NORMAL_ENCODING_XYZ,
+                                HRTS_NORMAL_SPACE_WORLD, 8},
+        [NORMAL_XYZ_RGB10A2] = {"xyz RGB10A2 world", VK_FORMAT_A2B10G10R10_UNORM_PACK32, HRTS_NORMAL_ENCODING_XYZ,
+                                HRTS_NORMAL_SPACE_WORLD, 4},
+        [NORMAL_XYZ_RGBA8] = {"xyz RGBA8 view", VK_FORMAT_R8G8B8A8_UNORM, HRTS_NORMAL_ENCODING_XYZ,
+                              HRTS_NORMAL_SPACE_VIEW, 4},
+        [NORMAL_OCT_RG16_SNORM] = {"octahedral RG16 snorm world", VK_FORMAT_R16G16_SNORM,
+                                   HRTS_NORMAL_ENCODING_OCTAHEDRAL, HRTS_NORMAL_SPACE_WORLD, 4},
+        [NORMAL_OCT_RG16_UNORM] = {"octahedral RG16 unorm view", VK_FORMAT_R16G16_UNORM,
+                                   HRTS_NORMAL_ENCODING_OCTAHEDRAL, HRTS_NORMAL_SPACE_VIEW, 4},
+        [NORMAL_OCT_RG16F] = {"octahedral RG16F view", VK_FORMAT_R16G16_SFLOAT, HRTS_NORMAL_ENCODING_OCTAHEDRAL,
+                              HRTS_NORMAL_SPACE_VIEW, 4},
+        [NORMAL_OCT_RGB10A2] = {"octahedral RGB10A2 world", VK_FORMAT_A2B10G10R10_UNORM_PACK32,
+                                HRTS_NORMAL_ENCODING_OCTAHEDRAL, HRTS_NORMAL_SPACE_WORLD, 4},
+        [NORMAL_NONE] = {"none (derived from depth)", VK_FORMAT_UNDEFINED, HRTS_NORMAL_ENCODING_NONE,
+                         HRTS_NORMAL_SPACE_WORLD, 0},
+    };
+    setup_camera(0.0);
+    upload_gbuffer(); /* depth of this view */
+    static float world[4 * PX];
+    static float unused_depth[PX];
+    draw_gbuffer(unused_depth, world);
+    Emitter lights[2] = {directional(v3(0.45, -1.0, 0.2)), point(v3(0.9, 2.3, 0.7))};
+    int failed_cases = 0;
+    for (int c = 0; c < NORMAL_CASES; c++) {
+        Img normal = {VK_NULL_HANDLE, VK_NULL_HANDLE};
+        if (cases[c].texel > 0) {
+            normal = make_image(cases[c].format, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, 1);
+            Buf staging = make_host_buffer(cases[c].texel * PX, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+            for (int i = 0; i < PX; i++) {
+                V3 n = v3(world[4 * i], world[4 * i + 1], world[4 * i + 2]);
+                if (cases[c].space == HRTS_NORMAL_SPACE_VIEW) n = v3(dot3(n, cam_r), dot3(n, cam_u), -dot3(n, cam_f));
+                double ex, ey;
+                octahedral_encode(world[4 * i + 3] != 0 ? n : v3(0, 0, 1), &ex, &ey);
+                uint16_t *h = (uint16_t *)staging.map + 4 * i;
+                uint32_t *u = (uint32_t *)staging.map + i;
+                int16_t *sn = (int16_t *)staging.map + 2 * i;
+                uint16_t *un = (uint16_t *)staging.map + 2 * i;
+                switch (c) {
+                case NORMAL_XYZ_RGBA16F:
+                    h[0] = float_to_half((float)n.x), h[1] = float_to_half((float)n.y), h[2] = float_to_half((float)n.z),
+                    h[3] = float_to_half(1.0f);
+                    break;
+                case NORMAL_XYZ_RGB10A2:
+                    *u = unorm(n.x, 1023) | unorm(n.y, 1023) << 10 | unorm(n.z, 1023) << 20 | 3u << 30;
+                    break;
+                case NORMAL_XYZ_RGBA8:
+                    *u = unorm(n.x, 255) | unorm(n.y, 255) << 8 | unorm(n.z, 255) << 16 | 255u << 24;
+                    break;
+                case NORMAL_OCT_RG16_SNORM:
+                    sn[0] = (int16_t)lround(ex * 32767), sn[1] = (int16_t)lround(ey * 32767);
+                    break;
+                case NORMAL_OCT_RG16_UNORM:
+                    un[0] = (uint16_t)unorm(ex, 65535), un[1] = (uint16_t)unorm(ey, 65535);
+                    break;
+                case NORMAL_OCT_RG16F:
+                    un[0] = float_to_half((float)ex), un[1] = float_to_half((float)ey);
+                    break;
+                case NORMAL_OCT_RGB10A2:
+                    *u = unorm(ex, 1023) | unorm(ey, 1023) << 10;
+                    break;
+                }
+            }
+            VkCommandBuffer cmd = begin();
+            barrier(cmd, normal.image, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+            VkBufferImageCopy region;
+            memset(&region, 0, sizeof region);
+            region.imageSubresource.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+            region.imageSubresource.layerCount = 1;
+            region.imageExtent.width = W;
+            region.imageExtent.height = H;
+            region.imageExtent.depth = 1;
+            vkCmdCopyBufferToImage(cmd, staging.buffer, normal.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+            barrier(cmd, normal.image, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                    VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+            submit_and_wait(cmd);
+            free_buffer(staging);
+        }
+        HrtsContext *ctx = create_context(vk, 1);
+        set_lights(lights, 2);
+        HrtsTargets t = targets();
+        t.normal_image = (uint64_t)(uintptr_t)normal.image;
+        t.normal_usage = cases[c].texel > 0 ? VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT : 0;
+        t.normal_format = (uint32_t)cases[c].format;
+        t.normal_encoding = cases[c].encoding;
+        t.normal_space = cases[c].space;
+        HrtsResult r = configure_all(ctx, 2, HRTS_SHADOW_MODE_HARD);
+        if (r == HRTS_RESULT_OK) r = hrts_set_geometry_cpu(ctx, g);
+        if (r == HRTS_RESULT_OK) r = hrts_set_targets(ctx, &t);
+        static float vis[2 * PX];
+        if (r == HRTS_RESULT_OK) r = run_frame(ctx, vis);
+        CHECK(r == HRTS_RESULT_OK, "normals %s: %s", cases[c].name, hrts_last_error(ctx));
+        int total = 0;
+        for (int l = 0; l < 2 && r == HRTS_RESULT_OK; l++) {
+            int near_edge, shadowed, lit;
+            int mismatches = count_mismatches(vis + l * PX, edge_tolerance(), &lights[l], &near_edge, &shadowed, &lit);
+            printf("normals %s, %s: %d lit, %d shadowed, %d near-edge, %d mismatches\n", cases[c].name,
+                   l == 0 ? "sun" : "point light", lit, shadowed, near_edge, mismatches);
+            total += mismatches;
+            CHECK(shadowed > 300, "normals %s: %d shadowed px", cases[c].name, shadowed);
+        }
+        CHECK(r == HRTS_RESULT_OK && total == 0, "normals %s: %d mismatches", cases[c].name, total);
+        failed_cases += r != HRTS_RESULT_OK || total != 0;
+        CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
+        if (cases[c].texel > 0) free_image(normal);
+    }
+    printf("engine normals: %d encodings, %d failed\n", NORMAL_CASES, failed_cases);
+    /* an xyz encoding in a two-channel image, and an unknown encoding, are refused */
+    HrtsContext *ctx = create_context(vk, 1);
+    HrtsTargets t = targets();
+    t.normal_format = VK_FORMAT_R16G16_SNORM;
+    t.normal_encoding = HRTS_NORMAL_ENCODING_XYZ;
+    CHECK(hrts_set_targets(ctx, &t) == HRTS_RESULT_ERROR_INVALID_ARGUMENT && strstr(hrts_last_error(ctx), "normal_format"),
+          "xyz in RG16 refused: %s", hrts_last_error(ctx));
+    t.normal_encoding = 7;
+    CHECK(hrts_set_targets(ctx, &t) == HRTS_RESULT_ERROR_INVALID_ENUM && strstr(hrts_last_error(ctx), "normal_encoding"),
+          "unknown normal encoding refused: %s", hrts_last_error(ctx));
+    CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
+    set_lights(lights, 1);
+}
+
 /* ---------- misuse: a table of calls that must fail with a given result and a message ---------- */
 /* Each case runs in table order on one context (some build on the state left by the ones before); after
  * each, the context must still answer. A successful call clears the last error, so a case that fails with
@@ -2137,6 +2307,8 @@ int main(void) {
     frames_in_flight(&vk, &g);
     phase = "moving geometry";
     moving_geometry_bounds(&vk);
+    phase = "engine normals";
+    engine_normals(&vk, &g);
     phase = "engine depth";
     engine_depth(&vk, &g);
     phase = "output formats";

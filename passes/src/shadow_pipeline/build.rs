@@ -12,6 +12,7 @@ use crate::ray_trace::{RayTraceInputs, RayTracePass};
 use crate::retire::RetireQueue;
 use crate::screen_pass::visibility_image;
 use crate::shadow_map::ShadowMapPass;
+use crate::surface::NormalEncoding;
 use crate::PassError;
 use rhi::{BufferUsage, Device, MemoryLocation};
 use std::sync::Arc;
@@ -50,10 +51,18 @@ impl ShadowPipeline {
         }
         let geometry = shared.geometry();
         let (width, height) = (inputs.depth.width(), inputs.depth.height());
-        if (inputs.normal.width(), inputs.normal.height()) != (width, height) {
+        let derived = inputs.surface.encoding == NormalEncoding::FromDepth;
+        if !derived && (inputs.normal.width(), inputs.normal.height()) != (width, height) {
             return Err(PassError::InvalidConfig(
                 "depth and normal images differ in size".into(),
             ));
+        }
+        if !inputs.surface.accepts(inputs.normal.format()) {
+            return Err(PassError::InvalidConfig(format!(
+                "a normal image of {:?} cannot hold {:?} normals",
+                inputs.normal.format(),
+                inputs.surface.encoding
+            )));
         }
         let caps = device.capabilities();
         config.map.validate(caps)?;
@@ -229,6 +238,7 @@ impl ShadowPipeline {
             width,
             height,
             depth_quantum: inputs.depth.format().depth_quantum(),
+            surface_mode: inputs.surface.mode(inputs.normal.format()),
         };
         // Every resource of the plan exists (a missing one would be a bug in the wiring above).
         if let Some(r) = pipeline

@@ -7,6 +7,9 @@ use crate::light::Light;
 use crate::pcss::PcssConfig;
 use crate::primitive_map::PrimitiveMapConfig;
 use crate::shadow_map::ShadowMapConfig;
+#[cfg(doc)]
+use crate::surface::NormalEncoding;
+use crate::surface::SurfaceInput;
 use glam::{Mat4, Vec3};
 use rhi::Image;
 
@@ -106,6 +109,9 @@ pub struct ShadowInputs<'a> {
     /// Depth as `FrameInputs::proj` writes it (any [`rhi::Format::DEPTH`] format, sampled through its depth
     /// aspect), `ShaderResource` state when the passes run.
     pub depth: &'a Image,
-    /// World-space geometric normal facing the camera (xyz), w = 0 on background, `ShaderResource` state.
+    /// The engine's normal image, as `surface` says it encodes the normal (for
+    /// [`NormalEncoding::FromDepth`], any image: it is bound but not read), `ShaderResource` state.
     pub normal: &'a Image,
+    /// How `normal` encodes the surface normal and in which space.
+    pub surface: SurfaceInput,
 }

@@ -10,6 +10,7 @@ use crate::prim_buffer::PrimBufferClaim;
 use crate::primitive_map::FaceMode;
 use crate::ray_trace::{RAY_OFFSET_FLOAT_BOUND, RAY_OFFSET_PIXELS};
 use crate::retire::completed_before;
+use crate::surface;
 use crate::PassError;
 use bytemuck::Zeroable;
 use glam::{UVec4, Vec4};
@@ -36,6 +37,8 @@ impl ShadowPipeline {
         let front_only = u32::from(cfg.faces == FaceMode::FrontOnly);
         let dir = light.direction;
         let sm = self.config.shadow_map;
+        let view_to_world = surface::view_to_world(inputs.view);
+        let surface = surface::surface_vector(inputs.proj);
         let pc = self.config.pcss;
         Ok(FrameConstants {
             light,
@@ -60,6 +63,9 @@ impl ShadowPipeline {
                 ),
                 misc: UVec4::new(front_only, self.geometry().triangle_count(), 0, 0),
                 light_pos: light.position.map_or(Vec4::ZERO, |p| p.extend(1.0)),
+                view_to_world,
+                surface_mode: self.surface_mode,
+                surface,
             },
             pcss: PcssConstants {
                 inv_view_proj_rel,
@@ -79,6 +85,9 @@ impl ShadowPipeline {
                     CONSTANT_TOLERANCE_TEXELS,
                 ),
                 light: light.gpu(sm.size, pc.light_size(light.position.is_some())),
+                view_to_world,
+                surface_mode: self.surface_mode,
+                surface,
             },
         })
     }

@@ -32,7 +32,7 @@ use crate::ray_trace::RayTracePass;
 use crate::retire::RetireQueue;
 use crate::shadow_map::ShadowMapPass;
 use crate::PassError;
-use glam::{DMat4, DVec3, Mat4, Vec3};
+use glam::{DMat4, DVec3, Mat4, UVec4, Vec3};
 use rhi::{BindGroup, Buffer, GpuTimer, Image};
 use std::sync::Arc;
 
@@ -117,6 +117,8 @@ pub struct ShadowPipeline {
     height: u32,
     /// One step of the engine's depth format (0 for float formats): part of the ray-origin offset.
     depth_quantum: f32,
+    /// How the passes decode the engine's normal ([`crate::surface::SurfaceInput::mode`]).
+    surface_mode: UVec4,
 }
 
 impl ShadowPipeline {
