@@ -121,6 +121,7 @@ pub fn upload_scene(device: &Device, scene: &Scene) -> Result<Geometry, PassErro
             first_index: o.first_triangle * 3,
             index_count: o.triangle_count * 3,
             model: Mat4::IDENTITY,
+            base_vertex: 0,
         })
         .collect();
     Geometry::upload(

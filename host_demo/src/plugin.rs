@@ -320,7 +320,7 @@ impl PluginRenderer {
         device.submit_and_wait(|enc| {
             if rebuild_prims {
                 self.prim_buffer
-                    .record(enc, &self.geometry)
+                    .record(enc, &self.geometry, None)
                     .map_err(recording_error)?;
                 enc.barriers(&[Barrier::Uav]);
             }
@@ -699,6 +699,7 @@ fn set_geometry(context: &Context, geometry: &Geometry, bounds: &Aabb) -> Result
             first_index: d.first_index,
             index_count: d.index_count,
             transform: d.model.to_cols_array(),
+            base_vertex: d.base_vertex,
         })
         .collect();
     let mut b = [0.0f32; 6];

@@ -40,7 +40,8 @@ void main() {
             if (pc.index_16bit != 0u) {
                 index = (i & 1u) != 0u ? index >> 16u : index & 0xFFFFu;
             }
-            ok = fetch(index, w);
+            int vertex = int(index) + pc.base_vertex;
+            ok = vertex >= 0 && fetch(uint(vertex), w);
         }
         valid = valid && ok;
         t.v[k] = w;

@@ -8,5 +8,5 @@ struct PrimBufferPush {
     uint vertex_offset;     // in floats, position of vertex 0
     uint vertex_count;      // vertices addressable by the draw (indices >= this are rejected)
     uint index_16bit;       // 1: indices are packed u16 (little-endian pairs), 0: u32
-    uint pad0;
+    int base_vertex;        // added to every index of the draw before it addresses a vertex
 };

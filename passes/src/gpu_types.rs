@@ -32,8 +32,8 @@ pub struct PrimBufferPush {
     pub vertex_count: u32,
     /// 1 for packed u16 indices, 0 for u32.
     pub index_16bit: u32,
-    /// Padding.
-    pub pad: u32,
+    /// Added to every index of the draw before it addresses a vertex (may be negative).
+    pub base_vertex: i32,
 }
 
 /// Push constants of the primitive-map passes (`map_push.glsl`).

@@ -22,6 +22,9 @@ pub struct Draw {
     pub index_count: u32,
     /// Object-to-world transform.
     pub model: Mat4,
+    /// Added to every index of the draw before it addresses a vertex (may be negative): a mesh stored at
+    /// vertex `base_vertex` of a shared vertex buffer.
+    pub base_vertex: i32,
 }
 
 /// Index element type.
@@ -102,10 +105,19 @@ impl Geometry {
         }
         let count = u32::try_from(positions.len() / 3)
             .map_err(|_| PassError::InvalidGeometry("too many vertices".into()))?;
-        if let Some(&i) = indices.iter().find(|&&i| i >= count) {
-            return Err(PassError::InvalidGeometry(format!(
-                "index {i} is out of range ({count} vertices)"
-            )));
+        for d in draws {
+            let used = indices
+                .iter()
+                .skip(d.first_index as usize)
+                .take(d.index_count as usize);
+            if let Some(&i) = used.into_iter().find(|&&i| {
+                !(0..i64::from(count)).contains(&(i64::from(i) + i64::from(d.base_vertex)))
+            }) {
+                return Err(PassError::InvalidGeometry(format!(
+                    "index {i} plus base vertex {} is out of range ({count} vertices)",
+                    d.base_vertex
+                )));
+            }
         }
         let index_count = u32::try_from(indices.len())
             .map_err(|_| PassError::InvalidGeometry("too many indices".into()))?;
@@ -291,16 +303,30 @@ impl PrimBufferPass {
         &self.prims
     }
 
-    /// Records one dispatch per draw.
-    pub fn record(&self, enc: &mut Encoder<'_>, geometry: &Geometry) -> Result<(), PassError> {
+    /// Records one dispatch per draw, each with its object-to-world transform in `models` (one per draw;
+    /// the draws' own when `None`).
+    pub fn record(
+        &self,
+        enc: &mut Encoder<'_>,
+        geometry: &Geometry,
+        models: Option<&[Mat4]>,
+    ) -> Result<(), PassError> {
+        if models.is_some_and(|m| m.len() != geometry.draws.len()) {
+            return Err(PassError::InvalidGeometry(format!(
+                "{} transforms for {} draws",
+                models.map_or(0, <[Mat4]>::len),
+                geometry.draws.len()
+            )));
+        }
         enc.begin_pass("prim buffer");
         let mut offset = 0u32;
-        for d in &geometry.draws {
+        for (i, d) in geometry.draws.iter().enumerate() {
             let count = d.index_count / 3;
             if count == 0 {
                 continue;
             }
-            let model = (DMat4::from_translation(-geometry.origin) * d.model.as_dmat4()).as_mat4();
+            let model = models.map_or(d.model, |m| m[i]);
+            let model = (DMat4::from_translation(-geometry.origin) * model.as_dmat4()).as_mat4();
             let push = PrimBufferPush {
                 model,
                 first_index: (geometry.index.offset / geometry.index.format.bytes()) as u32
@@ -311,7 +337,7 @@ impl PrimBufferPass {
                 vertex_offset: (geometry.vertex.offset / 4) as u32,
                 vertex_count: geometry.vertex.count,
                 index_16bit: u32::from(geometry.index.format == IndexFormat::U16),
-                pad: 0,
+                base_vertex: d.base_vertex,
             };
             enc.dispatch(
                 &self.pipeline,
@@ -346,11 +372,13 @@ pub struct SharedGeometry {
     map_scratch: MapScratchPool,
 }
 
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 struct PrimBufferState {
     dynamic: bool,
     built: bool,
     claimed: Option<u64>,
+    /// The draws' transforms when set after creation ([`SharedGeometry::set_transforms`]).
+    models: Option<Vec<Mat4>>,
 }
 
 impl SharedGeometry {
@@ -365,6 +393,7 @@ impl SharedGeometry {
                 dynamic,
                 built: false,
                 claimed: None,
+                models: None,
             }),
             map_scratch: MapScratchPool::default(),
         }))
@@ -416,8 +445,31 @@ impl SharedGeometry {
 
     /// Records the build of the prim buffer (by the pipeline whose claim was [`PrimBufferClaim::Record`]).
     pub(crate) fn record(&self, enc: &mut Encoder<'_>) -> Result<(), PassError> {
-        self.pass.record(enc, &self.geometry)?;
+        let models = self.lock().models.clone();
+        self.pass.record(enc, &self.geometry, models.as_deref())?;
         self.lock().built = true;
+        Ok(())
+    }
+
+    /// Moves the draws: `models` holds one object-to-world transform per draw. The next frame rebuilds the
+    /// prim buffer (once, for every light) and everything that depends on it; frames already recorded keep
+    /// the transforms they were recorded with.
+    pub fn set_transforms(&self, models: &[Mat4]) -> Result<(), PassError> {
+        if models.len() != self.geometry.draws.len() {
+            return Err(PassError::InvalidGeometry(format!(
+                "{} transforms for {} draws",
+                models.len(),
+                self.geometry.draws.len()
+            )));
+        }
+        if let Some(i) = models.iter().position(|m| !m.is_finite()) {
+            return Err(PassError::InvalidGeometry(format!(
+                "transform {i} is not finite"
+            )));
+        }
+        let mut s = self.lock();
+        s.models = Some(models.to_vec());
+        s.built = false;
         Ok(())
     }
 

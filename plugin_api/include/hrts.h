@@ -564,6 +564,9 @@ typedef struct HrtsDraw {
   uint32_t index_count;
   // Object-to-world matrix, column-major.
   float transform[16];
+  // Added to every index of the draw before it addresses a vertex (may be negative), as in
+  // `vkCmdDrawIndexed`'s `vertexOffset`.
+  int32_t base_vertex;
 } HrtsDraw;
 
 // Geometry in CPU arrays (copied by the call).
@@ -935,6 +938,19 @@ enum HrtsResult hrts_set_geometry_cpu(struct HrtsContext *context,
 // As for `hrts_get_capabilities`; the buffers are live `VkBuffer`s of the adopted device.
 enum HrtsResult hrts_set_geometry_vulkan(struct HrtsContext *context,
                                          const struct HrtsVulkanGeometry *geometry);
+
+// Moves the geometry's draws, as an engine moves its instances every frame: `transforms` holds
+// `draw_count` object-to-world matrices (16 floats each, column-major), one per draw of the last geometry
+// call, in its order. The next frame recorded rebuilds the prim buffer once for every light (and what
+// depends on it); frames already recorded keep their transforms. No pass is rebuilt and nothing is
+// recorded. With Vulkan geometry the bounds of the geometry call no longer hold: give each frame's in
+// `HrtsFrame::bounds` for the plugin to cull by them.
+//
+// # Safety
+// As for `hrts_get_capabilities`; `transforms` points at `16 * draw_count` floats.
+enum HrtsResult hrts_set_draw_transforms(struct HrtsContext *context,
+                                         uint32_t draw_count,
+                                         const float *transforms);
 
 // Sets the engine images read (depth, normal) and written (visibility, one layer per light). The passes
 // bound to the old images are destroyed once the frames recorded so far completed; the old images must

@@ -1,6 +1,7 @@
 //! The plugin context behind the C ABI: its device, lights, geometry and targets, the passes built from
 //! them, and what reconfiguration retired while frames in flight may still use it.
 
+use crate::convert::finite;
 use crate::convert::{
     binning_path_to_c, require_usage, resource_id, resource_index, shadow_config, surface_input,
     FrameLight, RESOURCES,
@@ -441,6 +442,26 @@ impl Context {
     pub(crate) fn set_geometry_vulkan(&mut self, g: &HrtsVulkanGeometry) -> ApiResult<()> {
         self.geometry = Some(vulkan_geometry(&self.device, g)?);
         self.retire_built();
+        Ok(())
+    }
+
+    /// Moves the geometry's draws: `transforms` holds 16 floats (column-major) per draw.
+    pub(crate) fn set_draw_transforms(&mut self, transforms: &[f32]) -> ApiResult<()> {
+        finite(transforms, "transforms")?;
+        let models: Vec<glam::Mat4> = transforms
+            .chunks_exact(16)
+            .map(glam::Mat4::from_cols_slice)
+            .collect();
+        let geometry = self.geometry.as_mut().ok_or_else(|| {
+            ApiError::new(
+                HrtsResult::ErrorInvalidState,
+                "set the geometry before moving its draws",
+            )
+        })?;
+        geometry.set_transforms(&models)?;
+        if let Some(built) = &self.built {
+            built.shared.set_transforms(&models)?;
+        }
         Ok(())
     }
 

@@ -31,17 +31,52 @@ pub(crate) enum GeometrySource {
         draws: Vec<Draw>,
         origin: DVec3,
         bounds: [DVec3; 2],
+        /// Whether `bounds` still hold (not after the draws were moved).
+        bounds_hold: bool,
     },
 }
 
 impl GeometrySource {
+    /// Moves the draws (one object-to-world transform each): CPU geometry recomputes its bounds; the
+    /// bounds given with Vulkan geometry no longer hold (frames may give theirs).
+    pub(crate) fn set_transforms(&mut self, models: &[glam::Mat4]) -> ApiResult<()> {
+        let draws = match self {
+            Self::Cpu { draws, .. } | Self::Vulkan { draws, .. } => draws,
+        };
+        if models.len() != draws.len() {
+            return Err(invalid(format!(
+                "draw_count {} differs from the {} draws of the geometry",
+                models.len(),
+                draws.len()
+            )));
+        }
+        for (d, m) in draws.iter_mut().zip(models) {
+            d.model = *m;
+        }
+        match self {
+            Self::Cpu {
+                positions,
+                indices,
+                draws,
+                bounds,
+                ..
+            } => *bounds = draw_bounds(positions, indices, draws)?,
+            Self::Vulkan { bounds_hold, .. } => *bounds_hold = false,
+        }
+        Ok(())
+    }
+
     /// World-space bounds (min, max) of every triangle in every frame, for culling: always for CPU
     /// geometry (copied once), for the engine's buffers only while they do not change (`dynamic` false:
     /// the engine's `bounds` describe what it gave).
     pub(crate) fn cull_bounds(&self, dynamic: bool) -> Option<[DVec3; 2]> {
         match self {
             Self::Cpu { bounds, .. } => Some(*bounds),
-            Self::Vulkan { bounds, .. } => (!dynamic).then_some(*bounds),
+            Self::Vulkan {
+                bounds,
+                bounds_hold,
+                ..
+            } => (!dynamic && *bounds_hold).then_some(*bounds),
         }
     }
 }
@@ -64,9 +99,40 @@ fn draws_from(ptr: *const HrtsDraw, count: u32) -> ApiResult<Vec<Draw>> {
                 first_index: d.first_index,
                 index_count: d.index_count,
                 model: mat4(&d.transform),
+                base_vertex: d.base_vertex,
             })
         })
         .collect()
+}
+
+/// World-space bounds (min, max) of the vertices `draws` reference, each moved by its transform.
+fn draw_bounds(positions: &[f32], indices: &[u32], draws: &[Draw]) -> ApiResult<[DVec3; 2]> {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for d in draws {
+        let model = d.model.as_dmat4();
+        for &i in indices
+            .iter()
+            .skip(d.first_index as usize)
+            .take(d.index_count as usize)
+        {
+            let vertex = usize::try_from(i64::from(i) + i64::from(d.base_vertex)).ok();
+            let Some(p) = vertex.and_then(|v| positions.get(v * 3..v * 3 + 3)) else {
+                return Err(invalid(format!(
+                    "index {i} plus base_vertex {} is out of range ({} vertices)",
+                    d.base_vertex,
+                    positions.len() / 3
+                )));
+            };
+            let w = model.transform_point3(Vec3::from_slice(p).as_dvec3());
+            lo = lo.min(w);
+            hi = hi.max(w);
+        }
+    }
+    if !lo.is_finite() || !hi.is_finite() {
+        return Err(invalid("the draws reference no vertices"));
+    }
+    Ok([lo, hi])
 }
 
 /// The geometry of `hrts_set_geometry_cpu`, copied and checked.
@@ -99,29 +165,7 @@ pub(crate) fn cpu_geometry(g: &HrtsCpuGeometry) -> ApiResult<GeometrySource> {
     // SAFETY: as above.
     let indices = unsafe { std::slice::from_raw_parts(g.indices, g.index_count as usize) }.to_vec();
     let draws = draws_from(g.draws, g.draw_count)?;
-    let mut lo = DVec3::splat(f64::INFINITY);
-    let mut hi = DVec3::splat(f64::NEG_INFINITY);
-    for d in &draws {
-        let model = d.model.as_dmat4();
-        for &i in indices
-            .iter()
-            .skip(d.first_index as usize)
-            .take(d.index_count as usize)
-        {
-            let Some(p) = positions.get(i as usize * 3..i as usize * 3 + 3) else {
-                return Err(invalid(format!(
-                    "index {i} is out of range ({} vertices)",
-                    g.vertex_count
-                )));
-            };
-            let w = model.transform_point3(Vec3::from_slice(p).as_dvec3());
-            lo = lo.min(w);
-            hi = hi.max(w);
-        }
-    }
-    if !lo.is_finite() || !hi.is_finite() {
-        return Err(invalid("the draws reference no vertices"));
-    }
+    let [lo, hi] = draw_bounds(&positions, &indices, &draws)?;
     for (n, d) in draws.iter().enumerate() {
         if !d.index_count.is_multiple_of(3)
             || u64::from(d.first_index) + u64::from(d.index_count) > indices.len() as u64
@@ -186,6 +230,7 @@ pub(crate) fn vulkan_geometry(
         draws,
         origin: frame_origin(lo, hi),
         bounds: [lo, hi],
+        bounds_hold: true,
     };
     geometry_from(device, &source)?;
     Ok(source)

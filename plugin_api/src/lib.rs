@@ -422,6 +422,34 @@ pub unsafe extern "C" fn hrts_set_geometry_vulkan(
     })
 }
 
+/// Moves the geometry's draws, as an engine moves its instances every frame: `transforms` holds
+/// `draw_count` object-to-world matrices (16 floats each, column-major), one per draw of the last geometry
+/// call, in its order. The next frame recorded rebuilds the prim buffer once for every light (and what
+/// depends on it); frames already recorded keep their transforms. No pass is rebuilt and nothing is
+/// recorded. With Vulkan geometry the bounds of the geometry call no longer hold: give each frame's in
+/// `HrtsFrame::bounds` for the plugin to cull by them.
+///
+/// # Safety
+/// As for `hrts_get_capabilities`; `transforms` points at `16 * draw_count` floats.
+#[no_mangle]
+pub unsafe extern "C" fn hrts_set_draw_transforms(
+    context: *mut HrtsContext,
+    draw_count: u32,
+    transforms: *const f32,
+) -> HrtsResult {
+    with_context(context, |c| {
+        if transforms.is_null() {
+            return Err(ApiError::new(
+                HrtsResult::ErrorNullPointer,
+                "transforms is NULL",
+            ));
+        }
+        // SAFETY: the caller guarantees `transforms` points at 16 * draw_count floats (documented).
+        let all = unsafe { std::slice::from_raw_parts(transforms, draw_count as usize * 16) };
+        c.set_draw_transforms(all)
+    })
+}
+
 /// Sets the engine images read (depth, normal) and written (visibility, one layer per light). The passes
 /// bound to the old images are destroyed once the frames recorded so far completed; the old images must
 /// live until then.

@@ -474,6 +474,9 @@ pub struct HrtsDraw {
     pub index_count: u32,
     /// Object-to-world matrix, column-major.
     pub transform: [f32; 16],
+    /// Added to every index of the draw before it addresses a vertex (may be negative), as in
+    /// `vkCmdDrawIndexed`'s `vertexOffset`.
+    pub base_vertex: i32,
 }
 
 /// Geometry in CPU arrays (copied by the call).

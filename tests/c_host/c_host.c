@@ -40,6 +40,8 @@ static int passed, failed;
 /* ---------- scene: ground quad y = 0 (|x|,|z| <= 4) and a box [-0.5,0.5]x[0.6,1.6]x[-0.5,0.5] ---------- */
 static const double BOX_MIN[3] = {-0.5, 0.6, -0.5};
 static const double BOX_MAX[3] = {0.5, 1.6, 0.5};
+/* Where the engine has moved the box (its draw's translation; 0 unless a test moves it). */
+static double box_shift[3];
 static const double GROUND = 4.0;
 /* World-space bounds of the scene's triangles (min xyz, max xyz). */
 static const float SCENE_BOUNDS[6] = {-4.0f, 0.0f, -4.0f, 4.0f, 1.6f, 4.0f};
@@ -72,7 +74,7 @@ static double ray_box(V3 o, V3 d, double grow, V3 *normal) {
     int axis = -1;
     double sign = 0;
     for (int i = 0; i < 3; i++) {
-        double lo = BOX_MIN[i] - grow, hi = BOX_MAX[i] + grow;
+        double lo = BOX_MIN[i] + box_shift[i] - grow, hi = BOX_MAX[i] + box_shift[i] + grow;
         if (d_[i] == 0.0) {
             if (o_[i] < lo || o_[i] > hi) return -1;
             continue;
@@ -1292,6 +1294,91 @@ static void output_formats(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g)
     CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
 }
 
+/* ---------- instances that move ---------- */
+static HrtsContext *hard_lights_context(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g, const Emitter *lights,
+                                       uint32_t n);
+
+/* The engine moves the box every frame with one call (hrts_set_draw_transforms): the next frame rebuilds
+ * the prim buffer (no pass is rebuilt) and its shadow is exact where the box now is; a frame without a move
+ * keeps the prim buffer. Bad calls are refused. */
+static void moving_instances(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
+    enum { PX = W * H };
+    setup_camera(0.0);
+    Emitter sun = directional(v3(0.45, -1.0, 0.2));
+    HrtsContext *ctx = hard_lights_context(vk, g, &sun, 1);
+    static float before[PX], moved[PX];
+    upload_gbuffer();
+    CHECK(run_frame(ctx, before) == HRTS_RESULT_OK, "instances: first frame: %s", hrts_last_error(ctx));
+    const double shift[3] = {0.7, 0.0, -0.4};
+    float transforms[2][16] = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1},
+                               {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, (float)shift[0], (float)shift[1], (float)shift[2], 1}};
+    CHECK(hrts_set_draw_transforms(ctx, 2, &transforms[0][0]) == HRTS_RESULT_OK, "instances: move: %s", hrts_last_error(ctx));
+    memcpy(box_shift, shift, sizeof box_shift);
+    upload_gbuffer();
+    CHECK(run_frame(ctx, moved) == HRTS_RESULT_OK, "instances: moved frame: %s", hrts_last_error(ctx));
+    HrtsFrameReport rep;
+    CHECK(report(ctx, next_frame - 1, 0, &rep) == HRTS_RESULT_OK, "instances: report: %s", hrts_last_error(ctx));
+    int near_edge, shadowed, lit;
+    int mismatches = count_mismatches(moved, edge_tolerance(), &sun, &near_edge, &shadowed, &lit);
+    int changed = differing(before, moved, PX);
+    printf("moved instance: prim buffer %s, passes built %u time(s), %d px changed, %d shadowed, %d mismatches\n",
+           rep.pass_status[HRTS_PASS_PRIM_BUFFER] == HRTS_PASS_STATUS_RAN ? "rebuilt" : "NOT rebuilt", rep.light_builds,
+           changed, shadowed, mismatches);
+    CHECK(rep.pass_status[HRTS_PASS_PRIM_BUFFER] == HRTS_PASS_STATUS_RAN && rep.light_builds == 1,
+          "instances: the prim buffer is rebuilt and no pass is");
+    CHECK(mismatches == 0 && changed > 100 && shadowed > 300, "instances: %d mismatches, %d px changed", mismatches, changed);
+    CHECK(run_frame(ctx, NULL) == HRTS_RESULT_OK && report(ctx, next_frame - 1, 0, &rep) == HRTS_RESULT_OK &&
+              rep.pass_status[HRTS_PASS_PRIM_BUFFER] == HRTS_PASS_STATUS_UP_TO_DATE,
+          "instances: a frame without a move keeps the prim buffer: %s", hrts_last_error(ctx));
+    CHECK(hrts_set_draw_transforms(ctx, 1, &transforms[0][0]) == HRTS_RESULT_ERROR_INVALID_ARGUMENT &&
+              strstr(hrts_last_error(ctx), "draw"),
+          "instances: a wrong draw count is refused: %s", hrts_last_error(ctx));
+    CHECK(hrts_set_draw_transforms(ctx, 2, NULL) == HRTS_RESULT_ERROR_NULL_POINTER, "instances: NULL refused");
+    transforms[1][12] = NAN;
+    CHECK(hrts_set_draw_transforms(ctx, 2, &transforms[0][0]) == HRTS_RESULT_ERROR_INVALID_ARGUMENT, "instances: NaN refused");
+    CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
+    memset(box_shift, 0, sizeof box_shift);
+    upload_gbuffer();
+}
+
+/* ---------- draws with a base vertex ---------- */
+/* A mesh stored at a vertex offset of a shared buffer: the box's indices rebased to 0 with base_vertex 4,
+ * or shifted by 10 with base_vertex -10, give the same visibility bit for bit. An index that the base vertex
+ * moves out of range is refused. */
+static void base_vertex_draws(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
+    enum { PX = W * H };
+    setup_camera(0.0);
+    upload_gbuffer();
+    Emitter sun = directional(v3(0.45, -1.0, 0.2));
+    HrtsContext *ctx = hard_lights_context(vk, g, &sun, 1);
+    static float original[PX], rebased[PX];
+    CHECK(run_frame(ctx, original) == HRTS_RESULT_OK, "base vertex: frame: %s", hrts_last_error(ctx));
+    const int bases[2] = {4, -10};
+    for (int k = 0; k < 2; k++) {
+        static uint32_t moved_indices[42];
+        HrtsDraw moved_draws[2];
+        memcpy(moved_draws, draws, sizeof moved_draws);
+        for (int i = 0; i < 42; i++) moved_indices[i] = i < 6 ? indices[i] : (uint32_t)((int)indices[i] - bases[k]);
+        moved_draws[1].base_vertex = bases[k];
+        HrtsCpuGeometry mg = *g;
+        mg.indices = moved_indices;
+        mg.draws = moved_draws;
+        CHECK(hrts_set_geometry_cpu(ctx, &mg) == HRTS_RESULT_OK && run_frame(ctx, rebased) == HRTS_RESULT_OK,
+              "base vertex %d: %s", bases[k], hrts_last_error(ctx));
+        int differ = differing(original, rebased, PX);
+        printf("base vertex %d: %d px differ from the draw without one\n", bases[k], differ);
+        CHECK(differ == 0, "base vertex %d: %d px differ", bases[k], differ);
+    }
+    HrtsDraw bad[2];
+    memcpy(bad, draws, sizeof bad);
+    bad[1].base_vertex = 100;
+    HrtsCpuGeometry bg = *g;
+    bg.draws = bad;
+    CHECK(hrts_set_geometry_cpu(ctx, &bg) == HRTS_RESULT_ERROR_INVALID_ARGUMENT && strstr(hrts_last_error(ctx), "base_vertex"),
+          "base vertex out of range refused: %s", hrts_last_error(ctx));
+    CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
+}
+
 /* ---------- the engine's normals as they are ---------- */
 /* Normals as engines keep them: xyz in half floats, RGB10A2 or RGBA8 (unorm: [0, 1] for [-1, 1]),
  * octahedral in RG16 snorm, unorm or float or in RGB10A2, in world or view space, or no normal image at
@@ -2305,6 +2392,10 @@ int main(void) {
     native_local_lights(&vk, &g);
     phase = "frames in flight";
     frames_in_flight(&vk, &g);
+    phase = "moving instances";
+    moving_instances(&vk, &g);
+    phase = "base vertex";
+    base_vertex_draws(&vk, &g);
     phase = "moving geometry";
     moving_geometry_bounds(&vk);
     phase = "engine normals";
