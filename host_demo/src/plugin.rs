@@ -723,6 +723,9 @@ fn set_geometry(context: &Context, geometry: &Geometry, bounds: &Aabb) -> Result
         draws: draws.as_ptr(),
         draw_count: draws.len() as u32,
         bounds: b,
+        vertex_format: 0,
+        position_scale: [0.0; 3],
+        position_offset: [0.0; 3],
     };
     // SAFETY: live context; the buffers live as long as the renderer, which destroys the context first.
     context.check("hrts_set_geometry_vulkan", unsafe {

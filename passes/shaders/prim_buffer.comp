@@ -13,11 +13,26 @@ layout(push_constant) uniform Push { PrimBufferPush pc; };
 
 bool fetch(uint index, out vec4 world) {
     uint base = pc.vertex_offset + index * pc.vertex_stride;
-    if (index >= pc.vertex_count || base + 2u >= uint(vertices.length())) {
+    uint last = pc.vertex_format == 0u ? base + 2u : base + 1u;
+    if (index >= pc.vertex_count || last >= uint(vertices.length())) {
         world = vec4(0.0, 0.0, 0.0, 1.0);
         return false;
     }
-    vec3 p = vec3(vertices[base], vertices[base + 1u], vertices[base + 2u]);
+    vec3 p;
+    if (pc.vertex_format == 0u) {
+        p = vec3(vertices[base], vertices[base + 1u], vertices[base + 2u]);
+    } else {
+        // Four 16-bit components in two words, x and y in the first (x in its low half), z and w in the second.
+        uint xy = floatBitsToUint(vertices[base]);
+        uint zw = floatBitsToUint(vertices[base + 1u]);
+        if (pc.vertex_format == 1u) {
+            p = vec3(unpackHalf2x16(xy), unpackHalf2x16(zw).x);
+        } else if (pc.vertex_format == 2u) {
+            p = vec3(unpackSnorm2x16(xy), unpackSnorm2x16(zw).x);
+        } else {
+            p = vec3(unpackUnorm2x16(xy), unpackUnorm2x16(zw).x);
+        }
+    }
     world = vec4((pc.model * vec4(p, 1.0)).xyz, 1.0);
     return true;
 }

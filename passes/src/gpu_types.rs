@@ -34,6 +34,10 @@ pub struct PrimBufferPush {
     pub index_16bit: u32,
     /// Added to every index of the draw before it addresses a vertex (may be negative).
     pub base_vertex: i32,
+    /// How positions are stored (`prim_buffer::VertexFormat`).
+    pub vertex_format: u32,
+    /// Padding.
+    pub pad: [u32; 3],
 }
 
 /// Push constants of the primitive-map passes (`map_push.glsl`).
@@ -248,7 +252,7 @@ pub struct HybridPush {
 
 const _: () = {
     assert!(std::mem::size_of::<GpuTriangle>() == 48);
-    assert!(std::mem::size_of::<PrimBufferPush>() == 96);
+    assert!(std::mem::size_of::<PrimBufferPush>() == 112);
     assert!(std::mem::offset_of!(PrimBufferPush, first_index) == 64);
     assert!(std::mem::size_of::<MapPush>() == 112);
     assert!(std::mem::offset_of!(MapPush, size) == 80);

@@ -34,7 +34,9 @@ pub use hybrid::HybridConfig;
 pub use light::{frustum_names, point_light_faces, spot_light_frusta, Light};
 pub use min_combine::MinCombine;
 pub use pcss::PcssConfig;
-pub use prim_buffer::{Draw, Geometry, IndexFormat, IndexLayout, SharedGeometry, VertexLayout};
+pub use prim_buffer::{
+    Draw, Geometry, IndexFormat, IndexLayout, SharedGeometry, VertexFormat, VertexLayout,
+};
 pub use primitive_map::{
     choose_binning_path, BinningPath, BinningRequest, FaceMode, PrimitiveMapConfig,
     DEFAULT_ENTRY_BUDGET, GUARD_VALUE, GUARD_WORDS, MIN_ENTRY_BUDGET,

@@ -50,10 +50,47 @@ impl IndexFormat {
 pub struct VertexLayout {
     /// Byte offset of vertex 0 (multiple of 4).
     pub offset: u64,
-    /// Byte stride (multiple of 4, at least 12).
+    /// Byte stride (multiple of 4, at least the position's size).
     pub stride: u32,
     /// Number of vertices.
     pub count: u32,
+    /// How a position is stored.
+    pub format: VertexFormat,
+}
+
+/// How a vertex position is stored. Normalized formats give values in [-1, 1] (snorm) or [0, 1] (unorm),
+/// which the draw's transform maps to the object's coordinates (a dequantization scale and offset folded
+/// into it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VertexFormat {
+    /// Three 32-bit floats.
+    Float3,
+    /// Four 16-bit floats (w ignored).
+    Half4,
+    /// Four 16-bit signed normalized integers (w ignored).
+    Snorm16x4,
+    /// Four 16-bit unsigned normalized integers (w ignored).
+    Unorm16x4,
+}
+
+impl VertexFormat {
+    /// Bytes a position takes.
+    pub fn bytes(self) -> u32 {
+        match self {
+            Self::Float3 => 12,
+            Self::Half4 | Self::Snorm16x4 | Self::Unorm16x4 => 8,
+        }
+    }
+
+    /// The shader's code for the format (`prim_buffer.comp`).
+    fn code(self) -> u32 {
+        match self {
+            Self::Float3 => 0,
+            Self::Half4 => 1,
+            Self::Snorm16x4 => 2,
+            Self::Unorm16x4 => 3,
+        }
+    }
 }
 
 /// Where indices are in an index buffer.
@@ -131,6 +168,7 @@ impl Geometry {
                 offset: 0,
                 stride: 12,
                 count,
+                format: VertexFormat::Float3,
             },
             device.create_buffer_init("indices", bytemuck::cast_slice(indices), usage)?,
             IndexLayout {
@@ -158,18 +196,19 @@ impl Geometry {
         if !origin.is_finite() {
             return bad("the frame origin is not finite".into());
         }
-        if vertex.stride < 12
+        let position_bytes = vertex.format.bytes();
+        if vertex.stride < position_bytes
             || !vertex.stride.is_multiple_of(4)
             || !vertex.offset.is_multiple_of(4)
             || vertex.count == 0
         {
-            return bad(format!("vertex layout {vertex:?}: stride must be a multiple of 4 and >= 12, offset a multiple of 4, count > 0"));
+            return bad(format!("vertex layout {vertex:?}: stride must be a multiple of 4 and >= {position_bytes}, offset a multiple of 4, count > 0"));
         }
         // Checked: an offset near u64::MAX must not wrap past the bounds check.
         let vertex_end = u64::from(vertex.count - 1)
             .checked_mul(u64::from(vertex.stride))
             .and_then(|b| b.checked_add(vertex.offset))
-            .and_then(|b| b.checked_add(12));
+            .and_then(|b| b.checked_add(u64::from(position_bytes)));
         if vertex_end.is_none_or(|end| end > vertices.size()) {
             return bad(format!(
                 "{} vertices of stride {} at offset {} do not fit the vertex buffer of {} bytes",
@@ -338,6 +377,8 @@ impl PrimBufferPass {
                 vertex_count: geometry.vertex.count,
                 index_16bit: u32::from(geometry.index.format == IndexFormat::U16),
                 base_vertex: d.base_vertex,
+                vertex_format: geometry.vertex.format.code(),
+                pad: [0; 3],
             };
             enc.dispatch(
                 &self.pipeline,

@@ -593,13 +593,13 @@ typedef struct HrtsCpuGeometry {
 typedef struct HrtsVulkanGeometry {
   // `sizeof(HrtsVulkanGeometry)`.
   uint32_t struct_size;
-  // `VkBuffer` holding positions (`R32G32B32_SFLOAT`).
+  // `VkBuffer` holding positions (`vertex_format`).
   uint64_t vertex_buffer;
   // Size of the vertex buffer in bytes.
   uint64_t vertex_buffer_size;
   // Byte offset of vertex 0 (multiple of 4).
   uint64_t vertex_offset;
-  // Bytes between vertices (>= 12, multiple of 4).
+  // Bytes between vertices (at least the position's size: 12, or 8 for 16-bit formats; a multiple of 4).
   uint32_t vertex_stride;
   // Number of vertices.
   uint32_t vertex_count;
@@ -620,6 +620,15 @@ typedef struct HrtsVulkanGeometry {
   // World-space bounds of all draws (min xyz, max xyz): the frame origin is their centre (rounded to
   // f32, so that vertex minus origin is exact for f32 vertices).
   float bounds[6];
+  // `VkFormat` of a position: `VK_FORMAT_R32G32B32_SFLOAT` (or 0), or 16-bit
+  // `VK_FORMAT_R16G16B16A16_SFLOAT`, `_SNORM` or `_UNORM` (w ignored).
+  uint32_t vertex_format;
+  // Dequantization: a stored position q (normalized to [-1, 1] or [0, 1] for snorm and unorm) is the
+  // object-space point `q * position_scale + position_offset`, per axis. A scale of 0 on every axis means
+  // 1 (no dequantization).
+  float position_scale[3];
+  // See `position_scale`.
+  float position_offset[3];
 } HrtsVulkanGeometry;
 
 // The engine's images the plugin reads and writes. All are 2D, one mip, one layer, same size.

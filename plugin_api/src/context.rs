@@ -459,8 +459,9 @@ impl Context {
             )
         })?;
         geometry.set_transforms(&models)?;
+        let stored_to_world = geometry.stored_to_world();
         if let Some(built) = &self.built {
-            built.shared.set_transforms(&models)?;
+            built.shared.set_transforms(&stored_to_world)?;
         }
         Ok(())
     }

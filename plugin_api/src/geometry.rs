@@ -4,8 +4,8 @@ use crate::convert::{enum_value, finite, mat4};
 use crate::error::{check_size, invalid, ApiError, ApiResult};
 use crate::types::*;
 use glam::{DVec3, Vec3};
-use passes::{Draw, Geometry, IndexFormat, IndexLayout, VertexLayout};
-use rhi::{BufferUsage, Device};
+use passes::{Draw, Geometry, IndexFormat, IndexLayout, VertexFormat, VertexLayout};
+use rhi::{BufferUsage, Device, Format};
 
 /// The frame origin of geometry within `lo..hi`: the centre, rounded to f32. Then the frame coordinates
 /// of f32 world positions near it (vertex minus origin) are differences of numbers on the same f32 grid,
@@ -33,10 +33,24 @@ pub(crate) enum GeometrySource {
         bounds: [DVec3; 2],
         /// Whether `bounds` still hold (not after the draws were moved).
         bounds_hold: bool,
+        /// Stored position to object space (`position_scale`, `position_offset`), applied before each
+        /// draw's transform.
+        dequantize: glam::Mat4,
     },
 }
 
 impl GeometrySource {
+    /// Each draw's transform from stored positions to world space: its own, after the dequantization of
+    /// Vulkan geometry.
+    pub(crate) fn stored_to_world(&self) -> Vec<glam::Mat4> {
+        match self {
+            Self::Cpu { draws, .. } => draws.iter().map(|d| d.model).collect(),
+            Self::Vulkan {
+                draws, dequantize, ..
+            } => draws.iter().map(|d| d.model * *dequantize).collect(),
+        }
+    }
+
     /// Moves the draws (one object-to-world transform each): CPU geometry recomputes its bounds; the
     /// bounds given with Vulkan geometry no longer hold (frames may give theirs).
     pub(crate) fn set_transforms(&mut self, models: &[glam::Mat4]) -> ApiResult<()> {
@@ -212,10 +226,52 @@ pub(crate) fn vulkan_geometry(
         return Err(invalid("bounds min exceeds max"));
     }
     let draws = draws_from(g.draws, g.draw_count)?;
+    let stored = match g.vertex_format {
+        0 => Some(Format::Rgb32Float),
+        raw => i32::try_from(raw)
+            .ok()
+            .and_then(Format::position_from_raw_vk),
+    };
+    let vertex_format = match stored {
+        Some(Format::Rgb32Float) => VertexFormat::Float3,
+        Some(Format::Rgba16Float) => VertexFormat::Half4,
+        Some(Format::Rgba16Snorm) => VertexFormat::Snorm16x4,
+        Some(Format::Rgba16Unorm) => VertexFormat::Unorm16x4,
+        _ => {
+            return Err(ApiError::new(
+                HrtsResult::ErrorInvalidEnum,
+                format!(
+                    "vertex_format {} is not R32G32B32_SFLOAT ({}, or 0), R16G16B16A16_SFLOAT ({}), _SNORM ({}) or _UNORM ({})",
+                    g.vertex_format,
+                    Format::Rgb32Float.raw_vk(),
+                    Format::Rgba16Float.raw_vk(),
+                    Format::Rgba16Snorm.raw_vk(),
+                    Format::Rgba16Unorm.raw_vk()
+                ),
+            ))
+        }
+    };
+    finite(&g.position_scale, "position_scale")?;
+    finite(&g.position_offset, "position_offset")?;
+    let scale = match Vec3::from_array(g.position_scale) {
+        Vec3::ZERO => Vec3::ONE,
+        s if s.cmpeq(Vec3::ZERO).any() => {
+            return Err(invalid(format!(
+                "position_scale {s} has a zero axis (all zero means no dequantization)"
+            )))
+        }
+        s => s,
+    };
+    let dequantize = glam::Mat4::from_scale_rotation_translation(
+        scale,
+        glam::Quat::IDENTITY,
+        Vec3::from_array(g.position_offset),
+    );
     let vertex = VertexLayout {
         offset: g.vertex_offset,
         stride: g.vertex_stride,
         count: g.vertex_count,
+        format: vertex_format,
     };
     let index = IndexLayout {
         offset: g.index_offset,
@@ -231,6 +287,7 @@ pub(crate) fn vulkan_geometry(
         origin: frame_origin(lo, hi),
         bounds: [lo, hi],
         bounds_hold: true,
+        dequantize,
     };
     geometry_from(device, &source)?;
     Ok(source)
@@ -252,8 +309,17 @@ pub(crate) fn geometry_from(device: &Device, source: &GeometrySource) -> ApiResu
             index,
             draws,
             origin,
+            dequantize,
             ..
         } => {
+            let draws: Vec<Draw> = draws
+                .iter()
+                .map(|d| Draw {
+                    model: d.model * *dequantize,
+                    ..*d
+                })
+                .collect();
+            let draws = &draws;
             // SAFETY: the engine guarantees its buffers are live and of the stated sizes (contract).
             let (vb, ib) = unsafe {
                 (

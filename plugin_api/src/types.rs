@@ -505,13 +505,13 @@ pub struct HrtsCpuGeometry {
 pub struct HrtsVulkanGeometry {
     /// `sizeof(HrtsVulkanGeometry)`.
     pub struct_size: u32,
-    /// `VkBuffer` holding positions (`R32G32B32_SFLOAT`).
+    /// `VkBuffer` holding positions (`vertex_format`).
     pub vertex_buffer: u64,
     /// Size of the vertex buffer in bytes.
     pub vertex_buffer_size: u64,
     /// Byte offset of vertex 0 (multiple of 4).
     pub vertex_offset: u64,
-    /// Bytes between vertices (>= 12, multiple of 4).
+    /// Bytes between vertices (at least the position's size: 12, or 8 for 16-bit formats; a multiple of 4).
     pub vertex_stride: u32,
     /// Number of vertices.
     pub vertex_count: u32,
@@ -532,6 +532,15 @@ pub struct HrtsVulkanGeometry {
     /// World-space bounds of all draws (min xyz, max xyz): the frame origin is their centre (rounded to
     /// f32, so that vertex minus origin is exact for f32 vertices).
     pub bounds: [f32; 6],
+    /// `VkFormat` of a position: `VK_FORMAT_R32G32B32_SFLOAT` (or 0), or 16-bit
+    /// `VK_FORMAT_R16G16B16A16_SFLOAT`, `_SNORM` or `_UNORM` (w ignored).
+    pub vertex_format: u32,
+    /// Dequantization: a stored position q (normalized to [-1, 1] or [0, 1] for snorm and unorm) is the
+    /// object-space point `q * position_scale + position_offset`, per axis. A scale of 0 on every axis means
+    /// 1 (no dequantization).
+    pub position_scale: [f32; 3],
+    /// See `position_scale`.
+    pub position_offset: [f32; 3],
 }
 
 /// The engine's images the plugin reads and writes. All are 2D, one mip, one layer, same size.

@@ -201,6 +201,12 @@ pub enum Format {
     Rg16Unorm,
     /// DXGI_FORMAT_R16G16_FLOAT.
     Rg16Float,
+    /// DXGI_FORMAT_R32G32B32_FLOAT.
+    Rgb32Float,
+    /// DXGI_FORMAT_R16G16B16A16_SNORM.
+    Rgba16Snorm,
+    /// DXGI_FORMAT_R16G16B16A16_UNORM.
+    Rgba16Unorm,
 }
 
 impl Format {
@@ -232,7 +238,23 @@ impl Format {
             Self::Rg16Snorm => vk::Format::R16G16_SNORM,
             Self::Rg16Unorm => vk::Format::R16G16_UNORM,
             Self::Rg16Float => vk::Format::R16G16_SFLOAT,
+            Self::Rgb32Float => vk::Format::R32G32B32_SFLOAT,
+            Self::Rgba16Snorm => vk::Format::R16G16B16A16_SNORM,
+            Self::Rgba16Unorm => vk::Format::R16G16B16A16_UNORM,
         }
+    }
+
+    /// The formats a vertex position may have in an engine's vertex buffer.
+    pub const POSITION: [Format; 4] = [
+        Self::Rgb32Float,
+        Self::Rgba16Float,
+        Self::Rgba16Snorm,
+        Self::Rgba16Unorm,
+    ];
+
+    /// The position format whose raw `VkFormat` value is `raw`, if it is one of [`Format::POSITION`].
+    pub fn position_from_raw_vk(raw: i32) -> Option<Format> {
+        Self::POSITION.into_iter().find(|f| f.raw_vk() == raw)
     }
 
     /// The formats an engine's normal image may have: four channels holding xyz (and w), or two holding
@@ -267,7 +289,13 @@ impl Format {
     /// Channels the format holds (of its colour aspect; 1 for depth).
     pub fn channels(self) -> u32 {
         match self {
-            Self::Rgba32Float | Self::Rgba8Unorm | Self::Rgba16Float | Self::Rgb10A2Unorm => 4,
+            Self::Rgba32Float
+            | Self::Rgba8Unorm
+            | Self::Rgba16Float
+            | Self::Rgb10A2Unorm
+            | Self::Rgba16Snorm
+            | Self::Rgba16Unorm => 4,
+            Self::Rgb32Float => 3,
             Self::Rg16Snorm | Self::Rg16Unorm | Self::Rg16Float => 2,
             _ => 1,
         }
@@ -293,7 +321,8 @@ impl Format {
     pub fn texel_size(self) -> u32 {
         match self {
             Self::Rgba32Float => 16,
-            Self::Rgba16Float => 8,
+            Self::Rgb32Float => 12,
+            Self::Rgba16Float | Self::Rgba16Snorm | Self::Rgba16Unorm => 8,
             Self::D16Unorm | Self::R16Float => 2,
             Self::R8Unorm => 1,
             _ => 4,

@@ -1549,6 +1549,80 @@ static void engine_normals(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g)
     set_lights(lights, 1);
 }
 
+/* ---------- quantized positions ---------- */
+/* Positions as engines store them to save memory: four 16-bit floats, or 16-bit snorm or unorm with a
+ * dequantization scale and offset (the plugin folds them into each draw's transform). Each gives the exact
+ * shadow of the scene (its quantization moves a vertex by at most 1e-4 m, far inside the edge tolerance).
+ * A vertex format the plugin does not read, and a scale with a zero axis, are refused. */
+static void quantized_positions(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
+    enum { PX = W * H };
+    setup_camera(0.0);
+    upload_gbuffer();
+    Emitter sun = directional(v3(0.45, -1.0, 0.2));
+    set_lights(&sun, 1);
+    const struct {
+        const char *name;
+        VkFormat format;
+        float scale[3], offset[3];
+    } formats[3] = {
+        {"R16G16B16A16_SFLOAT", VK_FORMAT_R16G16B16A16_SFLOAT, {0, 0, 0}, {0, 0, 0}},
+        {"R16G16B16A16_SNORM, scale 4", VK_FORMAT_R16G16B16A16_SNORM, {4, 4, 4}, {0, 0, 0}},
+        {"R16G16B16A16_UNORM, scale (8, 2, 8), offset (-4, 0, -4)", VK_FORMAT_R16G16B16A16_UNORM, {8, 2, 8}, {-4, 0, -4}},
+    };
+    Buf vb0, ib;
+    HrtsVulkanGeometry vg = engine_geometry(&vb0, &ib);
+    free_buffer(vb0);
+    for (int k = 0; k < 3; k++) {
+        Buf vb = make_host_buffer(12 * 8, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+        uint16_t *q = (uint16_t *)vb.map;
+        for (int v = 0; v < 12; v++)
+            for (int a = 0; a < 4; a++) {
+                double p = a < 3 ? positions[3 * v + a] : 1.0;
+                double scale = formats[k].scale[a < 3 ? a : 0], offset = formats[k].offset[a < 3 ? a : 0];
+                double n = scale != 0 ? (p - offset) / scale : p;
+                if (formats[k].format == VK_FORMAT_R16G16B16A16_SFLOAT) q[4 * v + a] = float_to_half((float)n);
+                else if (formats[k].format == VK_FORMAT_R16G16B16A16_SNORM) q[4 * v + a] = (uint16_t)(int16_t)lround(n * 32767.0);
+                else q[4 * v + a] = (uint16_t)lround(n * 65535.0);
+            }
+        HrtsVulkanGeometry qg = vg;
+        qg.vertex_buffer = (uint64_t)(uintptr_t)vb.buffer;
+        qg.vertex_buffer_size = 12 * 8;
+        qg.vertex_offset = 0;
+        qg.vertex_stride = 8;
+        qg.vertex_format = (uint32_t)formats[k].format;
+        memcpy(qg.position_scale, formats[k].scale, sizeof qg.position_scale);
+        memcpy(qg.position_offset, formats[k].offset, sizeof qg.position_offset);
+        HrtsContext *ctx = create_context(vk, 1);
+        HrtsTargets t = targets();
+        static float vis[PX];
+        HrtsResult r = configure_all(ctx, 1, HRTS_SHADOW_MODE_HARD);
+        if (r == HRTS_RESULT_OK) r = hrts_set_geometry_vulkan(ctx, &qg);
+        if (r == HRTS_RESULT_OK) r = hrts_set_targets(ctx, &t);
+        if (r == HRTS_RESULT_OK) r = run_frame(ctx, vis);
+        CHECK(r == HRTS_RESULT_OK, "positions %s: %s", formats[k].name, hrts_last_error(ctx));
+        int near_edge = 0, shadowed = 0, lit = 0, mismatches = -1;
+        if (r == HRTS_RESULT_OK) mismatches = count_mismatches(vis, edge_tolerance(), &sun, &near_edge, &shadowed, &lit);
+        printf("positions %s: %d lit, %d shadowed, %d near-edge, %d mismatches\n", formats[k].name, lit, shadowed,
+               near_edge, mismatches);
+        CHECK(mismatches == 0 && shadowed > 300, "positions %s: %d mismatches", formats[k].name, mismatches);
+        if (k == 2) {
+            HrtsVulkanGeometry bad = qg;
+            bad.vertex_format = VK_FORMAT_R8G8B8A8_SNORM;
+            CHECK(hrts_set_geometry_vulkan(ctx, &bad) == HRTS_RESULT_ERROR_INVALID_ENUM && strstr(hrts_last_error(ctx), "vertex_format"),
+                  "an 8-bit vertex format is refused: %s", hrts_last_error(ctx));
+            bad = qg;
+            bad.position_scale[1] = 0.0f;
+            CHECK(hrts_set_geometry_vulkan(ctx, &bad) == HRTS_RESULT_ERROR_INVALID_ARGUMENT && strstr(hrts_last_error(ctx), "position_scale"),
+                  "a zero scale axis is refused: %s", hrts_last_error(ctx));
+        }
+        VK(vkDeviceWaitIdle(device));
+        CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
+        free_buffer(vb);
+    }
+    free_buffer(ib);
+    (void)g;
+}
+
 /* ---------- misuse: a table of calls that must fail with a given result and a message ---------- */
 /* Each case runs in table order on one context (some build on the state left by the ones before); after
  * each, the context must still answer. A successful call clears the last error, so a case that fails with
@@ -2396,6 +2470,8 @@ int main(void) {
     moving_instances(&vk, &g);
     phase = "base vertex";
     base_vertex_draws(&vk, &g);
+    phase = "quantized positions";
+    quantized_positions(&vk, &g);
     phase = "moving geometry";
     moving_geometry_bounds(&vk);
     phase = "engine normals";
