@@ -182,13 +182,18 @@ pub(crate) fn frame_bounds(f: &HrtsFrame) -> ApiResult<Option<[glam::DVec3; 2]>>
     if f.has_bounds == 0 {
         return Ok(None);
     }
-    finite(&f.bounds, "bounds")?;
-    let lo = Vec3::from_slice(&f.bounds[..3]).as_dvec3();
-    let hi = Vec3::from_slice(&f.bounds[3..]).as_dvec3();
+    bounds(&f.bounds).map(Some)
+}
+
+/// World-space bounds given as min xyz, max xyz: finite, min not above max.
+pub(crate) fn bounds(b: &[f32; 6]) -> ApiResult<[glam::DVec3; 2]> {
+    finite(b, "bounds")?;
+    let lo = Vec3::from_slice(&b[..3]).as_dvec3();
+    let hi = Vec3::from_slice(&b[3..]).as_dvec3();
     if lo.cmpgt(hi).any() {
         return Err(invalid("bounds: min exceeds max"));
     }
-    Ok(Some([lo, hi]))
+    Ok([lo, hi])
 }
 
 /// One light of a frame: the frusta it is shadowed through (the camera in each), its type and range.

@@ -1,6 +1,6 @@
 //! Geometry intake: the engine's CPU arrays or Vulkan buffers, checked and kept to rebuild the passes.
 
-use crate::convert::{enum_value, finite, mat4};
+use crate::convert::{bounds, enum_value, finite, mat4};
 use crate::error::{check_size, invalid, ApiError, ApiResult};
 use crate::types::*;
 use glam::{DVec3, Vec3};
@@ -219,12 +219,7 @@ pub(crate) fn vulkan_geometry(
         "index_type",
         "HrtsIndexType",
     )?;
-    finite(&g.bounds, "bounds")?;
-    let lo = Vec3::from_slice(&g.bounds[..3]).as_dvec3();
-    let hi = Vec3::from_slice(&g.bounds[3..]).as_dvec3();
-    if lo.cmpgt(hi).any() {
-        return Err(invalid("bounds min exceeds max"));
-    }
+    let [lo, hi] = bounds(&g.bounds)?;
     let draws = draws_from(g.draws, g.draw_count)?;
     let stored = match g.vertex_format {
         0 => Some(Format::Rgb32Float),

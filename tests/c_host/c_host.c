@@ -1141,18 +1141,7 @@ static void engine_depth(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
                 else
                     ((uint32_t *)staging.map)[i] = (uint32_t)lround(d * 16777215.0);
             }
-            VkCommandBuffer cmd = begin();
-            barrier(cmd, depth.image, all, 1, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
-            VkBufferImageCopy region;
-            memset(&region, 0, sizeof region);
-            region.imageSubresource.aspectMask = VK_IMAGE_ASPECT_DEPTH_BIT;
-            region.imageSubresource.layerCount = 1;
-            region.imageExtent.width = W;
-            region.imageExtent.height = H;
-            region.imageExtent.depth = 1;
-            vkCmdCopyBufferToImage(cmd, staging.buffer, depth.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-            barrier(cmd, depth.image, all, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, layout);
-            submit_and_wait(cmd);
+            upload_image(depth, all, VK_IMAGE_ASPECT_DEPTH_BIT, staging, layout);
             free_buffer(staging);
 
             HrtsContext *ctx = create_context(vk, 1);
@@ -1292,6 +1281,23 @@ static void output_formats(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g)
     CHECK(hrts_set_targets(ctx, &t) == HRTS_RESULT_ERROR_INVALID_ENUM && strstr(hrts_last_error(ctx), "output_format"),
           "an RGBA8 output is refused: %s", hrts_last_error(ctx));
     CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
+}
+
+/* Uploads `staging` (tightly packed texels of the copied aspect) into one-layer `img` and leaves it in
+ * `layout`: `aspects` are the image's aspects (for the layout transitions), `copied` the one written. */
+static void upload_image(Img img, VkImageAspectFlags aspects, VkImageAspectFlags copied, Buf staging, VkImageLayout layout) {
+    VkCommandBuffer cmd = begin();
+    barrier(cmd, img.image, aspects, 1, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+    VkBufferImageCopy region;
+    memset(&region, 0, sizeof region);
+    region.imageSubresource.aspectMask = copied;
+    region.imageSubresource.layerCount = 1;
+    region.imageExtent.width = W;
+    region.imageExtent.height = H;
+    region.imageExtent.depth = 1;
+    vkCmdCopyBufferToImage(cmd, staging.buffer, img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    barrier(cmd, img.image, aspects, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, layout);
+    submit_and_wait(cmd);
 }
 
 /* ---------- instances that move ---------- */
@@ -1491,19 +1497,8 @@ static void engine_normals(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g)
                     break;
                 }
             }
-            VkCommandBuffer cmd = begin();
-            barrier(cmd, normal.image, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
-            VkBufferImageCopy region;
-            memset(&region, 0, sizeof region);
-            region.imageSubresource.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
-            region.imageSubresource.layerCount = 1;
-            region.imageExtent.width = W;
-            region.imageExtent.height = H;
-            region.imageExtent.depth = 1;
-            vkCmdCopyBufferToImage(cmd, staging.buffer, normal.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-            barrier(cmd, normal.image, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                    VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-            submit_and_wait(cmd);
+            upload_image(normal, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_ASPECT_COLOR_BIT, staging,
+                         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
             free_buffer(staging);
         }
         HrtsContext *ctx = create_context(vk, 1);
