@@ -416,6 +416,23 @@ static void submit_and_wait(VkCommandBuffer cmd) {
     vkFreeCommandBuffers(device, pool, 1, &cmd);
 }
 
+/* Uploads `staging` (tightly packed texels of the copied aspect) into one-layer `img` and leaves it in
+ * `layout`: `aspects` are the image's aspects (for the layout transitions), `copied` the one written. */
+static void upload_image(Img img, VkImageAspectFlags aspects, VkImageAspectFlags copied, Buf staging, VkImageLayout layout) {
+    VkCommandBuffer cmd = begin();
+    barrier(cmd, img.image, aspects, 1, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+    VkBufferImageCopy region;
+    memset(&region, 0, sizeof region);
+    region.imageSubresource.aspectMask = copied;
+    region.imageSubresource.layerCount = 1;
+    region.imageExtent.width = W;
+    region.imageExtent.height = H;
+    region.imageExtent.depth = 1;
+    vkCmdCopyBufferToImage(cmd, staging.buffer, img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    barrier(cmd, img.image, aspects, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, layout);
+    submit_and_wait(cmd);
+}
+
 /* A timeline semaphore at 0 that submissions held by the test wait on (value 1). */
 static VkSemaphore held_semaphore(void) {
     VkSemaphoreTypeCreateInfo sti = {.sType = VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
@@ -1281,23 +1298,6 @@ static void output_formats(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g)
     CHECK(hrts_set_targets(ctx, &t) == HRTS_RESULT_ERROR_INVALID_ENUM && strstr(hrts_last_error(ctx), "output_format"),
           "an RGBA8 output is refused: %s", hrts_last_error(ctx));
     CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
-}
-
-/* Uploads `staging` (tightly packed texels of the copied aspect) into one-layer `img` and leaves it in
- * `layout`: `aspects` are the image's aspects (for the layout transitions), `copied` the one written. */
-static void upload_image(Img img, VkImageAspectFlags aspects, VkImageAspectFlags copied, Buf staging, VkImageLayout layout) {
-    VkCommandBuffer cmd = begin();
-    barrier(cmd, img.image, aspects, 1, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
-    VkBufferImageCopy region;
-    memset(&region, 0, sizeof region);
-    region.imageSubresource.aspectMask = copied;
-    region.imageSubresource.layerCount = 1;
-    region.imageExtent.width = W;
-    region.imageExtent.height = H;
-    region.imageExtent.depth = 1;
-    vkCmdCopyBufferToImage(cmd, staging.buffer, img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-    barrier(cmd, img.image, aspects, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, layout);
-    submit_and_wait(cmd);
 }
 
 /* ---------- instances that move ---------- */
