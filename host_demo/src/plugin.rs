@@ -317,6 +317,8 @@ impl PluginRenderer {
         let rebuild_prims = self.frames == 0 || self.dynamic_geometry;
         let with_plugin = !c_lights.is_empty();
         let t = &self.targets;
+        let frame_in =
+            |command_buffer| c_frame(command_buffer, self.frames, camera, &c_lights, &self.bounds);
         device.submit_and_wait(|enc| {
             if rebuild_prims {
                 self.prim_buffer
@@ -326,14 +328,7 @@ impl PluginRenderer {
             }
             enc.attach_timer(&self.timer);
             if with_plugin {
-                let frame = c_frame(
-                    enc.raw_handle(),
-                    self.frames,
-                    camera,
-                    &c_lights,
-                    &self.bounds,
-                );
-                self.record_passes(&frame, HRTS_PASS_MASK_LIGHT_SPACE)?;
+                self.record_passes(&frame_in(enc.raw_handle()), HRTS_PASS_MASK_LIGHT_SPACE)?;
             }
             let undefined_to = |image, after| Barrier::Image {
                 image,
@@ -367,14 +362,7 @@ impl PluginRenderer {
         if with_plugin {
             let start = std::time::Instant::now();
             device.submit_and_wait(|enc| {
-                let frame = c_frame(
-                    enc.raw_handle(),
-                    self.frames,
-                    camera,
-                    &c_lights,
-                    &self.bounds,
-                );
-                self.record_passes(&frame, HRTS_PASS_MASK_SCREEN_SPACE)
+                self.record_passes(&frame_in(enc.raw_handle()), HRTS_PASS_MASK_SCREEN_SPACE)
             })?;
             let wall = start.elapsed().as_secs_f64() * 1e3;
             for light in 0..c_lights.len() as u32 {

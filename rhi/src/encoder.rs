@@ -705,13 +705,7 @@ impl<'a> Encoder<'a> {
                 dst.layers()
             )));
         }
-        let subresource = |base| {
-            vk::ImageSubresourceLayers::default()
-                .aspect_mask(vk::ImageAspectFlags::COLOR)
-                .mip_level(0)
-                .base_array_layer(base)
-                .layer_count(1)
-        };
+        let subresource = |base| layers_of(vk::ImageAspectFlags::COLOR, base, 1);
         let corner = vk::Offset3D {
             x: src.width() as i32,
             y: src.height() as i32,
@@ -741,13 +735,7 @@ impl<'a> Encoder<'a> {
     /// Records the copy of `layers` layers of `src`, from its first, into `dst` from layer `dst_layer`
     /// (checked by the callers).
     fn record_image_copy(&mut self, src: &Image, dst: &Image, dst_layer: u32, layers: u32) {
-        let subresource = |base| {
-            vk::ImageSubresourceLayers::default()
-                .aspect_mask(src.format().view_aspect())
-                .mip_level(0)
-                .base_array_layer(base)
-                .layer_count(layers)
-        };
+        let subresource = |base| layers_of(src.format().view_aspect(), base, layers);
         let region = vk::ImageCopy::default()
             .src_subresource(subresource(0))
             .dst_subresource(subresource(dst_layer))
@@ -862,4 +850,13 @@ impl Device {
             result
         }
     }
+}
+
+/// `count` layers from `base` of mip 0 of an image's `aspect`, for copies and blits.
+fn layers_of(aspect: vk::ImageAspectFlags, base: u32, count: u32) -> vk::ImageSubresourceLayers {
+    vk::ImageSubresourceLayers::default()
+        .aspect_mask(aspect)
+        .mip_level(0)
+        .base_array_layer(base)
+        .layer_count(count)
 }
