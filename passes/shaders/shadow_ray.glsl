@@ -40,8 +40,9 @@ int shadow_ray(ivec2 px, out vec3 o, out vec3 dir, out float t_max) {
     // its view ray by at most the distance from P to the points rebuilt from depth - q and depth + q (the
     // first kept in front of the far plane: a normalized depth that close to it may lie anywhere behind).
     float q = max(k.offset.w, depth * 1.1920929e-7);
-    vec4 h_near = k.inv_view_proj_rel * vec4(ndc, depth + q, 1.0);
-    vec4 h_far = k.inv_view_proj_rel * vec4(ndc, max(depth - q, 0.5 * depth), 1.0);
+    // h is affine in depth: moving depth by t moves h by t times the matrix's depth column.
+    vec4 h_near = h + q * k.inv_view_proj_rel[2];
+    vec4 h_far = h + (max(depth - q, 0.5 * depth) - depth) * k.inv_view_proj_rel[2];
     float depth_error = max(length(h_near.xyz / h_near.w - rel), length(h_far.xyz / h_far.w - rel));
     float delta = length(rel) * k.offset.x * k.offset.y + max(max(ap.x, ap.y), ap.z) * k.offset.z
         + depth_error;
