@@ -1,6 +1,10 @@
-// The engine's surface at a pixel: whether it holds geometry, and its normal in world orientation facing
-// the camera, decoded from the engine's normal image as it is, or derived from depth. Needs the includer's
-// `depth_tex` and `normal_tex`. Mirrors passes::surface.
+// The engine's surface at a pixel: whether it holds geometry, its point, and its normal in world orientation
+// facing the camera, decoded from the engine's normal image as it is, or derived from depth. Needs the
+// includer's `depth_tex` and `normal_tex`. Mirrors passes::surface.
+//
+// The depth image holds the projection's depth (surface.y == 0) or a linear view-space z (surface.y > 0:
+// its relative precision), as `HrtsFrame::view` gives it; a view-Z pixel holding 0, a value that is not
+// finite or one of magnitude 65504 or more is background.
 //
 // mode.x: the encoding. 0: xyz as stored, w = 0 on background (the plugin's original contract); 1: xyz;
 //   2: octahedral in the first two channels; 3: none (derived from depth).
@@ -32,6 +36,32 @@ vec3 surface_point(ivec2 px, float depth, mat4 inv_view_proj_rel, uvec2 dims) {
 
 bool covered(float depth, float background) {
     return depth > 0.0 && depth != background;
+}
+
+// The engine's point at `px` relative to the camera, and the value its depth image holds there; false on
+// background. A view-space z picks the point on the pixel's ray (through two points of it) whose view z it
+// is: the view's z axis is the last row of the view rotation, the inverse of `view_to_world`'s.
+bool engine_point(ivec2 px, mat4 inv_view_proj_rel, uvec2 dims, vec4 surface, mat4 view_to_world,
+                  out vec3 rel, out float stored) {
+    stored = texelFetch(depth_tex, px, 0).r;
+    rel = vec3(0.0);
+    if (surface.y == 0.0) {
+        if (!covered(stored, surface.x)) {
+            return false;
+        }
+        rel = surface_point(px, stored, inv_view_proj_rel, dims);
+        return true;
+    }
+    if (!(stored != 0.0 && abs(stored) < 65504.0)) {
+        return false;
+    }
+    vec3 a = surface_point(px, 0.25, inv_view_proj_rel, dims);
+    vec3 b = surface_point(px, 0.75, inv_view_proj_rel, dims);
+    vec3 z_axis = transpose(inverse(mat3(view_to_world)))[2];
+    float za = dot(a, z_axis);
+    float zb = dot(b, z_axis);
+    rel = a + (stored - za) / (zb - za) * (b - a);
+    return true;
 }
 
 // The neighbour of `px` along `axis` (one of its two sides) most likely on the same plane as `px`. A
@@ -71,12 +101,11 @@ bool surface_step(ivec2 px, ivec2 axis, vec3 center, float depth, mat4 inv_view_
     return found;
 }
 
+// The normal at `px`, whose point `engine_point` found at `rel` with the stored `depth`. Normals derived
+// from depth need a depth image of the projection's depth (the plugin refuses them with view Z).
 bool engine_surface(ivec2 px, float depth, vec3 rel, mat4 inv_view_proj_rel, uvec2 dims, uvec4 mode,
                     mat4 view_to_world, float background, out vec3 n) {
     n = vec3(0.0, 0.0, 1.0);
-    if (!covered(depth, background)) {
-        return false;
-    }
     if (mode.x == NORMAL_FROM_DEPTH) {
         // Two steps along the surface: along x and y, or, where an axis has no neighbour holding geometry
         // or a worse one than a diagonal, along the better diagonal (a sliver of surface between a

@@ -104,13 +104,12 @@ void main() {
     if (px.x >= int(k.dims.x) || px.y >= int(k.dims.y)) {
         return;
     }
-    float depth = texelFetch(depth_tex, px, 0).r;
-    vec2 ndc = (vec2(px) + 0.5) / vec2(k.dims.xy) * 2.0 - 1.0;
-    vec4 h = k.inv_view_proj_rel * vec4(ndc, depth, 1.0);
-    vec3 rel = h.xyz / h.w;
+    vec3 rel;
+    float depth;
     vec3 n;
-    if (!engine_surface(px, depth, rel, k.inv_view_proj_rel, k.dims.xy, k.surface_mode, k.view_to_world,
-                        k.surface.x, n)) {
+    if (!engine_point(px, k.inv_view_proj_rel, k.dims.xy, k.surface, k.view_to_world, rel, depth)
+        || !engine_surface(px, depth, rel, k.inv_view_proj_rel, k.dims.xy, k.surface_mode, k.view_to_world,
+                           k.surface.x, n)) {
         store(px, 1.0);     // background
         return;
     }

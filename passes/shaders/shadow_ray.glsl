@@ -7,8 +7,8 @@
 // The receiver point P is rebuilt from depth relative to the camera, then offset along its geometric
 // normal by a bound on its own error: a fraction of the pixel footprint, a few ulps of |P|, and how far the
 // depth format's precision lets P move along its view ray. No world-space bias. Any depth convention works
-// (reversed or standard Z, finite or infinite far plane): P is rebuilt through the engine's own projection,
-// and the normal's w marks the pixels that hold geometry. Directional light: the ray runs along -light_dir without end. Spot light: the ray runs
+// (reversed or standard Z, finite or infinite far plane, or a linear view-Z image): P is rebuilt through the
+// engine's own projection. Directional light: the ray runs along -light_dir without end. Spot light: the ray runs
 // from the offset origin to the light position and only hits before it count (t < t_max).
 
 const int SHADOW_RAY_TRACE = 0;     // trace o + t * dir, 0 < t < t_max
@@ -19,13 +19,12 @@ int shadow_ray(ivec2 px, out vec3 o, out vec3 dir, out float t_max) {
     o = vec3(0.0);
     dir = vec3(0.0, 0.0, 1.0);
     t_max = 1.0 / 0.0;
-    float depth = texelFetch(depth_tex, px, 0).r;
-    vec2 ndc = (vec2(px) + 0.5) / vec2(k.dims.xy) * 2.0 - 1.0;
-    vec4 h = k.inv_view_proj_rel * vec4(ndc, depth, 1.0);
-    vec3 rel = h.xyz / h.w;
+    vec3 rel;
+    float depth;
     vec3 n;
-    if (!engine_surface(px, depth, rel, k.inv_view_proj_rel, k.dims.xy, k.surface_mode, k.view_to_world,
-                        k.surface.x, n)) {
+    if (!engine_point(px, k.inv_view_proj_rel, k.dims.xy, k.surface, k.view_to_world, rel, depth)
+        || !engine_surface(px, depth, rel, k.inv_view_proj_rel, k.dims.xy, k.surface_mode, k.view_to_world,
+                           k.surface.x, n)) {
         return SHADOW_RAY_LIT;
     }
     vec3 p = k.camera_pos.xyz + rel;
@@ -39,11 +38,20 @@ int shadow_ray(ivec2 px, out vec3 o, out vec3 dir, out float t_max) {
     // (k.offset.w: rounded either way), or 2^-23 of the value for a float format (either rounding). P moves along
     // its view ray by at most the distance from P to the points rebuilt from depth - q and depth + q (the
     // first kept in front of the far plane: a normalized depth that close to it may lie anywhere behind).
-    float q = max(k.offset.w, depth * 1.1920929e-7);
-    // h is affine in depth: moving depth by t moves h by t times the matrix's depth column.
-    vec4 h_near = h + q * k.inv_view_proj_rel[2];
-    vec4 h_far = h + (max(depth - q, 0.5 * depth) - depth) * k.inv_view_proj_rel[2];
-    float depth_error = max(length(h_near.xyz / h_near.w - rel), length(h_far.xyz / h_far.w - rel));
+    // A view-Z image holds z within its relative precision (k.surface.y), and P scales with z along its ray
+    // from the camera; twice that covers the rounding of the ray's construction.
+    float depth_error;
+    if (k.surface.y > 0.0) {
+        depth_error = 2.0 * k.surface.y * length(rel);
+    } else {
+        float q = max(k.offset.w, depth * 1.1920929e-7);
+        vec2 ndc = (vec2(px) + 0.5) / vec2(k.dims.xy) * 2.0 - 1.0;
+        vec4 h = k.inv_view_proj_rel * vec4(ndc, depth, 1.0);
+        // h is affine in depth: moving depth by t moves h by t times the matrix's depth column.
+        vec4 h_near = h + q * k.inv_view_proj_rel[2];
+        vec4 h_far = h + (max(depth - q, 0.5 * depth) - depth) * k.inv_view_proj_rel[2];
+        depth_error = max(length(h_near.xyz / h_near.w - rel), length(h_far.xyz / h_far.w - rel));
+    }
     float delta = length(rel) * k.offset.x * k.offset.y + max(max(ap.x, ap.y), ap.z) * k.offset.z
         + depth_error;
     o = p + n * delta;

@@ -103,9 +103,25 @@ pub fn view_to_world(view: Mat4) -> Mat4 {
     Mat4::from_mat3(Mat3::from_mat4(view).inverse())
 }
 
-/// The shader's surface vector: x the background depth of `proj`.
-pub fn surface_vector(proj: Mat4) -> Vec4 {
-    Vec4::new(background_depth(proj), 0.0, 0.0, 0.0)
+/// The relative precision of a linear view-Z image of `format` (`R32_SFLOAT` or `R16_SFLOAT`: its value's
+/// rounding either way), or 0 for a depth image, which holds the projection's depth.
+pub fn view_z_precision(format: Format) -> f32 {
+    match format {
+        Format::R32Float => f32::EPSILON,
+        Format::R16Float => 1.0 / 1024.0,
+        _ => 0.0,
+    }
+}
+
+/// The shader's surface vector: x the background depth of `proj`, y the view-Z precision of a depth image
+/// of `depth_format` ([`view_z_precision`]).
+pub fn surface_vector(proj: Mat4, depth_format: Format) -> Vec4 {
+    Vec4::new(
+        background_depth(proj),
+        view_z_precision(depth_format),
+        0.0,
+        0.0,
+    )
 }
 
 #[cfg(test)]
@@ -136,6 +152,15 @@ mod tests {
             background_depth(Mat4::orthographic_rh(-1.0, 1.0, -1.0, 1.0, near, far)),
             1.0
         );
+    }
+
+    #[test]
+    fn view_z_images_say_their_precision() {
+        let proj = Mat4::perspective_infinite_reverse_rh(1.0, 1.5, 0.1);
+        assert_eq!(surface_vector(proj, Format::D32Float).y, 0.0);
+        assert_eq!(surface_vector(proj, Format::D24UnormS8Uint).y, 0.0);
+        assert_eq!(surface_vector(proj, Format::R32Float).y, f32::EPSILON);
+        assert_eq!(surface_vector(proj, Format::R16Float).y, 1.0 / 1024.0);
     }
 
     #[test]

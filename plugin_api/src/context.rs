@@ -490,23 +490,36 @@ impl Context {
                 t.output_layers, caps.max_image_array_layers
             )));
         }
+        let view_z = [Format::R32Float, Format::R16Float];
         let depth_format = match t.depth_format {
             0 => Format::D32Float,
             raw => i32::try_from(raw)
                 .ok()
-                .and_then(Format::depth_from_raw_vk)
+                .and_then(|raw| {
+                    Format::depth_from_raw_vk(raw)
+                        .or_else(|| view_z.into_iter().find(|f| f.raw_vk() == raw))
+                })
                 .ok_or_else(|| {
-                    let accepted: Vec<String> =
-                        Format::DEPTH.iter().map(|f| f.raw_vk().to_string()).collect();
+                    let accepted: Vec<String> = Format::DEPTH
+                        .iter()
+                        .chain(&view_z)
+                        .map(|f| f.raw_vk().to_string())
+                        .collect();
                     ApiError::new(
                         HrtsResult::ErrorInvalidEnum,
                         format!(
-                            "depth_format {raw} is not a depth format the plugin reads: one of {} (D16_UNORM, X8_D24_UNORM_PACK32, D24_UNORM_S8_UINT, D32_SFLOAT, D32_SFLOAT_S8_UINT), or 0 for D32_SFLOAT",
+                            "depth_format {raw} is not a depth format the plugin reads: one of {} (D16_UNORM, X8_D24_UNORM_PACK32, D24_UNORM_S8_UINT, D32_SFLOAT, D32_SFLOAT_S8_UINT, or view Z in R32_SFLOAT, R16_SFLOAT), or 0 for D32_SFLOAT",
                             accepted.join(", ")
                         ),
                     )
                 })?,
         };
+        if derived && view_z.contains(&depth_format) {
+            return Err(invalid(format!(
+                "normal_encoding NONE derives normals from the projection's depth; depth_format {} is a view-Z image: give the engine's normals",
+                depth_format.raw_vk()
+            )));
+        }
         if !self.device.can_sample(depth_format) {
             return Err(ApiError::new(
                 HrtsResult::ErrorUnsupported,

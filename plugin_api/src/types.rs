@@ -554,16 +554,19 @@ pub struct HrtsTargets {
     pub height: u32,
     /// The engine's depth `VkImage` (`depth_format`, usage includes SAMPLED), as its projection writes it:
     /// reversed or standard Z, finite or infinite far plane (the plugin rebuilds positions through
-    /// `HrtsFrame::proj`; the normal image's w says which pixels hold geometry).
+    /// `HrtsFrame::proj`), or a linear view-Z image.
     pub depth_image: u64,
     /// Usage flags the depth image was created with (`VkImageUsageFlags`).
     pub depth_usage: u32,
     /// `VkFormat` of the depth image: `VK_FORMAT_D16_UNORM`, `VK_FORMAT_X8_D24_UNORM_PACK32`,
     /// `VK_FORMAT_D24_UNORM_S8_UINT`, `VK_FORMAT_D32_SFLOAT` or `VK_FORMAT_D32_SFLOAT_S8_UINT` (sampled
     /// through its depth aspect; its layouts are given for both aspects), or 0 for `VK_FORMAT_D32_SFLOAT`.
-    /// The ray origins move off the surface by the format's depth error, so shadows stay exact at the
-    /// points the depth describes; a coarse format (D16 with a near plane close to the camera) moves
-    /// contact shadows' start by that error.
+    /// `VK_FORMAT_R32_SFLOAT` or `VK_FORMAT_R16_SFLOAT`: a linear view-Z image (as NRD's view-Z input): the
+    /// view-space z of the surface under `HrtsFrame::view` (negative in front of a right-handed camera); 0,
+    /// a value that is not finite, or one of magnitude 65504 or more marks background. Normals derived from
+    /// depth (`HRTS_NORMAL_ENCODING_NONE`) need a depth format. The ray origins move off the surface by the
+    /// format's depth error, so shadows stay exact at the points the depth describes; a coarse format (D16
+    /// with a near plane close to the camera, R16 view Z) moves contact shadows' start by that error.
     pub depth_format: u32,
     /// The engine's normal `VkImage` (`normal_format`, usage includes SAMPLED), encoded as
     /// `normal_encoding` says; ignored (may be 0) with `HRTS_NORMAL_ENCODING_NONE`.

@@ -94,6 +94,19 @@ pub const SHADER_STAGES: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::from
         | vk::PipelineStageFlags2::COMPUTE_SHADER.as_raw(),
 );
 
+/// `stages` without those a device cannot name in a barrier: the geometry stage unless `geometryShader` is
+/// enabled (an engine's device may lack it).
+pub fn enabled_stages(
+    stages: vk::PipelineStageFlags2,
+    geometry_shader: bool,
+) -> vk::PipelineStageFlags2 {
+    if geometry_shader {
+        stages
+    } else {
+        stages & !vk::PipelineStageFlags2::GEOMETRY_SHADER
+    }
+}
+
 /// Vulkan scope of a resource state: (image layout, pipeline stages, access mask).
 pub fn state_scope(
     state: ResourceState,
@@ -454,6 +467,20 @@ mod tests {
         assert_eq!(layout, vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL);
         assert_eq!(stages, vk::PipelineStageFlags2::ALL_COMMANDS);
         assert!(access.contains(vk::AccessFlags2::MEMORY_WRITE));
+    }
+
+    #[test]
+    fn barriers_leave_out_the_geometry_stage_without_geometry_shaders() {
+        let (_, stages, _) = state_scope(ResourceState::ShaderResource);
+        assert!(stages.contains(vk::PipelineStageFlags2::GEOMETRY_SHADER));
+        let without = enabled_stages(stages, false);
+        assert!(!without.contains(vk::PipelineStageFlags2::GEOMETRY_SHADER));
+        assert_eq!(
+            without | vk::PipelineStageFlags2::GEOMETRY_SHADER,
+            stages,
+            "only the geometry stage goes"
+        );
+        assert_eq!(enabled_stages(stages, true), stages);
     }
 
     #[test]

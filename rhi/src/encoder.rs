@@ -1,6 +1,6 @@
 //! Command recording with D3D12-flavoured barriers, per-pass debug labels and GPU timestamps.
 
-use crate::conv::{state_scope, uav_barrier, ResourceState};
+use crate::conv::{enabled_stages, state_scope, uav_barrier, ResourceState};
 use crate::device::Device;
 use crate::error::{Result, RhiError, VkResultExt};
 use crate::pipeline::{BindGroup, ComputePipeline, GraphicsPipeline, PipelineLayout};
@@ -199,6 +199,11 @@ impl<'a> Encoder<'a> {
         &self.device.shared.device
     }
 
+    /// `stages` without those the device's enabled features rule out of barriers.
+    fn enabled(&self, stages: vk::PipelineStageFlags2) -> vk::PipelineStageFlags2 {
+        enabled_stages(stages, self.device.shared.caps.geometry_shader)
+    }
+
     /// Starts timing passes with `timer` (resets its queries; must be outside a render pass).
     pub fn attach_timer(&mut self, timer: &GpuTimer) {
         let t = &timer.inner;
@@ -338,13 +343,14 @@ impl<'a> Encoder<'a> {
                 }
             }
         }
+        let stages = |s| self.enabled(widen(s));
         for b in &mut memory {
-            b.src_stage_mask = widen(b.src_stage_mask);
-            b.dst_stage_mask = widen(b.dst_stage_mask);
+            b.src_stage_mask = stages(b.src_stage_mask);
+            b.dst_stage_mask = stages(b.dst_stage_mask);
         }
         for b in &mut images {
-            b.src_stage_mask = widen(b.src_stage_mask);
-            b.dst_stage_mask = widen(b.dst_stage_mask);
+            b.src_stage_mask = stages(b.src_stage_mask);
+            b.dst_stage_mask = stages(b.dst_stage_mask);
         }
         let dep = vk::DependencyInfo::default()
             .memory_barriers(&memory)
@@ -417,6 +423,7 @@ impl<'a> Encoder<'a> {
         }
         let (_, reader_stages, reader_access) = state_scope(ResourceState::ShaderResource);
         let (_, copy_stages, copy_access) = state_scope(ResourceState::CopyDest);
+        let (reader_stages, copy_stages) = (self.enabled(reader_stages), self.enabled(copy_stages));
         let barrier = |src, src_access, dst, dst_access| {
             vk::BufferMemoryBarrier2::default()
                 .src_stage_mask(src)

@@ -1197,7 +1197,7 @@ static void engine_depth(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
     /* a format the plugin does not read, and a colour format, are refused */
     HrtsContext *ctx = create_context(vk, 1);
     HrtsTargets t = targets();
-    const uint32_t refused[] = {VK_FORMAT_S8_UINT, VK_FORMAT_R32_SFLOAT};
+    const uint32_t refused[] = {VK_FORMAT_S8_UINT, VK_FORMAT_R8G8B8A8_UNORM};
     for (int i = 0; i < 2; i++) {
         t.depth_format = refused[i];
         HrtsResult r = hrts_set_targets(ctx, &t);

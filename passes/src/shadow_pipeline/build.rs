@@ -57,6 +57,12 @@ impl ShadowPipeline {
                 "depth and normal images differ in size".into(),
             ));
         }
+        if derived && crate::surface::view_z_precision(inputs.depth.format()) > 0.0 {
+            return Err(PassError::InvalidConfig(
+                "normals derived from depth need the projection's depth, not a view-Z image: give the engine's normals"
+                    .into(),
+            ));
+        }
         if !inputs.surface.accepts(inputs.normal.format()) {
             return Err(PassError::InvalidConfig(format!(
                 "a normal image of {:?} cannot hold {:?} normals",
@@ -237,7 +243,7 @@ impl ShadowPipeline {
             statuses: Vec::new(),
             width,
             height,
-            depth_quantum: inputs.depth.format().depth_quantum(),
+            depth_format: inputs.depth.format(),
             surface_mode: inputs.surface.mode(inputs.normal.format()),
         };
         // Every resource of the plan exists (a missing one would be a bug in the wiring above).

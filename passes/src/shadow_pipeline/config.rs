@@ -107,7 +107,8 @@ impl ShadowConfig {
 /// The engine's images the pipeline reads, bound at creation.
 pub struct ShadowInputs<'a> {
     /// Depth as `FrameInputs::proj` writes it (any [`rhi::Format::DEPTH`] format, sampled through its depth
-    /// aspect), `ShaderResource` state when the passes run.
+    /// aspect), or a linear view-Z image (`R32Float` or `R16Float`: the view-space z of `FrameInputs::view`;
+    /// 0, non-finite or of magnitude 65504 or more on background), `ShaderResource` state when the passes run.
     pub depth: &'a Image,
     /// The engine's normal image, as `surface` says it encodes the normal (for
     /// [`NormalEncoding::FromDepth`], any image: it is bound but not read), `ShaderResource` state.

@@ -38,7 +38,7 @@ impl ShadowPipeline {
         let dir = light.direction;
         let sm = self.config.shadow_map;
         let view_to_world = surface::view_to_world(inputs.view);
-        let surface = surface::surface_vector(inputs.proj);
+        let surface = surface::surface_vector(inputs.proj, self.depth_format);
         let pc = self.config.pcss;
         Ok(FrameConstants {
             light,
@@ -59,7 +59,7 @@ impl ShadowPipeline {
                     radians_per_pixel,
                     RAY_OFFSET_PIXELS,
                     RAY_OFFSET_FLOAT_BOUND,
-                    self.depth_quantum,
+                    self.depth_format.depth_quantum(),
                 ),
                 misc: UVec4::new(front_only, self.geometry().triangle_count(), 0, 0),
                 light_pos: light.position.map_or(Vec4::ZERO, |p| p.extend(1.0)),

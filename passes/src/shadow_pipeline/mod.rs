@@ -115,8 +115,9 @@ pub struct ShadowPipeline {
     statuses: Vec<(PassId, PassStatus)>,
     width: u32,
     height: u32,
-    /// One step of the engine's depth format (0 for float formats): part of the ray-origin offset.
-    depth_quantum: f32,
+    /// The engine's depth format: its precision is part of the ray-origin offset; `R32Float` and
+    /// `R16Float` images hold linear view Z.
+    depth_format: rhi::Format,
     /// How the passes decode the engine's normal ([`crate::surface::SurfaceInput::mode`]).
     surface_mode: UVec4,
 }
