@@ -454,3 +454,79 @@ pub(crate) fn deformed_meshes(
     }
     Ok(deformed.to_vec())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One CPU mesh of 4 vertices.
+    fn quad() -> GeometrySource {
+        GeometrySource::Cpu {
+            positions: vec![0.0; 12],
+            indices: vec![0, 1, 2, 0, 2, 3],
+            draws: Vec::new(),
+            origin: DVec3::ZERO,
+            bounds: [DVec3::ZERO; 2],
+        }
+    }
+
+    fn frame(deformed: &[HrtsMeshVertices]) -> HrtsFrame {
+        // SAFETY: every field of `HrtsFrame` is an integer, a float or a raw pointer: all zeros is valid.
+        let mut f: HrtsFrame = unsafe { std::mem::zeroed() };
+        f.deformed = deformed.as_ptr();
+        f.deformed_count = deformed.len() as u32;
+        f
+    }
+
+    fn vertices(mesh: u32, size: u64, offset: u64) -> HrtsMeshVertices {
+        HrtsMeshVertices {
+            mesh,
+            vertex_buffer: 1,
+            vertex_buffer_size: size,
+            vertex_offset: offset,
+        }
+    }
+
+    #[test]
+    fn deformed_meshes_are_checked_against_the_geometry() {
+        let g = quad();
+        let ok = [vertices(0, 64, 16)];
+        assert_eq!(deformed_meshes(&frame(&ok), Some(&g)).unwrap(), ok);
+        assert!(deformed_meshes(&frame(&[]), None).unwrap().is_empty());
+        let code = |v: &[HrtsMeshVertices], g: Option<&GeometrySource>| {
+            deformed_meshes(&frame(v), g).map_err(|e| (e.code, e.message))
+        };
+        let mut null = frame(&ok);
+        null.deformed = std::ptr::null();
+        assert_eq!(
+            deformed_meshes(&null, Some(&g)).unwrap_err().code,
+            HrtsResult::ErrorNullPointer
+        );
+        assert_eq!(
+            code(&ok, None).unwrap_err().0,
+            HrtsResult::ErrorInvalidState
+        );
+        let (c, m) = code(&[vertices(1, 64, 0)], Some(&g)).unwrap_err();
+        assert!(
+            c == HrtsResult::ErrorInvalidArgument && m.contains("deformed[0].mesh 1"),
+            "{m}"
+        );
+        // 4 float3 vertices at offset 16 end at 64 bytes.
+        let (c, m) = code(&[vertices(0, 63, 16)], Some(&g)).unwrap_err();
+        assert!(
+            c == HrtsResult::ErrorInvalidArgument && m.contains("deformed[0] (mesh 0)"),
+            "{m}"
+        );
+        let (c, m) = code(&[vertices(0, 64, 0), vertices(0, 64, 0)], Some(&g)).unwrap_err();
+        assert!(
+            c == HrtsResult::ErrorInvalidArgument && m.contains("deformed_count 2"),
+            "{m}"
+        );
+        let mut unbound = vertices(0, 64, 0);
+        unbound.vertex_buffer = 0;
+        assert_eq!(
+            code(&[unbound], Some(&g)).unwrap_err().0,
+            HrtsResult::ErrorNullPointer
+        );
+    }
+}

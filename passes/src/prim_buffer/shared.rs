@@ -95,6 +95,12 @@ impl PrimBufferState {
             .all(|(built, model)| *built == Some(*model))
     }
 
+    /// Whether a build rewrites draw `draw`'s slots (`deformed`: its mesh reads a vertex buffer of the
+    /// frame).
+    fn rebuilds(&self, draw: usize, deformed: bool) -> bool {
+        self.dynamic || deformed || self.built_with[draw] != Some(self.models[draw])
+    }
+
     /// Whether `frame` must rebuild some of the prim buffer.
     fn stale(&self, frame: u64) -> bool {
         self.dynamic || !self.deformed_in(frame).is_empty() || !self.current()
@@ -182,10 +188,10 @@ impl SharedGeometry {
             .pass
             .record_draws(enc, &self.geometry, |mesh, draw, _| {
                 let from_frame = deformed.iter().find(|m| m.mesh == mesh);
-                let model = s.models[draw];
-                if !s.dynamic && from_frame.is_none() && s.built_with[draw] == Some(model) {
+                if !s.rebuilds(draw, from_frame.is_some()) {
                     return None;
                 }
+                let model = s.models[draw];
                 rebuilt[draw] = true;
                 Some(match from_frame {
                     Some(m) => DrawSource {
@@ -332,5 +338,66 @@ impl SharedGeometry {
     /// Whether every draw's slots hold its current transform applied to its mesh's own vertices.
     pub(crate) fn is_built(&self) -> bool {
         self.lock().current()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::prim_buffer::VertexFormat;
+    use glam::Vec3;
+
+    fn state(draws: usize) -> PrimBufferState {
+        PrimBufferState {
+            dynamic: false,
+            claimed: None,
+            models: vec![Mat4::IDENTITY; draws],
+            built_with: vec![None; draws],
+            frame_meshes: None,
+            frame_vertices: Vec::new(),
+            rebuilt: VecDeque::new(),
+        }
+    }
+
+    #[test]
+    fn a_frame_rebuilds_what_moved_or_deforms() {
+        let mut s = state(3);
+        assert!(
+            s.stale(0) && (0..3).all(|d| s.rebuilds(d, false)),
+            "never built"
+        );
+        s.built_with = s.models.iter().copied().map(Some).collect();
+        assert!(s.current() && !s.stale(1));
+        s.models[1] = Mat4::from_translation(Vec3::X);
+        assert!(s.stale(2));
+        assert_eq!(
+            (0..3).map(|d| s.rebuilds(d, false)).collect::<Vec<_>>(),
+            [false, true, false],
+            "only the moved draw"
+        );
+        s.built_with[1] = Some(s.models[1]);
+        assert!(!s.stale(3));
+        let vertex = VertexLayout {
+            offset: 0,
+            stride: 12,
+            count: 3,
+            format: VertexFormat::Float3,
+        };
+        s.frame_meshes = Some((
+            4,
+            vec![FrameMesh {
+                mesh: 0,
+                vertex,
+                entry: 0,
+            }],
+        ));
+        assert!(
+            s.stale(4) && s.deformed_in(4).len() == 1,
+            "deformed in frame 4"
+        );
+        assert!(!s.stale(5) && s.deformed_in(5).is_empty(), "not in frame 5");
+        assert!(s.rebuilds(0, true) && !s.rebuilds(0, false));
+        s.dynamic = true;
+        assert!(s.stale(5) && s.rebuilds(2, false), "dynamic: everything");
     }
 }
