@@ -2,7 +2,7 @@
 //! device, the scene's vertex and index buffers, a G-buffer and the visibility image (a layer per
 //! light: the plugin shades any number of lights, each with its own configuration); the plugin adopts
 //! the device (`hrts_context_create`), reads the scene from the demo's buffers
-//! (`hrts_set_geometry_vulkan`) and records into the demo's command buffer (`hrts_record_passes`): the
+//! (`hrts_set_geometry_vulkan_meshes`) and records into the demo's command buffer (`hrts_record_passes`): the
 //! light-space passes before the G-buffer, the screen-space passes and the output copy after it. Debug
 //! images come back through `hrts_record_resource_readback`, the report through `hrts_get_frame_report`.
 //! So what the demo shows is what an integrator gets.
@@ -482,6 +482,7 @@ impl PluginRenderer {
             resources,
             output,
             map_scratch_bytes: r.map_scratch_bytes,
+            prim_triangles_rebuilt: r.prim_triangles_rebuilt,
         };
         Ok(LightFrameReport {
             report,
@@ -675,49 +676,62 @@ fn create_context(device: &Device) -> Result<Context> {
     Ok(Context(context))
 }
 
-/// Hands the demo's vertex and index buffers to the plugin, with the scene's `bounds` (the plugin's frame
-/// origin is their centre, as the demo's).
+/// Hands the demo's meshes (their vertex and index buffers) to the plugin, each with the scene's
+/// `bounds`, which enclose it (the plugin's frame origin is the centre of their union, as the demo's).
 fn set_geometry(context: &Context, geometry: &Geometry, bounds: &Aabb) -> Result<()> {
-    let (vertices, vertex) = geometry.vertices();
-    let (indices, index) = geometry.indices();
-    let draws: Vec<HrtsDraw> = geometry
-        .draws()
-        .iter()
-        .map(|d| HrtsDraw {
-            first_index: d.first_index,
-            index_count: d.index_count,
-            transform: d.model.to_cols_array(),
-            base_vertex: d.base_vertex,
-        })
-        .collect();
     let mut b = [0.0f32; 6];
     b[..3].copy_from_slice(&bounds.min.to_array());
     b[3..].copy_from_slice(&bounds.max.to_array());
-    let g = HrtsVulkanGeometry {
-        struct_size: size_of::<HrtsVulkanGeometry>() as u32,
-        vertex_buffer: vertices.raw_handle(),
-        vertex_buffer_size: vertices.size(),
-        vertex_offset: vertex.offset,
-        vertex_stride: vertex.stride,
-        vertex_count: vertex.count,
-        index_buffer: indices.raw_handle(),
-        index_buffer_size: indices.size(),
-        index_offset: index.offset,
-        index_type: match index.format {
-            passes::IndexFormat::U16 => HrtsIndexType::Uint16,
-            passes::IndexFormat::U32 => HrtsIndexType::Uint32,
-        } as u32,
-        index_count: index.count,
-        draws: draws.as_ptr(),
-        draw_count: draws.len() as u32,
-        bounds: b,
-        vertex_format: 0,
-        position_scale: [0.0; 3],
-        position_offset: [0.0; 3],
-    };
-    // SAFETY: live context; the buffers live as long as the renderer, which destroys the context first.
-    context.check("hrts_set_geometry_vulkan", unsafe {
-        hrts_set_geometry_vulkan(context.0, &g)
+    let draws: Vec<Vec<HrtsDraw>> = geometry
+        .meshes()
+        .iter()
+        .map(|m| {
+            m.draws()
+                .iter()
+                .map(|d| HrtsDraw {
+                    first_index: d.first_index,
+                    index_count: d.index_count,
+                    transform: d.model.to_cols_array(),
+                    base_vertex: d.base_vertex,
+                })
+                .collect()
+        })
+        .collect();
+    let meshes: Vec<HrtsVulkanGeometry> = geometry
+        .meshes()
+        .iter()
+        .zip(&draws)
+        .map(|(m, draws)| {
+            let (vertices, vertex) = m.vertices();
+            let (indices, index) = m.indices();
+            HrtsVulkanGeometry {
+                struct_size: size_of::<HrtsVulkanGeometry>() as u32,
+                vertex_buffer: vertices.raw_handle(),
+                vertex_buffer_size: vertices.size(),
+                vertex_offset: vertex.offset,
+                vertex_stride: vertex.stride,
+                vertex_count: vertex.count,
+                index_buffer: indices.raw_handle(),
+                index_buffer_size: indices.size(),
+                index_offset: index.offset,
+                index_type: match index.format {
+                    passes::IndexFormat::U16 => HrtsIndexType::Uint16,
+                    passes::IndexFormat::U32 => HrtsIndexType::Uint32,
+                } as u32,
+                index_count: index.count,
+                draws: draws.as_ptr(),
+                draw_count: draws.len() as u32,
+                bounds: b,
+                vertex_format: 0,
+                position_scale: [0.0; 3],
+                position_offset: [0.0; 3],
+            }
+        })
+        .collect();
+    // SAFETY: live context; `meshes` holds `meshes.len()` meshes whose draws outlive the call; the buffers
+    // live as long as the renderer, which destroys the context first.
+    context.check("hrts_set_geometry_vulkan_meshes", unsafe {
+        hrts_set_geometry_vulkan_meshes(context.0, meshes.as_ptr(), meshes.len() as u32)
     })
 }
 
@@ -815,5 +829,7 @@ fn c_frame(
             bounds.max.z,
         ],
         has_bounds: 1,
+        deformed: std::ptr::null(),
+        deformed_count: 0,
     }
 }

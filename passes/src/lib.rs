@@ -35,7 +35,8 @@ pub use light::{frustum_names, point_light_faces, spot_light_frusta, Light};
 pub use min_combine::MinCombine;
 pub use pcss::PcssConfig;
 pub use prim_buffer::{
-    Draw, Geometry, IndexFormat, IndexLayout, SharedGeometry, VertexFormat, VertexLayout,
+    Draw, Geometry, IndexFormat, IndexLayout, Mesh, MeshVertices, SharedGeometry, VertexFormat,
+    VertexLayout,
 };
 pub use primitive_map::{
     choose_binning_path, BinningPath, BinningRequest, FaceMode, PrimitiveMapConfig,

@@ -9,7 +9,7 @@
 
 // Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 // version differs.
-#define HRTS_API_VERSION (5 << 22)
+#define HRTS_API_VERSION ((5 << 22) | (1 << 12))
 
 // The most lights one context shades (`hrts_configure_lights`); a point light counts once.
 #define HRTS_MAX_LIGHTS 64
@@ -589,7 +589,10 @@ typedef struct HrtsCpuGeometry {
   uint32_t draw_count;
 } HrtsCpuGeometry;
 
-// Geometry in the engine's Vulkan buffers (need `VK_BUFFER_USAGE_STORAGE_BUFFER_BIT`); read, never written.
+// One mesh in the engine's Vulkan buffers (need `VK_BUFFER_USAGE_STORAGE_BUFFER_BIT`); read, never
+// written. `hrts_set_geometry_vulkan` takes the whole geometry as one mesh,
+// `hrts_set_geometry_vulkan_meshes` a list of meshes, each with buffers, layouts, formats and draws of
+// its own.
 typedef struct HrtsVulkanGeometry {
   // `sizeof(HrtsVulkanGeometry)`.
   uint32_t struct_size;
@@ -617,8 +620,9 @@ typedef struct HrtsVulkanGeometry {
   const struct HrtsDraw *draws;
   // Number of draws.
   uint32_t draw_count;
-  // World-space bounds of all draws (min xyz, max xyz): the frame origin is their centre (rounded to
-  // f32, so that vertex minus origin is exact for f32 vertices).
+  // World-space bounds of all the mesh's draws (min xyz, max xyz). The frame origin is the centre of
+  // the union of every mesh's bounds (rounded to f32, so that vertex minus origin is exact for f32
+  // vertices).
   float bounds[6];
   // `VkFormat` of a position: `VK_FORMAT_R32G32B32_SFLOAT` (or 0), or 16-bit
   // `VK_FORMAT_R16G16B16A16_SFLOAT`, `_SNORM` or `_UNORM` (w ignored).
@@ -707,6 +711,24 @@ typedef struct HrtsLight {
   float outer_cone;
 } HrtsLight;
 
+// Where one mesh's positions are in one frame (`HrtsFrame::deformed`): a vertex buffer of that frame,
+// such as one of a ring of skinning outputs, one per frame in flight. It holds the mesh's vertex count in
+// the mesh's `vertex_format` and `vertex_stride`, and must stay alive until the frame completed. The
+// plugin keeps a descriptor per buffer for as long as frames in flight may use it (`frames_in_flight`
+// frames after the last that gave it): a buffer destroyed sooner must not be replaced by one that may
+// get the same handle within those frames.
+typedef struct HrtsMeshVertices {
+  // Index of the mesh in the last geometry call (0 for `hrts_set_geometry_vulkan` and
+  // `hrts_set_geometry_cpu`).
+  uint32_t mesh;
+  // `VkBuffer` holding the positions (`VK_BUFFER_USAGE_STORAGE_BUFFER_BIT`).
+  uint64_t vertex_buffer;
+  // Size of the vertex buffer in bytes.
+  uint64_t vertex_buffer_size;
+  // Byte offset of vertex 0 (multiple of 4).
+  uint64_t vertex_offset;
+} HrtsMeshVertices;
+
 // One frame to record into the engine's command buffer.
 typedef struct HrtsFrame {
   // `sizeof(HrtsFrame)`.
@@ -743,6 +765,14 @@ typedef struct HrtsFrame {
   float bounds[6];
   // Whether `bounds` holds this frame's bounds.
   HrtsBool has_bounds;
+  // The meshes deformed this frame (`deformed_count` entries; may be NULL if the count is 0): each
+  // reads its positions from a vertex buffer of this frame instead of its own, and its triangles are
+  // rebuilt this frame (from its own vertex buffer again in the next frame that does not deform it).
+  // Read by the call that begins the frame. A deformed mesh's bounds do not hold: give the frame's in
+  // `bounds`, or the plugin culls by the view and the lights' ranges alone.
+  const struct HrtsMeshVertices *deformed;
+  // Number of entries in `deformed`.
+  uint32_t deformed_count;
 } HrtsFrame;
 
 // Shape of a plugin resource, for reading it back.
@@ -849,6 +879,11 @@ typedef struct HrtsFrameReport {
   // GPU milliseconds of all of this light's passes in the frame (every frustum, the minimum over
   // them, and the light's share of nothing else).
   double gpu_milliseconds;
+  // Triangles whose prim-buffer slots the frame rewrote (shared by the context's lights, whichever
+  // recorded the build): every triangle on the first frame, those of the draws moved by
+  // `hrts_set_draw_transforms` and of the meshes deformed (`HrtsFrame::deformed`), every triangle each
+  // frame with `dynamic_geometry`; 0 when the prim buffer was up to date.
+  uint32_t prim_triangles_rebuilt;
 } HrtsFrameReport;
 
 // Every result, in value order.
@@ -941,22 +976,38 @@ enum HrtsResult hrts_configure_lights(struct HrtsContext *context,
 enum HrtsResult hrts_set_geometry_cpu(struct HrtsContext *context,
                                       const struct HrtsCpuGeometry *geometry);
 
-// Sets the shadow-casting geometry from the engine's Vulkan buffers (read by the GPU every time the prim
-// buffer is rebuilt). They must stay alive until the context is destroyed or, after the
-// next geometry call, until every frame recorded before that call has completed (`frames_in_flight`
-// frames later): frames still in flight read them.
+// Sets the shadow-casting geometry from the engine's Vulkan buffers as one mesh:
+// `hrts_set_geometry_vulkan_meshes` with one mesh.
 //
 // # Safety
-// As for `hrts_get_capabilities`; the buffers are live `VkBuffer`s of the adopted device.
+// As for `hrts_set_geometry_vulkan_meshes`.
 enum HrtsResult hrts_set_geometry_vulkan(struct HrtsContext *context,
                                          const struct HrtsVulkanGeometry *geometry);
 
+// Sets the shadow-casting geometry from the engine's meshes as they are: `mesh_count` meshes, each with
+// its own vertex and index buffers, layouts, index type, vertex format and dequantization, draws and
+// bounds (the scene's bounds are their union; the frame origin is its centre). The prim buffer holds
+// the triangles mesh after mesh, draw after draw; `hrts_set_draw_transforms` takes the draws in that
+// order and `HrtsFrame::deformed` names meshes by their index here. A message about one mesh names it
+// (`meshes[i]`). The buffers are read by the GPU every time the prim buffer is rebuilt: they must stay
+// alive until the context is destroyed or, after the next geometry call, until every frame recorded
+// before that call has completed (`frames_in_flight` frames later): frames still in flight read them.
+//
+// # Safety
+// As for `hrts_get_capabilities`; `meshes` points at `mesh_count` meshes; the buffers are live
+// `VkBuffer`s of the adopted device.
+enum HrtsResult hrts_set_geometry_vulkan_meshes(struct HrtsContext *context,
+                                                const struct HrtsVulkanGeometry *meshes,
+                                                uint32_t mesh_count);
+
 // Moves the geometry's draws, as an engine moves its instances every frame: `transforms` holds
 // `draw_count` object-to-world matrices (16 floats each, column-major), one per draw of the last geometry
-// call, in its order. The next frame recorded rebuilds the prim buffer once for every light (and what
-// depends on it); frames already recorded keep their transforms. No pass is rebuilt and nothing is
-// recorded. With Vulkan geometry the bounds of the geometry call no longer hold: give each frame's in
-// `HrtsFrame::bounds` for the plugin to cull by them.
+// call over all its meshes, in mesh order (mesh 0's draws in their order, then mesh 1's, ...). The next
+// frame recorded rebuilds, once for every light, the prim-buffer slots of the draws whose transform
+// changed since the prim buffer was last built (and what depends on the prim buffer); frames already
+// recorded keep their transforms. No pass is rebuilt and nothing is recorded. With Vulkan geometry the
+// bounds of the geometry call no longer hold: give each frame's in `HrtsFrame::bounds` for the plugin to
+// cull by them.
 //
 // # Safety
 // As for `hrts_get_capabilities`; `transforms` points at `16 * draw_count` floats.

@@ -352,18 +352,22 @@ impl Context {
         Ok(())
     }
 
-    /// Takes each light's number of frusta this frame: a light whose number changed (a spot light turned
-    /// point light, say) has its passes rebuilt.
     /// Which frusta of each light may hold a receiver in view within the light's range this frame, within
-    /// `frame_bounds` when the engine gave them, else the geometry's own bounds when they hold.
+    /// `frame_bounds` when the engine gave them, else the geometry's own bounds when they hold (not when
+    /// the frame `deforms` a mesh).
     pub(crate) fn schedule(
         &self,
         lights: &[FrameLight],
         frame_bounds: Option<[glam::DVec3; 2]>,
+        deforms: bool,
     ) -> Vec<LightSchedule> {
         let dynamic = self.lights.iter().any(|c| !c.static_geometry);
-        let bounds =
-            frame_bounds.or_else(|| self.geometry.as_ref().and_then(|g| g.cull_bounds(dynamic)));
+        let bounds = frame_bounds.or_else(|| {
+            self.geometry
+                .as_ref()
+                .filter(|_| !deforms)
+                .and_then(|g| g.cull_bounds(dynamic))
+        });
         let camera = lights
             .first()
             .and_then(|l| l.frusta.first())
@@ -396,6 +400,8 @@ impl Context {
         self.schedules.push_back(FrameSchedule { index, lights });
     }
 
+    /// Takes each light's number of frusta this frame: a light whose number changed (a spot light turned
+    /// point light, say) has its passes rebuilt.
     pub(crate) fn set_frusta(&mut self, frusta: &[usize]) {
         let mut replaced = Vec::new();
         for (i, (&new, old)) in frusta.iter().zip(&mut self.frusta).enumerate() {
@@ -439,13 +445,20 @@ impl Context {
         Ok(())
     }
 
-    pub(crate) fn set_geometry_vulkan(&mut self, g: &HrtsVulkanGeometry) -> ApiResult<()> {
-        self.geometry = Some(vulkan_geometry(&self.device, g)?);
+    /// Sets the engine's meshes: one (`listed` false: `hrts_set_geometry_vulkan`) or a list whose
+    /// messages name the mesh.
+    pub(crate) fn set_geometry_vulkan(
+        &mut self,
+        meshes: &[HrtsVulkanGeometry],
+        listed: bool,
+    ) -> ApiResult<()> {
+        self.geometry = Some(vulkan_geometry(&self.device, meshes, listed)?);
         self.retire_built();
         Ok(())
     }
 
-    /// Moves the geometry's draws: `transforms` holds 16 floats (column-major) per draw.
+    /// Moves the geometry's draws: `transforms` holds 16 floats (column-major) per draw, over all meshes in
+    /// order.
     pub(crate) fn set_draw_transforms(&mut self, transforms: &[f32]) -> ApiResult<()> {
         finite(transforms, "transforms")?;
         let models: Vec<glam::Mat4> = transforms
@@ -906,6 +919,7 @@ impl Context {
         out.frusta_culled = (schedule.recorded.len() - reports.len()) as u32;
         let (decision, reason) = schedule.decision();
         out.decision = decision as u32;
+        out.prim_triangles_rebuilt = built.shared.triangles_rebuilt(frame_index);
         out.decision_reason = [0; 128];
         for (dst, src) in out.decision_reason.iter_mut().zip(reason.bytes().take(127)) {
             *dst = src as std::ffi::c_char;

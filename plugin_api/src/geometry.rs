@@ -4,7 +4,7 @@ use crate::convert::{bounds, enum_value, finite, mat4};
 use crate::error::{check_size, invalid, ApiError, ApiResult};
 use crate::types::*;
 use glam::{DVec3, Vec3};
-use passes::{Draw, Geometry, IndexFormat, IndexLayout, VertexFormat, VertexLayout};
+use passes::{Draw, Geometry, IndexFormat, IndexLayout, Mesh, VertexFormat, VertexLayout};
 use rhi::{BufferUsage, Device, Format};
 
 /// The frame origin of geometry within `lo..hi`: the centre, rounded to f32. Then the frame coordinates
@@ -24,47 +24,55 @@ pub(crate) enum GeometrySource {
         bounds: [DVec3; 2],
     },
     Vulkan {
-        vertices: (u64, u64),
-        vertex: VertexLayout,
-        indices: (u64, u64),
-        index: IndexLayout,
-        draws: Vec<Draw>,
+        meshes: Vec<VulkanMesh>,
         origin: DVec3,
+        /// The union of the meshes' bounds.
         bounds: [DVec3; 2],
         /// Whether `bounds` still hold (not after the draws were moved).
         bounds_hold: bool,
-        /// Stored position to object space (`position_scale`, `position_offset`), applied before each
-        /// draw's transform.
-        dequantize: glam::Mat4,
     },
 }
 
+/// One mesh in the engine's buffers.
+pub(crate) struct VulkanMesh {
+    vertices: (u64, u64),
+    vertex: VertexLayout,
+    indices: (u64, u64),
+    index: IndexLayout,
+    draws: Vec<Draw>,
+    /// Stored position to object space (`position_scale`, `position_offset`), applied before each
+    /// draw's transform.
+    dequantize: glam::Mat4,
+}
+
 impl GeometrySource {
-    /// Each draw's transform from stored positions to world space: its own, after the dequantization of
-    /// Vulkan geometry.
+    /// Each draw's transform from stored positions to world, over all meshes in order: its own, after the
+    /// dequantization of its Vulkan mesh.
     pub(crate) fn stored_to_world(&self) -> Vec<glam::Mat4> {
         match self {
             Self::Cpu { draws, .. } => draws.iter().map(|d| d.model).collect(),
-            Self::Vulkan {
-                draws, dequantize, ..
-            } => draws.iter().map(|d| d.model * *dequantize).collect(),
+            Self::Vulkan { meshes, .. } => meshes
+                .iter()
+                .flat_map(|m| m.draws.iter().map(|d| d.model * m.dequantize))
+                .collect(),
         }
     }
 
-    /// Moves the draws (one object-to-world transform each): CPU geometry recomputes its bounds; the
-    /// bounds given with Vulkan geometry no longer hold (frames may give theirs).
+    /// Moves the draws (one object-to-world transform each, over all meshes in order): CPU geometry
+    /// recomputes its bounds; the bounds given with Vulkan geometry no longer hold (frames may give theirs).
     pub(crate) fn set_transforms(&mut self, models: &[glam::Mat4]) -> ApiResult<()> {
-        let draws = match self {
-            Self::Cpu { draws, .. } | Self::Vulkan { draws, .. } => draws,
+        let draws: Vec<&mut Draw> = match self {
+            Self::Cpu { draws, .. } => draws.iter_mut().collect(),
+            Self::Vulkan { meshes, .. } => meshes.iter_mut().flat_map(|m| &mut m.draws).collect(),
         };
         if models.len() != draws.len() {
             return Err(invalid(format!(
-                "draw_count {} differs from the {} draws of the geometry",
+                "draw_count {} differs from the {} draws of the geometry (over all its meshes)",
                 models.len(),
                 draws.len()
             )));
         }
-        for (d, m) in draws.iter_mut().zip(models) {
+        for (d, m) in draws.into_iter().zip(models) {
             d.model = *m;
         }
         match self {
@@ -91,6 +99,27 @@ impl GeometrySource {
                 bounds_hold,
                 ..
             } => (!dynamic && *bounds_hold).then_some(*bounds),
+        }
+    }
+
+    /// The number of meshes.
+    pub(crate) fn mesh_count(&self) -> usize {
+        match self {
+            Self::Cpu { .. } => 1,
+            Self::Vulkan { meshes, .. } => meshes.len(),
+        }
+    }
+
+    /// Where mesh `mesh`'s positions are in its vertex buffer (a CPU mesh's: packed xyz from 0).
+    pub(crate) fn vertex_layout(&self, mesh: usize) -> Option<VertexLayout> {
+        match self {
+            Self::Cpu { positions, .. } => (mesh == 0).then_some(VertexLayout {
+                offset: 0,
+                stride: 12,
+                count: (positions.len() / 3) as u32,
+                format: VertexFormat::Float3,
+            }),
+            Self::Vulkan { meshes, .. } => meshes.get(mesh).map(|m| m.vertex),
         }
     }
 }
@@ -198,11 +227,47 @@ pub(crate) fn cpu_geometry(g: &HrtsCpuGeometry) -> ApiResult<GeometrySource> {
     })
 }
 
-/// The geometry of `hrts_set_geometry_vulkan`, checked (its buffers are wrapped once to check them).
+/// The geometry of `hrts_set_geometry_vulkan` (one mesh, `listed` false) or
+/// `hrts_set_geometry_vulkan_meshes` (`listed`: messages name the mesh), checked (its buffers are wrapped
+/// once to check them).
 pub(crate) fn vulkan_geometry(
     device: &Device,
-    g: &HrtsVulkanGeometry,
+    meshes: &[HrtsVulkanGeometry],
+    listed: bool,
 ) -> ApiResult<GeometrySource> {
+    if meshes.is_empty() {
+        return Err(invalid("mesh_count is 0"));
+    }
+    let named = |i: usize, e: ApiError| match listed {
+        true => ApiError {
+            message: format!("meshes[{i}]: {}", e.message),
+            ..e
+        },
+        false => e,
+    };
+    let mut checked = Vec::with_capacity(meshes.len());
+    let mut wrapped = Vec::with_capacity(meshes.len());
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for (i, g) in meshes.iter().enumerate() {
+        let (mesh, [mesh_lo, mesh_hi]) = vulkan_mesh(g).map_err(|e| named(i, e))?;
+        wrapped.push(mesh_from(device, &mesh).map_err(|e| named(i, e))?);
+        checked.push(mesh);
+        lo = lo.min(mesh_lo);
+        hi = hi.max(mesh_hi);
+    }
+    let origin = frame_origin(lo, hi);
+    Geometry::new(wrapped, origin)?;
+    Ok(GeometrySource::Vulkan {
+        meshes: checked,
+        origin,
+        bounds: [lo, hi],
+        bounds_hold: true,
+    })
+}
+
+/// One mesh of the engine, checked but for its buffers' sizes, and its bounds.
+fn vulkan_mesh(g: &HrtsVulkanGeometry) -> ApiResult<(VulkanMesh, [DVec3; 2])> {
     check_size::<HrtsVulkanGeometry>(g.struct_size, "HrtsVulkanGeometry")?;
     if g.vertex_buffer == 0 || g.index_buffer == 0 {
         return Err(ApiError::new(
@@ -219,7 +284,7 @@ pub(crate) fn vulkan_geometry(
         "index_type",
         "HrtsIndexType",
     )?;
-    let [lo, hi] = bounds(&g.bounds)?;
+    let bounds = bounds(&g.bounds)?;
     let draws = draws_from(g.draws, g.draw_count)?;
     let stored = match g.vertex_format {
         0 => Some(Format::Rgb32Float),
@@ -262,30 +327,44 @@ pub(crate) fn vulkan_geometry(
         glam::Quat::IDENTITY,
         Vec3::from_array(g.position_offset),
     );
-    let vertex = VertexLayout {
-        offset: g.vertex_offset,
-        stride: g.vertex_stride,
-        count: g.vertex_count,
-        format: vertex_format,
-    };
-    let index = IndexLayout {
-        offset: g.index_offset,
-        format,
-        count: g.index_count,
-    };
-    let source = GeometrySource::Vulkan {
+    let mesh = VulkanMesh {
         vertices: (g.vertex_buffer, g.vertex_buffer_size),
-        vertex,
+        vertex: VertexLayout {
+            offset: g.vertex_offset,
+            stride: g.vertex_stride,
+            count: g.vertex_count,
+            format: vertex_format,
+        },
         indices: (g.index_buffer, g.index_buffer_size),
-        index,
+        index: IndexLayout {
+            offset: g.index_offset,
+            format,
+            count: g.index_count,
+        },
         draws,
-        origin: frame_origin(lo, hi),
-        bounds: [lo, hi],
-        bounds_hold: true,
         dequantize,
     };
-    geometry_from(device, &source)?;
-    Ok(source)
+    Ok((mesh, bounds))
+}
+
+/// A Vulkan mesh over the engine's buffers, its dequantization folded into its draws' transforms.
+fn mesh_from(device: &Device, m: &VulkanMesh) -> ApiResult<Mesh> {
+    let draws: Vec<Draw> = m
+        .draws
+        .iter()
+        .map(|d| Draw {
+            model: d.model * m.dequantize,
+            ..*d
+        })
+        .collect();
+    // SAFETY: the engine guarantees its buffers are live and of the stated sizes (contract).
+    let (vb, ib) = unsafe {
+        (
+            device.external_buffer(m.vertices.0, m.vertices.1, BufferUsage::STORAGE)?,
+            device.external_buffer(m.indices.0, m.indices.1, BufferUsage::STORAGE)?,
+        )
+    };
+    Ok(Mesh::from_buffers(vb, m.vertex, ib, m.index, &draws)?)
 }
 
 pub(crate) fn geometry_from(device: &Device, source: &GeometrySource) -> ApiResult<Geometry> {
@@ -297,32 +376,157 @@ pub(crate) fn geometry_from(device: &Device, source: &GeometrySource) -> ApiResu
             origin,
             ..
         } => Geometry::upload(device, positions, indices, draws, *origin)?,
-        GeometrySource::Vulkan {
-            vertices,
-            vertex,
-            indices,
-            index,
-            draws,
-            origin,
-            dequantize,
-            ..
-        } => {
-            let draws: Vec<Draw> = draws
+        GeometrySource::Vulkan { meshes, origin, .. } => Geometry::new(
+            meshes
                 .iter()
-                .map(|d| Draw {
-                    model: d.model * *dequantize,
-                    ..*d
-                })
-                .collect();
-            let draws = &draws;
-            // SAFETY: the engine guarantees its buffers are live and of the stated sizes (contract).
-            let (vb, ib) = unsafe {
-                (
-                    device.external_buffer(vertices.0, vertices.1, BufferUsage::STORAGE)?,
-                    device.external_buffer(indices.0, indices.1, BufferUsage::STORAGE)?,
-                )
-            };
-            Geometry::from_buffers(vb, *vertex, ib, *index, draws, *origin)?
-        }
+                .map(|m| mesh_from(device, m))
+                .collect::<ApiResult<Vec<Mesh>>>()?,
+            *origin,
+        )?,
     })
+}
+
+/// The meshes frame `f` deforms (`HrtsFrame::deformed`), each checked against `geometry`'s meshes: in
+/// range, given once, its buffer non-NULL and holding the mesh's vertices at its offset.
+pub(crate) fn deformed_meshes(
+    f: &HrtsFrame,
+    geometry: Option<&GeometrySource>,
+) -> ApiResult<Vec<HrtsMeshVertices>> {
+    let count = f.deformed_count as usize;
+    if count == 0 {
+        return Ok(Vec::new());
+    }
+    if f.deformed.is_null() {
+        return Err(ApiError::new(
+            HrtsResult::ErrorNullPointer,
+            format!("deformed is NULL with deformed_count {count}"),
+        ));
+    }
+    if !f.deformed.is_aligned() {
+        return Err(invalid(format!(
+            "deformed is not aligned to {} bytes",
+            std::mem::align_of::<HrtsMeshVertices>()
+        )));
+    }
+    let geometry = geometry.ok_or_else(|| {
+        ApiError::new(
+            HrtsResult::ErrorInvalidState,
+            "set the geometry before deforming its meshes",
+        )
+    })?;
+    let meshes = geometry.mesh_count();
+    if count > meshes {
+        return Err(invalid(format!(
+            "deformed_count {count} exceeds the {meshes} meshes of the geometry"
+        )));
+    }
+    // SAFETY: non-NULL and aligned; the caller guarantees `deformed_count` entries (documented contract).
+    let deformed = unsafe { std::slice::from_raw_parts(f.deformed, count) };
+    for (i, v) in deformed.iter().enumerate() {
+        let mesh = v.mesh as usize;
+        let layout = geometry.vertex_layout(mesh).ok_or_else(|| {
+            invalid(format!(
+                "deformed[{i}].mesh {mesh} is out of range: the geometry has {meshes} meshes"
+            ))
+        })?;
+        if let Some(j) = deformed[..i].iter().position(|o| o.mesh == v.mesh) {
+            return Err(invalid(format!(
+                "deformed[{i}].mesh {mesh} is deformed twice (deformed[{j}] names it too)"
+            )));
+        }
+        if v.vertex_buffer == 0 {
+            return Err(ApiError::new(
+                HrtsResult::ErrorNullPointer,
+                format!("deformed[{i}].vertex_buffer is NULL"),
+            ));
+        }
+        let at = VertexLayout {
+            offset: v.vertex_offset,
+            ..layout
+        };
+        at.check(v.vertex_buffer_size).map_err(|e| {
+            let e = ApiError::from(e);
+            ApiError {
+                message: format!("deformed[{i}] (mesh {mesh}): {}", e.message),
+                ..e
+            }
+        })?;
+    }
+    Ok(deformed.to_vec())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One CPU mesh of 4 vertices.
+    fn quad() -> GeometrySource {
+        GeometrySource::Cpu {
+            positions: vec![0.0; 12],
+            indices: vec![0, 1, 2, 0, 2, 3],
+            draws: Vec::new(),
+            origin: DVec3::ZERO,
+            bounds: [DVec3::ZERO; 2],
+        }
+    }
+
+    fn frame(deformed: &[HrtsMeshVertices]) -> HrtsFrame {
+        // SAFETY: every field of `HrtsFrame` is an integer, a float or a raw pointer: all zeros is valid.
+        let mut f: HrtsFrame = unsafe { std::mem::zeroed() };
+        f.deformed = deformed.as_ptr();
+        f.deformed_count = deformed.len() as u32;
+        f
+    }
+
+    fn vertices(mesh: u32, size: u64, offset: u64) -> HrtsMeshVertices {
+        HrtsMeshVertices {
+            mesh,
+            vertex_buffer: 1,
+            vertex_buffer_size: size,
+            vertex_offset: offset,
+        }
+    }
+
+    #[test]
+    fn deformed_meshes_are_checked_against_the_geometry() {
+        let g = quad();
+        let ok = [vertices(0, 64, 16)];
+        assert_eq!(deformed_meshes(&frame(&ok), Some(&g)).unwrap(), ok);
+        assert!(deformed_meshes(&frame(&[]), None).unwrap().is_empty());
+        let code = |v: &[HrtsMeshVertices], g: Option<&GeometrySource>| {
+            deformed_meshes(&frame(v), g).map_err(|e| (e.code, e.message))
+        };
+        let mut null = frame(&ok);
+        null.deformed = std::ptr::null();
+        assert_eq!(
+            deformed_meshes(&null, Some(&g)).unwrap_err().code,
+            HrtsResult::ErrorNullPointer
+        );
+        assert_eq!(
+            code(&ok, None).unwrap_err().0,
+            HrtsResult::ErrorInvalidState
+        );
+        let (c, m) = code(&[vertices(1, 64, 0)], Some(&g)).unwrap_err();
+        assert!(
+            c == HrtsResult::ErrorInvalidArgument && m.contains("deformed[0].mesh 1"),
+            "{m}"
+        );
+        // 4 float3 vertices at offset 16 end at 64 bytes.
+        let (c, m) = code(&[vertices(0, 63, 16)], Some(&g)).unwrap_err();
+        assert!(
+            c == HrtsResult::ErrorInvalidArgument && m.contains("deformed[0] (mesh 0)"),
+            "{m}"
+        );
+        let (c, m) = code(&[vertices(0, 64, 0), vertices(0, 64, 0)], Some(&g)).unwrap_err();
+        assert!(
+            c == HrtsResult::ErrorInvalidArgument && m.contains("deformed_count 2"),
+            "{m}"
+        );
+        let mut unbound = vertices(0, 64, 0);
+        unbound.vertex_buffer = 0;
+        assert_eq!(
+            code(&[unbound], Some(&g)).unwrap_err().0,
+            HrtsResult::ErrorNullPointer
+        );
+    }
 }

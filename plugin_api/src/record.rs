@@ -4,8 +4,10 @@
 use crate::context::{Built, Context, FrameProgress, OpenFrame};
 use crate::convert::{frame_bounds, frame_inputs, pass_from_index, resource_id};
 use crate::error::{check_size, invalid, ApiError, ApiResult};
+use crate::geometry::deformed_meshes;
 use crate::types::*;
-use passes::{PassError, PassId, ResourceId};
+use passes::retire::completed_before;
+use passes::{MeshVertices, PassError, PassId, ResourceId};
 use rhi::{Barrier, BufferUsage, Encoder, Format, Image, ResourceState as S};
 
 /// Pass-mask bits of the passes that read the engine's depth and normal images (the primitive map fits
@@ -34,6 +36,7 @@ impl Context {
         }
         let inputs = frame_inputs(f)?;
         let bounds = frame_bounds(f)?;
+        let deformed = deformed_meshes(f, self.geometry.as_ref())?;
         if inputs.len() != self.lights.len() {
             return Err(invalid(format!(
                 "light_count {} differs from the {} lights configured",
@@ -99,7 +102,7 @@ impl Context {
             .filter(|s| continues && s.index == f.frame_index);
         let schedule = match kept {
             Some(_) => None,
-            None => Some(self.schedule(&inputs, bounds)),
+            None => Some(self.schedule(&inputs, bounds, !deformed.is_empty())),
         };
         let recorded: Vec<Vec<bool>> = schedule
             .as_deref()
@@ -113,6 +116,31 @@ impl Context {
             None => return Err(ApiError::new(HrtsResult::ErrorInternal, "passes not built")),
         };
         if !continues {
+            // The frame's vertex buffers are bound before any light claims the prim buffer's build (the
+            // meshes they deform are rebuilt), and before anything is recorded.
+            let vertices = deformed
+                .iter()
+                .map(|v| {
+                    // SAFETY: the engine guarantees a live buffer of the stated size with storage usage,
+                    // alive until the frame completed (documented contract).
+                    let buffer = unsafe {
+                        device.external_buffer(
+                            v.vertex_buffer,
+                            v.vertex_buffer_size,
+                            BufferUsage::STORAGE,
+                        )?
+                    };
+                    Ok(MeshVertices {
+                        mesh: v.mesh as usize,
+                        buffer,
+                        offset: v.vertex_offset,
+                    })
+                })
+                .collect::<ApiResult<Vec<_>>>()?;
+            let completed = completed_before(frame_index, self.frames_in_flight);
+            built
+                .shared
+                .set_frame_vertices(device, frame_index, completed, vertices)?;
             self.progress.open = None;
             self.last_frame = Some(frame_index);
             for ((passes, light), recorded) in built

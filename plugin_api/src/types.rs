@@ -6,7 +6,7 @@ use std::ffi::c_char;
 
 /// Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 /// version differs.
-pub const HRTS_API_VERSION: u32 = 5 << 22;
+pub const HRTS_API_VERSION: u32 = 5 << 22 | 1 << 12;
 
 /// A flag in the C structs: 0 is false, any other value true. (A Rust `bool` would make any byte but 0
 /// and 1 undefined behaviour when the engine writes it.)
@@ -500,7 +500,10 @@ pub struct HrtsCpuGeometry {
     pub draw_count: u32,
 }
 
-/// Geometry in the engine's Vulkan buffers (need `VK_BUFFER_USAGE_STORAGE_BUFFER_BIT`); read, never written.
+/// One mesh in the engine's Vulkan buffers (need `VK_BUFFER_USAGE_STORAGE_BUFFER_BIT`); read, never
+/// written. `hrts_set_geometry_vulkan` takes the whole geometry as one mesh,
+/// `hrts_set_geometry_vulkan_meshes` a list of meshes, each with buffers, layouts, formats and draws of
+/// its own.
 #[repr(C)]
 pub struct HrtsVulkanGeometry {
     /// `sizeof(HrtsVulkanGeometry)`.
@@ -529,8 +532,9 @@ pub struct HrtsVulkanGeometry {
     pub draws: *const HrtsDraw,
     /// Number of draws.
     pub draw_count: u32,
-    /// World-space bounds of all draws (min xyz, max xyz): the frame origin is their centre (rounded to
-    /// f32, so that vertex minus origin is exact for f32 vertices).
+    /// World-space bounds of all the mesh's draws (min xyz, max xyz). The frame origin is the centre of
+    /// the union of every mesh's bounds (rounded to f32, so that vertex minus origin is exact for f32
+    /// vertices).
     pub bounds: [f32; 6],
     /// `VkFormat` of a position: `VK_FORMAT_R32G32B32_SFLOAT` (or 0), or 16-bit
     /// `VK_FORMAT_R16G16B16A16_SFLOAT`, `_SNORM` or `_UNORM` (w ignored).
@@ -659,6 +663,34 @@ pub struct HrtsFrame {
     pub bounds: [f32; 6],
     /// Whether `bounds` holds this frame's bounds.
     pub has_bounds: HrtsBool,
+    /// The meshes deformed this frame (`deformed_count` entries; may be NULL if the count is 0): each
+    /// reads its positions from a vertex buffer of this frame instead of its own, and its triangles are
+    /// rebuilt this frame (from its own vertex buffer again in the next frame that does not deform it).
+    /// Read by the call that begins the frame. A deformed mesh's bounds do not hold: give the frame's in
+    /// `bounds`, or the plugin culls by the view and the lights' ranges alone.
+    pub deformed: *const HrtsMeshVertices,
+    /// Number of entries in `deformed`.
+    pub deformed_count: u32,
+}
+
+/// Where one mesh's positions are in one frame (`HrtsFrame::deformed`): a vertex buffer of that frame,
+/// such as one of a ring of skinning outputs, one per frame in flight. It holds the mesh's vertex count in
+/// the mesh's `vertex_format` and `vertex_stride`, and must stay alive until the frame completed. The
+/// plugin keeps a descriptor per buffer for as long as frames in flight may use it (`frames_in_flight`
+/// frames after the last that gave it): a buffer destroyed sooner must not be replaced by one that may
+/// get the same handle within those frames.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HrtsMeshVertices {
+    /// Index of the mesh in the last geometry call (0 for `hrts_set_geometry_vulkan` and
+    /// `hrts_set_geometry_cpu`).
+    pub mesh: u32,
+    /// `VkBuffer` holding the positions (`VK_BUFFER_USAGE_STORAGE_BUFFER_BIT`).
+    pub vertex_buffer: u64,
+    /// Size of the vertex buffer in bytes.
+    pub vertex_buffer_size: u64,
+    /// Byte offset of vertex 0 (multiple of 4).
+    pub vertex_offset: u64,
 }
 
 /// The engine's host allocator. The plugin's host memory (not Vulkan's) goes through it for the whole
@@ -776,6 +808,11 @@ pub struct HrtsFrameReport {
     /// GPU milliseconds of all of this light's passes in the frame (every frustum, the minimum over
     /// them, and the light's share of nothing else).
     pub gpu_milliseconds: f64,
+    /// Triangles whose prim-buffer slots the frame rewrote (shared by the context's lights, whichever
+    /// recorded the build): every triangle on the first frame, those of the draws moved by
+    /// `hrts_set_draw_transforms` and of the meshes deformed (`HrtsFrame::deformed`), every triangle each
+    /// frame with `dynamic_geometry`; 0 when the prim buffer was up to date.
+    pub prim_triangles_rebuilt: u32,
 }
 
 /// A copy of a plugin resource into an engine buffer, recorded after a complete frame.

@@ -3,8 +3,9 @@
  * box floating over a ground plane itself (analytic ray casting on the CPU), records the plugin into its
  * own command buffers, reads back the visibility images and compares them with the exact shadow of every
  * light. It keeps 3 frames in flight over 120 frames while the camera and lights move and the lights are
- * reconfigured midway, checks 8 lights of two types in one context, runs a table of misuse cases and 100
- * create/destroy cycles. Prints "N passed, M failed" and exits non-zero on any failure. */
+ * reconfigured midway, checks 8 lights of two types in one context, the scene given as meshes of their own
+ * buffers and formats, a mesh deformed through per-frame vertex buffers, runs a table of misuse cases and
+ * 100 create/destroy cycles. Prints "N passed, M failed" and exits non-zero on any failure. */
 #define _POSIX_C_SOURCE 200112L
 #include "hrts.h"
 
@@ -1618,6 +1619,429 @@ static void quantized_positions(const HrtsVulkanDevice *vk, const HrtsCpuGeometr
     (void)g;
 }
 
+/* ---------- the engine's meshes as they are ---------- */
+/* The scene as three meshes with buffers of their own: the first ground triangle (float3 positions, 16-bit
+ * indices), the box (16-bit snorm positions with a dequantization, 32-bit indices, base vertex -4) and the
+ * second ground triangle (float4 positions at an offset, 32-bit indices). The box's dequantization (scale
+ * 0.5, offset (0, 1.1, 0)) puts its vertices at q = -1, 0 or 1, which every implementation decodes
+ * exactly, so the meshes give the triangles of the one-mesh scene bit for bit. */
+enum { SPLIT_MESHES = 3, BOX_VERTICES = 8 };
+static const float BOX_SCALE[3] = {0.5f, 0.5f, 0.5f}, BOX_OFFSET[3] = {0.0f, 1.1f, 0.0f};
+
+typedef struct {
+    Buf vb[SPLIT_MESHES], ib[SPLIT_MESHES];
+    HrtsDraw draws[SPLIT_MESHES];
+    HrtsVulkanGeometry meshes[SPLIT_MESHES];
+} SplitScene;
+
+/* The box's vertices as snorm16 (w = 0) at `at`; `half`: the box deformed, its x < 0 half gone. */
+static void box_snorm(uint16_t *at, int half) {
+    for (int k = 0; k < BOX_VERTICES; k++) {
+        for (int a = 0; a < 3; a++) {
+            double p = positions[3 * (4 + k) + a];
+            if (half && a == 0 && p < 0) p = 0.0;
+            double q = (p - BOX_OFFSET[a]) / BOX_SCALE[a];
+            at[4 * k + a] = (uint16_t)(int16_t)lround(fmax(-1.0, fmin(1.0, q)) * 32767.0);
+        }
+        at[4 * k + 3] = 0;
+    }
+}
+
+static HrtsVulkanGeometry vulkan_mesh(Buf vb, VkDeviceSize vb_size, Buf ib, VkDeviceSize ib_size, const HrtsDraw *draw) {
+    HrtsVulkanGeometry m;
+    memset(&m, 0, sizeof m);
+    m.struct_size = sizeof m;
+    m.vertex_buffer = (uint64_t)(uintptr_t)vb.buffer;
+    m.vertex_buffer_size = vb_size;
+    m.index_buffer = (uint64_t)(uintptr_t)ib.buffer;
+    m.index_buffer_size = ib_size;
+    m.draws = draw;
+    m.draw_count = 1;
+    return m;
+}
+
+static void split_scene(SplitScene *s) {
+    static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    memset(s, 0, sizeof *s);
+    for (int i = 0; i < SPLIT_MESHES; i++) memcpy(s->draws[i].transform, identity, sizeof identity);
+    /* mesh 0: ground triangle (0, 2, 1), float3, 16-bit indices at byte offset 4 */
+    s->vb[0] = make_host_buffer(4 * 12, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    memcpy(s->vb[0].map, positions, 4 * 12);
+    s->ib[0] = make_host_buffer(12, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    uint16_t *i16 = (uint16_t *)((char *)s->ib[0].map + 4);
+    for (int k = 0; k < 3; k++) i16[k] = (uint16_t)indices[k];
+    s->draws[0].index_count = 3;
+    HrtsVulkanGeometry *m = &s->meshes[0];
+    *m = vulkan_mesh(s->vb[0], 4 * 12, s->ib[0], 12, &s->draws[0]);
+    m->vertex_stride = 12;
+    m->vertex_count = 4;
+    m->index_offset = 4;
+    m->index_type = HRTS_INDEX_TYPE_UINT16;
+    m->index_count = 3;
+    const float ground0[6] = {-4, 0, -4, 4, 0, 4};
+    memcpy(m->bounds, ground0, sizeof ground0);
+    /* mesh 1: the box, snorm16 at byte offset 16, the scene's 32-bit indices (4..11) with base vertex -4 */
+    s->vb[1] = make_host_buffer(16 + BOX_VERTICES * 8, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    box_snorm((uint16_t *)((char *)s->vb[1].map + 16), 0);
+    s->ib[1] = make_host_buffer(36 * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    memcpy(s->ib[1].map, indices + 6, 36 * 4);
+    s->draws[1].index_count = 36;
+    s->draws[1].base_vertex = -4;
+    m = &s->meshes[1];
+    *m = vulkan_mesh(s->vb[1], 16 + BOX_VERTICES * 8, s->ib[1], 36 * 4, &s->draws[1]);
+    m->vertex_offset = 16;
+    m->vertex_stride = 8;
+    m->vertex_count = BOX_VERTICES;
+    m->index_type = HRTS_INDEX_TYPE_UINT32;
+    m->index_count = 36;
+    m->vertex_format = VK_FORMAT_R16G16B16A16_SNORM;
+    memcpy(m->position_scale, BOX_SCALE, sizeof BOX_SCALE);
+    memcpy(m->position_offset, BOX_OFFSET, sizeof BOX_OFFSET);
+    for (int a = 0; a < 3; a++) {
+        m->bounds[a] = (float)BOX_MIN[a];
+        m->bounds[3 + a] = (float)BOX_MAX[a];
+    }
+    /* mesh 2: ground triangle (0, 3, 2), float4 at byte offset 32, 32-bit indices at byte offset 8 */
+    s->vb[2] = make_host_buffer(32 + 4 * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    float *f4 = (float *)((char *)s->vb[2].map + 32);
+    for (int v = 0; v < 4; v++) {
+        memcpy(f4 + 4 * v, positions + 3 * v, 12);
+        f4[4 * v + 3] = 1.0f;
+    }
+    s->ib[2] = make_host_buffer(8 + 3 * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    memcpy((char *)s->ib[2].map + 8, indices + 3, 3 * 4);
+    s->draws[2].index_count = 3;
+    m = &s->meshes[2];
+    *m = vulkan_mesh(s->vb[2], 32 + 4 * 16, s->ib[2], 8 + 3 * 4, &s->draws[2]);
+    m->vertex_offset = 32;
+    m->vertex_stride = 16;
+    m->vertex_count = 4;
+    m->index_offset = 8;
+    m->index_type = HRTS_INDEX_TYPE_UINT32;
+    m->index_count = 3;
+    const float ground1[6] = {-4, 0, -4, 4, 0, 4};
+    memcpy(m->bounds, ground1, sizeof ground1);
+}
+
+static void free_split_scene(SplitScene *s) {
+    for (int i = 0; i < SPLIT_MESHES; i++) {
+        free_buffer(s->vb[i]);
+        free_buffer(s->ib[i]);
+    }
+}
+
+/* The same scene as one mesh (`engine_geometry`'s buffers) with the split scene's draws in the same prim
+ * buffer order: the first ground triangle, the box, the second ground triangle. */
+static HrtsDraw one_mesh_draws[SPLIT_MESHES];
+static HrtsVulkanGeometry one_mesh_scene(Buf *vb, Buf *ib) {
+    HrtsVulkanGeometry vg = engine_geometry(vb, ib);
+    static const uint32_t first[SPLIT_MESHES] = {0, 6, 3}, count[SPLIT_MESHES] = {3, 36, 3};
+    static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    for (int i = 0; i < SPLIT_MESHES; i++) {
+        memset(&one_mesh_draws[i], 0, sizeof one_mesh_draws[i]);
+        memcpy(one_mesh_draws[i].transform, identity, sizeof identity);
+        one_mesh_draws[i].first_index = first[i];
+        one_mesh_draws[i].index_count = count[i];
+    }
+    vg.draws = one_mesh_draws;
+    vg.draw_count = SPLIT_MESHES;
+    return vg;
+}
+
+/* A hard-shadow context of `frames_in_flight` frames for the sun, with `mesh_count` meshes and the targets. */
+static HrtsContext *meshes_context(const HrtsVulkanDevice *vk, uint32_t frames_in_flight, const HrtsVulkanGeometry *meshes,
+                                   uint32_t mesh_count) {
+    HrtsContext *ctx = create_context(vk, frames_in_flight);
+    HrtsTargets t = targets();
+    CHECK(configure_all(ctx, 1, HRTS_SHADOW_MODE_HARD) == HRTS_RESULT_OK &&
+              hrts_set_geometry_vulkan_meshes(ctx, meshes, mesh_count) == HRTS_RESULT_OK &&
+              hrts_set_targets(ctx, &t) == HRTS_RESULT_OK,
+          "meshes: setup: %s", hrts_last_error(ctx));
+    return ctx;
+}
+
+/* The three meshes give the one-mesh scene's visibility bit for bit (and the exact shadow). Moving the box
+ * (one draw of three, in mesh 1) rebuilds its 12 triangles alone, exactly where it now is, and as the one
+ * mesh moved the same way; the same transforms again rebuild nothing. Bad lists are refused with a message
+ * naming the mesh, and the context goes on as it was. */
+static void engine_meshes(const HrtsVulkanDevice *vk) {
+    enum { PX = W * H };
+    setup_camera(0.0);
+    Emitter sun = directional(v3(0.45, -1.0, 0.2));
+    set_lights(&sun, 1);
+    upload_gbuffer();
+    SplitScene s;
+    split_scene(&s);
+    Buf one_vb, one_ib;
+    HrtsVulkanGeometry one = one_mesh_scene(&one_vb, &one_ib);
+    static float one_vis[PX], split_vis[PX], moved_vis[PX], one_moved_vis[PX], after_vis[PX];
+    HrtsFrameReport rep;
+    HrtsContext *ctx = meshes_context(vk, 2, &one, 1);
+    CHECK(run_frame(ctx, one_vis) == HRTS_RESULT_OK, "meshes: one-mesh frame: %s", hrts_last_error(ctx));
+    CHECK(hrts_set_geometry_vulkan_meshes(ctx, s.meshes, SPLIT_MESHES) == HRTS_RESULT_OK, "meshes: the list: %s",
+          hrts_last_error(ctx));
+    CHECK(run_frame(ctx, split_vis) == HRTS_RESULT_OK && report(ctx, next_frame - 1, 0, &rep) == HRTS_RESULT_OK,
+          "meshes: split frame: %s", hrts_last_error(ctx));
+    uint32_t first_rebuilt = rep.prim_triangles_rebuilt;
+    CHECK(run_frame(ctx, NULL) == HRTS_RESULT_OK && report(ctx, next_frame - 1, 0, &rep) == HRTS_RESULT_OK,
+          "meshes: second frame: %s", hrts_last_error(ctx));
+    uint32_t kept_rebuilt = rep.prim_triangles_rebuilt, kept_status = rep.pass_status[HRTS_PASS_PRIM_BUFFER];
+    int near_edge, shadowed, lit;
+    int split_differ = differing(split_vis, one_vis, PX);
+    int split_mismatches = count_mismatches(split_vis, edge_tolerance(), &sun, &near_edge, &shadowed, &lit);
+    printf("3 meshes (float3 + u16, snorm16 + u32 + base vertex, float4 + u32): %d px differ from the one-mesh scene, "
+           "%d shadowed, %d mismatches with the exact shadow; triangles rebuilt: %u on the first frame, %u on the next (%s)\n",
+           split_differ, shadowed, split_mismatches, first_rebuilt, kept_rebuilt,
+           kept_status == HRTS_PASS_STATUS_UP_TO_DATE ? "up to date" : "NOT up to date");
+    CHECK(split_differ == 0 && split_mismatches == 0 && shadowed > 300, "meshes: %d px differ, %d mismatches", split_differ,
+          split_mismatches);
+    CHECK(first_rebuilt == 14 && kept_rebuilt == 0 && kept_status == HRTS_PASS_STATUS_UP_TO_DATE,
+          "meshes: %u then %u triangles rebuilt", first_rebuilt, kept_rebuilt);
+
+    /* move the box: one transform per draw over all meshes, in mesh order */
+    const double shift[3] = {0.7, 0.0, -0.4};
+    float transforms[SPLIT_MESHES][16];
+    for (int i = 0; i < SPLIT_MESHES; i++) memcpy(transforms[i], s.draws[i].transform, sizeof transforms[i]);
+    for (int a = 0; a < 3; a++) transforms[1][12 + a] = (float)shift[a];
+    CHECK(hrts_set_draw_transforms(ctx, SPLIT_MESHES, &transforms[0][0]) == HRTS_RESULT_OK, "meshes: move: %s",
+          hrts_last_error(ctx));
+    memcpy(box_shift, shift, sizeof box_shift);
+    upload_gbuffer();
+    CHECK(run_frame(ctx, moved_vis) == HRTS_RESULT_OK && report(ctx, next_frame - 1, 0, &rep) == HRTS_RESULT_OK,
+          "meshes: moved frame: %s", hrts_last_error(ctx));
+    uint32_t moved_rebuilt = rep.prim_triangles_rebuilt, moved_status = rep.pass_status[HRTS_PASS_PRIM_BUFFER];
+    int moved_mismatches = count_mismatches(moved_vis, edge_tolerance(), &sun, &near_edge, &shadowed, &lit);
+    int moved_changed = differing(moved_vis, split_vis, PX);
+    CHECK(hrts_set_draw_transforms(ctx, SPLIT_MESHES, &transforms[0][0]) == HRTS_RESULT_OK &&
+              run_frame(ctx, NULL) == HRTS_RESULT_OK && report(ctx, next_frame - 1, 0, &rep) == HRTS_RESULT_OK,
+          "meshes: the same transforms again: %s", hrts_last_error(ctx));
+    uint32_t same_rebuilt = rep.prim_triangles_rebuilt;
+    /* the one-mesh scene with the same draw moved */
+    memcpy(one_mesh_draws[1].transform, transforms[1], sizeof transforms[1]);
+    CHECK(hrts_set_geometry_vulkan(ctx, &one) == HRTS_RESULT_OK && run_frame(ctx, one_moved_vis) == HRTS_RESULT_OK,
+          "meshes: one mesh moved: %s", hrts_last_error(ctx));
+    int moved_differ = differing(moved_vis, one_moved_vis, PX);
+    printf("moved box (draw 1 of 3): %u triangles rebuilt (prim buffer %s), %d px changed, %d shadowed, %d mismatches, "
+           "%d px differ from the one mesh moved; the same transforms again rebuild %u\n",
+           moved_rebuilt, moved_status == HRTS_PASS_STATUS_RAN ? "ran" : "did NOT run", moved_changed, shadowed,
+           moved_mismatches, moved_differ, same_rebuilt);
+    CHECK(moved_rebuilt == 12 && moved_status == HRTS_PASS_STATUS_RAN, "meshes: moving the box rebuilt %u triangles",
+          moved_rebuilt);
+    CHECK(moved_mismatches == 0 && moved_changed > 100 && moved_differ == 0 && shadowed > 300,
+          "meshes: moved: %d mismatches, %d px changed, %d px differ from one mesh", moved_mismatches, moved_changed,
+          moved_differ);
+    CHECK(same_rebuilt == 0, "meshes: the same transforms again rebuilt %u triangles", same_rebuilt);
+
+    /* bad lists: refused with a message naming the mesh; the geometry stays as it was */
+    HrtsVulkanGeometry bad[SPLIT_MESHES];
+    memcpy(bad, s.meshes, sizeof bad);
+    bad[2].vertex_buffer_size = 32;
+    HrtsResult r_small = hrts_set_geometry_vulkan_meshes(ctx, bad, SPLIT_MESHES);
+    char small_msg[512];
+    snprintf(small_msg, sizeof small_msg, "%s", hrts_last_error(ctx));
+    memcpy(bad, s.meshes, sizeof bad);
+    bad[1].vertex_format = VK_FORMAT_R8G8B8A8_SNORM;
+    HrtsResult r_format = hrts_set_geometry_vulkan_meshes(ctx, bad, SPLIT_MESHES);
+    char format_msg[512];
+    snprintf(format_msg, sizeof format_msg, "%s", hrts_last_error(ctx));
+    HrtsResult r_zero = hrts_set_geometry_vulkan_meshes(ctx, s.meshes, 0);
+    HrtsResult r_null = hrts_set_geometry_vulkan_meshes(ctx, NULL, SPLIT_MESHES);
+    printf("bad mesh lists: a too small vertex buffer: %s (%s); an 8-bit format: %s (%s); mesh_count 0: %s; NULL: %s\n",
+           hrts_result_name(r_small), small_msg, hrts_result_name(r_format), format_msg, hrts_result_name(r_zero),
+           hrts_result_name(r_null));
+    CHECK(r_small == HRTS_RESULT_ERROR_INVALID_ARGUMENT && strstr(small_msg, "meshes[2]"), "meshes: too small: %s", small_msg);
+    CHECK(r_format == HRTS_RESULT_ERROR_INVALID_ENUM && strstr(format_msg, "meshes[1]"), "meshes: format: %s", format_msg);
+    CHECK(r_zero == HRTS_RESULT_ERROR_INVALID_ARGUMENT && r_null == HRTS_RESULT_ERROR_NULL_POINTER, "meshes: 0 / NULL");
+    CHECK(run_frame(ctx, after_vis) == HRTS_RESULT_OK, "meshes: frame after the refused lists: %s", hrts_last_error(ctx));
+    int after_differ = differing(after_vis, one_moved_vis, PX);
+    CHECK(after_differ == 0, "meshes: after the refused lists %d px differ", after_differ);
+    VK(vkDeviceWaitIdle(device));
+    CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
+    memset(box_shift, 0, sizeof box_shift);
+    upload_gbuffer();
+    free_split_scene(&s);
+    free_buffer(one_vb);
+    free_buffer(one_ib);
+}
+
+/* ---------- a deforming mesh ---------- */
+/* The engine skins the box into one vertex buffer per frame in flight (2): buffer A holds the box, buffer B
+ * the box deformed (its x < 0 half gone). Frames give them in turn through HrtsFrame::deformed, two frames
+ * pending on the GPU at once, with frames that deform nothing between. Each frame's visibility equals, bit
+ * for bit, the same geometry given statically (the box mesh's own buffer holding A's or B's vertices), each
+ * frame rebuilds the box's 12 triangles, and the frame after the last deformed one too (from the mesh's own
+ * buffer); then nothing. Bad deformed lists are refused and record nothing. */
+enum { DEFORM_FRAMES = 8 };
+static void deforming_mesh(const HrtsVulkanDevice *vk) {
+    enum { PX = W * H, IN_FLIGHT_2 = 2, NONE = -1, A = 0, B = 1 };
+    setup_camera(0.0);
+    Emitter sun = directional(v3(0.45, -1.0, 0.2));
+    set_lights(&sun, 1);
+    upload_gbuffer();
+    SplitScene s;
+    split_scene(&s);
+    /* the engine's per-frame vertex buffers: A at byte offset 8, B at 0 */
+    const VkDeviceSize offsets[2] = {8, 0};
+    Buf skinned[2];
+    for (int k = 0; k < 2; k++) {
+        skinned[k] = make_host_buffer(offsets[k] + BOX_VERTICES * 8, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+        box_snorm((uint16_t *)((char *)skinned[k].map + offsets[k]), k == B);
+    }
+    HrtsMeshVertices given[2];
+    for (int k = 0; k < 2; k++) {
+        given[k].mesh = 1;
+        given[k].vertex_buffer = (uint64_t)(uintptr_t)skinned[k].buffer;
+        given[k].vertex_buffer_size = offsets[k] + BOX_VERTICES * 8;
+        given[k].vertex_offset = offsets[k];
+    }
+    /* the expected visibility: the same geometry given statically, the box's own buffer A's or B's */
+    static float expected[2][PX];
+    for (int k = 0; k < 2; k++) {
+        HrtsVulkanGeometry meshes[SPLIT_MESHES];
+        memcpy(meshes, s.meshes, sizeof meshes);
+        meshes[1].vertex_buffer = given[k].vertex_buffer;
+        meshes[1].vertex_buffer_size = given[k].vertex_buffer_size;
+        meshes[1].vertex_offset = given[k].vertex_offset;
+        HrtsContext *ref = meshes_context(vk, 1, meshes, SPLIT_MESHES);
+        CHECK(run_frame(ref, expected[k]) == HRTS_RESULT_OK, "deforming: static reference %d: %s", k, hrts_last_error(ref));
+        CHECK(hrts_context_destroy(ref) == HRTS_RESULT_OK, "destroy");
+    }
+    int near_edge, shadowed, lit;
+    int ref_mismatches = count_mismatches(expected[A], edge_tolerance(), &sun, &near_edge, &shadowed, &lit);
+    int deformation_changes = differing(expected[A], expected[B], PX);
+    CHECK(ref_mismatches == 0 && deformation_changes > 100, "deforming: references: %d mismatches, B changes %d px",
+          ref_mismatches, deformation_changes);
+
+    HrtsContext *ctx = meshes_context(vk, IN_FLIGHT_2, s.meshes, SPLIT_MESHES);
+    const int plan[DEFORM_FRAMES] = {A, B, A, B, NONE, B, NONE, NONE};
+    /* the box's own buffer holds A's vertices: a frame deforming nothing shows A */
+    const uint32_t want_rebuilt[DEFORM_FRAMES] = {14, 12, 12, 12, 12, 12, 12, 0};
+    VkCommandBuffer cmds[IN_FLIGHT_2];
+    VkFence fences[IN_FLIGHT_2];
+    Buf back[IN_FLIGHT_2];
+    int pending[IN_FLIGHT_2] = {-1, -1};
+    VkCommandBufferAllocateInfo ai = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    ai.commandPool = pool;
+    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    ai.commandBufferCount = IN_FLIGHT_2;
+    VK(vkAllocateCommandBuffers(device, &ai, cmds));
+    for (int k = 0; k < IN_FLIGHT_2; k++) {
+        VkFenceCreateInfo fi = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+        VK(vkCreateFence(device, &fi, NULL, &fences[k]));
+        back[k] = make_host_buffer(sizeof(float) * PX, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    }
+    /* the first frame waits on a semaphore released once the second is submitted: both are pending then,
+     * reading different vertex buffers */
+    VkSemaphore hold = held_semaphore();
+    int errors_before = validation_errors, both_pending = 0, differ = 0, differing_frames = 0, wrong_rebuilt = 0;
+    uint64_t first = next_frame;
+    static float vis[PX];
+    for (int i = 0; i < DEFORM_FRAMES + IN_FLIGHT_2; i++) {
+        int slot = i % IN_FLIGHT_2;
+        if (pending[slot] >= 0) {
+            int done = pending[slot];
+            VK(vkWaitForFences(device, 1, &fences[slot], VK_TRUE, UINT64_MAX));
+            VK(vkResetFences(device, 1, &fences[slot]));
+            memcpy(vis, back[slot].map, sizeof vis);
+            int d = differing(vis, expected[plan[done] == B ? B : A], PX);
+            differ += d;
+            differing_frames += d > 0;
+            HrtsFrameReport rep;
+            HrtsResult r = report(ctx, first + (uint64_t)done, 0, &rep);
+            CHECK(r == HRTS_RESULT_OK, "deforming: report of frame %d: %s", done, hrts_last_error(ctx));
+            printf("deforming mesh, frame %d (%s): %d px differ from the static geometry, %u triangles rebuilt\n", done,
+                   plan[done] == NONE ? "own buffer" : plan[done] == A ? "buffer A" : "buffer B", d,
+                   rep.prim_triangles_rebuilt);
+            wrong_rebuilt += r != HRTS_RESULT_OK || rep.prim_triangles_rebuilt != want_rebuilt[done];
+            pending[slot] = -1;
+        }
+        if (i >= DEFORM_FRAMES) continue;
+        VK(vkResetCommandBuffer(cmds[slot], 0));
+        VkCommandBufferBeginInfo bi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+        bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+        VK(vkBeginCommandBuffer(cmds[slot], &bi));
+        HrtsFrame f = frame(cmds[slot], next_frame++);
+        if (plan[i] != NONE) {
+            f.deformed = &given[plan[i]];
+            f.deformed_count = 1;
+        }
+        CHECK(hrts_record_frame(ctx, &f) == HRTS_RESULT_OK, "deforming: frame %d: %s", i, hrts_last_error(ctx));
+        record_output_readback(cmds[slot], back[slot], 1);
+        if (i == 0) {
+            submit_held(cmds[slot], hold, fences[slot]);
+        } else {
+            submit(cmds[slot], fences[slot]);
+        }
+        pending[slot] = i;
+        if (i == 1) {
+            both_pending = vkGetFenceStatus(device, fences[0]) == VK_NOT_READY &&
+                           vkGetFenceStatus(device, fences[1]) == VK_NOT_READY;
+            release_held(hold);
+        }
+    }
+    int deform_errors = validation_errors - errors_before;
+    printf("deforming mesh: %d frames, 2 in flight (%s pending together), %d px in %d frames differ from the static "
+           "geometry, %d frames rebuilt other than the box's triangles, %d validation messages\n",
+           DEFORM_FRAMES, both_pending ? "A and B" : "NOT", differ, differing_frames, wrong_rebuilt, deform_errors);
+    CHECK(both_pending, "deforming: the first two frames were not pending together: the case was not tested");
+    CHECK(differ == 0, "deforming: %d px in %d frames differ", differ, differing_frames);
+    CHECK(wrong_rebuilt == 0, "deforming: %d frames rebuilt the wrong triangles", wrong_rebuilt);
+    CHECK(deform_errors == 0, "deforming: %d validation errors", deform_errors);
+
+    /* bad deformed lists: refused, nothing recorded, the context goes on */
+    VkCommandBuffer cmd = begin();
+    HrtsMeshVertices bad[2] = {given[B], given[B]};
+    struct {
+        const char *name;
+        HrtsResult want;
+        const char *names;
+        uint32_t count;
+    } cases[] = {
+        {"mesh 3 of 3", HRTS_RESULT_ERROR_INVALID_ARGUMENT, "deformed[0]", 1},
+        {"NULL with a count of 1", HRTS_RESULT_ERROR_NULL_POINTER, "deformed", 1},
+        {"a buffer too small", HRTS_RESULT_ERROR_INVALID_ARGUMENT, "deformed[0]", 1},
+        {"a NULL buffer", HRTS_RESULT_ERROR_NULL_POINTER, "deformed[0]", 1},
+        {"mesh 1 twice", HRTS_RESULT_ERROR_INVALID_ARGUMENT, "deformed[1]", 2},
+    };
+    int refused = 0;
+    for (int c = 0; c < 5; c++) {
+        bad[0] = bad[1] = given[B];
+        if (c == 0) bad[0].mesh = 3;
+        if (c == 2) bad[0].vertex_buffer_size = BOX_VERTICES * 8 - 4;
+        if (c == 3) bad[0].vertex_buffer = 0;
+        HrtsFrame f = frame(cmd, next_frame);
+        f.deformed = c == 1 ? NULL : bad;
+        f.deformed_count = cases[c].count;
+        HrtsResult r = hrts_record_frame(ctx, &f);
+        const char *msg = hrts_last_error(ctx);
+        printf("deformed %s: %s (%s)\n", cases[c].name, hrts_result_name(r), msg);
+        int ok = r == cases[c].want && strstr(msg, cases[c].names) != NULL;
+        CHECK(ok, "deformed %s: %s, \"%s\"", cases[c].name, hrts_result_name(r), msg);
+        refused += ok;
+    }
+    submit_and_wait(cmd);
+    VkCommandBuffer after = begin();
+    HrtsFrame f = frame(after, next_frame++);
+    f.deformed = &given[B];
+    f.deformed_count = 1;
+    CHECK(finish_frame(after, hrts_record_frame(ctx, &f), vis) == HRTS_RESULT_OK, "deforming: frame after: %s",
+          hrts_last_error(ctx));
+    int after_differ = differing(vis, expected[B], PX);
+    printf("bad deformed lists: %d of 5 refused as they must; the frame after differs from the static geometry in %d px\n",
+           refused, after_differ);
+    CHECK(after_differ == 0, "deforming: the frame after the refused lists differs in %d px", after_differ);
+    VK(vkDeviceWaitIdle(device));
+    CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
+    vkDestroySemaphore(device, hold, NULL);
+    for (int k = 0; k < IN_FLIGHT_2; k++) {
+        vkDestroyFence(device, fences[k], NULL);
+        free_buffer(back[k]);
+        free_buffer(skinned[k]);
+    }
+    vkFreeCommandBuffers(device, pool, IN_FLIGHT_2, cmds);
+    free_split_scene(&s);
+}
+
 /* ---------- misuse: a table of calls that must fail with a given result and a message ---------- */
 /* Each case runs in table order on one context (some build on the state left by the ones before); after
  * each, the context must still answer. A successful call clears the last error, so a case that fails with
@@ -1630,9 +2054,11 @@ enum {
     CONFIG_NAN_LIGHT_SIZE, CONFIG_NEGATIVE_WSS, CONFIG_PCF_TAPS, CONFIG_SHADOW_MAP_ZERO, CONFIG_DEFAULTS_NULL,
     CONFIG_FILTER, CONFIG_EXTRA_OUTPUT, CONFIG_FILTER_RADII, CONFIG_SLOPE_BIAS, LIGHTS_ZERO, LIGHTS_TOO_MANY,
     LIGHTS_NULL, LIGHTS_SECOND_INVALID, GEOMETRY_NULL_POSITIONS, GEOMETRY_STRIDE, GEOMETRY_NAN, GEOMETRY_INDEX,
-    GEOMETRY_NO_DRAWS, VULKAN_GEOMETRY_INDEX_TYPE, VULKAN_GEOMETRY_VERTEX_OFFSET_WRAP, VULKAN_GEOMETRY_INDEX_OFFSET_WRAP, TARGETS_ZERO_WIDTH, TARGETS_DEPTH_USAGE, TARGETS_OUTPUT_USAGE,
+    GEOMETRY_NO_DRAWS, VULKAN_GEOMETRY_INDEX_TYPE, VULKAN_GEOMETRY_VERTEX_OFFSET_WRAP, VULKAN_GEOMETRY_INDEX_OFFSET_WRAP, MESHES_COUNT_ZERO,
+    MESHES_NULL, MESHES_BUFFER_TOO_SMALL, TARGETS_ZERO_WIDTH, TARGETS_DEPTH_USAGE, TARGETS_OUTPUT_USAGE,
     TARGETS_NULL_NORMAL, TARGETS_ZERO_LAYERS, FRAME_ZERO_DIRECTION, FRAME_NAN_PROJECTION, FRAME_LIGHT_TYPE,
     FRAME_NULL_COMMAND_BUFFER, FRAME_STRUCT_SIZE, FRAME_NULL_LIGHTS, FRAME_LIGHT_COUNT_ZERO, FRAME_LIGHT_COUNT_OTHER,
+    FRAME_DEFORMED_NULL, FRAME_DEFORMED_MESH,
     FRAME_INDEX_REPEATED, FRAME_INDEX_BACKWARDS, REPORT_STRUCT_SIZE, REPORT_OLD_FRAME, REPORT_NO_SUCH_LIGHT,
     REPORT_NOT_COMPLETED, PASSES_EMPTY_MASK, PASSES_UNKNOWN_BIT, PASSES_RAY_TRACE_FIRST, PASSES_CAMERA_MOVED,
     PASSES_COPY_TOO_EARLY, PASSES_DEPTH_LAYOUT, REPORT_HALF_RECORDED, READBACK_HALF_RECORDED, READBACK_UNKNOWN,
@@ -1690,6 +2116,9 @@ static const struct {
     [VULKAN_GEOMETRY_INDEX_TYPE] = {"vulkan geometry(unknown index type)", HRTS_RESULT_ERROR_INVALID_ENUM},
     [VULKAN_GEOMETRY_VERTEX_OFFSET_WRAP] = {"vulkan geometry(vertex offset UINT64_MAX - 3)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [VULKAN_GEOMETRY_INDEX_OFFSET_WRAP] = {"vulkan geometry(index offset UINT64_MAX - 3)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [MESHES_COUNT_ZERO] = {"vulkan meshes(mesh_count 0)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [MESHES_NULL] = {"vulkan meshes(NULL meshes)", HRTS_RESULT_ERROR_NULL_POINTER},
+    [MESHES_BUFFER_TOO_SMALL] = {"vulkan meshes(meshes[2]'s vertex buffer too small)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [TARGETS_ZERO_WIDTH] = {"targets(zero width)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [TARGETS_DEPTH_USAGE] = {"targets(depth not SAMPLED)", HRTS_RESULT_ERROR_IMAGE_USAGE},
     [TARGETS_OUTPUT_USAGE] = {"targets(output not TRANSFER_DST)", HRTS_RESULT_ERROR_IMAGE_USAGE},
@@ -1703,6 +2132,8 @@ static const struct {
     [FRAME_NULL_LIGHTS] = {"frame(NULL lights)", HRTS_RESULT_ERROR_NULL_POINTER},
     [FRAME_LIGHT_COUNT_ZERO] = {"frame(0 lights)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [FRAME_LIGHT_COUNT_OTHER] = {"frame(2 lights, 1 configured)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [FRAME_DEFORMED_NULL] = {"frame(deformed NULL, deformed_count 1)", HRTS_RESULT_ERROR_NULL_POINTER},
+    [FRAME_DEFORMED_MESH] = {"frame(deformed mesh 1 of 1)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [FRAME_INDEX_REPEATED] = {"frame(index of the last frame again)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [FRAME_INDEX_BACKWARDS] = {"frame(index going back)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [REPORT_STRUCT_SIZE] = {"report(wrong size)", HRTS_RESULT_ERROR_STRUCT_SIZE},
@@ -1854,6 +2285,16 @@ static HrtsResult misuse_call(int id, Misuse *m) {
             vg.index_offset = UINT64_MAX - 3;
         return hrts_set_geometry_vulkan(ctx, &vg);
     }
+    case MESHES_COUNT_ZERO:
+    case MESHES_NULL:
+    case MESHES_BUFFER_TOO_SMALL: {
+        HrtsVulkanGeometry meshes[3] = {fake_vulkan_geometry(&g), fake_vulkan_geometry(&g), fake_vulkan_geometry(&g)};
+        meshes[2].vertex_buffer_size = 8;
+        if (id == MESHES_COUNT_ZERO) return hrts_set_geometry_vulkan_meshes(ctx, meshes, 0);
+        if (id == MESHES_NULL) return hrts_set_geometry_vulkan_meshes(ctx, NULL, 3);
+        HrtsResult r = hrts_set_geometry_vulkan_meshes(ctx, meshes, 3);
+        return r == HRTS_RESULT_OK || strstr(hrts_last_error(ctx), "meshes[2]") ? r : HRTS_RESULT_ERROR_INTERNAL;
+    }
     case TARGETS_ZERO_WIDTH: t.width = 0; return hrts_set_targets(ctx, &t);
     case TARGETS_DEPTH_USAGE: t.depth_usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT; return hrts_set_targets(ctx, &t);
     case TARGETS_OUTPUT_USAGE: t.output_usage = VK_IMAGE_USAGE_SAMPLED_BIT; return hrts_set_targets(ctx, &t);
@@ -1869,6 +2310,13 @@ static HrtsResult misuse_call(int id, Misuse *m) {
     case FRAME_NULL_LIGHTS: f.lights = NULL; return hrts_record_frame(ctx, &f);
     case FRAME_LIGHT_COUNT_ZERO: f.light_count = 0; return hrts_record_frame(ctx, &f);
     case FRAME_LIGHT_COUNT_OTHER: f.lights = lights; f.light_count = 2; return hrts_record_frame(ctx, &f);
+    case FRAME_DEFORMED_NULL: f.deformed_count = 1; return hrts_record_frame(ctx, &f);
+    case FRAME_DEFORMED_MESH: {
+        HrtsMeshVertices v = {1, 1, 1024, 0};
+        f.deformed = &v;
+        f.deformed_count = 1;
+        return hrts_record_frame(ctx, &f);
+    }
     case FRAME_INDEX_REPEATED: {
         if (run_frame(ctx, NULL) != HRTS_RESULT_OK) return HRTS_RESULT_ERROR_INTERNAL;
         VkCommandBuffer cmd = begin();
@@ -2467,6 +2915,10 @@ int main(void) {
     base_vertex_draws(&vk, &g);
     phase = "quantized positions";
     quantized_positions(&vk, &g);
+    phase = "engine meshes";
+    engine_meshes(&vk);
+    phase = "deforming mesh";
+    deforming_mesh(&vk);
     phase = "moving geometry";
     moving_geometry_bounds(&vk);
     phase = "engine normals";

@@ -222,7 +222,7 @@ impl ShadowPipeline {
         match pass {
             PassId::PrimBuffer => {
                 if frame.records_prims {
-                    self.shared.record(enc)?;
+                    self.shared.record(enc, frame.index)?;
                 }
             }
             PassId::ShadowMap => {

@@ -41,6 +41,9 @@ pub struct FrameReport {
     /// GPU bytes of the primitive map's build scratch, shared by the maps of every light over the same
     /// geometry (not in `resources`; 0 without a primitive map).
     pub map_scratch_bytes: u64,
+    /// Triangles whose prim-buffer slots the frame rewrote, whichever light's pipeline recorded the build
+    /// (0 when the prim buffer was up to date).
+    pub prim_triangles_rebuilt: u32,
 }
 
 impl FrameReport {
@@ -180,6 +183,7 @@ impl ShadowPipeline {
             resources,
             output: self.plan.final_output(),
             map_scratch_bytes: self.map_scratch_bytes(),
+            prim_triangles_rebuilt: slot.frame.map_or(0, |f| self.shared.triangles_rebuilt(f)),
         })
     }
 }

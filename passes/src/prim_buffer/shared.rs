@@ -1,0 +1,403 @@
+//! The prim buffer shared by the pipelines of a context's lights, and what each frame rebuilds of it: the
+//! draws moved since it was last built, the meshes that read a vertex buffer of the frame (deformed), or
+//! everything when the geometry changes every frame.
+
+use super::{DrawSource, Geometry, PrimBufferPass, VertexLayout};
+use crate::primitive_map::MapScratchPool;
+use crate::{PassError, MAX_FRAMES_IN_FLIGHT};
+use glam::Mat4;
+use rhi::{BindGroup, Buffer, Device, Encoder};
+use std::collections::VecDeque;
+use std::sync::{Arc, Mutex};
+
+/// Who records the shared prim buffer in a frame (see [`SharedGeometry`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum PrimBufferClaim {
+    /// The caller records the build this frame.
+    Record,
+    /// Another light's pipeline records it this frame, before the caller's passes.
+    RebuiltByAnother,
+    /// It is up to date (nothing moved or deformed since an earlier frame built it).
+    UpToDate,
+}
+
+/// A mesh's positions in one frame: a vertex buffer of that frame (an engine skinning into one buffer per
+/// frame in flight) that the mesh's draws read instead of the mesh's own, with the mesh's stride, format
+/// and vertex count.
+pub struct MeshVertices {
+    /// The mesh (its index in [`Geometry::meshes`]).
+    pub mesh: usize,
+    /// The vertex buffer (storage-buffer usage).
+    pub buffer: Buffer,
+    /// Byte offset of vertex 0 in `buffer` (a multiple of 4).
+    pub offset: u64,
+}
+
+/// A vertex buffer some frame read instead of a mesh's own, with the bind group that reads it: kept
+/// while a frame in flight may use it.
+struct CachedVertices {
+    mesh: usize,
+    buffer: Buffer,
+    group: BindGroup,
+    /// The last frame that read it.
+    last_used: u64,
+}
+
+/// A mesh that reads a vertex buffer of the frame.
+struct FrameMesh {
+    mesh: usize,
+    vertex: VertexLayout,
+    /// Its [`CachedVertices`] entry.
+    entry: usize,
+}
+
+/// The scene's geometry and its prim buffer, shared by the pipelines of several lights (one context): in
+/// each frame the first light that needs the prim buffer records its build and the others read it. A
+/// build rewrites only the slots that no longer hold what the frame needs.
+pub struct SharedGeometry {
+    geometry: Geometry,
+    pass: PrimBufferPass,
+    state: Mutex<PrimBufferState>,
+    map_scratch: MapScratchPool,
+}
+
+struct PrimBufferState {
+    /// The engine's buffers change every frame: every draw is rebuilt every frame.
+    dynamic: bool,
+    claimed: Option<u64>,
+    /// Each draw's transform from stored positions to world, over all meshes in order.
+    models: Vec<Mat4>,
+    /// The transform each draw's slots were last built with from its mesh's own vertex buffer (`None`:
+    /// never built, or last built from a vertex buffer of a frame).
+    built_with: Vec<Option<Mat4>>,
+    /// The frame whose per-frame vertex buffers were set last, and the meshes reading them.
+    frame_meshes: Option<(u64, Vec<FrameMesh>)>,
+    /// The vertex buffers frames read instead of their meshes' own.
+    frame_vertices: Vec<CachedVertices>,
+    /// The triangles each recent frame's build rewrote.
+    rebuilt: VecDeque<(u64, u32)>,
+}
+
+impl PrimBufferState {
+    /// The meshes that read vertex buffers of `frame`.
+    fn deformed_in(&self, frame: u64) -> &[FrameMesh] {
+        match &self.frame_meshes {
+            Some((f, meshes)) if *f == frame => meshes,
+            _ => &[],
+        }
+    }
+
+    /// Whether every draw's slots hold its current transform applied to its mesh's own vertices.
+    fn current(&self) -> bool {
+        self.built_with
+            .iter()
+            .zip(&self.models)
+            .all(|(built, model)| *built == Some(*model))
+    }
+
+    /// Whether a build rewrites draw `draw`'s slots (`deformed`: its mesh reads a vertex buffer of the
+    /// frame).
+    fn rebuilds(&self, draw: usize, deformed: bool) -> bool {
+        self.dynamic || deformed || self.built_with[draw] != Some(self.models[draw])
+    }
+
+    /// Whether `frame` must rebuild some of the prim buffer.
+    fn stale(&self, frame: u64) -> bool {
+        self.dynamic || !self.deformed_in(frame).is_empty() || !self.current()
+    }
+}
+
+impl SharedGeometry {
+    /// Creates the prim buffer of `geometry`. `dynamic`: the vertex or index buffers change between frames,
+    /// so the prim buffer is rebuilt every frame (else what moved or deformed).
+    pub fn new(device: &Device, geometry: Geometry, dynamic: bool) -> Result<Arc<Self>, PassError> {
+        let pass = PrimBufferPass::new(device, &geometry)?;
+        let models: Vec<Mat4> = geometry.draws().map(|(_, d)| d.model).collect();
+        Ok(Arc::new(Self {
+            state: Mutex::new(PrimBufferState {
+                dynamic,
+                claimed: None,
+                built_with: vec![None; models.len()],
+                models,
+                frame_meshes: None,
+                frame_vertices: Vec::new(),
+                rebuilt: VecDeque::new(),
+            }),
+            geometry,
+            pass,
+            map_scratch: MapScratchPool::default(),
+        }))
+    }
+
+    /// The geometry.
+    pub fn geometry(&self) -> &Geometry {
+        &self.geometry
+    }
+
+    /// The prim buffer (triangles in frame coordinates).
+    pub fn prims(&self) -> &Buffer {
+        self.pass.prims()
+    }
+
+    /// The build scratch the primitive maps over this geometry share (one light's map is built at a time).
+    pub fn map_scratch(&self) -> &MapScratchPool {
+        &self.map_scratch
+    }
+
+    /// Whether the prim buffer is rebuilt every frame.
+    pub fn is_dynamic(&self) -> bool {
+        self.lock().dynamic
+    }
+
+    /// Makes the geometry dynamic (rebuilt every frame) or static (kept once built, but for what moves
+    /// or deforms).
+    pub fn set_dynamic(&self, dynamic: bool) {
+        self.lock().dynamic = dynamic;
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, PrimBufferState> {
+        self.state
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    /// Decides, for a pipeline beginning `frame`, who records the prim buffer this frame.
+    pub(crate) fn claim(&self, frame: u64) -> PrimBufferClaim {
+        let mut s = self.lock();
+        if s.claimed == Some(frame) {
+            PrimBufferClaim::RebuiltByAnother
+        } else if s.stale(frame) {
+            s.claimed = Some(frame);
+            PrimBufferClaim::Record
+        } else {
+            PrimBufferClaim::UpToDate
+        }
+    }
+
+    /// Records frame `frame`'s build of the prim buffer (by the pipeline whose claim was
+    /// [`PrimBufferClaim::Record`]): a dispatch for each draw whose slots do not hold what the frame needs
+    /// (every draw of dynamic geometry; the draws moved since they were last built, or never built; the
+    /// draws of the meshes reading a vertex buffer of the frame, and of those that did in the frame that
+    /// last built them).
+    pub(crate) fn record(&self, enc: &mut Encoder<'_>, frame: u64) -> Result<(), PassError> {
+        let mut guard = self.lock();
+        let s = &*guard;
+        let deformed = s.deformed_in(frame);
+        let mut rebuilt = vec![false; s.models.len()];
+        let triangles = self
+            .pass
+            .record_draws(enc, &self.geometry, |mesh, draw, _| {
+                let from_frame = deformed.iter().find(|m| m.mesh == mesh);
+                if !s.rebuilds(draw, from_frame.is_some()) {
+                    return None;
+                }
+                let model = s.models[draw];
+                rebuilt[draw] = true;
+                Some(match from_frame {
+                    Some(m) => DrawSource {
+                        group: &s.frame_vertices[m.entry].group,
+                        vertex: m.vertex,
+                        model,
+                    },
+                    None => DrawSource {
+                        group: &self.pass.groups[mesh],
+                        vertex: self.geometry.meshes()[mesh].vertex,
+                        model,
+                    },
+                })
+            })?;
+        let deformed_meshes: Vec<usize> = deformed.iter().map(|m| m.mesh).collect();
+        let s = &mut *guard;
+        for ((draw, (mesh, _)), _) in self
+            .geometry
+            .draws()
+            .enumerate()
+            .zip(&rebuilt)
+            .filter(|(_, &r)| r)
+        {
+            s.built_with[draw] = (!deformed_meshes.contains(&mesh)).then_some(s.models[draw]);
+        }
+        match s.rebuilt.iter_mut().find(|(f, _)| *f == frame) {
+            // The frame begun again (abandoned, then recorded anew): its recordings add up.
+            Some((_, sum)) => *sum = sum.saturating_add(triangles),
+            None => {
+                if s.rebuilt.len() > MAX_FRAMES_IN_FLIGHT as usize {
+                    s.rebuilt.pop_front();
+                }
+                s.rebuilt.push_back((frame, triangles));
+            }
+        }
+        Ok(())
+    }
+
+    /// Triangles whose slots frame `frame`'s build rewrote (0 when the prim buffer was up to date, or for a
+    /// frame more than [`MAX_FRAMES_IN_FLIGHT`] builds ago).
+    pub fn triangles_rebuilt(&self, frame: u64) -> u32 {
+        self.lock()
+            .rebuilt
+            .iter()
+            .find(|(f, _)| *f == frame)
+            .map_or(0, |&(_, t)| t)
+    }
+
+    /// Moves the draws: `models` holds one object-to-world transform per draw, over all meshes in order.
+    /// The next frame rebuilds the slots of the draws whose transform changed (once, for every light) and
+    /// everything that depends on the prim buffer; frames already recorded keep the transforms they were
+    /// recorded with.
+    pub fn set_transforms(&self, models: &[Mat4]) -> Result<(), PassError> {
+        let draws = self.geometry.draw_count();
+        if models.len() != draws {
+            return Err(PassError::InvalidGeometry(format!(
+                "{} transforms for {draws} draws",
+                models.len(),
+            )));
+        }
+        if let Some(i) = models.iter().position(|m| !m.is_finite()) {
+            return Err(PassError::InvalidGeometry(format!(
+                "transform {i} is not finite"
+            )));
+        }
+        self.lock().models = models.to_vec();
+        Ok(())
+    }
+
+    /// Sets the vertex buffers frame `frame` reads instead of its meshes' own (none: every mesh reads its
+    /// own); those meshes' draws are rebuilt in that frame, and again from their own vertices in the next
+    /// frame that does not deform them. Bind groups are kept per buffer and dropped once no frame in
+    /// flight uses them: `completed` is the last frame known to have completed on the GPU (everything up
+    /// to `frame - frames_in_flight`). Checks every entry before it changes anything.
+    pub fn set_frame_vertices(
+        &self,
+        device: &Device,
+        frame: u64,
+        completed: Option<u64>,
+        vertices: Vec<MeshVertices>,
+    ) -> Result<(), PassError> {
+        let meshes = self.geometry.meshes();
+        let mut layouts = Vec::with_capacity(vertices.len());
+        for (i, v) in vertices.iter().enumerate() {
+            let what = format!("frame vertices {i} (mesh {})", v.mesh);
+            let mesh = meshes.get(v.mesh).ok_or_else(|| {
+                PassError::InvalidGeometry(format!(
+                    "{what}: the geometry has {} meshes",
+                    meshes.len()
+                ))
+            })?;
+            if vertices[..i].iter().any(|o| o.mesh == v.mesh) {
+                return Err(PassError::InvalidGeometry(format!(
+                    "{what}: the mesh is given twice"
+                )));
+            }
+            let vertex = VertexLayout {
+                offset: v.offset,
+                ..mesh.vertex
+            };
+            vertex.check(v.buffer.size()).map_err(|e| match e {
+                PassError::InvalidGeometry(m) => PassError::InvalidGeometry(format!("{what}: {m}")),
+                other => other,
+            })?;
+            layouts.push(vertex);
+        }
+        let mut s = self.lock();
+        // The entries of the last frame's meshes move when unused buffers go.
+        s.frame_meshes = None;
+        if let Some(done) = completed {
+            s.frame_vertices.retain(|c| c.last_used > done);
+        }
+        let mut frame_meshes = Vec::with_capacity(vertices.len());
+        for (v, vertex) in vertices.into_iter().zip(layouts) {
+            let key = (v.mesh, v.buffer.raw_handle(), v.buffer.size());
+            let cached = s
+                .frame_vertices
+                .iter()
+                .position(|c| (c.mesh, c.buffer.raw_handle(), c.buffer.size()) == key);
+            let entry = match cached {
+                Some(entry) => entry,
+                None => {
+                    let group = self.pass.bind(device, &meshes[v.mesh], &v.buffer)?;
+                    s.frame_vertices.push(CachedVertices {
+                        mesh: v.mesh,
+                        buffer: v.buffer,
+                        group,
+                        last_used: frame,
+                    });
+                    s.frame_vertices.len() - 1
+                }
+            };
+            s.frame_vertices[entry].last_used = frame;
+            frame_meshes.push(FrameMesh {
+                mesh: key.0,
+                vertex,
+                entry,
+            });
+        }
+        s.frame_meshes = Some((frame, frame_meshes));
+        Ok(())
+    }
+
+    /// Whether every draw's slots hold its current transform applied to its mesh's own vertices.
+    pub(crate) fn is_built(&self) -> bool {
+        self.lock().current()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::prim_buffer::VertexFormat;
+    use glam::Vec3;
+
+    fn state(draws: usize) -> PrimBufferState {
+        PrimBufferState {
+            dynamic: false,
+            claimed: None,
+            models: vec![Mat4::IDENTITY; draws],
+            built_with: vec![None; draws],
+            frame_meshes: None,
+            frame_vertices: Vec::new(),
+            rebuilt: VecDeque::new(),
+        }
+    }
+
+    #[test]
+    fn a_frame_rebuilds_what_moved_or_deforms() {
+        let mut s = state(3);
+        assert!(
+            s.stale(0) && (0..3).all(|d| s.rebuilds(d, false)),
+            "never built"
+        );
+        s.built_with = s.models.iter().copied().map(Some).collect();
+        assert!(s.current() && !s.stale(1));
+        s.models[1] = Mat4::from_translation(Vec3::X);
+        assert!(s.stale(2));
+        assert_eq!(
+            (0..3).map(|d| s.rebuilds(d, false)).collect::<Vec<_>>(),
+            [false, true, false],
+            "only the moved draw"
+        );
+        s.built_with[1] = Some(s.models[1]);
+        assert!(!s.stale(3));
+        let vertex = VertexLayout {
+            offset: 0,
+            stride: 12,
+            count: 3,
+            format: VertexFormat::Float3,
+        };
+        s.frame_meshes = Some((
+            4,
+            vec![FrameMesh {
+                mesh: 0,
+                vertex,
+                entry: 0,
+            }],
+        ));
+        assert!(
+            s.stale(4) && s.deformed_in(4).len() == 1,
+            "deformed in frame 4"
+        );
+        assert!(!s.stale(5) && s.deformed_in(5).is_empty(), "not in frame 5");
+        assert!(s.rebuilds(0, true) && !s.rebuilds(0, false));
+        s.dynamic = true;
+        assert!(s.stale(5) && s.rebuilds(2, false), "dynamic: everything");
+    }
+}
