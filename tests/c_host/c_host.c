@@ -419,6 +419,20 @@ static void submit_and_wait(VkCommandBuffer cmd) {
 
 /* Uploads `staging` (tightly packed texels of the copied aspect) into one-layer `img` and leaves it in
  * `layout`: `aspects` are the image's aspects (for the layout transitions), `copied` the one written. */
+/* `f` as an IEEE half, rounded to nearest even (values this small flush to zero: no view Z here is). */
+static uint16_t half_of(float f) {
+    uint32_t x;
+    memcpy(&x, &f, 4);
+    uint32_t sign = (x >> 16) & 0x8000;
+    int32_t e = (int32_t)((x >> 23) & 0xff) - 127 + 15;
+    uint32_t m = x & 0x7fffff;
+    if (e <= 0) return (uint16_t)sign;
+    if (e >= 31) return (uint16_t)(sign | 0x7c00);
+    uint32_t h = sign | (uint32_t)e << 10 | m >> 13, rest = m & 0x1fff;
+    if (rest > 0x1000 || (rest == 0x1000 && (h & 1))) h++;
+    return (uint16_t)h;
+}
+
 static void upload_image(Img img, VkImageAspectFlags aspects, VkImageAspectFlags copied, Buf staging, VkImageLayout layout) {
     VkCommandBuffer cmd = begin();
     barrier(cmd, img.image, aspects, 1, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
@@ -1106,37 +1120,45 @@ static void engine_depth(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
         {VK_FORMAT_D24_UNORM_S8_UINT, "D24_UNORM_S8_UINT"},
         {VK_FORMAT_D32_SFLOAT, "D32_SFLOAT"},
         {VK_FORMAT_D32_SFLOAT_S8_UINT, "D32_SFLOAT_S8_UINT"},
+        {VK_FORMAT_R32_SFLOAT, "view Z in R32_SFLOAT"},
+        {VK_FORMAT_R16_SFLOAT, "view Z in R16_SFLOAT"},
     };
     const double FAR = 50.0;
     setup_camera(0.0);
     Emitter sun = directional(v3(0.45, -1.0, 0.2));
     set_lights(&sun, 1);
     upload_gbuffer(); /* the normals of this view (and a depth the cases below replace) */
-    static double distance[PX];
+    static double distance[PX], view_z[PX];
     for (int y = 0; y < H; y++)
         for (int x = 0; x < W; x++) {
             V3 n;
             double t;
-            distance[y * W + x] = cast(cam_pos, pixel_ray(x, y), 0, &t, &n) ? t : -1.0;
+            V3 ray = pixel_ray(x, y);
+            distance[y * W + x] = cast(cam_pos, ray, 0, &t, &n) ? t : -1.0;
+            /* an engine's linear view Z: the view-space z of the hit (negative in front), 0 on background */
+            view_z[y * W + x] = distance[y * W + x] < 0 ? 0.0 : -t * dot3(ray, cam_f);
         }
     int cases = 0, failed_cases = 0;
     char skipped[256] = "";
     for (size_t k = 0; k < sizeof formats / sizeof formats[0]; k++) {
         VkFormat format = formats[k].format;
+        int linear = format == VK_FORMAT_R32_SFLOAT || format == VK_FORMAT_R16_SFLOAT;
         VkFormatProperties props;
         vkGetPhysicalDeviceFormatProperties(phys, format, &props);
         VkFormatFeatureFlags need = VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT | VK_FORMAT_FEATURE_TRANSFER_DST_BIT |
-                                    VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT;
+                                    (linear ? 0 : VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT);
         if ((props.optimalTilingFeatures & need) != need) {
             strcat(skipped, " ");
             strcat(skipped, formats[k].name);
             continue;
         }
         int stencil = format == VK_FORMAT_D24_UNORM_S8_UINT || format == VK_FORMAT_D32_SFLOAT_S8_UINT;
-        VkImageAspectFlags all = VK_IMAGE_ASPECT_DEPTH_BIT | (stencil ? VK_IMAGE_ASPECT_STENCIL_BIT : 0);
-        VkImageLayout layout =
-            stencil ? VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL : VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL;
-        size_t texel = format == VK_FORMAT_D16_UNORM ? 2 : 4;
+        VkImageAspectFlags data = linear ? VK_IMAGE_ASPECT_COLOR_BIT : VK_IMAGE_ASPECT_DEPTH_BIT;
+        VkImageAspectFlags all = data | (stencil ? VK_IMAGE_ASPECT_STENCIL_BIT : 0);
+        VkImageLayout layout = linear    ? VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL
+                               : stencil ? VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL
+                                         : VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL;
+        size_t texel = format == VK_FORMAT_D16_UNORM || format == VK_FORMAT_R16_SFLOAT ? 2 : 4;
         for (int forward = 0; forward < 2; forward++) {
             /* the projection: reversed Z to infinity (the default view), or standard Z to FAR */
             setup_camera(0.0);
@@ -1144,22 +1166,26 @@ static void engine_depth(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
                 proj[10] = (float)(FAR / (NEAR - FAR));
                 proj[14] = (float)(NEAR * FAR / (NEAR - FAR));
             }
-            /* an engine's depth buffer: a depth attachment it also samples */
-            VkImageUsageFlags usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
-                                      VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+            /* an engine's depth buffer: a depth attachment it also samples (or a view-Z image it writes) */
+            VkImageUsageFlags usage = (linear ? 0 : VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT) |
+                                      VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
             Img depth = make_image(format, usage, 1);
             Buf staging = make_host_buffer(texel * PX, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
             for (int i = 0; i < PX; i++) {
                 double t = distance[i];
                 double d = t < 0 ? (forward ? 1.0 : 0.0) : forward ? FAR / (FAR - NEAR) * (1.0 - NEAR / t) : NEAR / t;
-                if (format == VK_FORMAT_D16_UNORM)
+                if (format == VK_FORMAT_R32_SFLOAT)
+                    ((float *)staging.map)[i] = (float)view_z[i];
+                else if (format == VK_FORMAT_R16_SFLOAT)
+                    ((uint16_t *)staging.map)[i] = half_of((float)view_z[i]);
+                else if (format == VK_FORMAT_D16_UNORM)
                     ((uint16_t *)staging.map)[i] = (uint16_t)lround(d * 65535.0);
                 else if (format == VK_FORMAT_D32_SFLOAT || format == VK_FORMAT_D32_SFLOAT_S8_UINT)
                     ((float *)staging.map)[i] = (float)d;
                 else
                     ((uint32_t *)staging.map)[i] = (uint32_t)lround(d * 16777215.0);
             }
-            upload_image(depth, all, VK_IMAGE_ASPECT_DEPTH_BIT, staging, layout);
+            upload_image(depth, all, data, staging, layout);
             free_buffer(staging);
 
             HrtsContext *ctx = create_context(vk, 1);
@@ -1205,6 +1231,12 @@ static void engine_depth(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
         CHECK(r == HRTS_RESULT_ERROR_INVALID_ENUM && strstr(hrts_last_error(ctx), "depth_format"),
               "depth_format %u refused: %s", refused[i], hrts_last_error(ctx));
     }
+    /* normals derived from depth need the projection's depth, not view Z */
+    t.depth_format = VK_FORMAT_R32_SFLOAT;
+    t.normal_encoding = HRTS_NORMAL_ENCODING_NONE;
+    HrtsResult r = hrts_set_targets(ctx, &t);
+    CHECK(r == HRTS_RESULT_ERROR_INVALID_ARGUMENT && strstr(hrts_last_error(ctx), "view-Z"),
+          "view Z without normals refused: %s", hrts_last_error(ctx));
     CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
 }
 

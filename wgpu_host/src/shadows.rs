@@ -1,0 +1,507 @@
+//! Everything this renderer needed to add the plugin's shadows, in one file: the device wgpu opens with
+//! what the plugin adopts, the context, the renderer's meshes and images handed over as they are, and the
+//! frame recorded into a wgpu command encoder through wgpu-hal's Vulkan interop.
+
+use anyhow::{bail, Context as _, Result};
+use ash::vk::{self, Handle};
+use glam::Mat4;
+use hrts_plugin::*;
+use std::ffi::{c_char, c_void, CStr, CString};
+use wgpu::hal::api::Vulkan;
+
+/// What the plugin needs to know of the features wgpu enabled.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct EnabledFeatures {
+    geometry_shader: bool,
+    fragment_stores_and_atomics: bool,
+    depth_clamp: bool,
+}
+
+/// Opens a wgpu device on `adapter` with `features`, adding the two Vulkan 1.3 features the plugin records
+/// with (`synchronization2`, `dynamicRendering`) to what wgpu enables itself.
+pub fn open_device(
+    adapter: &wgpu::Adapter,
+    features: wgpu::Features,
+) -> Result<(wgpu::Device, wgpu::Queue, EnabledFeatures)> {
+    let mut sync2 = vk::PhysicalDeviceSynchronization2Features::default().synchronization2(true);
+    let mut dynamic_rendering =
+        vk::PhysicalDeviceDynamicRenderingFeatures::default().dynamic_rendering(true);
+    let mut enabled = EnabledFeatures::default();
+    let open = {
+        // SAFETY: the adapter outlives the guard; the callback only adds features the plugin checks for.
+        let hal = unsafe { adapter.as_hal::<Vulkan>() }.context("the adapter is not Vulkan")?;
+        let (sync2, dynamic_rendering, enabled) =
+            (&mut sync2, &mut dynamic_rendering, &mut enabled);
+        let callback: Box<wgpu::hal::vulkan::CreateDeviceCallback<'_>> = Box::new(move |args| {
+            let core = args.device_features.get_core();
+            *enabled = EnabledFeatures {
+                geometry_shader: core.geometry_shader == vk::TRUE,
+                fragment_stores_and_atomics: core.fragment_stores_and_atomics == vk::TRUE,
+                depth_clamp: core.depth_clamp == vk::TRUE,
+            };
+            let info = std::mem::take(args.create_info);
+            *args.create_info = info.push_next(sync2).push_next(dynamic_rendering);
+        });
+        // SAFETY: the features are supported by every Vulkan 1.3 device, which the plugin requires.
+        unsafe {
+            hal.open_with_callback(features, &wgpu::MemoryHints::Performance, Some(callback))
+        }?
+    };
+    let desc = wgpu::DeviceDescriptor {
+        label: Some("wgpu_host"),
+        required_features: features,
+        ..Default::default()
+    };
+    // SAFETY: `open` was created from this adapter with `features`.
+    let (device, queue) = unsafe { adapter.create_device_from_hal(open, &desc) }?;
+    Ok((device, queue, enabled))
+}
+
+/// The renderer's images the plugin reads and writes.
+pub struct ShadowTargets<'a> {
+    /// Depth buffer, or linear view-Z image (its usage includes `TEXTURE_BINDING`).
+    pub depth: &'a wgpu::Texture,
+    /// Normal target (`TEXTURE_BINDING`), encoded as `normal_encoding` says.
+    pub normal: &'a wgpu::Texture,
+    /// Octahedral or xyz.
+    pub normal_encoding: HrtsNormalEncoding,
+    /// View or world space.
+    pub normal_space: HrtsNormalSpace,
+    /// The shadow image the plugin writes, one layer per light (`COPY_DST`).
+    pub shadow: &'a wgpu::Texture,
+}
+
+/// A wgpu buffer the renderer created through Vulkan (wgpu does not expose a buffer's `VkBuffer`), so
+/// that the plugin can read it.
+pub struct SharedBuffer {
+    /// The buffer, for wgpu.
+    pub buffer: wgpu::Buffer,
+    /// Its `VkBuffer`.
+    pub raw: u64,
+}
+
+/// Creates a device-local buffer of `size` bytes for wgpu `usage` that the plugin may read as a storage
+/// buffer; wgpu owns it (and frees its memory) from then on.
+pub fn shared_buffer(
+    device: &wgpu::Device,
+    label: &str,
+    size: u64,
+    usage: wgpu::BufferUsages,
+) -> Result<SharedBuffer> {
+    let size = size.next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT);
+    // SAFETY: the guard lives through this function, the device beyond it.
+    let hal = unsafe { device.as_hal::<Vulkan>() }.context("the device is not Vulkan")?;
+    let raw_device = hal.raw_device();
+    let info = vk::BufferCreateInfo::default()
+        .size(size)
+        .usage(
+            vk::BufferUsageFlags::VERTEX_BUFFER
+                | vk::BufferUsageFlags::INDEX_BUFFER
+                | vk::BufferUsageFlags::STORAGE_BUFFER
+                | vk::BufferUsageFlags::TRANSFER_DST
+                | vk::BufferUsageFlags::TRANSFER_SRC,
+        )
+        .sharing_mode(vk::SharingMode::EXCLUSIVE);
+    // SAFETY: valid create info on a live device.
+    let raw = unsafe { raw_device.create_buffer(&info, None) }?;
+    // SAFETY: `raw` was created above.
+    let needs = unsafe { raw_device.get_buffer_memory_requirements(raw) };
+    let instance = hal.shared_instance().raw_instance();
+    // SAFETY: the physical device belongs to the instance.
+    let types =
+        unsafe { instance.get_physical_device_memory_properties(hal.raw_physical_device()) };
+    let type_index = (0..types.memory_type_count)
+        .filter(|&i| needs.memory_type_bits & (1 << i) != 0)
+        .max_by_key(|&i| {
+            types.memory_types[i as usize]
+                .property_flags
+                .contains(vk::MemoryPropertyFlags::DEVICE_LOCAL)
+        })
+        .context("no memory type for a vertex buffer")?;
+    let alloc = vk::MemoryAllocateInfo::default()
+        .allocation_size(needs.size)
+        .memory_type_index(type_index);
+    // SAFETY: a valid allocation for `raw`'s requirements, bound once, then handed to wgpu, which frees
+    // both when the wgpu buffer is dropped.
+    let buffer = unsafe {
+        let memory = raw_device.allocate_memory(&alloc, None)?;
+        raw_device.bind_buffer_memory(raw, memory, 0)?;
+        let hal_buffer = wgpu::hal::vulkan::Buffer::from_raw_managed(raw, memory, 0, size);
+        device.create_buffer_from_hal::<Vulkan>(
+            hal_buffer,
+            &wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: usage | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            },
+        )
+    };
+    Ok(SharedBuffer {
+        buffer,
+        raw: raw.as_raw(),
+    })
+}
+
+/// One of the renderer's meshes: its own vertex buffer of `Float32x3` positions and index buffer, and
+/// its instances.
+pub struct ShadowMesh<'a> {
+    /// Vertex buffer.
+    pub vertices: &'a SharedBuffer,
+    /// Number of vertices.
+    pub vertex_count: u32,
+    /// Index buffer.
+    pub indices: &'a SharedBuffer,
+    /// Number of indices.
+    pub index_count: u32,
+    /// 16- or 32-bit indices.
+    pub index_format: wgpu::IndexFormat,
+    /// Object-to-world transform of each instance.
+    pub instances: &'a [Mat4],
+    /// World-space bounds of the instances (min, max).
+    pub bounds: [glam::Vec3; 2],
+}
+
+/// A frame's camera, in wgpu's conventions, and its directional light.
+pub struct ShadowFrame {
+    /// Increasing frame counter.
+    pub index: u64,
+    /// World to view.
+    pub view: Mat4,
+    /// View to clip as wgpu takes it (clip y up).
+    pub proj: Mat4,
+    /// Camera position.
+    pub camera_position: glam::Vec3,
+    /// Direction the light travels.
+    pub light_direction: glam::Vec3,
+    /// Orthographic light view-projection enclosing the scene (Vulkan clip conventions).
+    pub light_view_proj: Mat4,
+    /// World-space bounds of the scene this frame (min, max): the plugin culls by them as instances move.
+    pub bounds: [glam::Vec3; 2],
+}
+
+/// The plugin's context on the renderer's device.
+pub struct Shadows {
+    context: *mut HrtsContext,
+    adapter: wgpu::Adapter,
+}
+
+impl Shadows {
+    /// Adopts `device` (opened by [`open_device`] on `adapter`) with one directional light in `mode` (hard:
+    /// the exact ray-traced visibility, without FXAA).
+    pub fn new(
+        adapter: &wgpu::Adapter,
+        device: &wgpu::Device,
+        enabled: EnabledFeatures,
+        frames_in_flight: u32,
+        mode: HrtsShadowMode,
+    ) -> Result<Self> {
+        // SAFETY: the guard is dropped at the end of this function; the handles stay valid as long as
+        // `device`, which the caller keeps beyond the context.
+        let hal = unsafe { device.as_hal::<Vulkan>() }.context("the device is not Vulkan")?;
+        let shared = hal.shared_instance();
+        let names: Vec<CString> = hal
+            .enabled_device_extensions()
+            .iter()
+            .map(|&n| n.to_owned())
+            .collect();
+        let name_ptrs: Vec<*const c_char> = names.iter().map(|n| n.as_ptr()).collect();
+        let debug_utils = shared.extensions().contains(&ash::ext::debug_utils::NAME);
+        let vulkan = HrtsVulkanDevice {
+            struct_size: size_of::<HrtsVulkanDevice>() as u32,
+            // SAFETY: the same function pointer type, with the loader's C calling convention.
+            get_instance_proc_addr: Some(unsafe {
+                std::mem::transmute::<
+                    vk::PFN_vkGetInstanceProcAddr,
+                    unsafe extern "C" fn(
+                        *mut c_void,
+                        *const c_char,
+                    ) -> Option<unsafe extern "C" fn()>,
+                >(shared.entry().static_fn().get_instance_proc_addr)
+            }),
+            instance: shared.raw_instance().handle().as_raw(),
+            physical_device: hal.raw_physical_device().as_raw(),
+            device: hal.raw_device().handle().as_raw(),
+            queue_family_index: hal.queue_family_index(),
+            queue_index: 0,
+            enabled_extensions: name_ptrs.as_ptr(),
+            enabled_extension_count: name_ptrs.len() as u32,
+            geometry_shader: enabled.geometry_shader.into(),
+            fragment_stores_and_atomics: enabled.fragment_stores_and_atomics.into(),
+            depth_clamp: enabled.depth_clamp.into(),
+            debug_utils: debug_utils.into(),
+        };
+        let info = HrtsContextCreateInfo {
+            struct_size: size_of::<HrtsContextCreateInfo>() as u32,
+            api_version: HRTS_API_VERSION,
+            vulkan: &vulkan,
+            device_name_filter: std::ptr::null(),
+            enable_validation: 0,
+            frames_in_flight,
+        };
+        let mut context = std::ptr::null_mut();
+        // SAFETY: valid structs whose pointers outlive the call.
+        let result = unsafe { hrts_context_create(&info, &mut context) };
+        if result != HrtsResult::Ok {
+            // SAFETY: NULL context: the thread's last error, a NUL-terminated string.
+            let why = unsafe { CStr::from_ptr(hrts_last_error(std::ptr::null())) };
+            bail!("hrts_context_create: {result:?}: {}", why.to_string_lossy());
+        }
+        let shadows = Self {
+            context,
+            adapter: adapter.clone(),
+        };
+        // SAFETY: plain data; all zeros is a valid value, filled by the defaults below.
+        let mut config: HrtsConfig = unsafe { std::mem::zeroed() };
+        config.struct_size = size_of::<HrtsConfig>() as u32;
+        // SAFETY: `config` is valid with its size set.
+        shadows.check("hrts_config_defaults", unsafe {
+            hrts_config_defaults(&mut config)
+        })?;
+        config.mode = mode as u32;
+        // Hard shadows as the rays give them, without FXAA: exact per pixel.
+        config.antialiasing = u32::from(mode != HrtsShadowMode::Hard);
+        // SAFETY: live context, valid configuration.
+        shadows.check("hrts_configure", unsafe {
+            hrts_configure(shadows.context, &config)
+        })?;
+        Ok(shadows)
+    }
+
+    /// Hands the meshes to the plugin: their buffers as they are, one draw per instance.
+    pub fn set_meshes(&self, meshes: &[ShadowMesh<'_>]) -> Result<()> {
+        let draws: Vec<Vec<HrtsDraw>> = meshes
+            .iter()
+            .map(|m| {
+                m.instances
+                    .iter()
+                    .map(|t| HrtsDraw {
+                        first_index: 0,
+                        index_count: m.index_count,
+                        transform: t.to_cols_array(),
+                        base_vertex: 0,
+                    })
+                    .collect()
+            })
+            .collect();
+        let geometry: Vec<HrtsVulkanGeometry> = meshes
+            .iter()
+            .zip(&draws)
+            .map(|(m, draws)| {
+                let [lo, hi] = m.bounds;
+                HrtsVulkanGeometry {
+                    struct_size: size_of::<HrtsVulkanGeometry>() as u32,
+                    vertex_buffer: m.vertices.raw,
+                    vertex_buffer_size: m.vertices.buffer.size(),
+                    vertex_offset: 0,
+                    vertex_stride: 12,
+                    vertex_count: m.vertex_count,
+                    index_buffer: m.indices.raw,
+                    index_buffer_size: m.indices.buffer.size(),
+                    index_offset: 0,
+                    index_type: match m.index_format {
+                        wgpu::IndexFormat::Uint16 => HrtsIndexType::Uint16,
+                        wgpu::IndexFormat::Uint32 => HrtsIndexType::Uint32,
+                    } as u32,
+                    index_count: m.index_count,
+                    draws: draws.as_ptr(),
+                    draw_count: draws.len() as u32,
+                    bounds: [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z],
+                    vertex_format: vk::Format::R32G32B32_SFLOAT.as_raw() as u32,
+                    position_scale: [0.0; 3],
+                    position_offset: [0.0; 3],
+                }
+            })
+            .collect();
+        // SAFETY: live context; `geometry` and the draws it points at outlive the call.
+        // SAFETY: live context; `geometry` and the draws it points at outlive the call.
+        self.check("hrts_set_geometry_vulkan_meshes", unsafe {
+            hrts_set_geometry_vulkan_meshes(self.context, geometry.as_ptr(), geometry.len() as u32)
+        })
+    }
+
+    /// Moves the instances: one transform per instance of every mesh, in mesh order.
+    pub fn move_instances(&self, transforms: &[Mat4]) -> Result<()> {
+        let floats: Vec<f32> = transforms.iter().flat_map(|t| t.to_cols_array()).collect();
+        // SAFETY: live context; 16 floats per transform.
+        self.check("hrts_set_draw_transforms", unsafe {
+            hrts_set_draw_transforms(self.context, transforms.len() as u32, floats.as_ptr())
+        })
+    }
+
+    /// Hands the renderer's images to the plugin.
+    pub fn set_targets(&self, targets: &ShadowTargets<'_>) -> Result<()> {
+        let size = targets.depth.size();
+        let raw = |t: &wgpu::Texture| -> Result<u64> {
+            // SAFETY: a live texture of the adopted device.
+            let hal = unsafe { t.as_hal::<Vulkan>() }.context("not a Vulkan texture")?;
+            // SAFETY: as above.
+            Ok(unsafe { hal.raw_handle() }.as_raw())
+        };
+        // SAFETY: the adapter outlives the guard.
+        let adapter = unsafe { self.adapter.as_hal::<Vulkan>() }.context("not a Vulkan adapter")?;
+        let format = |f| adapter.texture_format_as_raw(f).as_raw() as u32;
+        let t = HrtsTargets {
+            struct_size: size_of::<HrtsTargets>() as u32,
+            width: size.width,
+            height: size.height,
+            depth_image: raw(targets.depth)?,
+            depth_usage: vulkan_usage(targets.depth),
+            depth_format: format(targets.depth.format()),
+            normal_image: raw(targets.normal)?,
+            normal_usage: vulkan_usage(targets.normal),
+            normal_format: format(targets.normal.format()),
+            normal_encoding: targets.normal_encoding as u32,
+            normal_space: targets.normal_space as u32,
+            output_image: raw(targets.shadow)?,
+            output_usage: vulkan_usage(targets.shadow),
+            output_layers: targets.shadow.depth_or_array_layers(),
+            output_format: format(targets.shadow.format()),
+        };
+        // SAFETY: live context and images.
+        self.check("hrts_set_targets", unsafe {
+            hrts_set_targets(self.context, &t)
+        })
+    }
+
+    /// Records the frame's shadows: `before` leaves the targets in the states the plugin reads them in,
+    /// then the plugin's passes go into their own command encoder (wgpu records its passes when an encoder
+    /// finishes, so hal commands in the same encoder would run before them). Submit the two buffers in
+    /// order; wgpu's next use of the shadow image waits for the plugin's copy into it.
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        before: &mut wgpu::CommandEncoder,
+        targets: &ShadowTargets<'_>,
+        frame: &ShadowFrame,
+    ) -> Result<wgpu::CommandBuffer> {
+        let state = |texture, state| wgpu::TextureTransition {
+            texture,
+            selector: None,
+            state,
+        };
+        before.transition_resources(
+            std::iter::empty(),
+            [
+                state(targets.depth, wgpu::TextureUses::RESOURCE),
+                state(targets.normal, wgpu::TextureUses::RESOURCE),
+                state(targets.shadow, wgpu::TextureUses::COPY_DST),
+            ]
+            .into_iter(),
+        );
+        let light = HrtsLight {
+            light_type: HrtsLightType::Directional as u32,
+            position: [0.0; 3],
+            direction: frame.light_direction.to_array(),
+            view_proj: frame.light_view_proj.to_cols_array(),
+            range: 0.0,
+            outer_cone: 0.0,
+        };
+        let vulkan_clip = Mat4::from_scale(glam::Vec3::new(1.0, -1.0, 1.0));
+        // The layouts wgpu gives a sampled texture: depth formats are read in a depth read-only layout.
+        let depth_layout = if targets.depth.format().is_depth_stencil_format() {
+            vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL
+        } else {
+            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL
+        };
+        let transfer_dst = vk::ImageLayout::TRANSFER_DST_OPTIMAL.as_raw();
+        let [lo, hi] = frame.bounds;
+        let mut plugin = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("shadows"),
+        });
+        // SAFETY: nothing else records into `plugin` while the callback runs; the plugin leaves the command
+        // buffer open and the images in the layouts wgpu's states above give them.
+        let result = unsafe {
+            plugin.as_hal_mut::<Vulkan, _, _>(|encoder| {
+                let encoder = encoder.context("not a Vulkan command encoder")?;
+                let f = HrtsFrame {
+                    struct_size: size_of::<HrtsFrame>() as u32,
+                    command_buffer: encoder.raw_handle().as_raw(),
+                    frame_index: frame.index,
+                    view: frame.view.to_cols_array(),
+                    proj: (vulkan_clip * frame.proj).to_cols_array(),
+                    camera_position: frame.camera_position.to_array(),
+                    lights: &light,
+                    light_count: 1,
+                    depth_layout: depth_layout.as_raw(),
+                    normal_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL.as_raw(),
+                    output_layout_before: transfer_dst,
+                    output_layout_after: transfer_dst,
+                    bounds: [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z],
+                    has_bounds: 1,
+                    deformed: std::ptr::null(),
+                    deformed_count: 0,
+                };
+                anyhow::Ok(hrts_record_frame(self.context, &f))
+            })
+        }?;
+        self.check("hrts_record_frame", result)?;
+        Ok(plugin.finish())
+    }
+
+    /// The report of frame `frame_index` (completed on the GPU).
+    pub fn report(&self, frame_index: u64) -> Result<HrtsFrameReport> {
+        // SAFETY: plain data; all zeros is a valid value.
+        let mut report: HrtsFrameReport = unsafe { std::mem::zeroed() };
+        report.struct_size = size_of::<HrtsFrameReport>() as u32;
+        // SAFETY: live context; `report` has its size set.
+        self.check("hrts_get_frame_report", unsafe {
+            hrts_get_frame_report(self.context, frame_index, 0, &mut report)
+        })?;
+        Ok(report)
+    }
+
+    fn check(&self, call: &str, result: HrtsResult) -> Result<()> {
+        if result == HrtsResult::Ok {
+            return Ok(());
+        }
+        // SAFETY: live context; the message is NUL-terminated and read before the next call.
+        let why = unsafe { CStr::from_ptr(hrts_last_error(self.context)) };
+        bail!("{call}: {result:?}: {}", why.to_string_lossy())
+    }
+}
+
+impl Drop for Shadows {
+    fn drop(&mut self) {
+        // SAFETY: the context is live and destroyed once; the renderer waited for its frames.
+        unsafe { hrts_context_destroy(self.context) };
+    }
+}
+
+/// The `VkImageUsageFlags` of a texture's wgpu usages.
+fn vulkan_usage(texture: &wgpu::Texture) -> u32 {
+    let u = texture.usage();
+    let depth = texture.format().is_depth_stencil_format();
+    let mut flags = vk::ImageUsageFlags::empty();
+    for (wgpu_usage, vulkan) in [
+        (
+            wgpu::TextureUsages::COPY_SRC,
+            vk::ImageUsageFlags::TRANSFER_SRC,
+        ),
+        (
+            wgpu::TextureUsages::COPY_DST,
+            vk::ImageUsageFlags::TRANSFER_DST,
+        ),
+        (
+            wgpu::TextureUsages::TEXTURE_BINDING,
+            vk::ImageUsageFlags::SAMPLED,
+        ),
+        (
+            wgpu::TextureUsages::STORAGE_BINDING,
+            vk::ImageUsageFlags::STORAGE,
+        ),
+        (
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+            if depth {
+                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+            } else {
+                vk::ImageUsageFlags::COLOR_ATTACHMENT
+            },
+        ),
+    ] {
+        if u.contains(wgpu_usage) {
+            flags |= vulkan;
+        }
+    }
+    flags.as_raw()
+}
