@@ -10,6 +10,7 @@
 //! GPU timestamps around every pass; medians over the frames after the first.
 
 use crate::accuracy::compare_visibility;
+use crate::gbuffer::GBufferLayout;
 use crate::peer::run_peer;
 use crate::plugin::PluginRenderer;
 use crate::render::{map_bytes, median_timings};
@@ -54,6 +55,11 @@ pub struct BenchArgs {
     /// context, spread over each scene's interior; at most the plugin's light limit). 0: none.
     #[arg(long, default_value_t = 0, requires = "lights")]
     pub point_lights: u32,
+    /// Instead of the shadow table: the demo's G-buffer as the plugin first required it (RGBA32F world
+    /// normals and positions, D32 depth) against a compact one (D24S8 depth, octahedral RG16F view-space
+    /// normals), with the G-buffer's and the plugin's GPU ms on each model.
+    #[arg(long, conflicts_with = "lights")]
+    pub gbuffer: bool,
 }
 
 /// One benchmark model: a file of `../shared/models`, how it is shown, and the talk's GTX 980 times (ms)
@@ -202,7 +208,17 @@ fn frames_of(
     config: ShadowConfig,
     frames: u32,
 ) -> Result<(PluginRenderer, Vec<FrameReport>)> {
-    let mut renderer = PluginRenderer::new(device, view, config)?;
+    frames_with_layout(device, view, config, frames, GBufferLayout::ANALYSIS)
+}
+
+fn frames_with_layout(
+    device: &Device,
+    view: &View,
+    config: ShadowConfig,
+    frames: u32,
+    layout: GBufferLayout,
+) -> Result<(PluginRenderer, Vec<FrameReport>)> {
+    let mut renderer = PluginRenderer::with_layout(device, view, config, layout)?;
     let inputs = view.frame_inputs();
     let reports = (0..frames.max(2))
         .map(|_| renderer.render(device, &inputs))
@@ -392,6 +408,76 @@ pub fn run_bench(device: &Device, args: &BenchArgs) -> Result<String> {
     Ok(out)
 }
 
+/// The G-buffer table: per model, the demo's G-buffer pass and the plugin's passes (medians, ms) with the
+/// analysis G-buffer and with a compact one.
+pub fn run_gbuffer_bench(device: &Device, args: &BenchArgs) -> Result<String> {
+    let models = match &args.models {
+        Some(dir) => dir.clone(),
+        None => scene::models_dir().map_err(anyhow::Error::msg)?,
+    };
+    let caps = device.capabilities();
+    let compact = GBufferLayout::compact(device);
+    let chosen: Vec<&Model> = MODELS
+        .iter()
+        .filter(|m| args.only.is_empty() || args.only.iter().any(|o| m.file.contains(o.as_str())))
+        .collect();
+    let mut out = format!(
+        "Device: {} ({}); {}×{}, default settings (hybrid); medians of {} frames after the first (GPU \
+         timestamps, ms). G-buffer as first required: position and world normal RGBA32F, D32 depth (32 bytes \
+         a pixel written); compact: {:?} depth and octahedral view-space normals in {:?} (8 bytes a pixel).\n\n\
+         | model | G-buffer | G-buffer ms | plugin ms | map build ms | ray trace ms | PCSS ms | blend ms |\n\
+         |---|---|---:|---:|---:|---:|---:|---:|\n",
+        caps.device_name,
+        caps.driver,
+        args.width,
+        args.height,
+        args.frames.max(2) - 1,
+        compact.depth,
+        compact.normal,
+    );
+    let bar = crate::progress(chosen.len() as u64 * 2, "bench --gbuffer");
+    for model in chosen {
+        let view = view_of(model, &models, args)?;
+        for (name, layout) in [
+            ("as first required", GBufferLayout::ANALYSIS),
+            ("compact", compact),
+        ] {
+            bar.set_message(format!("{} ({name})", model.file));
+            let (_, reports) =
+                frames_with_layout(device, &view, ShadowConfig::default(), args.frames, layout)?;
+            let times = median_timings(&reports);
+            let sum = |prefix: &str| -> f64 {
+                times
+                    .iter()
+                    .filter(|(k, _)| k.starts_with(prefix))
+                    .fold(0.0, |total, (_, v)| total + v)
+            };
+            let plugin: f64 = times
+                .iter()
+                .filter(|(k, _)| {
+                    k.as_str() != "gbuffer" && k.as_str() != crate::plugin::SCREEN_SPACE_WALL
+                })
+                .fold(0.0, |total, (_, v)| total + v);
+            out.push_str(&format!(
+                "| {} | {name} | {:.3} | {plugin:.3} | {:.3} | {:.3} | {:.3} | {:.3} |\n",
+                model.file,
+                sum("gbuffer"),
+                sum("primitive map"),
+                sum("ray trace"),
+                sum("PCSS"),
+                sum("hybrid blend"),
+            ));
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    out.push_str(
+        "\nplugin ms = every pass the plugin timed (the shared prim buffer included), map build = every \
+         `primitive map:` pass.\n",
+    );
+    Ok(out)
+}
+
 /// Entry point of the subcommand: prints the tables and writes them to `out` if given.
 pub fn run_cli(device: &Device, args: &BenchArgs, out: Option<&Path>) -> Result<()> {
     let tables = if args.lights {
@@ -400,6 +486,8 @@ pub fn run_cli(device: &Device, args: &BenchArgs, out: Option<&Path>) -> Result<
             None => scene::models_dir().map_err(anyhow::Error::msg)?,
         };
         crate::light_bench::run_light_bench(device, args, &models)?
+    } else if args.gbuffer {
+        run_gbuffer_bench(device, args)?
     } else {
         run_bench(device, args)?
     };

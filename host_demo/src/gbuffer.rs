@@ -1,12 +1,14 @@
-//! G-buffer for the demo host: world position, camera-facing geometric normal, reversed-Z depth.
+//! G-buffer for the demo host: depth, the normal target the plugin reads (in any of the encodings engines
+//! keep), and, for analysis, frame-relative positions and world normals in RGBA32F.
 //!
-//! Reads: the pipeline's prim buffer. Writes: position, normal, depth. Shaders: `gbuffer.vert` and
-//! `gbuffer.frag` in `host_demo/shaders/`.
+//! Reads: the pipeline's prim buffer. Writes: the targets of its [`GBufferLayout`]. Shaders: `gbuffer.vert`
+//! and `gbuffer.frag` (analysis), `gbuffer_encoded.frag` (analysis and an encoded normal target),
+//! `gbuffer_compact.frag` (depth and the encoded normal alone) in `host_demo/shaders/`.
 
 use crate::{shader, CameraMatrices};
 use bytemuck::{Pod, Zeroable};
-use glam::{DMat4, DVec3, Mat4, Vec4};
-use passes::PassError;
+use glam::{DMat4, DVec3, Mat3, Mat4, Vec4};
+use passes::{NormalEncoding, NormalSpace, PassError, SurfaceInput};
 use rhi::{
     BindGroup, BindingKind, Buffer, ColorTarget, DepthState, DepthTarget, Device, Encoder, Format,
     GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, ImageUsage, Resource,
@@ -18,17 +20,23 @@ use rhi::{
 pub struct GBufferPush {
     /// proj * view with the camera at the origin.
     pub view_proj_rel: Mat4,
-    /// Camera position in frame coordinates (xyz).
+    /// Camera position in frame coordinates (xyz); w: the normal target's code ([`GBufferLayout::code`]).
     pub camera_pos: Vec4,
+    /// The view rotation's rows (world to view).
+    pub view_rows: [Vec4; 3],
 }
 
-const _: () = assert!(std::mem::size_of::<GBufferPush>() == 80);
+const _: () = assert!(std::mem::size_of::<GBufferPush>() == 128);
 
 impl GBufferPush {
-    /// The constants of `camera` for a prim buffer relative to `origin`: the view-projection of
-    /// coordinates relative to the camera, composed in f64 as the plugin composes its own
+    /// The constants of `camera` for a prim buffer relative to `origin` and a G-buffer of `layout`: the
+    /// view-projection of coordinates relative to the camera, composed in f64 as the plugin composes its own
     /// (`passes::camera_in_frame`), so that the G-buffer and the plugin agree on every pixel's ray.
-    pub fn for_camera(camera: &CameraMatrices, origin: DVec3) -> Result<Self, PassError> {
+    pub fn for_camera(
+        camera: &CameraMatrices,
+        origin: DVec3,
+        layout: &GBufferLayout,
+    ) -> Result<Self, PassError> {
         let relative_view =
             camera.view.as_dmat4() * DMat4::from_translation(camera.position.as_dvec3());
         let view_proj_rel = (camera.proj.as_dmat4() * relative_view).as_mat4();
@@ -38,46 +46,251 @@ impl GBufferPush {
                 "camera matrices are not finite".into(),
             ));
         }
+        let rows = Mat3::from_mat4(camera.view).transpose();
         Ok(Self {
             view_proj_rel,
-            camera_pos: camera_frame.extend(1.0),
+            camera_pos: camera_frame.extend(layout.code() as f32),
+            view_rows: [rows.x_axis, rows.y_axis, rows.z_axis].map(|r| r.extend(0.0)),
         })
     }
 }
 
-/// The G-buffer's images.
-pub struct GBufferTargets {
+/// What the demo's G-buffer keeps: the depth format, the normal target the plugin reads (format,
+/// encoding, space), and whether it also keeps the analysis targets that read-backs need.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GBufferLayout {
+    /// Depth format (reversed Z).
+    pub depth: Format,
+    /// Format of the normal target the plugin reads.
+    pub normal: Format,
+    /// How that target encodes the normal.
+    pub surface: SurfaceInput,
+    /// Whether the G-buffer keeps frame-relative positions and world normals (RGBA32F) to read back.
+    pub analysis: bool,
+}
+
+/// The normal targets the demo can keep, by name: every encoding the plugin reads.
+pub const NORMAL_TARGETS: [(&str, Format, NormalEncoding, NormalSpace); 8] = [
+    (
+        "rgba32f-world",
+        Format::Rgba32Float,
+        NormalEncoding::XyzCoverage,
+        NormalSpace::World,
+    ),
+    (
+        "rgba16f-world",
+        Format::Rgba16Float,
+        NormalEncoding::Xyz,
+        NormalSpace::World,
+    ),
+    (
+        "rgb10a2-view",
+        Format::Rgb10A2Unorm,
+        NormalEncoding::Xyz,
+        NormalSpace::View,
+    ),
+    (
+        "rgba8-world",
+        Format::Rgba8Unorm,
+        NormalEncoding::Xyz,
+        NormalSpace::World,
+    ),
+    (
+        "oct-rg16snorm-view",
+        Format::Rg16Snorm,
+        NormalEncoding::Octahedral,
+        NormalSpace::View,
+    ),
+    (
+        "oct-rg16unorm-world",
+        Format::Rg16Unorm,
+        NormalEncoding::Octahedral,
+        NormalSpace::World,
+    ),
+    (
+        "oct-rg16f-view",
+        Format::Rg16Float,
+        NormalEncoding::Octahedral,
+        NormalSpace::View,
+    ),
+    (
+        "oct-rgb10a2-world",
+        Format::Rgb10A2Unorm,
+        NormalEncoding::Octahedral,
+        NormalSpace::World,
+    ),
+];
+
+impl GBufferLayout {
+    /// The analysis G-buffer: D32 depth and RGBA32F world normals with coverage in w, which the plugin
+    /// reads as they are, and positions.
+    pub const ANALYSIS: Self = Self {
+        depth: Format::D32Float,
+        normal: Format::Rgba32Float,
+        surface: SurfaceInput {
+            encoding: NormalEncoding::XyzCoverage,
+            space: NormalSpace::World,
+        },
+        analysis: true,
+    };
+
+    /// A compact G-buffer as engines keep one: D24S8 depth (D32 where the device cannot render and sample
+    /// D24S8) and octahedral view-space normals in RG16F; nothing to read back.
+    pub fn compact(device: &Device) -> Self {
+        let d24s8 = Format::D24UnormS8Uint;
+        let usable = device.can_render(d24s8) && device.can_sample(d24s8);
+        Self {
+            depth: if usable { d24s8 } else { Format::D32Float },
+            normal: Format::Rg16Float,
+            surface: SurfaceInput {
+                encoding: NormalEncoding::Octahedral,
+                space: NormalSpace::View,
+            },
+            analysis: false,
+        }
+    }
+
+    /// The analysis G-buffer with the normal target named `name` (one of [`NORMAL_TARGETS`]) for the plugin.
+    pub fn analysis_with(name: &str) -> Result<Self, String> {
+        let &(_, normal, encoding, space) =
+            NORMAL_TARGETS.iter().find(|t| t.0 == name).ok_or_else(|| {
+                let names: Vec<&str> = NORMAL_TARGETS.iter().map(|t| t.0).collect();
+                format!(
+                    "unknown normal target {name:?}: one of {}",
+                    names.join(", ")
+                )
+            })?;
+        Ok(Self {
+            normal,
+            surface: SurfaceInput { encoding, space },
+            ..Self::ANALYSIS
+        })
+    }
+
+    /// The shaders' code of the normal target: bit 0 octahedral, bit 1 unorm channels, bit 2 view space.
+    pub fn code(&self) -> u32 {
+        u32::from(self.surface.encoding == NormalEncoding::Octahedral)
+            | u32::from(self.normal.is_unorm()) << 1
+            | u32::from(self.surface.space == NormalSpace::View) << 2
+    }
+
+    /// Whether the plugin reads the analysis normals themselves (no separate normal target).
+    fn reads_analysis_normals(&self) -> bool {
+        self.analysis
+            && self.normal == Self::ANALYSIS.normal
+            && self.surface == Self::ANALYSIS.surface
+    }
+
+    /// Colour formats of the pass, in attachment order.
+    fn color_formats(&self) -> Vec<Format> {
+        match (self.analysis, self.reads_analysis_normals()) {
+            (true, true) => vec![Format::Rgba32Float; 2],
+            (true, false) => vec![Format::Rgba32Float, Format::Rgba32Float, self.normal],
+            (false, _) => vec![self.normal],
+        }
+    }
+
+    fn fragment_shader(&self) -> &'static str {
+        match (self.analysis, self.reads_analysis_normals()) {
+            (true, true) => "gbuffer.frag",
+            (true, false) => "gbuffer_encoded.frag",
+            (false, _) => "gbuffer_compact.frag",
+        }
+    }
+}
+
+/// The analysis targets: what read-backs and reports need besides what the plugin reads.
+pub struct AnalysisTargets {
     /// World position in frame coordinates (xyz), w = 1 on geometry, 0 on background.
     pub position: Image,
-    /// Geometric normal facing the camera (xyz), w = 1 on geometry.
+    /// Geometric normal facing the camera (world xyz), w = 1 on geometry; none when the plugin's normal
+    /// target is this very image.
+    pub normal: Option<Image>,
+}
+
+/// The G-buffer's images.
+pub struct GBufferTargets {
+    /// What they hold.
+    pub layout: GBufferLayout,
+    /// The normal target the plugin reads.
     pub normal: Image,
     /// Reversed-Z depth (1 near, 0 far/background).
     pub depth: Image,
+    /// The analysis targets, if the layout keeps them.
+    pub analysis: Option<AnalysisTargets>,
 }
 
 impl GBufferTargets {
-    /// Creates `width` x `height` targets.
-    pub fn new(device: &Device, width: u32, height: u32) -> Result<Self, PassError> {
-        let color = |name| ImageDesc {
+    /// Creates `width` x `height` targets of `layout`.
+    pub fn new(
+        device: &Device,
+        width: u32,
+        height: u32,
+        layout: GBufferLayout,
+    ) -> Result<Self, PassError> {
+        for format in [layout.depth, layout.normal] {
+            if !device.can_render(format) || !device.can_sample(format) {
+                return Err(PassError::InvalidConfig(format!(
+                    "the device cannot render to and sample {format:?} for the G-buffer"
+                )));
+            }
+        }
+        let color = |name, format| ImageDesc {
             name,
-            format: Format::Rgba32Float,
+            format,
             width,
             height,
             layers: 1,
             usage: ImageUsage::COLOR_TARGET | ImageUsage::SAMPLED | ImageUsage::COPY_SRC,
         };
+        let analysis = layout
+            .analysis
+            .then(|| -> Result<_, PassError> {
+                Ok(AnalysisTargets {
+                    position: device
+                        .create_image(&color("gbuffer position", Format::Rgba32Float))?,
+                    normal: (!layout.reads_analysis_normals())
+                        .then(|| device.create_image(&color("gbuffer normal", Format::Rgba32Float)))
+                        .transpose()?,
+                })
+            })
+            .transpose()?;
         Ok(Self {
-            position: device.create_image(&color("gbuffer position"))?,
-            normal: device.create_image(&color("gbuffer normal"))?,
+            layout,
+            normal: device.create_image(&color("gbuffer engine normal", layout.normal))?,
             depth: device.create_image(&ImageDesc {
                 name: "gbuffer depth",
-                format: Format::D32Float,
+                format: layout.depth,
                 width,
                 height,
                 layers: 1,
                 usage: ImageUsage::DEPTH_TARGET | ImageUsage::SAMPLED | ImageUsage::COPY_SRC,
             })?,
+            analysis,
         })
+    }
+
+    /// The colour targets in attachment order.
+    pub fn colors(&self) -> Vec<&Image> {
+        match &self.analysis {
+            Some(a) => match &a.normal {
+                Some(n) => vec![&a.position, n, &self.normal],
+                None => vec![&a.position, &self.normal],
+            },
+            None => vec![&self.normal],
+        }
+    }
+
+    /// The frame-relative positions (analysis layouts).
+    pub fn position(&self) -> Option<&Image> {
+        self.analysis.as_ref().map(|a| &a.position)
+    }
+
+    /// The world normals with coverage in w (analysis layouts).
+    pub fn world_normal(&self) -> Option<&Image> {
+        self.analysis
+            .as_ref()
+            .map(|a| a.normal.as_ref().unwrap_or(&self.normal))
     }
 }
 
@@ -88,18 +301,18 @@ pub struct GBufferPass {
 }
 
 impl GBufferPass {
-    /// Creates the pass rasterizing `prims` into targets of [`GBufferTargets`].
-    pub fn new(device: &Device, prims: &Buffer) -> Result<Self, PassError> {
+    /// Creates the pass rasterizing `prims` into targets of `layout`.
+    pub fn new(device: &Device, prims: &Buffer, layout: &GBufferLayout) -> Result<Self, PassError> {
         let pipeline = device.create_graphics_pipeline(&GraphicsPipelineDesc {
             name: "gbuffer",
             vertex: &shader("gbuffer.vert")?,
             geometry: None,
-            fragment: &shader("gbuffer.frag")?,
+            fragment: &shader(layout.fragment_shader())?,
             bindings: &[BindingKind::StorageBuffer],
             push_constant_size: std::mem::size_of::<GBufferPush>() as u32,
-            color_formats: &[Format::Rgba32Float, Format::Rgba32Float],
+            color_formats: &layout.color_formats(),
             depth: Some(DepthState {
-                format: Format::D32Float,
+                format: layout.depth,
                 write: true,
                 greater: true,
             }),
@@ -119,18 +332,17 @@ impl GBufferPass {
         triangle_count: u32,
     ) -> Result<(), PassError> {
         enc.begin_pass("gbuffer");
+        let colors: Vec<ColorTarget<'_>> = targets
+            .colors()
+            .into_iter()
+            .map(|image| ColorTarget {
+                image,
+                clear: [0.0; 4],
+            })
+            .collect();
         enc.begin_rendering(
-            (targets.position.width(), targets.position.height()),
-            &[
-                ColorTarget {
-                    image: &targets.position,
-                    clear: [0.0; 4],
-                },
-                ColorTarget {
-                    image: &targets.normal,
-                    clear: [0.0; 4],
-                },
-            ],
+            (targets.depth.width(), targets.depth.height()),
+            &colors,
             Some(DepthTarget {
                 image: &targets.depth,
                 clear: 0.0,

@@ -8,6 +8,7 @@
 //! capacity).
 
 use crate::bench::BenchArgs;
+use crate::gbuffer::GBufferLayout;
 use crate::plugin::{c_point_light, LightsFrame, PluginRenderer};
 use crate::scene_plan::{plan_scene, PlanSettings};
 use crate::scene_render::SceneRenderer;
@@ -231,8 +232,14 @@ fn measure_native_points(
     name: String,
     args: &BenchArgs,
 ) -> Result<LightCost> {
-    let mut plugin =
-        PluginRenderer::for_scene(device, &file.scene, args.width, args.height, false)?;
+    let mut plugin = PluginRenderer::for_scene(
+        device,
+        &file.scene,
+        args.width,
+        args.height,
+        false,
+        GBufferLayout::ANALYSIS,
+    )?;
     let config = ShadowConfig {
         mode: ShadowMode::Hard,
         antialiasing: false,

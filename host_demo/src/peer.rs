@@ -4,7 +4,7 @@
 
 use crate::plugin::PluginRenderer;
 use crate::{read_images, FrameImages, FrameOutput};
-use anyhow::Result;
+use anyhow::{Context as _, Result};
 use passes::rt_peer::{shadow_ray_constants, RtPeerPass};
 use passes::{FrameInputs, PassError};
 use rhi::{Device, ResourceState as S};
@@ -44,7 +44,9 @@ pub fn run_peer(
         renderer.prims(),
         geometry.triangle_count(),
         &targets.depth,
-        &targets.normal,
+        targets
+            .world_normal()
+            .context("the ray-tracing peer reads the analysis G-buffer's world normals")?,
         width,
         height,
     )?;

@@ -7,7 +7,7 @@
 //! images come back through `hrts_record_resource_readback`, the report through `hrts_get_frame_report`.
 //! So what the demo shows is what an integrator gets.
 
-use crate::gbuffer::{GBufferPass, GBufferPush, GBufferTargets};
+use crate::gbuffer::{GBufferLayout, GBufferPass, GBufferPush, GBufferTargets};
 use crate::{read_images, upload_scene, CameraMatrices, FrameImages, FrameOutput, View};
 use anyhow::{bail, Context as _, Result};
 use glam::Mat4;
@@ -140,6 +140,16 @@ impl PluginRenderer {
     /// its size, and a plugin context on `device` configured with `config` (one light), asking for the
     /// blocker distance when it traces rays (the demo compares it with the exact reference).
     pub fn new(device: &Device, view: &View, config: impl Into<ShadowConfig>) -> Result<Self> {
+        Self::with_layout(device, view, config, GBufferLayout::ANALYSIS)
+    }
+
+    /// [`PluginRenderer::new`] with a G-buffer of `layout`.
+    pub fn with_layout(
+        device: &Device,
+        view: &View,
+        config: impl Into<ShadowConfig>,
+        layout: GBufferLayout,
+    ) -> Result<Self> {
         let config = crate::renderer::with_blocker_distance(config.into());
         let mut renderer = Self::for_scene(
             device,
@@ -147,6 +157,7 @@ impl PluginRenderer {
             view.width,
             view.height,
             !config.static_geometry,
+            layout,
         )?;
         renderer.configure_lights(device, &[config])?;
         Ok(renderer)
@@ -155,21 +166,22 @@ impl PluginRenderer {
     /// Uploads `scene` into the demo's buffers, creates the G-buffer for a `width` x `height` frame and a
     /// plugin context on `device` that has the geometry but no light yet ([`PluginRenderer::configure_lights`]).
     /// `dynamic_geometry`: the demo rebuilds its own prim buffer every frame, as the plugin does when a
-    /// light's configuration says so.
+    /// light's configuration says so. `layout`: what the G-buffer keeps.
     pub fn for_scene(
         device: &Device,
         scene: &Scene,
         width: u32,
         height: u32,
         dynamic_geometry: bool,
+        layout: GBufferLayout,
     ) -> Result<Self> {
         if width == 0 || height == 0 {
             bail!("frame size must be non-zero");
         }
         let geometry = upload_scene(device, scene).context("uploading the scene")?;
         let prim_buffer = PrimBufferPass::new(device, &geometry)?;
-        let gbuffer = GBufferPass::new(device, prim_buffer.prims())?;
-        let targets = GBufferTargets::new(device, width, height)?;
+        let gbuffer = GBufferPass::new(device, prim_buffer.prims(), &layout)?;
+        let targets = GBufferTargets::new(device, width, height, layout)?;
         let context = create_context(device)?;
         set_geometry(&context, &geometry, &scene.bounds())?;
         Ok(Self {
@@ -220,8 +232,11 @@ impl PluginRenderer {
                 normal_image: t.normal.raw_handle(),
                 normal_usage: t.normal.raw_usage(),
                 normal_format: t.normal.format().raw_vk() as u32,
-                normal_encoding: HrtsNormalEncoding::XyzCoverage as u32,
-                normal_space: HrtsNormalSpace::World as u32,
+                normal_encoding: normal_encoding(t.layout.surface.encoding) as u32,
+                normal_space: match t.layout.surface.space {
+                    passes::NormalSpace::World => HrtsNormalSpace::World,
+                    passes::NormalSpace::View => HrtsNormalSpace::View,
+                } as u32,
                 output_image: output.raw_handle(),
                 output_usage: output.raw_usage(),
                 output_layers: layers,
@@ -312,7 +327,7 @@ impl PluginRenderer {
                 self.configured.len()
             );
         }
-        let push = GBufferPush::for_camera(camera, self.geometry.origin())?;
+        let push = GBufferPush::for_camera(camera, self.geometry.origin(), &self.targets.layout)?;
         let tris = self.geometry.triangle_count();
         let rebuild_prims = self.frames == 0 || self.dynamic_geometry;
         let with_plugin = !c_lights.is_empty();
@@ -330,16 +345,7 @@ impl PluginRenderer {
             if with_plugin {
                 self.record_passes(&frame_in(enc.raw_handle()), HRTS_PASS_MASK_LIGHT_SPACE)?;
             }
-            let undefined_to = |image, after| Barrier::Image {
-                image,
-                before: S::Undefined,
-                after,
-            };
-            enc.barriers(&[
-                undefined_to(&t.position, S::RenderTarget),
-                undefined_to(&t.normal, S::RenderTarget),
-                undefined_to(&t.depth, S::DepthWrite),
-            ]);
+            enc.barriers(&t.to_render());
             self.gbuffer
                 .record(enc, t, &push, tris)
                 .map_err(recording_error)?;
@@ -625,6 +631,16 @@ pub const SCREEN_SPACE_WALL: &str = "screen-space submission (wall clock)";
 /// An error while recording, in the form `Device::submit_and_wait` passes on.
 fn recording_error(e: impl std::fmt::Display) -> rhi::RhiError {
     rhi::RhiError::InvalidArgument(format!("{e:#}"))
+}
+
+/// The C encoding of `encoding`.
+fn normal_encoding(encoding: passes::NormalEncoding) -> HrtsNormalEncoding {
+    match encoding {
+        passes::NormalEncoding::XyzCoverage => HrtsNormalEncoding::XyzCoverage,
+        passes::NormalEncoding::Xyz => HrtsNormalEncoding::Xyz,
+        passes::NormalEncoding::Octahedral => HrtsNormalEncoding::Octahedral,
+        passes::NormalEncoding::FromDepth => HrtsNormalEncoding::None,
+    }
 }
 
 /// A context adopting `device`.

@@ -1,12 +1,12 @@
 //! The demo host's frame: prim buffer → G-buffer → [`ShadowPipeline`], submitted and waited for, with
 //! read-back of every output the plan produced.
 
-use crate::gbuffer::{GBufferPass, GBufferPush, GBufferTargets};
+use crate::gbuffer::{GBufferLayout, GBufferPass, GBufferPush, GBufferTargets};
 use crate::CameraMatrices;
 use glam::DVec3;
 use passes::{
     FrameInputs, FrameReport, Geometry, PassError, PassId, ResourceId, ShadowConfig, ShadowInputs,
-    ShadowMode, ShadowPipeline, SurfaceInput,
+    ShadowMode, ShadowPipeline,
 };
 use rhi::{Barrier, Buffer, BufferUsage, Device, Image, MemoryLocation, ResourceState as S};
 
@@ -68,17 +68,17 @@ impl ShadowRenderer {
         }
         let mut config = with_blocker_distance(config.into());
         config.extra_outputs = config.extra_outputs.with(ResourceId::PrimBuffer);
-        let targets = GBufferTargets::new(device, width, height)?;
+        let targets = GBufferTargets::new(device, width, height, GBufferLayout::ANALYSIS)?;
         let inputs = ShadowInputs {
             depth: &targets.depth,
             normal: &targets.normal,
-            surface: SurfaceInput::default(),
+            surface: targets.layout.surface,
         };
         let pipeline = ShadowPipeline::new(device, geometry, &inputs, config)?;
         let prims = pipeline.prims().ok_or_else(|| {
             PassError::InvalidConfig("the demo G-buffer needs the prim buffer".into())
         })?;
-        let gbuffer = GBufferPass::new(device, prims)?;
+        let gbuffer = GBufferPass::new(device, prims, &targets.layout)?;
         Ok(Self {
             targets,
             gbuffer,
@@ -100,6 +100,7 @@ impl ShadowRenderer {
         let push = GBufferPush::for_camera(
             &CameraMatrices::of_frame(inputs),
             self.pipeline.geometry().origin(),
+            &self.targets.layout,
         )?;
         let tris = self.pipeline.geometry().triangle_count();
         let Self {
@@ -111,23 +112,7 @@ impl ShadowRenderer {
         device.submit_and_wait(|enc| {
             let (prim_buffer, rest) = PassId::ALL.split_at(1);
             pipeline.record_passes(enc, prim_buffer).map_err(into_rhi)?;
-            enc.barriers(&[
-                Barrier::Image {
-                    image: &targets.position,
-                    before: S::Undefined,
-                    after: S::RenderTarget,
-                },
-                Barrier::Image {
-                    image: &targets.normal,
-                    before: S::Undefined,
-                    after: S::RenderTarget,
-                },
-                Barrier::Image {
-                    image: &targets.depth,
-                    before: S::Undefined,
-                    after: S::DepthWrite,
-                },
-            ]);
+            enc.barriers(&targets.to_render());
             gbuffer
                 .record(enc, targets, &push, tris)
                 .map_err(into_rhi)?;
@@ -181,13 +166,41 @@ impl ShadowRenderer {
 }
 
 impl GBufferTargets {
-    /// The G-buffer images, their state after a frame, and where they go in [`FrameImages`].
+    /// The G-buffer images read back, their state after a frame, and where they go in [`FrameImages`]:
+    /// the analysis targets and the depth (none for a compact G-buffer).
     pub fn outputs(&self) -> Vec<(&Image, S, FrameOutput)> {
+        let (Some(position), Some(normal)) = (self.position(), self.world_normal()) else {
+            return Vec::new();
+        };
+        let normal_state = if std::ptr::eq(normal, &self.normal) {
+            S::ShaderResource
+        } else {
+            S::RenderTarget
+        };
         vec![
-            (&self.position, S::RenderTarget, FrameOutput::Position),
-            (&self.normal, S::ShaderResource, FrameOutput::Normal),
+            (position, S::RenderTarget, FrameOutput::Position),
+            (normal, normal_state, FrameOutput::Normal),
             (&self.depth, S::ShaderResource, FrameOutput::Depth),
         ]
+    }
+
+    /// Barriers taking every target from undefined contents to its rendering state.
+    pub fn to_render(&self) -> Vec<Barrier<'_>> {
+        let mut barriers: Vec<Barrier<'_>> = self
+            .colors()
+            .into_iter()
+            .map(|image| Barrier::Image {
+                image,
+                before: S::Undefined,
+                after: S::RenderTarget,
+            })
+            .collect();
+        barriers.push(Barrier::Image {
+            image: &self.depth,
+            before: S::Undefined,
+            after: S::DepthWrite,
+        });
+        barriers
     }
 }
 

@@ -3,6 +3,7 @@
 //! light's visibility, and per frame and light what ran, what was culled or reused and why, and the
 //! memory it holds.
 
+use crate::gbuffer::GBufferLayout;
 use crate::output::{write_exr_rgba, write_exr_scalar, write_png};
 use crate::plugin::{LightFrameReport, LightsFrame, PluginRenderer};
 use crate::scene_plan::{plan_scene, PlanSettings, ScenePlan};
@@ -45,8 +46,14 @@ impl SceneRenderer {
     /// frame; the geometry is dynamic if any object is not static.
     pub fn new(device: &Device, file: &SceneFile, width: u32, height: u32) -> Result<Self> {
         let dynamic_geometry = file.static_objects.iter().any(|&s| !s);
-        let plugin =
-            PluginRenderer::for_scene(device, &file.scene, width, height, dynamic_geometry)?;
+        let plugin = PluginRenderer::for_scene(
+            device,
+            &file.scene,
+            width,
+            height,
+            dynamic_geometry,
+            GBufferLayout::ANALYSIS,
+        )?;
         Ok(Self {
             plugin,
             width,

@@ -101,51 +101,80 @@ bool surface_step(ivec2 px, ivec2 axis, vec3 center, float depth, mat4 inv_view_
     return found;
 }
 
+// The normal at `px` derived from depth, facing the camera: two steps along the surface, along x and y, or,
+// where an axis has no neighbour holding geometry or a worse one than a diagonal, along the better diagonal
+// (a sliver of surface between a silhouette and the background). A pixel with no two steps on its surface
+// gets a normal facing the camera; false then.
+bool derived_normal(ivec2 px, float depth, vec3 rel, mat4 inv_view_proj_rel, uvec2 dims, float background,
+                    out vec3 n) {
+    vec3 dx, dy, da, db;
+    float sx, sy, sa, sb;
+    bool has_x = surface_step(px, ivec2(1, 0), rel, depth, inv_view_proj_rel, dims, background, dx, sx);
+    bool has_y = surface_step(px, ivec2(0, 1), rel, depth, inv_view_proj_rel, dims, background, dy, sy);
+    bool has_a = surface_step(px, ivec2(1, 1), rel, depth, inv_view_proj_rel, dims, background, da, sa);
+    bool has_b = surface_step(px, ivec2(1, -1), rel, depth, inv_view_proj_rel, dims, background, db, sb);
+    vec3 diagonal = (has_a && (!has_b || sa <= sb)) ? da : db;
+    float sd = (has_a && (!has_b || sa <= sb)) ? sa : sb;
+    bool has_d = has_a || has_b;
+    if (has_d && (!has_x || sd < sx) && has_y) {
+        dx = diagonal;
+        has_x = true;
+    } else if (has_d && (!has_y || sd < sy) && has_x) {
+        dy = diagonal;
+        has_y = true;
+    }
+    vec3 c = cross(dx, dy);
+    bool found = has_x && has_y && dot(c, c) > 0.0;
+    n = found ? normalize(c) : -normalize(rel);
+    if (dot(n, rel) > 0.0) {
+        n = -n;
+    }
+    return found;
+}
+
 // The normal at `px`, whose point `engine_point` found at `rel` with the stored `depth`. Normals derived
 // from depth need a depth image of the projection's depth (the plugin refuses them with view Z).
 bool engine_surface(ivec2 px, float depth, vec3 rel, mat4 inv_view_proj_rel, uvec2 dims, uvec4 mode,
                     mat4 view_to_world, float background, out vec3 n) {
     n = vec3(0.0, 0.0, 1.0);
     if (mode.x == NORMAL_FROM_DEPTH) {
-        // Two steps along the surface: along x and y, or, where an axis has no neighbour holding geometry
-        // or a worse one than a diagonal, along the better diagonal (a sliver of surface between a
-        // silhouette and the background).
-        vec3 dx, dy, da, db;
-        float sx, sy, sa, sb;
-        bool has_x = surface_step(px, ivec2(1, 0), rel, depth, inv_view_proj_rel, dims, background, dx, sx);
-        bool has_y = surface_step(px, ivec2(0, 1), rel, depth, inv_view_proj_rel, dims, background, dy, sy);
-        bool has_a = surface_step(px, ivec2(1, 1), rel, depth, inv_view_proj_rel, dims, background, da, sa);
-        bool has_b = surface_step(px, ivec2(1, -1), rel, depth, inv_view_proj_rel, dims, background, db, sb);
-        vec3 diagonal = (has_a && (!has_b || sa <= sb)) ? da : db;
-        float sd = (has_a && (!has_b || sa <= sb)) ? sa : sb;
-        bool has_d = has_a || has_b;
-        if (has_d && (!has_x || sd < sx) && has_y) {
-            dx = diagonal;
-            has_x = true;
-        } else if (has_d && (!has_y || sd < sy) && has_x) {
-            dy = diagonal;
-            has_y = true;
-        }
-        vec3 c = cross(dx, dy);
-        // A pixel with no two steps on its surface: the normal faces the camera.
-        n = has_x && has_y && dot(c, c) > 0.0 ? normalize(c) : -normalize(rel);
-    } else {
-        vec4 v = texelFetch(normal_tex, px, 0);
-        if (mode.x == NORMAL_XYZ_COVERAGE && v.w == 0.0) {
-            return false;
-        }
-        vec4 s = mode.y != 0u ? v * 2.0 - 1.0 : v;
-        n = mode.x == NORMAL_OCTAHEDRAL ? octahedral_decode(s.xy) : s.xyz;
-        if (mode.z != 0u) {
-            n = mat3(view_to_world) * n;
-        }
-        if (!(dot(n, n) > 0.0)) {
-            return false;
-        }
-        n = normalize(n);
+        derived_normal(px, depth, rel, inv_view_proj_rel, dims, background, n);
+        return true;
     }
+    vec4 v = texelFetch(normal_tex, px, 0);
+    if (mode.x == NORMAL_XYZ_COVERAGE && v.w == 0.0) {
+        return false;
+    }
+    vec4 s = mode.y != 0u ? v * 2.0 - 1.0 : v;
+    n = mode.x == NORMAL_OCTAHEDRAL ? octahedral_decode(s.xy) : s.xyz;
+    if (mode.z != 0u) {
+        n = mat3(view_to_world) * n;
+    }
+    if (!(dot(n, n) > 0.0)) {
+        return false;
+    }
+    n = normalize(n);
     if (dot(n, rel) > 0.0) {
         n = -n;     // the side the camera sees
     }
     return true;
+}
+
+// Whether the surface at `px` (normal `n` from engine_surface) faces a light in direction `to_light`. The
+// engine's normal decides, unless it lies within its own precision (surface.z: the sine of the largest
+// angle by which the encoding tilts it) of perpendicular to the light: then the normal derived from a depth
+// image of the projection's depth decides where it agrees with the engine's within that precision, as on a
+// surface's interior, where it holds the plane far better than an 8-bit channel does.
+bool faces_light(ivec2 px, vec3 n, vec3 to_light, float depth, vec3 rel, mat4 inv_view_proj_rel,
+                 uvec2 dims, vec4 surface) {
+    float c = dot(n, normalize(to_light));
+    vec3 d;
+    // The derived normal is taken only where it describes the same surface: within twice the encoding's
+    // tilt of the engine's normal (not at a silhouette or a thin part, where the neighbours lie elsewhere).
+    if (abs(c) > surface.z || surface.y > 0.0
+        || !derived_normal(px, depth, rel, inv_view_proj_rel, dims, surface.x, d)
+        || length(cross(d, n)) > 2.0 * surface.z || dot(d, n) <= 0.0) {
+        return c > 0.0;
+    }
+    return dot(d, to_light) > 0.0;
 }

@@ -16,5 +16,6 @@ struct PcssConstants {
     GpuLight light;
     mat4 view_to_world;     // the camera's rotation, view to world (for view-space normals)
     uvec4 surface_mode;     // the engine's normal: see engine_surface.glsl
-    vec4 surface;           // x: the depth of background pixels, y: a view-Z image's relative precision
+    vec4 surface;           // x: the depth of background pixels, y: a view-Z image's relative precision,
+                            // z: the normal image's precision
 };

@@ -116,10 +116,12 @@ void main() {
     vec3 p = k.camera_pos.xyz + rel;
     vec3 to_light = is_spot() ? normalize(k.light.position.xyz - p) : -k.light.direction.xyz;
     float cos_t = dot(n, to_light);
-    if (!(cos_t > 0.0)) {
+    if (!faces_light(px, n, to_light, depth, rel, k.inv_view_proj_rel, k.dims.xy, k.surface)) {
         store(px, 0.0);     // the visible side faces away from the light
         return;
     }
+    // Facing decided within the normal's precision may leave a cosine at or below 0: keep the slope finite.
+    cos_t = max(cos_t, 1e-4);
     vec4 lc = k.light.view_proj * vec4(p, 1.0);
     if (!(lc.w > 0.0)) {
         store(px, 1.0);     // behind a spot light

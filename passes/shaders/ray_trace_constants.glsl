@@ -13,6 +13,7 @@ struct RayTraceConstants {
     vec4 light_pos;             // spot light: xyz position in frame coordinates, w = 1; directional: w = 0
     mat4 view_to_world;         // the camera's rotation, view to world (for view-space normals)
     uvec4 surface_mode;         // the engine's normal: see engine_surface.glsl
-    vec4 surface;               // x: the depth of background pixels, y: a view-Z image's relative precision
+    vec4 surface;               // x: the depth of background pixels, y: a view-Z image's relative precision,
+                                // z: the normal image's precision (engine_surface.glsl)
                                 // (0: the depth image holds the projection's depth)
 };

@@ -30,7 +30,7 @@ int shadow_ray(ivec2 px, out vec3 o, out vec3 dir, out float t_max) {
     vec3 p = k.camera_pos.xyz + rel;
     bool spot = k.light_pos.w != 0.0;
     vec3 to_light = spot ? k.light_pos.xyz - p : -k.light_dir.xyz;
-    if (dot(n, to_light) <= 0.0) {
+    if (!faces_light(px, n, to_light, depth, rel, k.inv_view_proj_rel, k.dims.xy, k.surface)) {
         return SHADOW_RAY_FACING_AWAY;
     }
     vec3 ap = abs(p);

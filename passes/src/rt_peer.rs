@@ -195,6 +195,6 @@ pub fn shadow_ray_constants(
         light_pos: light.position.map_or(Vec4::ZERO, |p| p.extend(1.0)),
         view_to_world: crate::surface::view_to_world(inputs.view),
         surface_mode: crate::surface::SurfaceInput::default().mode(rhi::Format::Rgba32Float),
-        surface: crate::surface::surface_vector(inputs.proj, rhi::Format::D32Float),
+        surface: crate::surface::surface_vector(inputs.proj, rhi::Format::D32Float, 0.0),
     })
 }

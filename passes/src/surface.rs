@@ -65,6 +65,23 @@ impl SurfaceInput {
         }
     }
 
+    /// The sine of the largest angle by which a normal image of `format` tilts the normal it holds in this
+    /// encoding (0 for normals derived from depth): three times a channel's rounding error e, which bounds
+    /// the tilt of an xyz encoding (√3 e) and of an octahedral one (2√2 e). Below it the passes let the
+    /// normal derived from depth decide whether a receiver faces the light.
+    pub fn normal_precision(&self, format: Format) -> f32 {
+        let e = match format {
+            _ if self.encoding == NormalEncoding::FromDepth => return 0.0,
+            Format::Rgba32Float => f32::EPSILON / 2.0,
+            Format::Rgba16Float | Format::Rg16Float => 1.0 / 2048.0,
+            Format::Rg16Unorm => 1.0 / 65535.0,
+            Format::Rg16Snorm => 0.5 / 32767.0,
+            Format::Rgb10A2Unorm => 1.0 / 1023.0,
+            _ => 1.0 / 255.0,
+        };
+        3.0 * e
+    }
+
     /// The shader's mode vector for a normal image of `format`: x the encoding, y whether the channels are
     /// normalized to [0, 1] (mapped to [-1, 1]), z whether the normal is in view space.
     pub fn mode(&self, format: Format) -> UVec4 {
@@ -114,12 +131,13 @@ pub fn view_z_precision(format: Format) -> f32 {
 }
 
 /// The shader's surface vector: x the background depth of `proj`, y the view-Z precision of a depth image
-/// of `depth_format` ([`view_z_precision`]).
-pub fn surface_vector(proj: Mat4, depth_format: Format) -> Vec4 {
+/// of `depth_format` ([`view_z_precision`]), z the normal image's precision
+/// ([`SurfaceInput::normal_precision`]).
+pub fn surface_vector(proj: Mat4, depth_format: Format, normal_precision: f32) -> Vec4 {
     Vec4::new(
         background_depth(proj),
         view_z_precision(depth_format),
-        0.0,
+        normal_precision,
         0.0,
     )
 }
@@ -157,10 +175,34 @@ mod tests {
     #[test]
     fn view_z_images_say_their_precision() {
         let proj = Mat4::perspective_infinite_reverse_rh(1.0, 1.5, 0.1);
-        assert_eq!(surface_vector(proj, Format::D32Float).y, 0.0);
-        assert_eq!(surface_vector(proj, Format::D24UnormS8Uint).y, 0.0);
-        assert_eq!(surface_vector(proj, Format::R32Float).y, f32::EPSILON);
-        assert_eq!(surface_vector(proj, Format::R16Float).y, 1.0 / 1024.0);
+        assert_eq!(surface_vector(proj, Format::D32Float, 0.0).y, 0.0);
+        assert_eq!(surface_vector(proj, Format::D24UnormS8Uint, 0.0).y, 0.0);
+        assert_eq!(surface_vector(proj, Format::R32Float, 0.0).y, f32::EPSILON);
+        assert_eq!(surface_vector(proj, Format::R16Float, 0.0).y, 1.0 / 1024.0);
+    }
+
+    #[test]
+    fn normal_precision_follows_the_channels() {
+        let xyz = SurfaceInput {
+            encoding: NormalEncoding::Xyz,
+            space: NormalSpace::World,
+        };
+        let rgba8 = xyz.normal_precision(Format::Rgba8Unorm);
+        // An 8-bit channel tilts the normal by up to about 0.4°: more than a light 0.1° from grazing.
+        assert!(rgba8 > 0.1f32.to_radians().sin() && rgba8 < 1.0f32.to_radians().sin());
+        assert!(xyz.normal_precision(Format::Rgba32Float) < 1e-6);
+        let oct = SurfaceInput {
+            encoding: NormalEncoding::Octahedral,
+            ..xyz
+        };
+        assert!(
+            oct.normal_precision(Format::Rg16Unorm) < oct.normal_precision(Format::Rgb10A2Unorm)
+        );
+        let derived = SurfaceInput {
+            encoding: NormalEncoding::FromDepth,
+            ..xyz
+        };
+        assert_eq!(derived.normal_precision(Format::Rgba8Unorm), 0.0);
     }
 
     #[test]

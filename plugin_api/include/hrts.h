@@ -289,7 +289,10 @@ typedef uint32_t HrtsLightDecision;
 // How the engine's normal image encodes the surface normal (`HrtsTargets::normal_encoding`). The normal
 // may be a shading normal: a receiver whose normal faces away from the light is in its own shadow, as the
 // engine shades it, and the ray origin moves off the surface along it (a quantized encoding tilts it by
-// under 0.5°, inside the offset's margin).
+// under 0.5°, inside the offset's margin). Where the normal lies within its encoding's tilt of
+// perpendicular to the light (a grazing light), the normal derived from a depth image decides which side
+// faces the light wherever the two agree within that tilt, so an 8-bit normal does not flip a plane lit
+// 0.1° from grazing into shadow.
 enum HrtsNormalEncoding
 #if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
   : uint32_t

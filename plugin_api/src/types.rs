@@ -266,7 +266,10 @@ pub enum HrtsLightType {
 /// How the engine's normal image encodes the surface normal (`HrtsTargets::normal_encoding`). The normal
 /// may be a shading normal: a receiver whose normal faces away from the light is in its own shadow, as the
 /// engine shades it, and the ray origin moves off the surface along it (a quantized encoding tilts it by
-/// under 0.5°, inside the offset's margin).
+/// under 0.5°, inside the offset's margin). Where the normal lies within its encoding's tilt of
+/// perpendicular to the light (a grazing light), the normal derived from a depth image decides which side
+/// faces the light wherever the two agree within that tilt, so an 8-bit normal does not flip a plane lit
+/// 0.1° from grazing into shadow.
 #[repr(u32)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum HrtsNormalEncoding {

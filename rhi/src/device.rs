@@ -582,6 +582,17 @@ impl Device {
             .contains(vk::FormatFeatureFlags::SAMPLED_IMAGE)
     }
 
+    /// Whether images of `format` can be rendered to with optimal tiling: as a colour attachment, or as a
+    /// depth attachment for depth formats.
+    pub fn can_render(&self, format: Format) -> bool {
+        let needed = if format.is_depth() {
+            vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT
+        } else {
+            vk::FormatFeatureFlags::COLOR_ATTACHMENT
+        };
+        self.optimal_features(format).contains(needed)
+    }
+
     /// Whether [`crate::Encoder::blit_into_layer`] can write optimally tiled images of `dst` from images
     /// of `src`.
     pub fn can_blit(&self, src: Format, dst: Format) -> bool {

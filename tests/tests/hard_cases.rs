@@ -18,15 +18,21 @@
 mod common;
 
 use common::{assert_no_validation_errors, device, models};
+use host_demo::gbuffer::GBufferLayout;
 use host_demo::hardcases::{run_cases, table, Outcome};
 use scene::hard_cases::{family, Expectation, Family};
 
 /// Runs the light cases of `f` on a validated device, prints their table and checks each.
 fn check_family(f: Family) -> Vec<Outcome> {
+    check_family_with(f, GBufferLayout::ANALYSIS)
+}
+
+/// [`check_family`] with the plugin reading a G-buffer of `layout`.
+fn check_family_with(f: Family, layout: GBufferLayout) -> Vec<Outcome> {
     let device = device();
     let cases: Vec<_> = family(f, &models()).into_iter().collect();
     assert!(!cases.is_empty());
-    let outcomes = run_cases(&device, &cases, None);
+    let outcomes = run_cases(&device, &cases, layout, None);
     println!("{}", table(&outcomes, false));
     for (case, o) in cases.iter().zip(&outcomes) {
         match case.expectation {
@@ -167,5 +173,20 @@ fn overflow_keeps_the_guard_layer_and_exact_visibility() {
             o.name
         );
         assert_eq!(o.guard_written, Some(0), "{}", o.name);
+    }
+}
+
+/// The families where the engine's normal decides most (which side of a grazing light a receiver faces,
+/// where a ray leaves a surface touching another), with the plugin reading each normal target engines keep
+/// instead of RGBA32F: quantized and octahedral normals, in world and view space. (The whole suite for every
+/// encoding: `host_demo hardcases --normals NAME`, docs/hardcases_normal_encodings_lavapipe.txt.)
+#[test]
+fn grazing_and_contact_cases_hold_with_every_normal_encoding() {
+    for (name, ..) in host_demo::gbuffer::NORMAL_TARGETS.iter().skip(1) {
+        let layout = GBufferLayout::analysis_with(name).expect("a named normal target");
+        for f in [Family::Grazing, Family::Contact, Family::Coplanar] {
+            println!("normals {name}, {}", f.name());
+            check_family_with(f, layout);
+        }
     }
 }

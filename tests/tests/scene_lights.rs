@@ -344,8 +344,15 @@ fn a_native_point_light_matches_the_exact_reference() {
     let lamp = Vec3::new(0.15, 2.5, 0.1);
     let file = closed_room(lamp);
     let camera = camera(&file);
-    let mut plugin =
-        PluginRenderer::for_scene(&device, &file.scene, WIDTH, HEIGHT, false).expect("plugin");
+    let mut plugin = PluginRenderer::for_scene(
+        &device,
+        &file.scene,
+        WIDTH,
+        HEIGHT,
+        false,
+        host_demo::gbuffer::GBufferLayout::ANALYSIS,
+    )
+    .expect("plugin");
     let config = ShadowConfig {
         mode: ShadowMode::Hard,
         antialiasing: false,

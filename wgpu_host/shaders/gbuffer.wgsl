@@ -18,9 +18,9 @@ struct Varyings {
     @location(1) view_z: f32,
 }
 
+// The normal target and a linear view-space z (`fs_view_z`, for renderers that keep one).
 struct Targets {
     @location(0) normal: vec4<f32>,
-    // Linear view-space z, for renderers that keep it (written only where the pipeline has the target).
     @location(1) view_z: f32,
 }
 
@@ -38,8 +38,7 @@ fn octahedral(n: vec3<f32>) -> vec2<f32> {
     return (1.0 - abs(p.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), p >= vec2<f32>(0.0));
 }
 
-@fragment
-fn fs(v: Varyings) -> Targets {
+fn encoded_normal(v: Varyings) -> vec4<f32> {
     var n = normalize(cross(dpdx(v.rel), dpdy(v.rel)));
     if dot(n, v.rel) > 0.0 {
         n = -n;
@@ -54,5 +53,15 @@ fn fs(v: Varyings) -> Targets {
     if (camera.normal_code & 2u) != 0u {
         e = vec4<f32>(e.xyz * 0.5 + 0.5, 1.0);
     }
-    return Targets(e, v.view_z);
+    return e;
+}
+
+@fragment
+fn fs(v: Varyings) -> @location(0) vec4<f32> {
+    return encoded_normal(v);
+}
+
+@fragment
+fn fs_view_z(v: Varyings) -> Targets {
+    return Targets(encoded_normal(v), v.view_z);
 }

@@ -535,7 +535,11 @@ fn gbuffer_pipeline(
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
             module: &module,
-            entry_point: Some("fs"),
+            entry_point: Some(if conventions.view_z.is_some() {
+                "fs_view_z"
+            } else {
+                "fs"
+            }),
             compilation_options: Default::default(),
             targets: &[
                 Some(conventions.normals.format().into()),

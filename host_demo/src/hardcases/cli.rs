@@ -1,6 +1,7 @@
 //! The `host_demo hardcases` subcommand: its arguments, the run, and the outcome table.
 
 use super::{run_cases, Outcome};
+use crate::gbuffer::GBufferLayout;
 use anyhow::{bail, Result};
 use scene::hard_cases::{Family, HardCase};
 use std::path::PathBuf;
@@ -22,6 +23,10 @@ pub struct HardcasesArgs {
     /// Write a shaded preview PNG of every case into this folder (pixels failing an analytic check in red).
     #[arg(long)]
     pub previews: Option<PathBuf>,
+    /// The normal target the plugin reads: rgba32f-world (the default), rgba16f-world, rgb10a2-view,
+    /// rgba8-world, oct-rg16snorm-view, oct-rg16unorm-world, oct-rg16f-view, oct-rgb10a2-world.
+    #[arg(long, default_value = "rgba32f-world", value_parser = GBufferLayout::analysis_with)]
+    pub normals: GBufferLayout,
 }
 
 fn parse_family(s: &str) -> Result<Family, String> {
@@ -57,7 +62,7 @@ pub fn run_cli(
         .flat_map(|&f| scene::hard_cases::family(f, &models))
         .collect();
     let start = Instant::now();
-    let outcomes = run_cases(&device, &cases, args.previews.as_deref());
+    let outcomes = run_cases(&device, &cases, args.normals, args.previews.as_deref());
     let caps = device.capabilities();
     let path = outcomes
         .iter()
@@ -65,11 +70,14 @@ pub fn run_cli(
         .find(|p| !p.is_empty())
         .unwrap_or("none");
     println!(
-        "Hard cases on {} ({}), {} binning, validation {}: {:.1} s\n",
+        "Hard cases on {} ({}), {} binning, validation {}, the plugin reading {:?} normals ({:?}, {:?}): {:.1} s\n",
         caps.device_name,
         caps.driver,
         path,
         if validation { "on" } else { "off" },
+        args.normals.surface.encoding,
+        args.normals.normal,
+        args.normals.surface.space,
         start.elapsed().as_secs_f64()
     );
     print!("{}", table(&outcomes, args.markdown));

@@ -17,6 +17,7 @@
 //! cannot drift apart.
 
 use crate::accuracy::{compare_map, compare_visibility, fitted_light_matrix};
+use crate::gbuffer::GBufferLayout;
 use crate::output::write_png;
 use crate::plugin::PluginRenderer;
 use crate::{FrameImages, View};
@@ -233,16 +234,22 @@ impl Outcome {
     }
 }
 
-/// Runs `cases` in order on `device`; a case whose [`Check::SameAs`] names an earlier case is compared
-/// with that case's image. With `previews`, writes a shaded PNG per case there (analytic failures red).
-pub fn run_cases(device: &Device, cases: &[HardCase], previews: Option<&Path>) -> Vec<Outcome> {
+/// Runs `cases` in order on `device`, the plugin reading a G-buffer of `layout`; a case whose
+/// [`Check::SameAs`] names an earlier case is compared with that case's image. With `previews`, writes a
+/// shaded PNG per case there (analytic failures red).
+pub fn run_cases(
+    device: &Device,
+    cases: &[HardCase],
+    layout: GBufferLayout,
+    previews: Option<&Path>,
+) -> Vec<Outcome> {
     let mut bases = HashMap::new();
     let bar = crate::progress(cases.len() as u64, "hard cases");
     let outcomes = cases
         .iter()
         .map(|c| {
             bar.set_message(c.name);
-            let o = run_case(device, c, &mut bases, previews);
+            let o = run_case(device, c, layout, &mut bases, previews);
             bar.inc(1);
             o
         })
@@ -257,6 +264,7 @@ type Bases = HashMap<&'static str, (Vec<f32>, Vec<bool>)>;
 fn run_case(
     device: &Device,
     case: &HardCase,
+    layout: GBufferLayout,
     bases: &mut Bases,
     previews: Option<&Path>,
 ) -> Outcome {
@@ -273,7 +281,7 @@ fn run_case(
         }
         (Err(e), Expectation::Renders(_)) => o.error = Some(format!("loading failed: {e}")),
         (Ok(scene), Expectation::Renders(checks)) => {
-            if let Err(e) = measure(device, case, scene, checks, bases, previews, &mut o) {
+            if let Err(e) = measure(device, case, scene, checks, layout, bases, previews, &mut o) {
                 o.error = Some(format!("{e:#}"));
             }
         }
@@ -283,11 +291,13 @@ fn run_case(
     o
 }
 
+#[allow(clippy::too_many_arguments)]
 fn measure(
     device: &Device,
     case: &HardCase,
     scene: &Scene,
     checks: &[Check],
+    layout: GBufferLayout,
     bases: &mut Bases,
     previews: Option<&Path>,
     o: &mut Outcome,
@@ -327,8 +337,8 @@ fn measure(
         receiver_culling: case.map.receiver_culling,
         ..PrimitiveMapConfig::default()
     };
-    let mut renderer =
-        PluginRenderer::new(device, &view, config).context("creating the renderer")?;
+    let mut renderer = PluginRenderer::with_layout(device, &view, config, layout)
+        .context("creating the renderer")?;
     let mut report = renderer.render(device, &inputs).context("rendering")?;
     if report.stats.texels_past_capacity > 0 && case.map.overflow == Overflow::Forbidden {
         // The lists grew to what this frame needed: the next frame, as an engine's would, fits.

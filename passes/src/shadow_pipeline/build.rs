@@ -245,6 +245,7 @@ impl ShadowPipeline {
             height,
             depth_format: inputs.depth.format(),
             surface_mode: inputs.surface.mode(inputs.normal.format()),
+            normal_precision: inputs.surface.normal_precision(inputs.normal.format()),
         };
         // Every resource of the plan exists (a missing one would be a bug in the wiring above).
         if let Some(r) = pipeline

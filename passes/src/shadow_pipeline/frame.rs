@@ -38,7 +38,8 @@ impl ShadowPipeline {
         let dir = light.direction;
         let sm = self.config.shadow_map;
         let view_to_world = surface::view_to_world(inputs.view);
-        let surface = surface::surface_vector(inputs.proj, self.depth_format);
+        let surface =
+            surface::surface_vector(inputs.proj, self.depth_format, self.normal_precision);
         let pc = self.config.pcss;
         Ok(FrameConstants {
             light,

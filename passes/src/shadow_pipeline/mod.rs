@@ -120,6 +120,8 @@ pub struct ShadowPipeline {
     depth_format: rhi::Format,
     /// How the passes decode the engine's normal ([`crate::surface::SurfaceInput::mode`]).
     surface_mode: UVec4,
+    /// The engine's normal image's precision ([`crate::surface::SurfaceInput::normal_precision`]).
+    normal_precision: f32,
 }
 
 impl ShadowPipeline {
