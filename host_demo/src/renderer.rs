@@ -73,6 +73,7 @@ impl ShadowRenderer {
             depth: &targets.depth,
             normal: &targets.normal,
             surface: targets.layout.surface,
+            direct_output: None,
         };
         let pipeline = ShadowPipeline::new(device, geometry, &inputs, config)?;
         let prims = pipeline.prims().ok_or_else(|| {

@@ -32,14 +32,18 @@ pub struct FxaaPass {
 }
 
 impl FxaaPass {
-    /// Creates the pass over `input` (same size as its output).
-    pub fn new(device: &Device, input: &Image) -> Result<Self, PassError> {
-        let output = visibility_image(
-            device,
-            "rt visibility (FXAA)",
-            input.width(),
-            input.height(),
-        )?;
+    /// Creates the pass over `input` (same size as its output), writing `output` when given (else an image
+    /// of its own).
+    pub fn new(device: &Device, input: &Image, output: Option<Image>) -> Result<Self, PassError> {
+        let output = match output {
+            Some(image) => image,
+            None => visibility_image(
+                device,
+                "rt visibility (FXAA)",
+                input.width(),
+                input.height(),
+            )?,
+        };
         let step = ScreenPass::new(
             device,
             "FXAA",

@@ -108,14 +108,19 @@ pub struct BlendPass {
 }
 
 impl BlendPass {
-    /// Creates the pass blending `rts` and `pcss` by `lerp_factor`.
+    /// Creates the pass blending `rts` and `pcss` by `lerp_factor` into `output` when given (else an image
+    /// of its own).
     pub fn new(
         device: &Device,
         rts: &Image,
         pcss: &Image,
         lerp_factor: &Image,
+        output: Option<Image>,
     ) -> Result<Self, PassError> {
-        let output = visibility_image(device, "hybrid visibility", rts.width(), rts.height())?;
+        let output = match output {
+            Some(image) => image,
+            None => visibility_image(device, "hybrid visibility", rts.width(), rts.height())?,
+        };
         let step = ScreenPass::new(
             device,
             "hybrid blend",

@@ -10,22 +10,34 @@ use rhi::{Barrier, BindingKind, Device, Encoder, Image, Resource, ResourceState 
 /// The min-combine pass of one light and its output.
 pub struct MinCombine {
     steps: Vec<ScreenPass>,
+    /// Fills the output with 1 (no frustum recorded); bound to the output alone, since a frustum that never
+    /// ran has an image in no layout to bind.
+    lit: ScreenPass,
     /// `R32_SFLOAT` visibility of the light.
     pub output: Image,
 }
 
 impl MinCombine {
-    /// Creates the pass over `frusta` (at least one, all of the same size).
-    pub fn new(device: &Device, frusta: &[&Image]) -> Result<Self, PassError> {
+    /// Creates the pass over `frusta` (at least one, all of the same size), writing `output` when given
+    /// (an `R32_SFLOAT` storage image of their size, such as a layer of the engine's output) or an image of
+    /// its own.
+    pub fn new(
+        device: &Device,
+        frusta: &[&Image],
+        output: Option<Image>,
+    ) -> Result<Self, PassError> {
         let first = frusta
             .first()
             .ok_or_else(|| PassError::InvalidConfig("a light needs at least one frustum".into()))?;
-        let output = visibility_image(
-            device,
-            "light visibility (min over frusta)",
-            first.width(),
-            first.height(),
-        )?;
+        let output = match output {
+            Some(image) => image,
+            None => visibility_image(
+                device,
+                "light visibility (min over frusta)",
+                first.width(),
+                first.height(),
+            )?,
+        };
         let steps = frusta
             .iter()
             .map(|frustum| {
@@ -39,7 +51,15 @@ impl MinCombine {
                 )
             })
             .collect::<Result<_, _>>()?;
-        Ok(Self { steps, output })
+        let lit = ScreenPass::new(
+            device,
+            "min over frusta",
+            "min_combine.comp",
+            &[BindingKind::StorageImage, BindingKind::StorageImage],
+            &[Resource::Image(&output), Resource::Image(&output)],
+            12,
+        )?;
+        Ok(Self { steps, lit, output })
     }
 
     /// GPU bytes of the combined image.
@@ -73,7 +93,8 @@ impl MinCombine {
         }
         if folded == 0 {
             let push: [u32; 3] = [width, height, MODE_LIT];
-            self.steps[0].record(enc, bytemuck::bytes_of(&push), width, height)?;
+            self.lit
+                .record(enc, bytemuck::bytes_of(&push), width, height)?;
             enc.barriers(&[Barrier::Uav]);
         }
         Ok(())

@@ -124,14 +124,14 @@ pub struct PcssPass {
 }
 
 impl PcssPass {
-    /// Creates the pass and its `width` x `height` output.
+    /// Creates the pass and its `width` x `height` output (`output` when given).
     pub(crate) fn new(
         device: &Device,
         inputs: &PcssInputs<'_>,
         kind: PcssKind,
         filter: PenumbraFilter,
-        width: u32,
-        height: u32,
+        (width, height): (u32, u32),
+        output: Option<Image>,
     ) -> Result<Self, PassError> {
         let (name, image_name, mode) = match kind {
             PcssKind::ClassicTest => ("shadow map test", "shadow map visibility", 2),
@@ -144,7 +144,10 @@ impl PcssPass {
                 },
             ),
         };
-        let output = visibility_image(device, image_name, width, height)?;
+        let output = match output {
+            Some(image) => image,
+            None => visibility_image(device, image_name, width, height)?,
+        };
         let constants = constant_buffer::<PcssConstants>(device, image_name)?;
         let mut bindings = vec![
             BindingKind::UniformBuffer,

@@ -50,13 +50,15 @@ pub struct RayTracePass {
 }
 
 impl RayTracePass {
-    /// Creates `width` x `height` outputs: the visibility, and the blocker distance if `blocker_distance`.
+    /// Creates `width` x `height` outputs: the visibility (`visibility` when given), and the blocker distance
+    /// if `blocker_distance`.
     pub fn new(
         device: &Device,
         inputs: &RayTraceInputs<'_>,
         width: u32,
         height: u32,
         blocker_distance: bool,
+        visibility: Option<Image>,
     ) -> Result<Self, PassError> {
         let out = |name| ImageDesc {
             name,
@@ -66,7 +68,10 @@ impl RayTracePass {
             layers: 1,
             usage: ImageUsage::STORAGE | ImageUsage::SAMPLED | ImageUsage::COPY_SRC,
         };
-        let visibility = device.create_image(&out("rt visibility"))?;
+        let visibility = match visibility {
+            Some(image) => image,
+            None => device.create_image(&out("rt visibility"))?,
+        };
         let (blocker_distance, unused_blocker) = if blocker_distance {
             (
                 Some(device.create_image(&out("rt blocker distance"))?),

@@ -9,7 +9,7 @@
 
 // Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 // version differs.
-#define HRTS_API_VERSION ((5 << 22) | (2 << 12))
+#define HRTS_API_VERSION ((5 << 22) | (3 << 12))
 
 // The most lights one context shades (`hrts_configure_lights`); a point light counts once.
 #define HRTS_MAX_LIGHTS 64
@@ -683,7 +683,8 @@ typedef struct HrtsTargets {
   uint32_t output_usage;
   // Array layers of the output image: at least the number of lights when a frame is recorded.
   uint32_t output_layers;
-  // `VkFormat` of the output image: `VK_FORMAT_R32_SFLOAT` (or 0), written by a copy, or
+  // `VkFormat` of the output image: `VK_FORMAT_R32_SFLOAT` (or 0), written by a copy, or directly by
+  // each light's last pass when the image also has STORAGE usage (no copy), or
   // `VK_FORMAT_R8_UNORM` or `VK_FORMAT_R16_SFLOAT`, written by a converting blit (the device must
   // support blits from `R32_SFLOAT` to it).
   uint32_t output_format;
@@ -757,7 +758,9 @@ typedef struct HrtsFrame {
   int32_t depth_layout;
   // `VkImageLayout` of the normal image when the commands run; restored afterwards.
   int32_t normal_layout;
-  // `VkImageLayout` of the output image before (its contents are discarded).
+  // `VkImageLayout` of the output image before (its contents are discarded): in the call with
+  // `HRTS_PASS_OUTPUT_COPY`, or, for a light that writes its layer directly
+  // (`HrtsFrameReport::output_direct`), in the call recording the light's last screen-space pass.
   int32_t output_layout_before;
   // `VkImageLayout` the output image is left in.
   int32_t output_layout_after;
@@ -846,7 +849,7 @@ typedef struct HrtsFrameReport {
   uint32_t pass_status[HRTS_PASS_COUNT];
   // Bytes of each `HrtsResource` the plugin allocated (0: not allocated).
   uint64_t resource_bytes[HRTS_RESOURCE_COUNT];
-  // The `HrtsResource` copied into the output image.
+  // The `HrtsResource` copied into the output image (or written into it directly: `output_direct`).
   uint32_t output_resource;
   // Bytes of the prim buffer (triangles in frame coordinates; 0 if the plan has none), shared by the
   // context's lights.
@@ -887,6 +890,11 @@ typedef struct HrtsFrameReport {
   // `hrts_set_draw_transforms` and of the meshes deformed (`HrtsFrame::deformed`), every triangle each
   // frame with `dynamic_geometry`; 0 when the prim buffer was up to date.
   uint32_t prim_triangles_rebuilt;
+  // Whether the light's last pass wrote its layer of the output image directly, with no copy: the
+  // output is `R32_SFLOAT` with STORAGE usage (the layer is then in the GENERAL layout between that
+  // pass and the output-copy call, which takes it to `output_layout_after`), and the configuration does
+  // not read the final output back through `extra_outputs`.
+  HrtsBool output_direct;
 } HrtsFrameReport;
 
 // Every result, in value order.

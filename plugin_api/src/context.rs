@@ -31,6 +31,8 @@ pub(crate) struct TargetSource {
     pub(crate) surface: SurfaceInput,
     pub(crate) output: u64,
     pub(crate) output_layers: u32,
+    /// Usage of the output image: with storage usage and `R32_SFLOAT`, lights write their layers directly.
+    pub(crate) output_usage: ImageUsage,
 }
 
 /// The passes of one light: one pipeline per frustum it is shadowed through and, for several, the
@@ -38,6 +40,8 @@ pub(crate) struct TargetSource {
 pub(crate) struct LightPasses {
     pub(crate) frusta: Vec<ShadowPipeline>,
     pub(crate) combine: Option<MinCombine>,
+    /// Whether the light's last pass writes its layer of the engine's output directly (no copy).
+    pub(crate) direct: bool,
 }
 
 impl LightPasses {
@@ -77,6 +81,9 @@ pub(crate) struct Built {
     /// How the passes decode the normal.
     pub(crate) surface: SurfaceInput,
     pub(crate) output: Image,
+    /// Each layer of the output, when lights may write theirs directly (`R32_SFLOAT` with storage usage);
+    /// empty otherwise.
+    pub(crate) output_layers: Vec<Image>,
 }
 
 impl Built {
@@ -607,7 +614,7 @@ impl Context {
                 "SAMPLED",
             )?;
         }
-        require_usage(
+        let output_usage = require_usage(
             t.output_usage,
             ImageUsage::COPY_DST,
             "output_image",
@@ -624,6 +631,7 @@ impl Context {
             surface,
             output: t.output_image,
             output_layers: t.output_layers,
+            output_usage,
         });
         self.retire_built();
         Ok(())
@@ -666,12 +674,19 @@ impl Context {
             .enumerate()
         {
             if slot.is_none() {
-                let inputs = ShadowInputs {
-                    depth: &built.depth,
-                    normal: &built.normal,
-                    surface: built.surface,
-                };
+                // The light's layer, written directly unless the configuration reads the final output
+                // back (from the pipeline's own image).
+                let read_back = config
+                    .extra_outputs
+                    .contains(config.plan_request().final_output());
+                let layer = built.output_layers.get(i).filter(|_| !read_back);
                 let passes = (|| -> Result<LightPasses, passes::PassError> {
+                    let inputs = ShadowInputs {
+                        depth: &built.depth,
+                        normal: &built.normal,
+                        surface: built.surface,
+                        direct_output: layer.filter(|_| frusta == 1),
+                    };
                     let frusta = (0..frusta)
                         .map(|_| {
                             ShadowPipeline::with_shared_geometry(
@@ -684,11 +699,16 @@ impl Context {
                         .collect::<Result<Vec<_>, _>>()?;
                     let combine = if frusta.len() > 1 {
                         let outputs: Vec<&Image> = frusta.iter().map(|p| p.output()).collect();
-                        Some(MinCombine::new(device, &outputs)?)
+                        let output = layer.map(Image::alias).transpose()?;
+                        Some(MinCombine::new(device, &outputs, output)?)
                     } else {
                         None
                     };
-                    Ok(LightPasses { frusta, combine })
+                    Ok(LightPasses {
+                        frusta,
+                        combine,
+                        direct: layer.is_some(),
+                    })
                 })()
                 .map_err(|e| {
                     let e = ApiError::from(e);
@@ -728,7 +748,29 @@ impl Context {
             // SAFETY: the engine guarantees its images are live and match the description (contract).
             unsafe { device.external_image(handle, &desc) }
         };
+        let direct =
+            t.output_format == Format::R32Float && t.output_usage.contains(ImageUsage::STORAGE);
+        let output_layers = if direct {
+            (0..t.output_layers)
+                .map(|layer| {
+                    let desc = ImageDesc {
+                        name: "engine visibility layer",
+                        format: Format::R32Float,
+                        width: t.width,
+                        height: t.height,
+                        layers: 1,
+                        usage: ImageUsage::STORAGE | ImageUsage::COPY_DST,
+                    };
+                    // SAFETY: the engine guarantees its output is live, R32_SFLOAT with storage usage, of
+                    // `output_layers` layers (contract; checked against its stated usage and format).
+                    unsafe { device.external_image_layer(t.output, &desc, layer) }
+                })
+                .collect::<Result<Vec<_>, _>>()?
+        } else {
+            Vec::new()
+        };
         Ok(Built {
+            output_layers,
             lights: (0..self.lights.len()).map(|_| None).collect(),
             shared,
             depth: wrap(
@@ -899,21 +941,28 @@ impl Context {
             .map(ShadowPipeline::map_scratch_bytes)
             .max()
             .unwrap_or(0);
+        let output = planned.final_output();
+        // A layer written directly is the engine's memory, not the plugin's.
+        let engine_owned = |r: ResourceId| passes.direct && passes.combine.is_none() && r == output;
         for r in passes.frusta.iter().flat_map(|p| p.resources()) {
+            if engine_owned(r.resource) {
+                continue;
+            }
             if let Some(i) = RESOURCES.iter().position(|&id| id == r.resource) {
                 out.resource_bytes[i] += r.bytes;
             } else if r.resource == ResourceId::PrimBuffer {
                 out.prim_buffer_bytes = r.bytes;
             }
         }
-        let output = planned.final_output();
-        if let (Some(combine), Some(i)) = (
+        if let (Some(combine), Some(i), false) = (
             &passes.combine,
             RESOURCES.iter().position(|&id| id == output),
+            passes.direct,
         ) {
             out.resource_bytes[i] += combine.bytes();
         }
         out.output_resource = resource_index(output)?;
+        out.output_direct = passes.direct.into();
         out.light_builds = self.light_builds.get(light as usize).copied().unwrap_or(0);
         out.frusta = reports.len() as u32;
         out.frusta_culled = (schedule.recorded.len() - reports.len()) as u32;

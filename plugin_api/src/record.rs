@@ -248,7 +248,18 @@ impl Context {
             ));
         }
         let id = resource_id(r.resource)?;
-        let pipeline = self.finished_frame()?.light(r.light)?.single(r.light)?;
+        let light = self.finished_frame()?.light(r.light)?;
+        let pipeline = light.single(r.light)?;
+        if light.direct && id == pipeline.plan().final_output() {
+            return Err(ApiError::new(
+                HrtsResult::ErrorInvalidState,
+                format!(
+                    "{} of light {} is written into its layer of the output image directly: read the output (or add it to extra_outputs for a copy of the plugin's own)",
+                    id.name(),
+                    r.light
+                ),
+            ));
+        }
         let (image, list) = (pipeline.image(id), pipeline.buffer(id));
         let bytes = match (image, list) {
             (Some(image), _) => image.byte_size(),
@@ -389,6 +400,9 @@ fn record_output_copy(
     }
     let lit =
         |l: &crate::context::LightPasses, r: &[bool]| l.combine.is_none() && !r.contains(&true);
+    if !b.output_layers.is_empty() {
+        return record_output_layers(enc, b, f, recorded, lit);
+    }
     // The layer of each light, and the visibility to copy into it (none: fill with 1).
     let layers: Vec<(u32, Option<&Image>)> = b
         .lights
@@ -432,6 +446,66 @@ fn record_output_copy(
         after: S::Engine(f.output_layout_after),
     });
     enc.barriers(&back);
+    enc.end_pass();
+    Ok(())
+}
+
+/// [`record_output_copy`] into an output image the lights may write directly (`R32_SFLOAT` with storage
+/// usage), layer by layer: a layer its light wrote goes to `output_layout_after`; the others get their
+/// light's visibility copied in, or 1 for a light with no frustum recorded.
+fn record_output_layers(
+    enc: &mut Encoder<'_>,
+    b: &Built,
+    f: &HrtsFrame,
+    recorded: &[Vec<bool>],
+    lit: impl Fn(&crate::context::LightPasses, &[bool]) -> bool,
+) -> ApiResult<()> {
+    let after = S::Engine(f.output_layout_after);
+    enc.begin_pass("output copy");
+    for ((light, r), layer) in b
+        .lights
+        .iter()
+        .flatten()
+        .zip(recorded)
+        .zip(&b.output_layers)
+    {
+        let unlit = lit(light, r);
+        if light.direct && !unlit {
+            enc.barriers(&[Barrier::Image {
+                image: layer,
+                before: S::UnorderedAccess,
+                after,
+            }]);
+            continue;
+        }
+        let source = (!unlit).then(|| light.output());
+        let mut to_copy = vec![Barrier::Image {
+            image: layer,
+            before: S::Engine(f.output_layout_before),
+            after: S::CopyDest,
+        }];
+        to_copy.extend(source.map(|image| Barrier::Image {
+            image,
+            before: S::UnorderedAccess,
+            after: S::CopySource,
+        }));
+        enc.barriers(&to_copy);
+        match source {
+            Some(image) => enc.copy_image_into_layer(image, layer, 0)?,
+            None => enc.clear_uint_layer(layer, 0, 1.0f32.to_bits())?,
+        }
+        let mut back = vec![Barrier::Image {
+            image: layer,
+            before: S::CopyDest,
+            after,
+        }];
+        back.extend(source.map(|image| Barrier::Image {
+            image,
+            before: S::CopySource,
+            after: S::UnorderedAccess,
+        }));
+        enc.barriers(&back);
+    }
     enc.end_pass();
     Ok(())
 }

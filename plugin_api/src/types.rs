@@ -6,7 +6,7 @@ use std::ffi::c_char;
 
 /// Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 /// version differs.
-pub const HRTS_API_VERSION: u32 = 5 << 22 | 2 << 12;
+pub const HRTS_API_VERSION: u32 = 5 << 22 | 3 << 12;
 
 /// A flag in the C structs: 0 is false, any other value true. (A Rust `bool` would make any byte but 0
 /// and 1 undefined behaviour when the engine writes it.)
@@ -596,7 +596,8 @@ pub struct HrtsTargets {
     pub output_usage: u32,
     /// Array layers of the output image: at least the number of lights when a frame is recorded.
     pub output_layers: u32,
-    /// `VkFormat` of the output image: `VK_FORMAT_R32_SFLOAT` (or 0), written by a copy, or
+    /// `VkFormat` of the output image: `VK_FORMAT_R32_SFLOAT` (or 0), written by a copy, or directly by
+    /// each light's last pass when the image also has STORAGE usage (no copy), or
     /// `VK_FORMAT_R8_UNORM` or `VK_FORMAT_R16_SFLOAT`, written by a converting blit (the device must
     /// support blits from `R32_SFLOAT` to it).
     pub output_format: u32,
@@ -655,7 +656,9 @@ pub struct HrtsFrame {
     pub depth_layout: i32,
     /// `VkImageLayout` of the normal image when the commands run; restored afterwards.
     pub normal_layout: i32,
-    /// `VkImageLayout` of the output image before (its contents are discarded).
+    /// `VkImageLayout` of the output image before (its contents are discarded): in the call with
+    /// `HRTS_PASS_OUTPUT_COPY`, or, for a light that writes its layer directly
+    /// (`HrtsFrameReport::output_direct`), in the call recording the light's last screen-space pass.
     pub output_layout_before: i32,
     /// `VkImageLayout` the output image is left in.
     pub output_layout_after: i32,
@@ -775,7 +778,7 @@ pub struct HrtsFrameReport {
     pub pass_status: [u32; HRTS_PASS_COUNT],
     /// Bytes of each `HrtsResource` the plugin allocated (0: not allocated).
     pub resource_bytes: [u64; HRTS_RESOURCE_COUNT],
-    /// The `HrtsResource` copied into the output image.
+    /// The `HrtsResource` copied into the output image (or written into it directly: `output_direct`).
     pub output_resource: u32,
     /// Bytes of the prim buffer (triangles in frame coordinates; 0 if the plan has none), shared by the
     /// context's lights.
@@ -816,6 +819,11 @@ pub struct HrtsFrameReport {
     /// `hrts_set_draw_transforms` and of the meshes deformed (`HrtsFrame::deformed`), every triangle each
     /// frame with `dynamic_geometry`; 0 when the prim buffer was up to date.
     pub prim_triangles_rebuilt: u32,
+    /// Whether the light's last pass wrote its layer of the output image directly, with no copy: the
+    /// output is `R32_SFLOAT` with STORAGE usage (the layer is then in the GENERAL layout between that
+    /// pass and the output-copy call, which takes it to `output_layout_after`), and the configuration does
+    /// not read the final output back through `extra_outputs`.
+    pub output_direct: HrtsBool,
 }
 
 /// A copy of a plugin resource into an engine buffer, recorded after a complete frame.

@@ -338,7 +338,10 @@ impl<'a> Encoder<'a> {
                             .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
                             .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
                             .image(image.raw)
-                            .subresource_range(subresource_range(image.format(), image.layers())),
+                            .subresource_range(
+                                subresource_range(image.format(), image.layers())
+                                    .base_array_layer(image.base_layer()),
+                            ),
                     );
                 }
             }
@@ -380,7 +383,8 @@ impl<'a> Encoder<'a> {
 
     fn clear_uint_layer_range(&mut self, image: &Image, first: u32, count: u32, value: u32) {
         let clear = vk::ClearColorValue { uint32: [value; 4] };
-        let range = subresource_range(image.format(), count).base_array_layer(first);
+        let range =
+            subresource_range(image.format(), count).base_array_layer(image.base_layer() + first);
         // SAFETY: the image is in TRANSFER_DST_OPTIMAL (CopyDest) by contract; the layers exist.
         unsafe {
             self.d().cmd_clear_color_image(
@@ -648,7 +652,7 @@ impl<'a> Encoder<'a> {
                 vk::ImageSubresourceLayers::default()
                     .aspect_mask(image.format().view_aspect())
                     .mip_level(0)
-                    .base_array_layer(0)
+                    .base_array_layer(image.base_layer())
                     .layer_count(image.layers()),
             )
             .image_extent(vk::Extent3D {
@@ -719,9 +723,9 @@ impl<'a> Encoder<'a> {
             z: 1,
         };
         let region = vk::ImageBlit::default()
-            .src_subresource(subresource(0))
+            .src_subresource(subresource(src.base_layer()))
             .src_offsets([vk::Offset3D::default(), corner])
-            .dst_subresource(subresource(layer))
+            .dst_subresource(subresource(dst.base_layer() + layer))
             .dst_offsets([vk::Offset3D::default(), corner]);
         // SAFETY: checked sizes, layers and aspects; the images are in the stated layouts by contract and
         // the caller checked the formats' blit support.
@@ -744,8 +748,8 @@ impl<'a> Encoder<'a> {
     fn record_image_copy(&mut self, src: &Image, dst: &Image, dst_layer: u32, layers: u32) {
         let subresource = |base| layers_of(src.format().view_aspect(), base, layers);
         let region = vk::ImageCopy::default()
-            .src_subresource(subresource(0))
-            .dst_subresource(subresource(dst_layer))
+            .src_subresource(subresource(src.base_layer()))
+            .dst_subresource(subresource(dst.base_layer() + dst_layer))
             .extent(vk::Extent3D {
                 width: src.width(),
                 height: src.height(),

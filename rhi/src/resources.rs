@@ -152,6 +152,9 @@ pub struct Image {
     width: u32,
     height: u32,
     layers: u32,
+    /// The first array layer of the underlying `VkImage` this image is (0 but for a layer of an engine's
+    /// array image, [`Device::external_image_layer`]).
+    base_layer: u32,
     usage: ImageUsage,
     owned: bool,
 }
@@ -340,7 +343,7 @@ impl Device {
             }
         };
         // SAFETY: `raw` is bound to memory; the view is destroyed before the image.
-        let view = match unsafe { self.create_view(raw, desc) } {
+        let view = match unsafe { self.create_view(raw, desc, 0) } {
             Ok(v) => v,
             Err(e) => {
                 // SAFETY: `raw` is unused; the allocation is returned to the allocator.
@@ -363,6 +366,7 @@ impl Device {
             width: desc.width,
             height: desc.height,
             layers: desc.layers,
+            base_layer: 0,
             usage: desc.usage,
             owned: true,
         })
@@ -382,7 +386,7 @@ impl Device {
         }
         let raw: vk::Image = ash::vk::Handle::from_raw(handle);
         // SAFETY: the caller guarantees `raw` is a live image of this device matching `desc`.
-        let view = unsafe { self.create_view(raw, desc) }?;
+        let view = unsafe { self.create_view(raw, desc, 0) }?;
         Ok(Image {
             shared: self.shared.clone(),
             raw,
@@ -392,6 +396,42 @@ impl Device {
             width: desc.width,
             height: desc.height,
             layers: desc.layers,
+            base_layer: 0,
+            usage: desc.usage,
+            owned: false,
+        })
+    }
+
+    /// Wraps array layer `layer` of an engine's `VkImage` as an image of one layer (`desc.layers` is 1):
+    /// its view, barriers, clears and copies address that layer alone, so that a pass writes it directly.
+    ///
+    /// # Safety
+    /// As for [`Device::external_image`]; the image has more than `layer` layers.
+    pub unsafe fn external_image_layer(
+        &self,
+        handle: u64,
+        desc: &ImageDesc<'_>,
+        layer: u32,
+    ) -> Result<Image> {
+        if handle == 0 || desc.width == 0 || desc.height == 0 || desc.layers != 1 {
+            return Err(RhiError::InvalidArgument(format!(
+                "external image layer {} is null, empty or not one layer",
+                desc.name
+            )));
+        }
+        let raw: vk::Image = ash::vk::Handle::from_raw(handle);
+        // SAFETY: the caller guarantees `raw` is a live image of this device with layer `layer`.
+        let view = unsafe { self.create_view(raw, desc, layer) }?;
+        Ok(Image {
+            shared: self.shared.clone(),
+            raw,
+            view,
+            allocation: None,
+            format: desc.format,
+            width: desc.width,
+            height: desc.height,
+            layers: 1,
+            base_layer: layer,
             usage: desc.usage,
             owned: false,
         })
@@ -436,28 +476,14 @@ impl Device {
     ///
     /// # Safety
     /// `raw` must be a live image of this device created as `desc` says.
-    unsafe fn create_view(&self, raw: vk::Image, desc: &ImageDesc<'_>) -> Result<vk::ImageView> {
-        let viewable = ImageUsage::SAMPLED
-            | ImageUsage::STORAGE
-            | ImageUsage::COLOR_TARGET
-            | ImageUsage::DEPTH_TARGET;
-        if desc.usage.0 & viewable.0 == 0 {
-            return Ok(vk::ImageView::null());
-        }
-        let view_type = if desc.layers > 1 {
-            vk::ImageViewType::TYPE_2D_ARRAY
-        } else {
-            vk::ImageViewType::TYPE_2D
-        };
-        let view_info = vk::ImageViewCreateInfo::default()
-            .image(raw)
-            .view_type(view_type)
-            .format(desc.format.to_vk())
-            .subresource_range(
-                subresource_range(desc.format, desc.layers).aspect_mask(desc.format.view_aspect()),
-            );
+    unsafe fn create_view(
+        &self,
+        raw: vk::Image,
+        desc: &ImageDesc<'_>,
+        base_layer: u32,
+    ) -> Result<vk::ImageView> {
         // SAFETY: guaranteed by the caller.
-        unsafe { self.shared.device.create_image_view(&view_info, None) }.call("vkCreateImageView")
+        unsafe { create_view(&self.shared, raw, desc, base_layer) }
     }
 
     fn allocate(
@@ -503,6 +529,41 @@ impl Device {
         // SAFETY: `handle` is a live object of type `ty` on this device; naming is advisory.
         let _ = unsafe { utils.set_debug_utils_object_name(&info) };
     }
+}
+
+/// A view of `desc.layers` layers of `raw` from `base_layer` (none for images no shader or attachment reads).
+///
+/// # Safety
+/// `raw` must be a live image of `shared`'s device created as `desc` says, with those layers.
+unsafe fn create_view(
+    shared: &Shared,
+    raw: vk::Image,
+    desc: &ImageDesc<'_>,
+    base_layer: u32,
+) -> Result<vk::ImageView> {
+    let viewable = ImageUsage::SAMPLED
+        | ImageUsage::STORAGE
+        | ImageUsage::COLOR_TARGET
+        | ImageUsage::DEPTH_TARGET;
+    if desc.usage.0 & viewable.0 == 0 {
+        return Ok(vk::ImageView::null());
+    }
+    let view_type = if desc.layers > 1 {
+        vk::ImageViewType::TYPE_2D_ARRAY
+    } else {
+        vk::ImageViewType::TYPE_2D
+    };
+    let view_info = vk::ImageViewCreateInfo::default()
+        .image(raw)
+        .view_type(view_type)
+        .format(desc.format.to_vk())
+        .subresource_range(
+            subresource_range(desc.format, desc.layers)
+                .aspect_mask(desc.format.view_aspect())
+                .base_array_layer(base_layer),
+        );
+    // SAFETY: guaranteed by the caller.
+    unsafe { shared.device.create_image_view(&view_info, None) }.call("vkCreateImageView")
 }
 
 pub(crate) fn subresource_range(format: Format, layers: u32) -> vk::ImageSubresourceRange {
@@ -606,6 +667,44 @@ impl Image {
     /// Array layers.
     pub fn layers(&self) -> u32 {
         self.layers
+    }
+    /// The first array layer of the underlying `VkImage` this image is.
+    pub fn base_layer(&self) -> u32 {
+        self.base_layer
+    }
+
+    /// Another handle on an engine's image (wrapped by [`Device::external_image`] or
+    /// [`Device::external_image_layer`], whose callers guarantee it outlives every use): its own view of the
+    /// same layers. The plugin's own images cannot be aliased.
+    pub fn alias(&self) -> Result<Image> {
+        if self.owned {
+            return Err(RhiError::InvalidArgument(
+                "only an engine's image can be aliased".into(),
+            ));
+        }
+        let desc = ImageDesc {
+            name: "engine image",
+            format: self.format,
+            width: self.width,
+            height: self.height,
+            layers: self.layers,
+            usage: self.usage,
+        };
+        // SAFETY: `self` wraps a live image of this device matching `desc` (its wrapper's contract).
+        let view = unsafe { create_view(&self.shared, self.raw, &desc, self.base_layer) }?;
+        Ok(Image {
+            shared: self.shared.clone(),
+            raw: self.raw,
+            view,
+            allocation: None,
+            format: self.format,
+            width: self.width,
+            height: self.height,
+            layers: self.layers,
+            base_layer: self.base_layer,
+            usage: self.usage,
+            owned: false,
+        })
     }
     /// Declared usage.
     pub fn usage(&self) -> ImageUsage {

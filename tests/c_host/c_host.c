@@ -1240,6 +1240,69 @@ static void engine_depth(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
     CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
 }
 
+/* ---------- the output written directly ---------- */
+/* With an R32_SFLOAT output that also has STORAGE usage, each light's last pass writes its layer (no copy):
+ * the visibility equals the copied one bit for bit for a sun (hard, and hybrid: the blend's output), a point
+ * light (the minimum over its faces), and a point light and a spot light whose ranges reach nothing (their
+ * layers filled with 1), recorded in one call and split as an engine splits a frame; the report says which
+ * lights wrote directly. */
+static void output_direct(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
+    enum { PX = W * H, N = 4 };
+    setup_camera(0.0);
+    Emitter lights[N] = {directional(v3(0.45, -1.0, 0.2)), point(v3(0.9, 2.3, 0.7)), point(v3(0.0, 6.0, 0.0)),
+                         fitted_spot(v3(0.0, 6.0, 0.0), v3(0.0, 7.0, 0.0), 0.5)};
+    lights[2].c.range = 2.0f;
+    lights[3].c.range = 2.0f;
+    set_lights(lights, N);
+    upload_gbuffer();
+    const uint32_t modes[2] = {HRTS_SHADOW_MODE_HARD, HRTS_SHADOW_MODE_HYBRID};
+    Img copied = out_img;
+    Img direct = make_image(VK_FORMAT_R32_SFLOAT,
+                            VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                            LAYERS);
+    static float want[N * PX], got[N * PX];
+    for (int m = 0; m < 2; m++)
+        for (int split = 0; split < 2; split++) {
+            uint32_t directs[2] = {0, 0};
+            for (int d = 0; d < 2; d++) {
+                out_img = d ? direct : copied;
+                HrtsContext *ctx = create_context(vk, 1);
+                HrtsTargets t = targets();
+                if (d) t.output_usage |= VK_IMAGE_USAGE_STORAGE_BIT;
+                HrtsResult r = configure_all(ctx, N, modes[m]);
+                if (r == HRTS_RESULT_OK) r = hrts_set_geometry_cpu(ctx, g);
+                if (r == HRTS_RESULT_OK) r = hrts_set_targets(ctx, &t);
+                if (r == HRTS_RESULT_OK) r = split ? run_frame_in_parts(ctx, d ? got : want, 0) : run_frame(ctx, d ? got : want);
+                CHECK(r == HRTS_RESULT_OK, "direct output %d: %s", d, hrts_last_error(ctx));
+                for (uint32_t l = 0; l < N && r == HRTS_RESULT_OK; l++) {
+                    HrtsFrameReport rep;
+                    CHECK(report(ctx, next_frame - 1, l, &rep) == HRTS_RESULT_OK, "report: %s", hrts_last_error(ctx));
+                    directs[d] += rep.output_direct != 0;
+                }
+                if (d && modes[m] == HRTS_SHADOW_MODE_HARD && r == HRTS_RESULT_OK) {
+                    /* the sun's final output is the engine's layer: it is read there, not back from the plugin */
+                    static float one[PX];
+                    CHECK(read_resource(ctx, 0, HRTS_RESOURCE_RT_VISIBILITY, one, sizeof one) == HRTS_RESULT_ERROR_INVALID_STATE &&
+                              strstr(hrts_last_error(ctx), "directly"),
+                          "a read-back of a final output written directly is refused: %s", hrts_last_error(ctx));
+                }
+                CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
+            }
+            out_img = copied;
+            int differ = 0;
+            for (int i = 0; i < N * PX; i++) differ += memcmp(&want[i], &got[i], sizeof(float)) != 0;
+            int lit = 0;
+            for (int i = 2 * PX; i < 4 * PX; i++) lit += got[i] == 1.0f;
+            printf("output written directly (%s, %s): %u of %d lights direct (%u with a copy), %d px differ from the copied "
+                   "output, the unreached lights' layers %d of %d px lit\n",
+                   modes[m] == HRTS_SHADOW_MODE_HARD ? "hard" : "hybrid", split ? "split frame" : "one call", directs[1],
+                   N, directs[0], differ, lit, 2 * PX);
+            CHECK(directs[1] == N && directs[0] == 0 && differ == 0 && lit == 2 * PX,
+                  "direct output: %u direct, %d px differ, %d lit", directs[1], differ, lit);
+        }
+    free_image(direct);
+}
+
 /* ---------- the engine's output format ---------- */
 /* The visibility written into an R8_UNORM or R16_SFLOAT output image (a converting blit) equals the
  * R32_SFLOAT output to the format's precision: hard shadows exactly (0 and 1), the hybrid's penumbrae
@@ -2959,6 +3022,8 @@ int main(void) {
     engine_depth(&vk, &g);
     phase = "output formats";
     output_formats(&vk, &g);
+    phase = "output written directly";
+    output_direct(&vk, &g);
     phase = "read-back retire";
     readback_retire(&vk, &g);
     phase = "partial record";

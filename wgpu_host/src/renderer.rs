@@ -187,10 +187,16 @@ impl Renderer {
         let view_z = conventions
             .view_z
             .map(|format| texture("view z", format, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING));
+        // An R32Float shadow image with storage usage is written by the plugin's last pass directly.
+        let storage = if conventions.shadow_format == wgpu::TextureFormat::R32Float {
+            U::STORAGE_BINDING
+        } else {
+            U::empty()
+        };
         let shadow = texture(
             "shadow",
             conventions.shadow_format,
-            U::COPY_DST | U::TEXTURE_BINDING | U::COPY_SRC,
+            U::COPY_DST | U::TEXTURE_BINDING | U::COPY_SRC | storage,
         );
         let color = texture(
             "color",

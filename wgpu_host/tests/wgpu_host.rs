@@ -123,7 +123,7 @@ fn render(
 fn same_visibility_as_host_demo() {
     let gpu = gpu();
     let view = host_demo_view();
-    let (wgpu_vis, drawn, _) = render(
+    let (wgpu_vis, drawn, report) = render(
         &gpu,
         Conventions {
             shadow_format: F::R32Float,
@@ -140,6 +140,10 @@ fn same_visibility_as_host_demo() {
     );
     let c = compare_with_reference(&wgpu_ref, &wgpu_vis, None, None);
     assert_eq!(c.mismatches, 0, "wgpu_host vs reference: {:?}", c.examples);
+    assert_eq!(
+        report.output_direct, 1,
+        "an R32Float shadow image with storage usage is written directly"
+    );
 
     let device = rhi::Device::new_headless(&rhi::DeviceDesc {
         validation: true,

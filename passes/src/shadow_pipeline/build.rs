@@ -77,6 +77,26 @@ impl ShadowPipeline {
         config.hybrid.validate()?;
         let plan = FramePlan::derive(config.plan_request());
         let runs = |p| plan.runs(p);
+        // The final visibility goes into the engine's layer when it is written directly (not when the
+        // configuration also asks to read it back: that reads the pipeline's own image).
+        let final_output = plan.final_output();
+        if inputs.direct_output.is_some() && config.extra_outputs.contains(final_output) {
+            return Err(PassError::InvalidConfig(format!(
+                "the final output ({}) is written into the engine's image directly and cannot also be read back",
+                final_output.name()
+            )));
+        }
+        let mut direct = inputs
+            .direct_output
+            .map(|image| direct_output(image, width, height))
+            .transpose()?;
+        let mut direct_for = |resource: ResourceId| {
+            if resource == final_output {
+                direct.take()
+            } else {
+                None
+            }
+        };
 
         let prims = runs(PassId::PrimBuffer).then(|| shared.prims());
         let need_prims = || {
@@ -121,10 +141,11 @@ impl ShadowPipeline {
                 height,
                 plan.writes(PassId::RayTrace)
                     .contains(ResourceId::BlockerDistance),
+                direct_for(ResourceId::RtVisibility),
             )?),
             _ => None,
         };
-        let pcss_pass = |kind| -> Result<Option<PcssPass>, PassError> {
+        let pcss_pass = |kind, output| -> Result<Option<PcssPass>, PassError> {
             let Some(sm) = &shadow_map else {
                 return Ok(None);
             };
@@ -139,13 +160,16 @@ impl ShadowPipeline {
                 &pcss_inputs,
                 kind,
                 config.pcss.filter,
-                width,
-                height,
+                (width, height),
+                output,
             )
             .map(Some)
         };
         let shadow_map_test = if runs(PassId::ShadowMapTest) {
-            pcss_pass(PcssKind::ClassicTest)?
+            pcss_pass(
+                PcssKind::ClassicTest,
+                direct_for(ResourceId::ShadowMapVisibility),
+            )?
         } else {
             None
         };
@@ -154,12 +178,16 @@ impl ShadowPipeline {
             _ => HardEdge::ShadowMap,
         };
         let pcss = if runs(PassId::Pcss) {
-            pcss_pass(PcssKind::Pcss(edge))?
+            pcss_pass(PcssKind::Pcss(edge), direct_for(ResourceId::Pcss))?
         } else {
             None
         };
         let fxaa = match (&ray, runs(PassId::Fxaa)) {
-            (Some(r), true) => Some(FxaaPass::new(device, &r.visibility)?),
+            (Some(r), true) => Some(FxaaPass::new(
+                device,
+                &r.visibility,
+                direct_for(ResourceId::RtAntialiased),
+            )?),
             _ => None,
         };
         let lerp = match (&ray, runs(PassId::LerpFactor)) {
@@ -179,16 +207,23 @@ impl ShadowPipeline {
                 ray.as_ref().map(|r| &r.visibility)
             };
             match (rts, &pcss, &lerp) {
-                (Some(rts), Some(p), Some(l)) => {
-                    Some(BlendPass::new(device, rts, &p.output, &l.output)?)
-                }
+                (Some(rts), Some(p), Some(l)) => Some(BlendPass::new(
+                    device,
+                    rts,
+                    &p.output,
+                    &l.output,
+                    direct_for(ResourceId::Hybrid),
+                )?),
                 _ => None,
             }
         } else {
             None
         };
         let lit = if runs(PassId::FillLit) {
-            Some(visibility_image(device, "lit", width, height)?)
+            match direct_for(ResourceId::Lit) {
+                Some(image) => Some(image),
+                None => Some(visibility_image(device, "lit", width, height)?),
+            }
         } else {
             None
         };
@@ -261,4 +296,23 @@ impl ShadowPipeline {
         }
         Ok(pipeline)
     }
+}
+
+/// The pipeline's own handle on the engine's image its final pass writes, checked against what that pass
+/// writes.
+fn direct_output(image: &rhi::Image, width: u32, height: u32) -> Result<rhi::Image, PassError> {
+    if image.format() != rhi::Format::R32Float
+        || image.layers() != 1
+        || (image.width(), image.height()) != (width, height)
+        || !image.usage().contains(rhi::ImageUsage::STORAGE)
+    {
+        return Err(PassError::InvalidConfig(format!(
+            "an output written directly must be one R32_SFLOAT layer of {width}x{height} with storage usage, not {:?} {}x{}x{}",
+            image.format(),
+            image.width(),
+            image.height(),
+            image.layers()
+        )));
+    }
+    Ok(image.alias()?)
 }

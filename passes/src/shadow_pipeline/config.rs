@@ -115,4 +115,9 @@ pub struct ShadowInputs<'a> {
     pub normal: &'a Image,
     /// How `normal` encodes the surface normal and in which space.
     pub surface: SurfaceInput,
+    /// An engine's image (`R32_SFLOAT`, one layer, storage usage, of the depth image's size; typically a layer
+    /// of its output, `Device::external_image_layer`) that the pass producing the final visibility writes
+    /// directly, instead of an image of the pipeline's own that is then copied (none: its own). Its former
+    /// contents are discarded; it is left in `UnorderedAccess` state.
+    pub direct_output: Option<&'a Image>,
 }
