@@ -384,22 +384,8 @@ impl Device {
                 desc.name
             )));
         }
-        let raw: vk::Image = ash::vk::Handle::from_raw(handle);
-        // SAFETY: the caller guarantees `raw` is a live image of this device matching `desc`.
-        let view = unsafe { self.create_view(raw, desc, 0) }?;
-        Ok(Image {
-            shared: self.shared.clone(),
-            raw,
-            view,
-            allocation: None,
-            format: desc.format,
-            width: desc.width,
-            height: desc.height,
-            layers: desc.layers,
-            base_layer: 0,
-            usage: desc.usage,
-            owned: false,
-        })
+        // SAFETY: the caller guarantees `handle` is a live image of this device matching `desc`.
+        unsafe { engine_image(&self.shared, ash::vk::Handle::from_raw(handle), desc, 0) }
     }
 
     /// Wraps array layer `layer` of an engine's `VkImage` as an image of one layer (`desc.layers` is 1):
@@ -419,22 +405,8 @@ impl Device {
                 desc.name
             )));
         }
-        let raw: vk::Image = ash::vk::Handle::from_raw(handle);
-        // SAFETY: the caller guarantees `raw` is a live image of this device with layer `layer`.
-        let view = unsafe { self.create_view(raw, desc, layer) }?;
-        Ok(Image {
-            shared: self.shared.clone(),
-            raw,
-            view,
-            allocation: None,
-            format: desc.format,
-            width: desc.width,
-            height: desc.height,
-            layers: 1,
-            base_layer: layer,
-            usage: desc.usage,
-            owned: false,
-        })
+        // SAFETY: the caller guarantees `handle` is a live image of this device with layer `layer`.
+        unsafe { engine_image(&self.shared, ash::vk::Handle::from_raw(handle), desc, layer) }
     }
 
     /// Wraps an engine's `VkBuffer` of `size` bytes, to be used as `usage` says (a storage buffer must fit
@@ -529,6 +501,35 @@ impl Device {
         // SAFETY: `handle` is a live object of type `ty` on this device; naming is advisory.
         let _ = unsafe { utils.set_debug_utils_object_name(&info) };
     }
+}
+
+/// An engine's image `raw` (not owned: never destroyed by its wrapper), `desc.layers` layers from
+/// `base_layer`, with a view of its own.
+///
+/// # Safety
+/// `raw` must be a live image of `shared`'s device created as `desc` says, with those layers, that outlives
+/// every use of the wrapper.
+unsafe fn engine_image(
+    shared: &Arc<Shared>,
+    raw: vk::Image,
+    desc: &ImageDesc<'_>,
+    base_layer: u32,
+) -> Result<Image> {
+    // SAFETY: guaranteed by the caller.
+    let view = unsafe { create_view(shared, raw, desc, base_layer) }?;
+    Ok(Image {
+        shared: shared.clone(),
+        raw,
+        view,
+        allocation: None,
+        format: desc.format,
+        width: desc.width,
+        height: desc.height,
+        layers: desc.layers,
+        base_layer,
+        usage: desc.usage,
+        owned: false,
+    })
 }
 
 /// A view of `desc.layers` layers of `raw` from `base_layer` (none for images no shader or attachment reads).
@@ -691,20 +692,7 @@ impl Image {
             usage: self.usage,
         };
         // SAFETY: `self` wraps a live image of this device matching `desc` (its wrapper's contract).
-        let view = unsafe { create_view(&self.shared, self.raw, &desc, self.base_layer) }?;
-        Ok(Image {
-            shared: self.shared.clone(),
-            raw: self.raw,
-            view,
-            allocation: None,
-            format: self.format,
-            width: self.width,
-            height: self.height,
-            layers: self.layers,
-            base_layer: self.base_layer,
-            usage: self.usage,
-            owned: false,
-        })
+        unsafe { engine_image(&self.shared, self.raw, &desc, self.base_layer) }
     }
     /// Declared usage.
     pub fn usage(&self) -> ImageUsage {

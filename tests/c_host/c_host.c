@@ -448,6 +448,19 @@ static void upload_image(Img img, VkImageAspectFlags aspects, VkImageAspectFlags
     submit_and_wait(cmd);
 }
 
+/* `n` command buffers of the pool and `n` unsignalled fences: a ring of frames in flight. */
+static void frames_in_flight_ring(uint32_t n, VkCommandBuffer *cmds, VkFence *fences) {
+    VkCommandBufferAllocateInfo ai = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    ai.commandPool = pool;
+    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    ai.commandBufferCount = n;
+    VK(vkAllocateCommandBuffers(device, &ai, cmds));
+    for (uint32_t k = 0; k < n; k++) {
+        VkFenceCreateInfo fi = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+        VK(vkCreateFence(device, &fi, NULL, &fences[k]));
+    }
+}
+
 /* A timeline semaphore at 0 that submissions held by the test wait on (value 1). */
 static VkSemaphore held_semaphore(void) {
     VkSemaphoreTypeCreateInfo sti = {.sType = VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
@@ -2015,16 +2028,8 @@ static void deforming_mesh(const HrtsVulkanDevice *vk) {
     VkFence fences[IN_FLIGHT_2];
     Buf back[IN_FLIGHT_2];
     int pending[IN_FLIGHT_2] = {-1, -1};
-    VkCommandBufferAllocateInfo ai = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    ai.commandPool = pool;
-    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    ai.commandBufferCount = IN_FLIGHT_2;
-    VK(vkAllocateCommandBuffers(device, &ai, cmds));
-    for (int k = 0; k < IN_FLIGHT_2; k++) {
-        VkFenceCreateInfo fi = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-        VK(vkCreateFence(device, &fi, NULL, &fences[k]));
-        back[k] = make_host_buffer(sizeof(float) * PX, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-    }
+    frames_in_flight_ring(IN_FLIGHT_2, cmds, fences);
+    for (int k = 0; k < IN_FLIGHT_2; k++) back[k] = make_host_buffer(sizeof(float) * PX, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     /* the first frame waits on a semaphore released once the second is submitted: both are pending then,
      * reading different vertex buffers */
     VkSemaphore hold = held_semaphore();
@@ -2750,14 +2755,8 @@ static void frames_in_flight(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *
     VkFence fences[IN_FLIGHT];
     Buf depth[IN_FLIGHT], normal[IN_FLIGHT], back[IN_FLIGHT];
     int pending[IN_FLIGHT];
-    VkCommandBufferAllocateInfo ai = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    ai.commandPool = pool;
-    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    ai.commandBufferCount = IN_FLIGHT;
-    VK(vkAllocateCommandBuffers(device, &ai, cmds));
+    frames_in_flight_ring(IN_FLIGHT, cmds, fences);
     for (int s = 0; s < IN_FLIGHT; s++) {
-        VkFenceCreateInfo fi = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-        VK(vkCreateFence(device, &fi, NULL, &fences[s]));
         depth[s] = make_host_buffer(sizeof(float) * PX, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
         normal[s] = make_host_buffer(sizeof(float) * 4 * PX, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
         back[s] = make_host_buffer(sizeof(float) * LIGHTS * PX, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
