@@ -5,7 +5,7 @@
 //! and `gbuffer.frag` (analysis), `gbuffer_encoded.frag` (analysis and an encoded normal target),
 //! `gbuffer_compact.frag` (depth and the encoded normal alone) in `host_demo/shaders/`.
 
-use crate::{shader, CameraMatrices};
+use crate::{shader, CameraMatrices, FrameImages};
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, Mat3, Mat4, Vec4};
 use passes::{NormalEncoding, NormalSpace, PassError, SurfaceInput};
@@ -358,4 +358,66 @@ impl GBufferPass {
         enc.end_pass();
         Ok(())
     }
+}
+
+/// The read-back of a compact G-buffer (RG16F octahedral view-space normals, D24S8 or D32 depth) as the
+/// analysis G-buffer holds it: depth, world normals with coverage in w, and world positions rebuilt from
+/// depth through `camera` (in f64).
+pub fn decode_compact(
+    layout: &GBufferLayout,
+    camera: &CameraMatrices,
+    (width, height): (u32, u32),
+    normal: &[u8],
+    depth: &[u8],
+) -> Result<FrameImages, PassError> {
+    let pixels = width as usize * height as usize;
+    if layout.normal != Format::Rg16Float
+        || layout.surface.encoding != NormalEncoding::Octahedral
+        || layout.surface.space != NormalSpace::View
+        || normal.len() != pixels * 4
+        || depth.len() != pixels * 4
+    {
+        return Err(PassError::InvalidConfig(format!(
+            "a compact G-buffer read back holds RG16F octahedral view-space normals, not {layout:?}"
+        )));
+    }
+    let words: Vec<u32> = bytemuck::pod_collect_to_vec(depth);
+    let depth: Vec<f32> = words
+        .iter()
+        .map(|&w| match layout.depth {
+            Format::D32Float => f32::from_bits(w),
+            _ => (w & 0xFF_FFFF) as f32 / 16_777_215.0,
+        })
+        .collect();
+    let halves: Vec<u16> = bytemuck::pod_collect_to_vec(normal);
+    let view_to_world = Mat3::from_mat4(camera.view).inverse().as_dmat3();
+    let inverse = (camera.proj.as_dmat4() * camera.view.as_dmat4()).inverse();
+    let mut frame = FrameImages::default();
+    for (i, &d) in depth.iter().enumerate() {
+        if d <= 0.0 {
+            frame.normal.push([0.0; 4]);
+            frame.position.push([0.0; 4]);
+            continue;
+        }
+        let e = glam::DVec2::new(
+            half::f16::from_bits(halves[2 * i]).to_f64(),
+            half::f16::from_bits(halves[2 * i + 1]).to_f64(),
+        );
+        let mut n = DVec3::new(e.x, e.y, 1.0 - e.x.abs() - e.y.abs());
+        let t = (-n.z).max(0.0);
+        n.x += if n.x >= 0.0 { -t } else { t };
+        n.y += if n.y >= 0.0 { -t } else { t };
+        let n = (view_to_world * n).normalize_or_zero().as_vec3();
+        frame.normal.push([n.x, n.y, n.z, 1.0]);
+        let (x, y) = ((i % width as usize) as f64, (i / width as usize) as f64);
+        let ndc = DVec3::new(
+            (x + 0.5) / f64::from(width) * 2.0 - 1.0,
+            (y + 0.5) / f64::from(height) * 2.0 - 1.0,
+            f64::from(d),
+        );
+        let p = inverse.project_point3(ndc).as_vec3();
+        frame.position.push([p.x, p.y, p.z, 1.0]);
+    }
+    frame.depth = depth;
+    Ok(frame)
 }

@@ -133,6 +133,9 @@ pub struct PluginRenderer {
     frames: u64,
     frames_with_plugin_passes: u64,
     native_tier: ConservativeRasterTier,
+    /// The camera of the last frame: a compact G-buffer's read-back rebuilds positions and world normals
+    /// through it.
+    last_camera: Option<CameraMatrices>,
 }
 
 impl PluginRenderer {
@@ -198,6 +201,7 @@ impl PluginRenderer {
             bounds: scene.bounds(),
             frames: 0,
             frames_with_plugin_passes: 0,
+            last_camera: None,
             native_tier: device.capabilities().conservative_raster_tier,
         })
     }
@@ -328,6 +332,7 @@ impl PluginRenderer {
             );
         }
         let push = GBufferPush::for_camera(camera, self.geometry.origin(), &self.targets.layout)?;
+        self.last_camera = Some(*camera);
         let tris = self.geometry.triangle_count();
         let rebuild_prims = self.frames == 0 || self.dynamic_geometry;
         let with_plugin = !c_lights.is_empty();
@@ -508,6 +513,11 @@ impl PluginRenderer {
     pub fn read_frame(&self, device: &Device) -> Result<(FrameImages, Vec<Vec<f32>>)> {
         let own = self.targets.outputs();
         let mut images: Vec<(&Image, S)> = own.iter().map(|&(i, s, _)| (i, s)).collect();
+        let compact = self.targets.analysis.is_none();
+        if compact {
+            images.push((&self.targets.normal, S::ShaderResource));
+            images.push((&self.targets.depth, S::ShaderResource));
+        }
         let output = self.output.as_ref().filter(|_| !self.configured.is_empty());
         images.extend(output.map(|o| (o, S::ShaderResource)));
         let mut bytes = read_images(device, &images)?;
@@ -525,6 +535,19 @@ impl PluginRenderer {
         };
         let origin = self.geometry.origin();
         let mut frame = FrameImages::default();
+        if compact {
+            let camera = self.last_camera.context("no frame rendered")?;
+            let (width, height) = (self.targets.depth.width(), self.targets.depth.height());
+            let depth = bytes.pop().unwrap_or_default();
+            let normal = bytes.pop().unwrap_or_default();
+            frame = crate::gbuffer::decode_compact(
+                &self.targets.layout,
+                &camera,
+                (width, height),
+                &normal,
+                &depth,
+            )?;
+        }
         for ((_, _, output), bytes) in own.iter().zip(&bytes) {
             frame.insert(*output, bytes, origin);
         }

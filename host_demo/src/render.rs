@@ -1,5 +1,6 @@
 //! `host_demo render`: one view of a scene through every pass its plan runs, written to a folder.
 
+use crate::gbuffer::GBufferLayout;
 use crate::images::lerp_factor_preview;
 use crate::output::{shade_preview, write_exr_rgba, write_exr_scalar, write_png};
 use crate::plugin::PluginRenderer;
@@ -313,8 +314,11 @@ pub fn render_to_folder(
 ) -> Result<FrameReport> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let config = options.shadow_config(view);
-    let mut renderer =
-        PluginRenderer::new(device, view, config).context("creating the shadow passes")?;
+    // The demo's G-buffer as engines keep one (D24S8 depth, octahedral RG16F normals); its read-back
+    // rebuilds positions and world normals for the outputs below.
+    let layout = GBufferLayout::compact(device);
+    let mut renderer = PluginRenderer::with_layout(device, view, config, layout)
+        .context("creating the shadow passes")?;
     let inputs = view.frame_inputs();
     let mut reports = Vec::new();
     let bar = crate::progress(u64::from(options.frames.max(1)), "frames");

@@ -233,3 +233,60 @@ fn soft_and_none_modes_match() {
         check(mode.name(), &view, config, 1, false);
     }
 }
+
+/// The demo's compact G-buffer (D24S8 depth, octahedral RG16F view-space normals), as `render` keeps it: its
+/// read-back rebuilds the analysis G-buffer's world normals and positions (same coverage, normals within the
+/// encoding's tilt, positions within the depth's precision), and the hard shadow it gives is exact.
+#[test]
+fn compact_gbuffer_reads_back_as_the_analysis_one_and_shadows_exactly() {
+    let device = device();
+    let view = View::framed(scene::procedural_default(), 192, 108);
+    let config = PrimitiveMapConfig::default();
+    let layouts = [
+        host_demo::gbuffer::GBufferLayout::ANALYSIS,
+        host_demo::gbuffer::GBufferLayout::compact(&device),
+    ];
+    let images: Vec<FrameImages> = layouts
+        .iter()
+        .map(|&layout| {
+            let mut r =
+                PluginRenderer::with_layout(&device, &view, config, layout).expect("renderer");
+            r.render(&device, &view.frame_inputs()).expect("render");
+            r.read_back(&device, false).expect("read back")
+        })
+        .collect();
+    let (full, compact) = (&images[0], &images[1]);
+    let radius = f64::from(view.scene.bounds().radius());
+    let (mut coverage, mut tilt, mut shift) = (0, 0.0f64, 0.0f64);
+    for i in 0..full.normal.len() {
+        let (a, b) = (full.normal[i], compact.normal[i]);
+        if (a[3] != 0.0) != (b[3] != 0.0) {
+            coverage += 1;
+            continue;
+        }
+        if a[3] == 0.0 {
+            continue;
+        }
+        let (na, nb) = (
+            glam::Vec3::from_slice(&a).as_dvec3(),
+            glam::Vec3::from_slice(&b).as_dvec3(),
+        );
+        tilt = tilt.max(na.angle_between(nb).to_degrees());
+        let (pa, pb) = (
+            glam::Vec3::from_slice(&full.position[i]).as_dvec3(),
+            glam::Vec3::from_slice(&compact.position[i]).as_dvec3(),
+        );
+        shift = shift.max(pa.distance(pb) / radius);
+    }
+    println!("compact G-buffer: {coverage} px of other coverage, normals within {tilt:.4}°, positions within {shift:.2e} of the scene's radius");
+    assert_eq!(coverage, 0, "coverage differs");
+    assert!(tilt < 0.1, "normals tilted by {tilt}°");
+    assert!(shift < 1e-3, "positions moved by {shift} radii");
+    let c = compare_visibility(&reference::RefScene::new(&view.scene), &view, compact);
+    assert_eq!(
+        c.mismatches, 0,
+        "compact G-buffer vs reference: {:?}",
+        c.examples
+    );
+    assert_no_validation_errors(&device);
+}
