@@ -330,7 +330,15 @@ mod tests {
     #[test]
     fn every_demo_shader_is_embedded_spirv() {
         let names: Vec<&str> = shaders::ALL.iter().map(|(n, _)| *n).collect();
-        assert_eq!(names, ["gbuffer.frag", "gbuffer.vert"]);
+        assert_eq!(
+            names,
+            [
+                "gbuffer.frag",
+                "gbuffer.vert",
+                "gbuffer_compact.frag",
+                "gbuffer_encoded.frag"
+            ]
+        );
         for n in names {
             let words = shader(n).unwrap();
             assert!(words.len() > 5, "{n} is too short for a SPIR-V module");
