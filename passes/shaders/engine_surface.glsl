@@ -160,6 +160,15 @@ bool engine_surface(ivec2 px, float depth, vec3 rel, mat4 inv_view_proj_rel, uve
     return true;
 }
 
+// The receiver at `px`: its point relative to the camera, the value its depth image holds and its normal
+// (engine_point, then engine_surface); false on background.
+bool engine_receiver(ivec2 px, mat4 inv_view_proj_rel, uvec2 dims, uvec4 mode, vec4 surface,
+                     mat4 view_to_world, out vec3 rel, out float depth, out vec3 n) {
+    n = vec3(0.0, 0.0, 1.0);
+    return engine_point(px, inv_view_proj_rel, dims, surface, view_to_world, rel, depth)
+        && engine_surface(px, depth, rel, inv_view_proj_rel, dims, mode, view_to_world, surface.x, n);
+}
+
 // Whether the surface at `px` (normal `n` from engine_surface) faces a light in direction `to_light`. The
 // engine's normal decides, unless it lies within its own precision (surface.z: the sine of the largest
 // angle by which the encoding tilts it) of perpendicular to the light: then the normal derived from a depth

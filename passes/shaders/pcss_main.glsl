@@ -107,9 +107,8 @@ void main() {
     vec3 rel;
     float depth;
     vec3 n;
-    if (!engine_point(px, k.inv_view_proj_rel, k.dims.xy, k.surface, k.view_to_world, rel, depth)
-        || !engine_surface(px, depth, rel, k.inv_view_proj_rel, k.dims.xy, k.surface_mode, k.view_to_world,
-                           k.surface.x, n)) {
+    if (!engine_receiver(px, k.inv_view_proj_rel, k.dims.xy, k.surface_mode, k.surface, k.view_to_world, rel,
+                         depth, n)) {
         store(px, 1.0);     // background
         return;
     }

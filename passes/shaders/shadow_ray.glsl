@@ -22,9 +22,8 @@ int shadow_ray(ivec2 px, out vec3 o, out vec3 dir, out float t_max) {
     vec3 rel;
     float depth;
     vec3 n;
-    if (!engine_point(px, k.inv_view_proj_rel, k.dims.xy, k.surface, k.view_to_world, rel, depth)
-        || !engine_surface(px, depth, rel, k.inv_view_proj_rel, k.dims.xy, k.surface_mode, k.view_to_world,
-                           k.surface.x, n)) {
+    if (!engine_receiver(px, k.inv_view_proj_rel, k.dims.xy, k.surface_mode, k.surface, k.view_to_world, rel,
+                         depth, n)) {
         return SHADOW_RAY_LIT;
     }
     vec3 p = k.camera_pos.xyz + rel;

@@ -433,16 +433,22 @@ static uint16_t half_of(float f) {
     return (uint16_t)h;
 }
 
-static void upload_image(Img img, VkImageAspectFlags aspects, VkImageAspectFlags copied, Buf staging, VkImageLayout layout) {
-    VkCommandBuffer cmd = begin();
-    barrier(cmd, img.image, aspects, 1, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+/* A copy region covering `layers` whole W x H layers of an image's `aspect`, from layer 0. */
+static VkBufferImageCopy frame_region(VkImageAspectFlags aspect, uint32_t layers) {
     VkBufferImageCopy region;
     memset(&region, 0, sizeof region);
-    region.imageSubresource.aspectMask = copied;
-    region.imageSubresource.layerCount = 1;
+    region.imageSubresource.aspectMask = aspect;
+    region.imageSubresource.layerCount = layers;
     region.imageExtent.width = W;
     region.imageExtent.height = H;
     region.imageExtent.depth = 1;
+    return region;
+}
+
+static void upload_image(Img img, VkImageAspectFlags aspects, VkImageAspectFlags copied, Buf staging, VkImageLayout layout) {
+    VkCommandBuffer cmd = begin();
+    barrier(cmd, img.image, aspects, 1, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+    VkBufferImageCopy region = frame_region(copied, 1);
     vkCmdCopyBufferToImage(cmd, staging.buffer, img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
     barrier(cmd, img.image, aspects, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, layout);
     submit_and_wait(cmd);
@@ -710,13 +716,7 @@ static void record_gbuffer_upload(VkCommandBuffer cmd, Buf depth, Buf normal, in
     VkImageLayout normal_from = first ? VK_IMAGE_LAYOUT_UNDEFINED : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
     barrier(cmd, depth_img.image, VK_IMAGE_ASPECT_DEPTH_BIT, 1, depth_from, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
     barrier(cmd, normal_img.image, VK_IMAGE_ASPECT_COLOR_BIT, 1, normal_from, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
-    VkBufferImageCopy region;
-    memset(&region, 0, sizeof region);
-    region.imageSubresource.aspectMask = VK_IMAGE_ASPECT_DEPTH_BIT;
-    region.imageSubresource.layerCount = 1;
-    region.imageExtent.width = W;
-    region.imageExtent.height = H;
-    region.imageExtent.depth = 1;
+    VkBufferImageCopy region = frame_region(VK_IMAGE_ASPECT_DEPTH_BIT, 1);
     vkCmdCopyBufferToImage(cmd, depth.buffer, depth_img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
     region.imageSubresource.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
     vkCmdCopyBufferToImage(cmd, normal.buffer, normal_img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
@@ -740,13 +740,7 @@ static void upload_gbuffer(void) {
 
 /* Records the copy of the first `layers` output layers into `back` (tightly packed, layer after layer). */
 static void record_output_readback(VkCommandBuffer cmd, Buf back, uint32_t layers) {
-    VkBufferImageCopy region;
-    memset(&region, 0, sizeof region);
-    region.imageSubresource.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
-    region.imageSubresource.layerCount = layers;
-    region.imageExtent.width = W;
-    region.imageExtent.height = H;
-    region.imageExtent.depth = 1;
+    VkBufferImageCopy region = frame_region(VK_IMAGE_ASPECT_COLOR_BIT, layers);
     vkCmdCopyImageToBuffer(cmd, out_img.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, back.buffer, 1, &region);
     host_read_barrier(cmd);
 }
@@ -1370,13 +1364,7 @@ static void output_formats(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g)
                 HrtsFrame f = frame(cmd, next_frame++);
                 r = hrts_record_frame(ctx, &f);
                 if (r == HRTS_RESULT_OK) {
-                    VkBufferImageCopy region;
-                    memset(&region, 0, sizeof region);
-                    region.imageSubresource.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
-                    region.imageSubresource.layerCount = 1;
-                    region.imageExtent.width = W;
-                    region.imageExtent.height = H;
-                    region.imageExtent.depth = 1;
+                    VkBufferImageCopy region = frame_region(VK_IMAGE_ASPECT_COLOR_BIT, 1);
                     vkCmdCopyImageToBuffer(cmd, out.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, back.buffer, 1, &region);
                     host_read_barrier(cmd);
                 }
