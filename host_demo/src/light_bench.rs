@@ -1,11 +1,10 @@
 //! `host_demo bench --lights`: what each kind of light costs inside whole scenes. The shared Sponza and
 //! Conference models, seen from inside, each with one light at a time: the sun, a spot light inside and a
 //! point light at three positions inside, planned as `render --scene` plans a glTF scene and drawn through
-//! the plugin's C ABI (a point light given as a point light: the plugin records the cube faces that may
-//! hold a receiver in view); with `--point-lights N`, N point lights in one context. Per light: frusta
-//! recorded of those built, GPU ms of its passes (the median over the frames after the first of the
-//! per-frame sum over its frusta), memory, and its lists (entries, mean and longest list, texels past
-//! capacity).
+//! the plugin's C ABI (a point light given as a point light: the plugin builds its cube faces as one map);
+//! with `--point-lights N`, N point lights in one context. Per light: frusta recorded of those built, GPU
+//! ms of its passes (the median over the frames after the first of the per-frame sum over its frusta),
+//! per pass, memory, and its lists (entries, mean and longest list, texels past capacity).
 
 use crate::bench::BenchArgs;
 use crate::gbuffer::GBufferLayout;
@@ -120,6 +119,10 @@ struct LightCost {
     mean_list: f64,
     longest: u32,
     past_capacity: u64,
+    /// Median ms of each pass (summed over the light's frusta), in the order first seen.
+    passes: Vec<(String, f64)>,
+    /// Bytes of the build scratch the context's lights share.
+    scratch_bytes: u64,
 }
 
 /// Median of `v` (0 when empty).
@@ -140,6 +143,27 @@ fn frame_ms(frame: &LightsFrame, keep: impl Fn(&str) -> bool) -> f64 {
         .filter(|t| keep(&t.name))
         .map(|t| t.ms)
         .sum()
+}
+
+/// Median over frames of each pass's ms, summed over `frames`' lights and frusta, in the order first seen.
+fn pass_medians(frames: &[LightsFrame]) -> Vec<(String, f64)> {
+    let mut names: Vec<String> = Vec::new();
+    for t in frames
+        .iter()
+        .flat_map(|f| &f.lights)
+        .flat_map(|l| &l.report.timings)
+    {
+        if !names.contains(&t.name) {
+            names.push(t.name.clone());
+        }
+    }
+    names
+        .into_iter()
+        .map(|name| {
+            let ms = median(frames.iter().map(|f| frame_ms(f, |n| n == name)).collect());
+            (name, ms)
+        })
+        .collect()
 }
 
 /// Medians over frames of every light's own passes (the shared prim buffer is not the light's), of its
@@ -171,6 +195,7 @@ fn measure_light(
     };
     let plan = plan_scene(file, camera, &settings)?;
     let mut renderer = SceneRenderer::new(device, file, args.width, args.height)?;
+    renderer.write_outputs_directly();
     let mut frames = Vec::new();
     for _ in 0..args.frames.max(2) {
         frames.push(renderer.render(device, camera, &plan)?);
@@ -210,6 +235,8 @@ fn measure_light(
             .iter()
             .map(|r| u64::from(r.stats.texels_past_capacity))
             .sum(),
+        passes: pass_medians(&frames[1..]),
+        scratch_bytes: reports.iter().map(|r| r.map_scratch_bytes).max().unwrap_or(0),
     })
 }
 
@@ -221,9 +248,8 @@ fn frusta_of(frame: &LightsFrame) -> (u32, u32) {
 }
 
 /// The cost of point lights at `positions` given to the plugin as point lights (the C ABI's
-/// `HRTS_LIGHT_TYPE_POINT`) in one context: the plugin fits six cube faces to each, records those that may
-/// hold a receiver in view, and combines them. Statistics are those of the first light; time and memory
-/// are the sum over all.
+/// `HRTS_LIGHT_TYPE_POINT`) in one context: the plugin builds each one's six cube faces as one map.
+/// Statistics are those of the first light; time and memory are the sum over all.
 fn measure_native_points(
     device: &Device,
     file: &SceneFile,
@@ -240,6 +266,7 @@ fn measure_native_points(
         false,
         GBufferLayout::ANALYSIS,
     )?;
+    plugin.write_outputs_directly();
     let config = ShadowConfig {
         mode: ShadowMode::Hard,
         antialiasing: false,
@@ -279,6 +306,8 @@ fn measure_native_points(
         mean_list: st.mean_list(),
         longest: st.longest_list,
         past_capacity: u64::from(st.texels_past_capacity),
+        passes: pass_medians(&frames[1..]),
+        scratch_bytes: light.report.map_scratch_bytes,
     })
 }
 
@@ -288,8 +317,9 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
     let mut out = format!(
         "Device: {} ({}); {}×{}, hard shadows (zero-size lights), no FXAA; one light at a time, planned as \
          `render --scene` plans it; GPU ms = median over {} frames after the first of the light's passes \
-         summed over its frusta (the shared prim buffer excluded); memory = the light's own resources; frusta = \
-         recorded / built (the plugin skips those holding no receiver in view).\n\n\
+         summed over its frusta (the shared prim buffer excluded); memory = the light's own resources (each light \
+         writes its layer of an R32F storage output directly; the build scratch shared by all lights is listed \
+         below); frusta = recorded / built (the plugin skips those holding no receiver in view).\n\n\
          | scene | light | frusta | GPU ms | × sun | map ms | ray trace ms | MiB | entries | mean list | longest | past capacity |\n\
          |---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         caps.device_name,
@@ -307,6 +337,9 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
         .map(|s| 2 + s.points.len() + usize::from(args.point_lights > 0))
         .sum();
     let bar = crate::progress(total as u64, "bench --lights");
+    let mut per_pass = String::from(
+        "\nPer pass (median ms over the same frames, summed over the light's frusta):\n\n",
+    );
     for scene_case in chosen {
         let path = models.join(scene_case.file);
         let scene =
@@ -384,8 +417,22 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
                 c.longest,
                 c.past_capacity
             );
+            let passes: Vec<String> = c
+                .passes
+                .iter()
+                .map(|(name, ms)| format!("{name} {ms:.3}"))
+                .collect();
+            let _ = writeln!(
+                per_pass,
+                "- {} {}: {}; shared build scratch {:.1} MiB",
+                scene_case.file.trim_end_matches(".obj"),
+                c.name,
+                passes.join(", "),
+                c.scratch_bytes as f64 / f64::from(1 << 20)
+            );
         }
     }
     bar.finish_and_clear();
+    out.push_str(&per_pass);
     Ok(out)
 }

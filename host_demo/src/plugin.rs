@@ -125,6 +125,9 @@ pub struct PluginRenderer {
     replaced_outputs: Vec<Image>,
     /// The configurations the plugin holds, one per light.
     configured: Vec<ShadowConfig>,
+    /// Usage of the visibility image: with storage usage, each light's last pass writes its layer
+    /// directly (its final output can then only be read from the visibility image).
+    output_usage: ImageUsage,
     timer: GpuTimer,
     dynamic_geometry: bool,
     /// The scene's bounds, given with every frame: the demo does not animate its scenes, so they hold in
@@ -196,6 +199,7 @@ impl PluginRenderer {
             output: None,
             replaced_outputs: Vec::new(),
             configured: Vec::new(),
+            output_usage: ImageUsage::COPY_DST | ImageUsage::COPY_SRC | ImageUsage::SAMPLED,
             timer: device.create_timer(4)?,
             dynamic_geometry,
             bounds: scene.bounds(),
@@ -204,6 +208,13 @@ impl PluginRenderer {
             last_camera: None,
             native_tier: device.capabilities().conservative_raster_tier,
         })
+    }
+
+    /// Gives the visibility image storage usage, as an engine whose output the lights write directly
+    /// (`HrtsFrameReport::output_direct`): the final outputs are then read from it, not read back as
+    /// resources. Takes effect when the lights are next configured with more layers than the image has.
+    pub fn write_outputs_directly(&mut self) {
+        self.output_usage = self.output_usage | ImageUsage::STORAGE;
     }
 
     /// Gives the plugin one configuration per light (`hrts_configure_lights`; none: later frames give the
@@ -223,7 +234,7 @@ impl PluginRenderer {
                 width: self.targets.depth.width(),
                 height: self.targets.depth.height(),
                 layers,
-                usage: ImageUsage::COPY_DST | ImageUsage::COPY_SRC | ImageUsage::SAMPLED,
+                usage: self.output_usage,
             })?;
             let t = &self.targets;
             let c_targets = HrtsTargets {
@@ -487,6 +498,8 @@ impl PluginRenderer {
                 entries: r.entries,
                 capacity: r.entry_capacity,
                 texels_past_capacity: r.texels_past_capacity,
+                pairs: r.bin_pairs,
+                pair_capacity: r.bin_pair_capacity,
             },
             map_to_texels: Mat4::from_cols_array(&r.map_to_texels),
             passes,
@@ -791,6 +804,7 @@ fn c_light(light: &Light) -> HrtsLight {
             direction: direction.to_array(),
             ..c_point_light(position, 0.0)
         },
+        Light::Point { position, range } => c_point_light(position, range.unwrap_or(0.0)),
     }
 }
 

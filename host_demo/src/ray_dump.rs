@@ -189,9 +189,11 @@ fn shadow_rays(rs: &RefScene, view: &View, inputs: &FrameInputs, origin: DVec3) 
         passes::Light::Directional { direction, .. } => reference::Light::Directional {
             direction: direction.as_dvec3().normalize_or_zero(),
         },
-        passes::Light::Spot { position, .. } => reference::Light::Point {
-            position: position.as_dvec3(),
-        },
+        passes::Light::Spot { position, .. } | passes::Light::Point { position, .. } => {
+            reference::Light::Point {
+                position: position.as_dvec3(),
+            }
+        }
     };
     // As `accuracy::compare_visibility` builds the reference the GPU is checked against.
     let params = VisibilityParams {

@@ -61,6 +61,12 @@ impl SceneRenderer {
         })
     }
 
+    /// Has each light write its layer of the visibility image directly
+    /// ([`PluginRenderer::write_outputs_directly`]); call before the first frame.
+    pub fn write_outputs_directly(&mut self) {
+        self.plugin.write_outputs_directly();
+    }
+
     /// The plugin driver.
     pub fn plugin(&self) -> &PluginRenderer {
         &self.plugin

@@ -55,12 +55,50 @@ bool bin_overlaps(BinTri t, vec2 centre) {
     return true;    // a point or a cover: the bounding box decided
 }
 
-// `receiver` is the texel's word of the receiver map: 0 without a ray origin, else the ordered largest
-// depth key (plus its error) of the texel's ray origins. Without `cull`, every overlapped texel is accepted
-// (a debug mode whose lists tests compare with exact binning).
-bool bin_accepts(BinTri t, uint receiver, vec2 centre, bool cull) {
-    if (cull && (receiver == 0u || t.cmd.w > unordered(receiver))) {
-        return false;
+// Unit roundoff of f32.
+#define BIN_U 5.9604645e-8
+
+// A bound on the rounding of evaluating the edge function of edge `e` from point `a` (or, with a = 0, a
+// homogeneous line of coefficients e) anywhere within `h` of `c`, in the texel test or in the tile test
+// below: both evaluate the same affine function, so their difference is at most twice this.
+float bin_rounding(vec2 e, vec2 a, vec2 c, vec2 h) {
+    vec2 reach = abs(c) + h + abs(a) + 1.0;
+    return 16.0 * BIN_U * (abs(e.x) * reach.y + abs(e.y) * reach.x) * 1.01;
+}
+
+// Whether any texel centre within `h` (per axis) of `c` may be accepted by bin_overlaps: each edge
+// function's best value over that box (its value at `c` plus the half-extent times its gradient) is tested
+// with the texel test's growth and both evaluations' rounding. Conservative: a tile it rejects holds no
+// texel bin_overlaps accepts, so the binning skips the tile's texels without changing any list.
+bool bin_tile_overlaps(BinTri t, vec2 c, vec2 h) {
+    float grow = 0.5 + t.cmd.z;
+    vec2 a = t.ab.xy, b = t.ab.zw, cc = t.cmd.xy;
+    if (t.info.z == MODE_TRIANGLE) {
+        vec2 e0 = b - a, e1 = cc - b, e2 = a - cc;
+        return cross2(e0, c - a) + dot(h, abs(e0.yx)) + grow * (abs(e0.x) + abs(e0.y))
+                   + 2.0 * bin_rounding(e0, a, c, h) >= 0.0
+            && cross2(e1, c - b) + dot(h, abs(e1.yx)) + grow * (abs(e1.x) + abs(e1.y))
+                   + 2.0 * bin_rounding(e1, b, c, h) >= 0.0
+            && cross2(e2, c - cc) + dot(h, abs(e2.yx)) + grow * (abs(e2.x) + abs(e2.y))
+                   + 2.0 * bin_rounding(e2, cc, c, h) >= 0.0;
     }
-    return bin_overlaps(t, centre);
+    if (t.info.z == MODE_SEGMENT) {
+        vec2 e = b - a;
+        return abs(cross2(e, c - a)) - dot(h, abs(e.yx))
+            <= grow * (abs(e.x) + abs(e.y)) + 2.0 * bin_rounding(e, a, c, h);
+    }
+    if (t.info.z == MODE_CLIPPED) {
+        vec3 p = vec3(c, 1.0);
+        vec3 l0 = t.ab.xyz, l1 = vec3(t.ab.w, t.cmd.xy), l2 = t.ext.xyz;
+        vec3 f = vec3(dot(l0, p), dot(l1, p), dot(l2, p));
+        vec3 spread = vec3(dot(h, abs(l0.xy)), dot(h, abs(l1.xy)), dot(h, abs(l2.xy)));
+        vec3 g = grow * vec3(abs(l0.x) + abs(l0.y), abs(l1.x) + abs(l1.y), abs(l2.x) + abs(l2.y));
+        vec3 r = 2.0 * vec3(bin_rounding(l0.yx, vec2(0.0), c, h) + 16.0 * BIN_U * abs(l0.z),
+                            bin_rounding(l1.yx, vec2(0.0), c, h) + 16.0 * BIN_U * abs(l1.z),
+                            bin_rounding(l2.yx, vec2(0.0), c, h) + 16.0 * BIN_U * abs(l2.z));
+        bool positive = t.ext.w >= 0.0 && all(greaterThanEqual(f + spread + g + r, vec3(0.0)));
+        bool negative = t.ext.w <= 0.0 && all(lessThanEqual(f - spread - g - r, vec3(0.0)));
+        return positive || negative;
+    }
+    return true;    // a point or a cover: the bounding box decided
 }

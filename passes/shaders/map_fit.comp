@@ -1,52 +1,82 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// One invocation. mode 0: resets the map state for a new frame. mode 1: fits the map to the receivers'
-// light-space bounds (padded by 1/256 of their extent): `to_texels` maps frame coordinates to homogeneous
-// texel space, the light's view-projection followed by the 2D affine fit.
+// One invocation. mode 0: resets the map state of every frustum for a new frame. mode 1: fits each frustum's grid to its receivers' light-space bounds (padded by 1/256
+// of their extent): `to_texels` maps frame coordinates to homogeneous texel space, the frustum's
+// view-projection followed by the 2D affine fit; `grid` places the grid in the map's texels.
+#include "ray_trace_constants.glsl"
 #include "map_state.glsl"
 #include "map_push.glsl"
 
 layout(local_size_x = 1) in;
-layout(set = 0, binding = 0) buffer State { MapState ms; };
+layout(set = 0, binding = 0) buffer State { MapState faces[]; };
+layout(set = 0, binding = 1) uniform Constants { RayTraceConstants k; mat4 frusta[6]; };
 layout(push_constant) uniform Push { MapPush pc; };
 
 const uint MIN_GRID = 16u;
 
 void main() {
     if (pc.mode == 0u) {
-        ms.to_texels = mat4(1.0);
-        ms.bounds = uvec4(0xFFFFFFFFu, 0xFFFFFFFFu, 0u, 0u);
-        ms.receivers = uvec4(0u);
-        ms.fit = vec4(0.0);
-        ms.totals = uvec4(0u, 0u, pc.capacity, 0u);
-        ms.stats = uvec4(0u);
+        for (uint f = 0u; f < pc.faces; ++f) {
+            faces[f].to_texels = mat4(1.0);
+            faces[f].bounds = uvec4(0xFFFFFFFFu, 0xFFFFFFFFu, 0u, 0u);
+            faces[f].receivers = uvec4(0u);
+            faces[f].fit = vec4(0.0);
+            faces[f].totals = uvec4(0u, 0u, f == 0u ? pc.capacity : 0u, 0u);
+            faces[f].stats = uvec4(0u);
+            faces[f].grid = uvec4(0u, 0u, 0u, f == 0u ? pc.pairs : 0u);
+        }
         return;
     }
-    if (ms.bounds.x > ms.bounds.z || ms.bounds.y > ms.bounds.w) {
-        return;     // no receivers: no pixel traces a ray, the map stays empty
+    uint rays = 0u;
+    for (uint f = 0u; f < pc.faces; ++f) {
+        rays += faces[f].receivers.w;
     }
-    vec2 lo = vec2(unordered(ms.bounds.x), unordered(ms.bounds.y));
-    vec2 hi = vec2(unordered(ms.bounds.z), unordered(ms.bounds.w));
-    vec2 extent = max(hi - lo, max(abs(lo), abs(hi)) * 1e-6 + 1e-30);
-    lo -= extent / 256.0;
-    hi += extent / 256.0;
-    // With receiver culling, a texel holds a list only where a ray origin lies, so a grid much finer than
-    // the rays only multiplies the binning work of large triangles (a face of a point light that sees a
-    // handful of pixels would otherwise spread every triangle over N^2 texels). The grid keeps about 16
-    // texels per ray origin, at least MIN_GRID and at most N per side; without culling (a debug mode whose
-    // lists are compared texel by texel), always N.
-    uint n = pc.size;
-    if (pc.cull != 0u) {
-        n = clamp(4u * uint(ceil(sqrt(float(ms.receivers.w)))), min(MIN_GRID, pc.size), pc.size);
+    uint min_grid = min(MIN_GRID, pc.size);
+    uint base = 0u;
+    for (uint f = 0u; f < pc.faces; ++f) {
+        uvec4 b = faces[f].bounds;
+        if (b.x > b.z || b.y > b.w) {
+            continue;   // no receivers: no pixel traces a ray through this frustum, its grid stays empty
+        }
+        vec2 lo = vec2(unordered(b.x), unordered(b.y));
+        vec2 hi = vec2(unordered(b.z), unordered(b.w));
+        vec2 extent = max(hi - lo, max(abs(lo), abs(hi)) * 1e-6 + 1e-30);
+        lo -= extent / 256.0;
+        hi += extent / 256.0;
+        // With receiver culling, a texel holds a list only where a ray origin lies, so a grid much finer
+        // than the rays only multiplies the binning work of large triangles (a face of a point light that
+        // sees a handful of pixels would otherwise spread every triangle over N^2 texels). The grid keeps
+        // about 16 texels per ray origin, at least MIN_GRID and at most N per side; without culling (a
+        // debug mode whose lists are compared texel by texel), always N. A point light's faces share N^2
+        // texels (plus MIN_GRID^2 each) in proportion to their rays.
+        uint n = pc.size;
+        uint rays_f = faces[f].receivers.w;
+        if (pc.cull != 0u) {
+            n = clamp(4u * uint(ceil(sqrt(float(rays_f)))), min_grid, pc.size);
+        }
+        uint stride = pc.size;
+        if (pc.faces > 1u) {
+            uint share = uint(float(pc.size) * sqrt(float(rays_f) / float(max(rays, 1u))));
+            n = min(n, max(share, min_grid));
+            n = max(min(n, uint(sqrt(float(pc.texels - base)))), 1u);
+            while (n > 1u && n * n > pc.texels - base) {
+                n -= 1u;
+            }
+            stride = n;
+        }
+        faces[f].fit.y = float(n);
+        vec2 s = float(n) / (hi - lo);
+        // texel * w = s * (clip.xy - lo * clip.w)
+        mat4 fit = mat4(1.0);
+        fit[0][0] = s.x;
+        fit[1][1] = s.y;
+        fit[3][0] = -lo.x * s.x;
+        fit[3][1] = -lo.y * s.y;
+        faces[f].to_texels = fit * frusta[f];
+        faces[f].fit.x = 1.0;
+        faces[f].grid.xy = uvec2(base, stride);
+        if (pc.faces > 1u) {
+            base += n * n;
+        }
     }
-    ms.fit.y = float(n);
-    vec2 s = float(n) / (hi - lo);
-    // texel * w = s * (clip.xy - lo * clip.w)
-    mat4 fit = mat4(1.0);
-    fit[0][0] = s.x;
-    fit[1][1] = s.y;
-    fit[3][0] = -lo.x * s.x;
-    fit[3][1] = -lo.y * s.y;
-    ms.to_texels = fit * pc.light_view_proj;
-    ms.fit.x = 1.0;
 }

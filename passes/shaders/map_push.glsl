@@ -1,6 +1,5 @@
-// Mirrors passes::gpu_types::MapPush (112 bytes): push constants of the primitive-map passes.
+// Mirrors passes::gpu_types::MapPush (64 bytes): push constants of the primitive-map passes.
 struct MapPush {
-    mat4 light_view_proj;   // light view-projection in frame coordinates
     vec4 to_light;          // xyz: direction towards the light (directional); w: 1 for a spot light
     uint size;              // N: texels per side
     uint mode;              // pass-specific mode
@@ -10,4 +9,8 @@ struct MapPush {
     uint tile_threads;      // threads of the binning dispatch (grid-stride over the bin items)
     uint guard;             // 1: guard words follow the entries and must stay untouched
     uint cull;              // 1: bin only into texels with ray origins, and not behind all of them
+    uint faces;             // frusta in the map: 1, or 6 for a point light's cube faces
+    uint pairs;             // (triangle, face) pairs the bin items hold (a point light's map)
+    uint texels;            // texels of the map's grids together
+    uint pad;
 };

@@ -1,12 +1,19 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Per triangle: culls what can never shadow a ray origin of this frame, projects the rest into the fitted
-// map and counts the 4x4-texel tiles of its bounding box (the bin items, scanned into offsets next).
+// Per triangle and frustum (a point light's six cube faces, or the light's one): culls what can never
+// shadow a ray origin of this frame, projects the rest into the frustum's fitted grid and counts the
+// 4x4-texel tiles of its bounding box (the bin items, scanned into offsets next). A light of one frustum
+// writes triangle i's bin item at i (the raster paths draw them in that order); a point light appends the
+// (triangle, face) pairs it keeps, up to the pairs the bin items hold, and counts them all (a frame that
+// keeps more traces exhaustively, and the pairs grow for the next one).
 // Culled: zero-area triangles with two equal vertices (the ray test's determinant is exactly 0 for them,
 // so they never hit), back faces in front-only mode, triangles outside the receivers' texels, triangles
 // wholly farther from the light than every ray origin, and, for a perspective light, triangles wholly on or
 // behind the light's plane. Triangles that cross that plane keep exactly their part in front of it
 // (clipped_setup).
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_shader_subgroup_basic : require
 #include "triangle.glsl"
 #include "map_state.glsl"
 #include "map_project.glsl"
@@ -15,9 +22,10 @@
 
 layout(local_size_x = 64) in;
 layout(set = 0, binding = 0) readonly buffer Prims { Triangle tris[]; };
-layout(set = 0, binding = 1) buffer State { MapState ms; };
+layout(set = 0, binding = 1) buffer State { MapState faces[]; };
 layout(set = 0, binding = 2) writeonly buffer BinTris { BinTri bin_tris[]; };
 layout(set = 0, binding = 3) writeonly buffer TileCounts { uint tile_counts[]; };
+layout(set = 0, binding = 4) writeonly buffer PairOwners { uint pair_owner[]; };
 layout(push_constant) uniform Push { MapPush pc; };
 
 // Projected coordinates beyond this many texels cover the whole clamped box (no edge functions that could
@@ -75,8 +83,7 @@ int clip_polygon(inout vec2 poly[8], int n, vec3 l, float slack) {
 
 // Bounding box (lo, hi) of the map square [0, N]^2 where every line, times `orientation`, is >= minus its
 // slack; false when that is empty.
-bool clipped_box(vec3 l[3], vec3 slack, float orientation, out vec2 lo, out vec2 hi) {
-    float n = ms.fit.y;
+bool clipped_box(float n, vec3 l[3], vec3 slack, float orientation, out vec2 lo, out vec2 hi) {
     vec2 poly[8] = vec2[8](vec2(0.0), vec2(n, 0.0), vec2(n), vec2(0.0, n), vec2(0.0), vec2(0.0),
                            vec2(0.0), vec2(0.0));
     int count = 4;
@@ -111,14 +118,14 @@ bool clipped_box(vec3 l[3], vec3 slack, float orientation, out vec2 lo, out vec2
 // map square to the three half-planes with one more texel of slack and grows by one texel, which absorbs
 // the rounding of the clip. With a known orientation, each edge's error bound is folded into that edge
 // (its constant term), and the edges are stored oriented.
-uint clipped_setup(HPoint h[3], float min_depth, float margin_base, inout BinTri bt) {
+uint clipped_setup(float n, HPoint h[3], float min_depth, float margin_base, inout BinTri bt) {
     Line lines[3] = Line[3](edge_line(h[1], h[2]), edge_line(h[2], h[0]), edge_line(h[0], h[1]));
     precise float d = dot(h[0].h, lines[0].l);
     float d_err = (dot(h[0].err, abs(lines[0].l)) + dot(abs(h[0].h), lines[0].e)
                    + dot(h[0].err, lines[0].e) + 4.0 * U * dot(abs(h[0].h), abs(lines[0].l))) * ROUND_UP;
     float orientation = abs(d) > d_err ? sign(d) : 0.0;
     // Any texel centre, grown by the base margin, lies within this distance of the map's origin per axis.
-    float reach = ms.fit.y + 1.0 + margin_base;
+    float reach = n + 1.0 + margin_base;
     vec3 l[3];
     float slack_of[3] = float[3](0.0, 0.0, 0.0);
     float extra = 0.0;
@@ -167,7 +174,7 @@ uint clipped_setup(HPoint h[3], float min_depth, float margin_base, inout BinTri
     for (int k = 0; k < 2; ++k) {
         float o = k == 0 ? 1.0 : -1.0;
         vec2 blo, bhi;
-        if ((orientation == 0.0 || orientation == o) && clipped_box(l, slack, o, blo, bhi)) {
+        if ((orientation == 0.0 || orientation == o) && clipped_box(n, l, slack, o, blo, bhi)) {
             lo = min(lo, blo);
             hi = max(hi, bhi);
             any_part = true;
@@ -176,7 +183,7 @@ uint clipped_setup(HPoint h[3], float min_depth, float margin_base, inout BinTri
     if (!any_part) {
         return 0u;  // no part of it in front of the light projects into the map
     }
-    int last = int(ms.fit.y) - 1;
+    int last = int(n) - 1;
     ivec2 lo_t = clamp(ivec2(floor(lo)) - 1, ivec2(0), ivec2(last));
     ivec2 hi_t = clamp(ivec2(floor(hi)) + 1, ivec2(0), ivec2(last));
     bt.ab = vec4(l[0], l[1].x);
@@ -187,59 +194,53 @@ uint clipped_setup(HPoint h[3], float min_depth, float margin_base, inout BinTri
     return tiles.x * tiles.y;
 }
 
-uint setup(uint index, out BinTri bt) {
+// The bin item of the triangle (v0, v1, v2) in frustum `f`: its tiles (0: culled).
+uint setup(uint f, vec3 v0, vec3 v1, vec3 v2, out BinTri bt) {
     bt.ab = vec4(0.0);
     bt.cmd = vec4(0.0);
     bt.info = uvec4(0u);
     bt.ext = vec4(0.0);
-    if (ms.fit.x == 0.0) {
+    if (faces[f].fit.x == 0.0) {
         return 0u;
     }
-    vec3 v0 = tris[index].v[0].xyz, v1 = tris[index].v[1].xyz, v2 = tris[index].v[2].xyz;
-    if (v0 == v1 || v1 == v2 || v2 == v0) {
-        return 0u;
-    }
-    if (pc.front_only != 0u && dot(cross(v1 - v0, v2 - v0), pc.to_light.xyz) <= 0.0) {
-        return 0u;
-    }
+    mat4 to_texels = faces[f].to_texels;
+    float n = faces[f].fit.y;
     bool perspective = pc.to_light.w != 0.0;
-    float margin = ACCEPT_MARGIN + 2.0 * unordered(ms.receivers.y);
+    float margin = ACCEPT_MARGIN + 2.0 * unordered(faces[f].receivers.y);
     HPoint h[3];
     bool reaches_plane = false;
     if (perspective) {
-        h = HPoint[3](project_h(ms.to_texels, v0), project_h(ms.to_texels, v1),
-                      project_h(ms.to_texels, v2));
+        h = HPoint[3](project_h(to_texels, v0), project_h(to_texels, v1), project_h(to_texels, v2));
         if (h[0].h.z + h[0].err.z <= 0.0 && h[1].h.z + h[1].err.z <= 0.0 && h[2].h.z + h[2].err.z <= 0.0) {
             return 0u;  // wholly on or behind the light's plane: it blocks no segment in front of it
         }
         reaches_plane = h[0].h.z - h[0].err.z <= 0.0 || h[1].h.z - h[1].err.z <= 0.0
                      || h[2].h.z - h[2].err.z <= 0.0;
     }
-    Projected p[3] = Projected[3](project(ms.to_texels, v0, perspective),
-                                  project(ms.to_texels, v1, perspective),
-                                  project(ms.to_texels, v2, perspective));
+    Projected p[3] = Projected[3](project(to_texels, v0, perspective), project(to_texels, v1, perspective),
+                                  project(to_texels, v2, perspective));
     float min_depth = min(min(p[0].depth - p[0].depth_err, p[1].depth - p[1].depth_err),
                           p[2].depth - p[2].depth_err);
-    if (pc.cull != 0u && min_depth > unordered(ms.receivers.z)) {
+    if (pc.cull != 0u && min_depth > unordered(faces[f].receivers.z)) {
         return 0u;  // behind every ray origin as seen from the light
     }
     if (reaches_plane) {
-        return clipped_setup(h, min_depth, margin, bt);
+        return clipped_setup(n, h, min_depth, margin, bt);
     }
-    int last = int(ms.fit.y) - 1;
+    int last = int(n) - 1;
     uint mode = MODE_COVER;
     float err = max(max(max(p[0].xy_err.x, p[0].xy_err.y), max(p[1].xy_err.x, p[1].xy_err.y)),
                     max(p[2].xy_err.x, p[2].xy_err.y));
     // The per-texel edge functions (map_bin.glsl) are products of differences of coordinates up to R
     // texels: their rounding, in texels, is within 8u R (doubled here), beyond ACCEPT_MARGIN once R
     // reaches tens of thousands of texels.
-    vec2 reach = max(max(abs(p[0].xy), abs(p[1].xy)), max(abs(p[2].xy), vec2(ms.fit.y)));
+    vec2 reach = max(max(abs(p[0].xy), abs(p[1].xy)), max(abs(p[2].xy), vec2(n)));
     margin += err + 16.0 * U * max(reach.x, reach.y);
     vec2 lo = min(min(p[0].xy, p[1].xy), p[2].xy) - margin;
     vec2 hi = max(max(p[0].xy, p[1].xy), p[2].xy) + margin;
     bool far = any(greaterThan(abs(vec4(lo, hi)), vec4(FAR_TEXELS)));
     if (far && perspective) {
-        return clipped_setup(h, min_depth, ACCEPT_MARGIN + 2.0 * unordered(ms.receivers.y), bt);
+        return clipped_setup(n, h, min_depth, ACCEPT_MARGIN + 2.0 * unordered(faces[f].receivers.y), bt);
     }
     if (any(greaterThan(lo, vec2(float(last) + 1.0))) || any(lessThan(hi, vec2(0.0)))) {
         return 0u;  // outside the map: no ray origin projects there
@@ -292,19 +293,53 @@ void main() {
     }
     barrier();
     uint index = gl_GlobalInvocationID.x;
-    if (index < pc.triangles) {
-        BinTri bt;
-        uint tiles = setup(index, bt);
-        bin_tris[index] = bt;
-        tile_counts[index] = tiles;
-        if (tiles > 0u) {
-            atomicAdd(group_kept, 1u);
+    vec3 v0 = vec3(0.0), v1 = vec3(0.0), v2 = vec3(0.0);
+    bool live = index < pc.triangles;
+    if (live) {
+        v0 = tris[index].v[0].xyz;
+        v1 = tris[index].v[1].xyz;
+        v2 = tris[index].v[2].xyz;
+        // Zero area with two equal vertices, or a back face in front-only mode: culled in every frustum.
+        live = v0 != v1 && v1 != v2 && v2 != v0
+            && (pc.front_only == 0u || dot(cross(v1 - v0, v2 - v0), pc.to_light.xyz) > 0.0);
+    }
+    bool kept = false;
+    if (pc.faces == 1u) {
+        if (index < pc.triangles) {
+            BinTri bt = BinTri(vec4(0.0), vec4(0.0), uvec4(0u), vec4(0.0));
+            uint tiles = live ? setup(0u, v0, v1, v2, bt) : 0u;
+            bin_tris[index] = bt;
+            tile_counts[index] = tiles;
+            kept = tiles > 0u;
+        } else if (index == pc.triangles) {
+            tile_counts[index] = 0u;    // the exclusive scan's last element becomes the total
         }
-    } else if (index == pc.triangles) {
-        tile_counts[index] = 0u;    // the exclusive scan's last element becomes the total
+    } else {
+        // Every invocation runs the loop (its subgroup operations need the whole subgroup): one atomic per
+        // subgroup and face reserves the slots of the pairs kept.
+        for (uint f = 0u; f < pc.faces; ++f) {
+            BinTri bt = BinTri(vec4(0.0), vec4(0.0), uvec4(0u), vec4(0.0));
+            uint tiles = live ? setup(f, v0, v1, v2, bt) : 0u;
+            bool keep = tiles > 0u;
+            uint count = subgroupAdd(keep ? 1u : 0u);
+            uint first = 0u;
+            if (subgroupElect() && count > 0u) {
+                first = atomicAdd(faces[0].grid.z, count);
+            }
+            uint slot = subgroupBroadcastFirst(first) + subgroupExclusiveAdd(keep ? 1u : 0u);
+            if (keep && slot < pc.pairs) {
+                bin_tris[slot] = bt;
+                tile_counts[slot] = tiles;
+                pair_owner[slot] = index | (f << 29);
+            }
+            kept = kept || keep;
+        }
+    }
+    if (kept) {
+        atomicAdd(group_kept, 1u);
     }
     barrier();
     if (gl_LocalInvocationIndex == 0u && group_kept > 0u) {
-        atomicAdd(ms.totals.w, group_kept);
+        atomicAdd(faces[0].totals.w, group_kept);
     }
 }

@@ -1,6 +1,8 @@
-// Mirrors passes::gpu_types::MapState (144 bytes): the primitive map's per-frame GPU state, written by the
-// map passes and read by the ray trace. The map covers the light-space bounds of the receivers the camera
-// sees (fitted every frame on the GPU), so nothing of it is spent on what no pixel can look up.
+// Mirrors passes::gpu_types::MapState (160 bytes): the primitive map's per-frame GPU state of one frustum,
+// written by the map passes and read by the ray trace. The map covers the light-space bounds of the
+// receivers the camera sees (fitted every frame on the GPU), so nothing of it is spent on what no pixel can
+// look up. A point light's map holds one state per cube face (+X, -X, +Y, -Y, +Z, -Z), their grids packed
+// one after another in one texel array; the first state also holds the map's totals and statistics.
 struct MapState {
     mat4 to_texels;     // frame coordinates -> homogeneous map texel space: texel = floor(xy / w)
     uvec4 bounds;       // ordered-float light NDC bounds of the ray origins: min x, min y, max x, max y
@@ -13,7 +15,14 @@ struct MapState {
                         // z: entry capacity, w: triangles kept by the setup's culling
     uvec4 stats;        // x: texels with a list, y: longest list, z: texels past the capacity (traced
                         // exhaustively), w: texels with receivers
+    uvec4 grid;         // x: index of the grid's first texel, y: texels per grid row; first state only: z
+                        // (triangle, face) pairs a point light's setup kept, w: pairs the bin items hold
 };
+
+// The texel index of texel `t` of the grid whose state's `grid` is `grid`.
+uint texel_index(uvec4 grid, uvec2 t) {
+    return grid.x + t.y * grid.y + t.x;
+}
 
 // Monotonic float <-> uint encoding for atomicMin/atomicMax on floats; 0 is below every encoded value, so
 // a zero-cleared word means "nothing recorded".

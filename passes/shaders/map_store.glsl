@@ -1,5 +1,24 @@
-// Counts (mode 0) or stores (mode 1) triangle `tri` in the list of `texel`; shared by the compute and
-// raster binning paths. Needs the includer's `counts`, `offsets`, `entries` and `pc`.
+// The texel test and the store of the compute and raster binning paths (after map_bin.glsl). Needs the
+// includer's `receiver`, `counts`, `offsets`, `entries` and `pc`.
+
+// Whether `texel`, centred at `centre`, gets triangle `t`: it overlaps the triangle, and (with `cull`) a
+// ray origin lies in it and the triangle is not wholly farther from the light than all of them. The
+// includer's `receiver[texel]` is the texel's word of the receiver map: 0 without a ray origin, else the
+// ordered largest depth key (plus its error) of its ray origins; it is read only for overlapped texels.
+// Without `cull`, every overlapped texel is accepted (a debug mode whose lists tests compare with exact
+// binning).
+bool bin_accepts(BinTri t, uint texel, vec2 centre, bool cull) {
+    if (!bin_overlaps(t, centre)) {
+        return false;
+    }
+    if (!cull) {
+        return true;
+    }
+    uint word = receiver[texel];
+    return word != 0u && t.cmd.w <= unordered(word);
+}
+
+// Counts (mode 0) or stores (mode 1) triangle `tri` in the list of `texel`.
 // Fill: the slot is offsets[texel] + (counts[texel] -= 1), so the counts return to 0 for the next frame.
 // Nothing is written at or past the entry capacity: such texels are traced exhaustively, and reported.
 void bin_store(uint tri, uint texel) {

@@ -151,13 +151,16 @@ void main() {
     uint begin = texel == TEXEL_NO_RAY ? 0u : offsets[texel];
     uint end = texel == TEXEL_NO_RAY ? 0u : offsets[texel + 1u];
     // An empty list is complete wherever it lies; a list is complete when it ends within the capacity.
-    if (texel != TEXEL_NO_RAY && (end <= ms.totals.z || begin == end)) {
+    // A point light's frame that kept more (triangle, face) pairs than its bin items hold has no complete
+    // list.
+    bool binned = ms.grid.z <= ms.grid.w;
+    if (texel != TEXEL_NO_RAY && binned && (end <= ms.totals.z || begin == end)) {
         for (uint i = begin; i < end; ++i) {
             consider(entries[i], nearest);
         }
     } else {
-        // Past the entry capacity (or, never seen, a pixel the receiver pass gave no ray): exhaustive and
-        // exact. Unrolled 16x by hand: llvmpipe (lavapipe) silently ends a shader's loops after 65535
+        // Past the entry or pair capacity (or, never seen, a pixel the receiver pass gave no ray):
+        // exhaustive and exact. Unrolled 16x by hand: llvmpipe (lavapipe) silently ends a shader's loops after 65535
         // iterations in total, which would drop every triangle past that index; unrolled, its cap is 1M.
         uint total = min(k.misc.y, uint(tris.length()));
         for (uint base = 0u; base < total; base += 16u) {

@@ -44,8 +44,6 @@ pub struct PrimBufferPush {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub struct MapPush {
-    /// Light view-projection in frame coordinates.
-    pub light_view_proj: Mat4,
     /// Direction towards the light (xyz, directional); w: 1 for a spot light.
     pub to_light: Vec4,
     /// Map size N.
@@ -64,6 +62,26 @@ pub struct MapPush {
     pub guard: u32,
     /// 1 = bin only into texels with ray origins, and skip triangles behind all of them.
     pub cull: u32,
+    /// Frusta in the map: 1, or 6 for a point light's cube faces.
+    pub faces: u32,
+    /// (Triangle, face) pairs the bin items hold (a point light's map; 0 otherwise).
+    pub pairs: u32,
+    /// Texels of the map's grids together.
+    pub texels: u32,
+    /// Padding.
+    pub pad: u32,
+}
+
+/// Constants of the primitive map's passes: the ray trace's (the receivers trace the same rays), and the
+/// view-projection of each of the light's frusta in frame coordinates (one, or a point light's six cube
+/// faces; unused ones repeat the first).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct MapConstants {
+    /// The ray trace's constants.
+    pub ray: RayTraceConstants,
+    /// The frusta's view-projections.
+    pub frusta: [Mat4; 6],
 }
 
 /// Constants of the ray trace (`ray_trace_constants.glsl`).
@@ -96,7 +114,8 @@ pub struct RayTraceConstants {
     pub surface: Vec4,
 }
 
-/// The primitive map's per-frame GPU state (`map_state.glsl`), read back for the frame report.
+/// The primitive map's per-frame GPU state of one frustum (`map_state.glsl`), read back for the frame
+/// report. A point light's map has one per cube face; the first also holds the totals and statistics.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct MapState {
@@ -114,6 +133,9 @@ pub struct MapState {
     pub totals: UVec4,
     /// x: texels with a list, y: longest list, z: texels past the capacity, w: texels with receivers.
     pub stats: UVec4,
+    /// x: the grid's first texel, y: texels per grid row; first state only: z (triangle, face) pairs a
+    /// point light's setup kept, w: pairs the bin items held.
+    pub grid: UVec4,
 }
 
 /// What the primitive map held in a frame (decoded from [`MapState`]).
@@ -135,13 +157,21 @@ pub struct MapStats {
     pub capacity: u32,
     /// Texels whose list did not fit the capacity: traced exhaustively (exact, slower).
     pub texels_past_capacity: u32,
+    /// A point light's (triangle, face) pairs kept by the setup (0 for a light of one frustum). Past the
+    /// pairs the map held (`pair_capacity`), the frame traced every ray exhaustively (exact, slower), and
+    /// the map grows for the next.
+    pub pairs: u32,
+    /// The (triangle, face) pairs the map held this frame.
+    pub pair_capacity: u32,
 }
 
 impl MapStats {
-    /// Decodes the statistics of a read-back [`MapState`].
-    pub fn from_state(s: &MapState) -> Self {
+    /// Decodes the statistics of the read-back states of a map's frusta (the first holds the totals).
+    pub fn from_states(states: &[MapState]) -> Self {
+        let zero = MapState::zeroed();
+        let s = states.first().unwrap_or(&zero);
         Self {
-            receiver_pixels: s.receivers.x,
+            receiver_pixels: states.iter().map(|f| f.receivers.x).sum(),
             receiver_texels: s.stats.w,
             triangles_binned: s.totals.w,
             texels_with_list: s.stats.x,
@@ -149,6 +179,8 @@ impl MapStats {
             entries: s.totals.y,
             capacity: s.totals.z,
             texels_past_capacity: s.stats.z,
+            pairs: s.grid.z,
+            pair_capacity: s.grid.w,
         }
     }
 
@@ -254,14 +286,16 @@ const _: () = {
     assert!(std::mem::size_of::<GpuTriangle>() == 48);
     assert!(std::mem::size_of::<PrimBufferPush>() == 112);
     assert!(std::mem::offset_of!(PrimBufferPush, first_index) == 64);
-    assert!(std::mem::size_of::<MapPush>() == 112);
-    assert!(std::mem::offset_of!(MapPush, size) == 80);
+    assert!(std::mem::size_of::<MapPush>() == 64);
+    assert!(std::mem::offset_of!(MapPush, size) == 16);
     assert!(std::mem::size_of::<RayTraceConstants>() == 320);
     assert!(std::mem::offset_of!(RayTraceConstants, light_pos) == 208);
     assert!(std::mem::offset_of!(RayTraceConstants, dims) == 160);
     assert!(std::mem::offset_of!(RayTraceConstants, offset) == 176);
-    assert!(std::mem::size_of::<MapState>() == 144);
+    assert!(std::mem::size_of::<MapState>() == 160);
+    assert!(std::mem::size_of::<MapConstants>() == 704);
     assert!(std::mem::offset_of!(MapState, totals) == 112);
+    assert!(std::mem::offset_of!(MapState, grid) == 144);
     assert!(std::mem::size_of::<GpuLight>() == 208);
     assert!(std::mem::offset_of!(GpuLight, params) == 192);
     assert!(std::mem::size_of::<ShadowMapPush>() == 64);

@@ -1,5 +1,6 @@
-//! The light of a frame — directional (orthographic light frustum) or spot (perspective light frustum) —
-//! and the light-space constants every light-space pass derives from it, in frame coordinates.
+//! The light of a frame — directional (orthographic light frustum), spot (perspective light frustum) or
+//! point (the six cube faces, built as one map) — and the light-space constants every light-space pass
+//! derives from it, in frame coordinates.
 
 use crate::gpu_types::GpuLight;
 use crate::PassError;
@@ -28,36 +29,60 @@ pub enum Light {
         /// coordinates). Receivers outside it count as lit (no recorded occluder).
         view_proj: Mat4,
     },
+    /// Point light: a point emitter shadowed in every direction through its six cube faces
+    /// ([`point_light_faces`]), built as one primitive map (`PrimitiveMapConfig::cube`). Hard shadows
+    /// only: a shadow map and PCSS need one frustum (give the faces as spot lights for those).
+    Point {
+        /// Emitter position (world coordinates): shadow rays end there.
+        position: Vec3,
+        /// Range (`None`: unlimited): sets the near plane of the faces' projections.
+        range: Option<f32>,
+    },
 }
 
 impl Light {
-    /// The light view-projection (world coordinates).
+    /// The light view-projection (world coordinates): a point light's +X face.
     pub fn view_proj(&self) -> Mat4 {
         match *self {
             Self::Directional { view_proj, .. } | Self::Spot { view_proj, .. } => view_proj,
+            Self::Point { .. } => self.frusta()[0],
         }
     }
 
-    /// The direction of travel (directional) or the cone axis (spot), as given.
+    /// The view-projection of each frustum the light is shadowed through (world coordinates): its one, or
+    /// a point light's six cube faces (+X, -X, +Y, -Y, +Z, -Z).
+    pub fn frusta(&self) -> Vec<Mat4> {
+        match *self {
+            Self::Directional { view_proj, .. } | Self::Spot { view_proj, .. } => vec![view_proj],
+            Self::Point { position, range } => point_light_faces(position, range)
+                .iter()
+                .map(Light::view_proj)
+                .collect(),
+        }
+    }
+
+    /// The direction of travel (directional) or the cone axis (spot), as given; +X for a point light.
     pub fn direction(&self) -> Vec3 {
         match *self {
             Self::Directional { direction, .. } | Self::Spot { direction, .. } => direction,
+            Self::Point { .. } => Vec3::X,
         }
     }
 
-    /// The emitter position of a spot light.
+    /// The emitter position of a spot or point light.
     pub fn position(&self) -> Option<Vec3> {
         match *self {
             Self::Directional { .. } => None,
-            Self::Spot { position, .. } => Some(position),
+            Self::Spot { position, .. } | Self::Point { position, .. } => Some(position),
         }
     }
 
-    /// "directional" or "spot".
+    /// "directional", "spot" or "point".
     pub fn kind_name(&self) -> &'static str {
         match self {
             Self::Directional { .. } => "directional",
             Self::Spot { .. } => "spot",
+            Self::Point { .. } => "point",
         }
     }
 }
@@ -104,6 +129,9 @@ fn perspective(position: Vec3, forward: Vec3, up: Vec3, tan_half: f32, near: f32
 
 /// Names of a point light's cube faces, in the order of [`point_light_faces`].
 pub const POINT_FACE_NAMES: [&str; 6] = ["+X", "-X", "+Y", "-Y", "+Z", "-Z"];
+
+/// The name of a point light's one frustum when its faces are built as one cube map.
+pub const CUBE_MAP_NAME: [&str; 1] = ["cube"];
 
 /// Names of the faces of a spot light wider than [`MAX_SINGLE_FRUSTUM_CONE`], in the order of
 /// [`spot_light_frusta`]: its axis, then the four directions across it.
@@ -185,6 +213,10 @@ pub(crate) struct LightFrame {
     pub lin_num: Vec4,
     /// See `lin_num`.
     pub lin_den: Vec4,
+    /// View-projection of each frustum in frame coordinates: `view_proj`, or a point light's six faces.
+    pub frusta: [Mat4; 6],
+    /// Frusta in use in `frusta`: 1 or 6.
+    pub frustum_count: usize,
 }
 
 /// `m * translation(origin)` in f64: `m` applied to coordinates relative to `origin`.
@@ -199,6 +231,9 @@ fn invalid(what: &str) -> PassError {
 impl LightFrame {
     /// Validates `light` and moves it into the frame whose origin is `origin`.
     pub fn new(light: &Light, origin: DVec3) -> Result<Self, PassError> {
+        if let Light::Point { position, range } = *light {
+            return Self::point(position, range, origin);
+        }
         let m = rebased(light.view_proj(), origin);
         let dir = light.direction().as_dvec3().normalize_or_zero();
         if !m.is_finite() || dir == DVec3::ZERO || !dir.is_finite() {
@@ -228,7 +263,7 @@ impl LightFrame {
                 }
                 (dir, None, dir.extend(0.0))
             }
-            Light::Spot { position, .. } => {
+            Light::Spot { position, .. } | Light::Point { position, .. } => {
                 let p = position.as_dvec3() - origin;
                 if !p.is_finite() {
                     return Err(invalid("the spot light position is not finite"));
@@ -277,11 +312,38 @@ impl LightFrame {
             position: position.map(|p| p.as_vec3()),
             lin_num: num.as_vec4(),
             lin_den: den.as_vec4(),
+            frusta: [m.as_mat4(); 6],
+            frustum_count: 1,
         };
         if !frame.inv_view_proj.is_finite() || !frame.lin_num.is_finite() {
             return Err(invalid("the light view-projection is too ill-conditioned"));
         }
         Ok(frame)
+    }
+
+    /// A point light at `position` of `range`: its +X face as the light's one frustum (validated as a spot
+    /// light's), and the six faces, each built in f64 around the light's position in frame coordinates.
+    fn point(position: Vec3, range: Option<f32>, origin: DVec3) -> Result<Self, PassError> {
+        if range.is_some_and(|r| !(r.is_finite() && r > 0.0)) {
+            return Err(invalid(
+                "a point light's range must be a positive finite distance",
+            ));
+        }
+        let faces = point_light_faces(position, range);
+        let mut frame = Self::new(&faces[0], origin)?;
+        for (slot, face) in frame.frusta.iter_mut().zip(&faces) {
+            *slot = rebased(face.view_proj(), origin).as_mat4();
+        }
+        frame.frustum_count = 6;
+        if !frame.frusta.iter().all(Mat4::is_finite) {
+            return Err(invalid("the point light's cube faces are not finite"));
+        }
+        Ok(frame)
+    }
+
+    /// The view-projections of the light's frusta in frame coordinates (one, or a point light's six).
+    pub fn frusta(&self) -> &[Mat4] {
+        &self.frusta[..self.frustum_count]
     }
 
     /// World size of one texel of a `size`² map: constant for a directional light, per unit of linear

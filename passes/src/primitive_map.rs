@@ -20,7 +20,7 @@
 //! Reads: prim buffer, depth, normal. Writes: receiver map, per-pixel texels, list offsets, list entries,
 //! map state (fit, statistics); occupancy image (occupancy pass).
 
-use crate::gpu_types::{constant_buffer, MapPush, MapState, RayTraceConstants};
+use crate::gpu_types::{constant_buffer, MapConstants, MapPush, MapState, RayTraceConstants};
 use crate::scan::{PrefixScan, ScanPipeline};
 use crate::{shader, PassError};
 use rhi::{
@@ -174,6 +174,14 @@ pub struct PrimitiveMapConfig {
     /// Debug: `GUARD_WORDS` words after the entry capacity, filled with `GUARD_VALUE` every frame, that no
     /// pass may write: tests read them back to prove the fill never writes out of bounds.
     pub guard: bool,
+    /// A point light's map: its six cube faces built together, their grids sharing N² texels (plus a
+    /// minimum grid each) in proportion to the rays each face holds, with one setup, count, scan, fill and
+    /// ray trace for the whole light. Needs compute binning.
+    pub cube: bool,
+    /// (Triangle, face) pairs a cube map starts with (0: two per triangle, at least 1024). A frame that
+    /// keeps more traces the light's rays exhaustively (exact, slower, reported) and the pairs grow for the
+    /// next, up to six per triangle.
+    pub initial_pairs: u32,
 }
 
 /// Value of every guard word (never a valid prim-buffer index).
@@ -191,6 +199,12 @@ pub const MIN_ENTRY_BUDGET: u64 = 4096;
 /// Threads of the compute binning dispatch (a grid-stride loop over the bin items).
 const BIN_THREADS: u32 = 64 * 4096;
 
+/// Smallest grid side a frustum with receivers gets (`map_fit.comp`).
+const MIN_GRID: u32 = 16;
+
+/// Bytes of one bin triangle (`BinTri` in `map_bin.glsl`).
+const BIN_TRI_BYTES: u64 = 64;
+
 impl Default for PrimitiveMapConfig {
     fn default() -> Self {
         Self {
@@ -201,6 +215,8 @@ impl Default for PrimitiveMapConfig {
             initial_entries: 0,
             receiver_culling: true,
             guard: false,
+            cube: false,
+            initial_pairs: 0,
         }
     }
 }
@@ -223,6 +239,16 @@ impl PrimitiveMapConfig {
                 self.size, grid, caps.max_storage_buffer_range
             )));
         }
+        if self.cube && !matches!(self.binning, BinningRequest::Auto | BinningRequest::Compute) {
+            return Err(PassError::InvalidConfig(
+                "a point light's cube map is binned in compute: request auto or compute binning".into(),
+            ));
+        }
+        if self.cube && self.faces == FaceMode::FrontOnly {
+            return Err(PassError::InvalidConfig(
+                "a front-only primitive map needs a directional light, not a point light's cube".into(),
+            ));
+        }
         if self.entry_budget < MIN_ENTRY_BUDGET {
             return Err(PassError::InvalidConfig(format!(
                 "primitive map entry budget {} bytes is below the minimum of {MIN_ENTRY_BUDGET} bytes",
@@ -230,6 +256,36 @@ impl PrimitiveMapConfig {
             )));
         }
         Ok(())
+    }
+
+    /// Frusta the map holds: 6 for a point light's cube, else 1.
+    pub fn frusta(&self) -> u32 {
+        if self.cube {
+            6
+        } else {
+            1
+        }
+    }
+
+    /// Texels of the map's grids together: N², and for a cube the minimum grid of each face besides.
+    pub fn texels(&self) -> u64 {
+        let n2 = u64::from(self.size) * u64::from(self.size);
+        if self.cube {
+            let min_grid = u64::from(MIN_GRID.min(self.size)) + 1;
+            n2 + 6 * min_grid * min_grid
+        } else {
+            n2
+        }
+    }
+
+    /// Bin triangles a map over `triangles` triangles starts with: one per triangle, or for a cube
+    /// [`PrimitiveMapConfig::initial_pairs`] (it grows to what frames keep).
+    pub fn starting_pairs(&self, triangles: u32) -> u32 {
+        match (self.cube, self.initial_pairs) {
+            (false, _) => triangles,
+            (true, 0) => triangles.saturating_mul(2).max(1024),
+            (true, given) => given,
+        }
     }
 
     /// Most entries the budget and the device allow.
@@ -289,86 +345,238 @@ fn storage_buffer(
     )
 }
 
-/// The buffers a map uses only while it is built (per-triangle bin items and tile offsets, per-texel
+/// The buffers a map uses only while it is built (bin triangles, their tile offsets and owners, per-texel
 /// counts), shared by every map over the same geometry: the builds are recorded one after another with
 /// barriers between them (each clears the counts first), so one set serves every light and frustum.
 pub struct MapScratch {
     bin_tris: Buffer,
     tile_offsets: Buffer,
+    pair_owners: Buffer,
     counts: Buffer,
-    /// The largest map size N the counts hold.
-    size: u32,
+    /// The texels the counts hold.
+    texels: u64,
+    /// The bin triangles the buffers hold.
+    bins: u32,
+    /// The (triangle, face) owners held (0 until a point light's map asked for some).
+    owners: u32,
 }
 
 impl MapScratch {
     /// GPU bytes of the scratch.
     pub fn bytes(&self) -> u64 {
-        [&self.bin_tris, &self.tile_offsets, &self.counts]
-            .iter()
-            .map(|b| b.size())
-            .sum()
+        [
+            &self.bin_tris,
+            &self.tile_offsets,
+            &self.pair_owners,
+            &self.counts,
+        ]
+        .iter()
+        .map(|b| b.size())
+        .sum()
     }
 }
 
-/// The scratch shared by the maps over one geometry: it grows to the largest map size asked for; a map
-/// keeps the scratch it was created with (the pool's newer, larger one serves the maps created after).
+/// The scratch shared by the maps over one geometry: it grows to the largest map asked for; a map keeps
+/// the scratch it was created with until it needs a larger one (the pool's newer, larger one serves the
+/// maps created or grown after).
 #[derive(Default)]
 pub struct MapScratchPool {
     current: std::sync::Mutex<Option<std::sync::Arc<MapScratch>>>,
+    /// The receiver map (one `u32` per texel) shared by the maps that draw no occupancy view.
+    receivers: std::sync::Mutex<Option<std::sync::Arc<Buffer>>>,
 }
 
 impl MapScratchPool {
-    /// The scratch for a map of size `size` over `triangles` triangles: the pool's, or a new one as large
-    /// as the largest asked for so far.
+    /// Scratch with counts for `texels` texels, `bins` bin triangles and `owners` (triangle, face) owners:
+    /// the pool's, or a new one as large as the largest asked for so far.
     pub fn get(
         &self,
         device: &Device,
-        size: u32,
-        triangles: u32,
+        texels: u64,
+        bins: u32,
+        owners: u32,
     ) -> Result<std::sync::Arc<MapScratch>, PassError> {
         let mut current = self
             .current
             .lock()
             .map_err(|_| PassError::InvalidConfig("map scratch pool poisoned".into()))?;
-        if let Some(s) = current.as_ref().filter(|s| s.size >= size) {
+        if let Some(s) = current
+            .as_ref()
+            .filter(|s| s.texels >= texels && s.bins >= bins && s.owners >= owners)
+        {
             return Ok(s.clone());
         }
-        let size = current.as_ref().map_or(size, |s| s.size.max(size));
-        let n2 = u64::from(size) * u64::from(size);
-        let tris = u64::from(triangles);
+        let (texels, bins, owners) = current.as_ref().map_or((texels, bins, owners), |s| {
+            (s.texels.max(texels), s.bins.max(bins), s.owners.max(owners))
+        });
         let storage = |name, bytes, usage| storage_buffer(device, name, bytes, usage);
         let scratch = std::sync::Arc::new(MapScratch {
-            bin_tris: storage("primitive map triangles", tris * 64, BufferUsage::default())?,
+            bin_tris: storage(
+                "primitive map bin triangles",
+                u64::from(bins) * BIN_TRI_BYTES,
+                BufferUsage::default(),
+            )?,
             tile_offsets: storage(
                 "primitive map tile offsets",
-                (tris + 1) * 4,
+                (u64::from(bins) + 1) * 4,
+                BufferUsage::default(),
+            )?,
+            pair_owners: storage(
+                "primitive map pair owners",
+                u64::from(owners) * 4,
                 BufferUsage::default(),
             )?,
             counts: storage(
                 "primitive map counts",
-                (n2 + 1) * 4,
+                (texels + 1) * 4,
                 BufferUsage::COPY_DST | BufferUsage::COPY_SRC,
             )?,
-            size,
+            texels,
+            bins,
+            owners,
         });
         *current = Some(scratch.clone());
         Ok(scratch)
     }
 
-    /// GPU bytes of the pool's current scratch (0 before any map asked for one).
+    /// A receiver map of at least `texels` texels: the pool's, or a new one as large.
+    pub fn receivers(
+        &self,
+        device: &Device,
+        texels: u64,
+    ) -> Result<std::sync::Arc<Buffer>, PassError> {
+        let mut current = self
+            .receivers
+            .lock()
+            .map_err(|_| PassError::InvalidConfig("map scratch pool poisoned".into()))?;
+        if let Some(r) = current.as_ref().filter(|r| r.size() >= texels * 4) {
+            return Ok(r.clone());
+        }
+        let receivers = std::sync::Arc::new(storage_buffer(
+            device,
+            "primitive map receivers",
+            texels * 4,
+            BufferUsage::COPY_DST | BufferUsage::COPY_SRC,
+        )?);
+        *current = Some(receivers.clone());
+        Ok(receivers)
+    }
+
+    /// GPU bytes of the pool's current scratch and receiver map (0 before any map asked for them).
     pub fn bytes(&self) -> u64 {
-        self.current
+        let scratch = self
+            .current
             .lock()
             .ok()
             .and_then(|c| c.as_ref().map(|s| s.bytes()))
-            .unwrap_or(0)
+            .unwrap_or(0);
+        let receivers = self
+            .receivers
+            .lock()
+            .ok()
+            .and_then(|r| r.as_ref().map(|r| r.size()))
+            .unwrap_or(0);
+        scratch + receivers
     }
+}
+
+/// What a map binds of its scratch: replaced together when a point light's map outgrows its pairs.
+pub struct ScratchBindings {
+    scratch: std::sync::Arc<MapScratch>,
+    setup_group: BindGroup,
+    bin_group: BindGroup,
+    tile_scan: PrefixScan,
+    offset_scan: PrefixScan,
 }
 
 /// The binning pipelines of the path in use.
 enum Binner {
     Compute(ComputePipeline),
     Raster(GraphicsPipeline),
+}
+
+/// The map's pipelines.
+struct MapPipelines {
+    fit: ComputePipeline,
+    receivers: ComputePipeline,
+    setup: ComputePipeline,
+    scan: ScanPipeline,
+    binner: Binner,
+    occupancy: ComputePipeline,
+}
+
+/// The buffers the scratch bindings pair with the scratch.
+struct BindTargets<'a> {
+    prims: &'a Buffer,
+    state: &'a Buffer,
+    receivers: &'a Buffer,
+    offsets: &'a Buffer,
+    entries: &'a Buffer,
+}
+
+impl ScratchBindings {
+    /// Binds `scratch` for a map of `texels` texels and `bins` bin triangles.
+    fn new(
+        device: &Device,
+        pipes: &MapPipelines,
+        scratch: std::sync::Arc<MapScratch>,
+        t: &BindTargets<'_>,
+        (texels, bins): (u64, u32),
+    ) -> Result<Self, PassError> {
+        let b = Resource::Buffer;
+        let s = &*scratch;
+        let setup_group = device.create_bind_group(
+            pipes.setup.layout(),
+            &[
+                b(t.prims),
+                b(t.state),
+                b(&s.bin_tris),
+                b(&s.tile_offsets),
+                b(&s.pair_owners),
+            ],
+        )?;
+        let bin_group = match &pipes.binner {
+            Binner::Compute(p) => device.create_bind_group(
+                p.layout(),
+                &[
+                    b(&s.bin_tris),
+                    b(&s.tile_offsets),
+                    b(t.receivers),
+                    b(&s.counts),
+                    b(t.offsets),
+                    b(t.entries),
+                    b(t.state),
+                    b(&s.pair_owners),
+                ],
+            )?,
+            Binner::Raster(p) => device.create_bind_group(
+                p.layout(),
+                &[
+                    b(&s.bin_tris),
+                    b(t.receivers),
+                    b(&s.counts),
+                    b(t.offsets),
+                    b(t.entries),
+                ],
+            )?,
+        };
+        let tile_scan = PrefixScan::new(
+            device,
+            &pipes.scan,
+            &s.tile_offsets,
+            &s.tile_offsets,
+            bins + 1,
+        )?;
+        let offset_scan =
+            PrefixScan::new(device, &pipes.scan, &s.counts, t.offsets, (texels + 1) as u32)?;
+        Ok(Self {
+            scratch,
+            setup_group,
+            bin_group,
+            tile_scan,
+            offset_scan,
+        })
+    }
 }
 
 /// The primitive map's resources and passes.
@@ -378,28 +586,24 @@ pub struct PrimitiveMap {
     triangles: u32,
     screen: (u32, u32),
     capacity: u32,
-    fit: ComputePipeline,
-    receivers_pipeline: ComputePipeline,
-    setup: ComputePipeline,
-    scan: ScanPipeline,
-    binner: Binner,
-    occupancy_pipeline: ComputePipeline,
+    /// Bin triangles the scratch bindings hold: the triangles, or a cube's (triangle, face) pairs.
+    bins: u32,
+    pipes: MapPipelines,
     fit_group: BindGroup,
     receivers_group: BindGroup,
-    setup_group: BindGroup,
-    bin_group: BindGroup,
     occupancy_group: BindGroup,
-    tile_scan: PrefixScan,
-    offset_scan: PrefixScan,
+    bound: ScratchBindings,
     constants: Buffer,
-    scratch: std::sync::Arc<MapScratch>,
-    /// The map's per-frame state ([`MapState`]): fitted transform, totals, statistics.
+    /// The map's per-frame state: one [`MapState`] per frustum (fitted transform and grid; the totals and
+    /// statistics in the first).
     pub state: Buffer,
-    /// N² `u32`: 0 where no ray origin lies, else the ordered largest depth key of the texel's origins.
-    pub receivers: Buffer,
+    /// One `u32` per texel, used while the map is built: 0 where no ray origin lies, else the ordered
+    /// largest depth key of the texel's origins. Shared by the maps over the same geometry (the pool's),
+    /// unless the map draws an occupancy view, which reads it after the build.
+    receivers: std::sync::Arc<Buffer>,
     /// One `u32` per screen pixel: the texel of its ray origin (or a no-ray / outside marker).
     pub pixel_texels: Buffer,
-    /// N² + 1 `u32`: texel t's list is `entries[offsets[t] .. offsets[t + 1]]`.
+    /// One `u32` per texel, plus one: texel t's list is `entries[offsets[t] .. offsets[t + 1]]`.
     pub offsets: Buffer,
     /// The lists' triangle indices (capacity `u32`, plus the guard words in guard mode).
     pub entries: Buffer,
@@ -419,26 +623,27 @@ impl PrimitiveMap {
         config.validate(caps)?;
         let path = choose_binning_path(caps, config.binning)?;
         let n = config.size;
-        let n2 = u64::from(n) * u64::from(n);
+        let texels = config.texels();
         let (width, height) = (inputs.depth.width(), inputs.depth.height());
         let storage = |name, bytes, usage| storage_buffer(device, name, bytes, usage);
         let copy = BufferUsage::COPY_DST | BufferUsage::COPY_SRC;
-        let constants = constant_buffer::<RayTraceConstants>(device, "primitive map constants")?;
+        let constants = constant_buffer::<MapConstants>(device, "primitive map constants")?;
         let state = storage(
             "primitive map state",
-            std::mem::size_of::<MapState>() as u64,
+            u64::from(config.frusta()) * std::mem::size_of::<MapState>() as u64,
             copy,
         )?;
-        let receivers = storage("primitive map receivers", n2 * 4, copy)?;
+        let receivers = if inputs.occupancy_view {
+            std::sync::Arc::new(storage("primitive map receivers", texels * 4, copy)?)
+        } else {
+            inputs.scratch.receivers(device, texels)?
+        };
         let pixel_texels = storage(
             "primitive map pixel texels",
             u64::from(width) * u64::from(height) * 4,
             copy,
         )?;
-        let scratch = inputs.scratch.get(device, n, inputs.triangles)?;
-        let (bin_tris, tile_offsets, counts) =
-            (&scratch.bin_tris, &scratch.tile_offsets, &scratch.counts);
-        let offsets = storage("primitive map list offsets", (n2 + 1) * 4, copy)?;
+        let offsets = storage("primitive map list offsets", (texels + 1) * 4, copy)?;
         let capacity = config.starting_entries(caps, inputs.triangles);
         let entries = Self::create_entries(device, &config, capacity)?;
         let view_size = if inputs.occupancy_view { n } else { 1 };
@@ -450,57 +655,13 @@ impl PrimitiveMap {
             layers: 1,
             usage: ImageUsage::STORAGE | ImageUsage::COPY_SRC,
         })?;
-        let push = std::mem::size_of::<MapPush>() as u32;
-        let buffers = |count| vec![BindingKind::StorageBuffer; count];
-        let fit = device.create_compute_pipeline(
-            "map fit",
-            &shader("map_fit.comp")?,
-            &buffers(1),
-            push,
+        let pipes = Self::pipelines(device, path)?;
+        let fit_group = device.create_bind_group(
+            pipes.fit.layout(),
+            &[Resource::Buffer(&state), Resource::Buffer(&constants)],
         )?;
-        let receivers_pipeline = device.create_compute_pipeline(
-            "map receivers",
-            &shader("map_receivers.comp")?,
-            &[
-                BindingKind::UniformBuffer,
-                BindingKind::SampledImage,
-                BindingKind::SampledImage,
-                BindingKind::StorageBuffer,
-                BindingKind::StorageBuffer,
-                BindingKind::StorageBuffer,
-            ],
-            push,
-        )?;
-        let setup = device.create_compute_pipeline(
-            "map setup",
-            &shader("map_setup.comp")?,
-            &buffers(4),
-            push,
-        )?;
-        let scan = ScanPipeline::new(device)?;
-        let binner = match path {
-            BinningPath::Compute => Binner::Compute(device.create_compute_pipeline(
-                "map bin",
-                &shader("map_bin.comp")?,
-                &buffers(6),
-                push,
-            )?),
-            raster => Binner::Raster(Self::raster_pipeline(device, raster)?),
-        };
-        let occupancy_pipeline = device.create_compute_pipeline(
-            "occupancy",
-            &shader("occupancy.comp")?,
-            &[
-                BindingKind::StorageBuffer,
-                BindingKind::StorageBuffer,
-                BindingKind::StorageImage,
-                BindingKind::StorageBuffer,
-            ],
-            std::mem::size_of::<[u32; 2]>() as u32,
-        )?;
-        let fit_group = device.create_bind_group(fit.layout(), &[Resource::Buffer(&state)])?;
         let receivers_group = device.create_bind_group(
-            receivers_pipeline.layout(),
+            pipes.receivers.layout(),
             &[
                 Resource::Buffer(&constants),
                 Resource::Image(inputs.depth),
@@ -510,18 +671,8 @@ impl PrimitiveMap {
                 Resource::Buffer(&pixel_texels),
             ],
         )?;
-        let setup_group = device.create_bind_group(
-            setup.layout(),
-            &[
-                Resource::Buffer(inputs.prims),
-                Resource::Buffer(&state),
-                Resource::Buffer(bin_tris),
-                Resource::Buffer(tile_offsets),
-            ],
-        )?;
-        let bin_group = Self::bin_group(device, &binner, &scratch, &receivers, &offsets, &entries)?;
         let occupancy_group = device.create_bind_group(
-            occupancy_pipeline.layout(),
+            pipes.occupancy.layout(),
             &[
                 Resource::Buffer(&offsets),
                 Resource::Buffer(&receivers),
@@ -529,35 +680,30 @@ impl PrimitiveMap {
                 Resource::Buffer(&state),
             ],
         )?;
-        let tile_scan = PrefixScan::new(
-            device,
-            &scan,
-            tile_offsets,
-            tile_offsets,
-            inputs.triangles + 1,
-        )?;
-        let offset_scan = PrefixScan::new(device, &scan, counts, &offsets, (n2 + 1) as u32)?;
+        let bins = config.starting_pairs(inputs.triangles);
+        let owners = if config.cube { bins } else { 0 };
+        let scratch = inputs.scratch.get(device, texels, bins, owners)?;
+        let targets = BindTargets {
+            prims: inputs.prims,
+            state: &state,
+            receivers: &receivers,
+            offsets: &offsets,
+            entries: &entries,
+        };
+        let bound = ScratchBindings::new(device, &pipes, scratch, &targets, (texels, bins))?;
         Ok(Self {
             config,
             path,
             triangles: inputs.triangles,
             screen: (width, height),
             capacity,
-            fit,
-            receivers_pipeline,
-            setup,
-            scan,
-            binner,
-            occupancy_pipeline,
+            bins,
+            pipes,
             fit_group,
             receivers_group,
-            setup_group,
-            bin_group,
             occupancy_group,
-            tile_scan,
-            offset_scan,
+            bound,
             constants,
-            scratch,
             state,
             receivers,
             pixel_texels,
@@ -565,6 +711,59 @@ impl PrimitiveMap {
             entries,
             occupancy,
             occupancy_view: inputs.occupancy_view,
+        })
+    }
+
+    fn pipelines(device: &Device, path: BinningPath) -> Result<MapPipelines, PassError> {
+        let push = std::mem::size_of::<MapPush>() as u32;
+        let buffers = |count| vec![BindingKind::StorageBuffer; count];
+        Ok(MapPipelines {
+            fit: device.create_compute_pipeline(
+                "map fit",
+                &shader("map_fit.comp")?,
+                &[BindingKind::StorageBuffer, BindingKind::UniformBuffer],
+                push,
+            )?,
+            receivers: device.create_compute_pipeline(
+                "map receivers",
+                &shader("map_receivers.comp")?,
+                &[
+                    BindingKind::UniformBuffer,
+                    BindingKind::SampledImage,
+                    BindingKind::SampledImage,
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
+                ],
+                push,
+            )?,
+            setup: device.create_compute_pipeline(
+                "map setup",
+                &shader("map_setup.comp")?,
+                &buffers(5),
+                push,
+            )?,
+            scan: ScanPipeline::new(device)?,
+            binner: match path {
+                BinningPath::Compute => Binner::Compute(device.create_compute_pipeline(
+                    "map bin",
+                    &shader("map_bin.comp")?,
+                    &buffers(8),
+                    push,
+                )?),
+                raster => Binner::Raster(Self::raster_pipeline(device, raster)?),
+            },
+            occupancy: device.create_compute_pipeline(
+                "occupancy",
+                &shader("occupancy.comp")?,
+                &[
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageImage,
+                    BindingKind::StorageBuffer,
+                ],
+                std::mem::size_of::<[u32; 3]>() as u32,
+            )?,
         })
     }
 
@@ -607,36 +806,6 @@ impl PrimitiveMap {
         })?)
     }
 
-    fn bin_group(
-        device: &Device,
-        binner: &Binner,
-        scratch: &MapScratch,
-        receivers: &Buffer,
-        offsets: &Buffer,
-        entries: &Buffer,
-    ) -> Result<BindGroup, PassError> {
-        let b = Resource::Buffer;
-        let (bin_tris, tile_offsets, counts) =
-            (&scratch.bin_tris, &scratch.tile_offsets, &scratch.counts);
-        Ok(match binner {
-            Binner::Compute(p) => device.create_bind_group(
-                p.layout(),
-                &[
-                    b(bin_tris),
-                    b(tile_offsets),
-                    b(receivers),
-                    b(counts),
-                    b(offsets),
-                    b(entries),
-                ],
-            )?,
-            Binner::Raster(p) => device.create_bind_group(
-                p.layout(),
-                &[b(bin_tris), b(receivers), b(counts), b(offsets), b(entries)],
-            )?,
-        })
-    }
-
     /// The configuration.
     pub fn config(&self) -> &PrimitiveMapConfig {
         &self.config
@@ -655,22 +824,18 @@ impl PrimitiveMap {
     /// Bytes the map holds on the GPU (its share of the build scratch aside: see
     /// [`PrimitiveMap::scratch`]).
     pub fn bytes(&self) -> u64 {
-        [
-            &self.state,
-            &self.receivers,
-            &self.pixel_texels,
-            &self.offsets,
-            &self.entries,
-        ]
-        .iter()
-        .map(|b| b.size())
-        .sum::<u64>()
-            + self.occupancy_view().map_or(0, Image::byte_size)
+        [&self.state, &self.pixel_texels, &self.offsets, &self.entries]
+            .iter()
+            .map(|b| b.size())
+            .sum::<u64>()
+            + self
+                .occupancy_view()
+                .map_or(0, |v| v.byte_size() + self.receivers.size())
     }
 
     /// The build scratch the map shares with the other maps over its geometry.
     pub fn scratch(&self) -> &MapScratch {
-        &self.scratch
+        &self.bound.scratch
     }
 
     /// The occupancy view, when the map draws one.
@@ -698,28 +863,74 @@ impl PrimitiveMap {
         }
         let capacity = (u64::from(needed) * 5 / 4).min(u64::from(max)) as u32;
         let entries = Self::create_entries(device, &self.config, capacity)?;
-        let (layout, binding) = match &self.binner {
+        let (layout, binding) = match &self.pipes.binner {
             Binner::Compute(p) => (p.layout(), 5),
             Binner::Raster(p) => (p.layout(), 4),
         };
-        let group = device.rebound(layout, &self.bin_group, binding, &entries)?;
+        let group = device.rebound(layout, &self.bound.bin_group, binding, &entries)?;
         self.capacity = capacity;
         Ok(Some((
             std::mem::replace(&mut self.entries, entries),
-            std::mem::replace(&mut self.bin_group, group),
+            std::mem::replace(&mut self.bound.bin_group, group),
         )))
     }
 
-    /// Records the build of the lists for this frame's receivers. Depth and normal must be in
+    /// Grows a cube map's (triangle, face) pairs to hold `needed` (with a quarter to spare, at most six per
+    /// triangle), when a frame kept more than it held, taking larger scratch from `pool` and binding the
+    /// prim buffer `prims` anew. Returns the bindings replaced (frames in flight may still use them: drop
+    /// them once those completed).
+    pub fn grow_pairs(
+        &mut self,
+        device: &Device,
+        pool: &MapScratchPool,
+        prims: &Buffer,
+        needed: u32,
+    ) -> Result<Option<ScratchBindings>, PassError> {
+        let most = self.triangles.saturating_mul(6);
+        if !self.config.cube || needed <= self.bins || self.bins >= most {
+            return Ok(None);
+        }
+        let bins = (u64::from(needed) * 5 / 4).min(u64::from(most)) as u32;
+        let texels = self.config.texels();
+        let scratch = pool.get(device, texels, bins, bins)?;
+        let targets = BindTargets {
+            prims,
+            state: &self.state,
+            receivers: &self.receivers,
+            offsets: &self.offsets,
+            entries: &self.entries,
+        };
+        let bound = ScratchBindings::new(device, &self.pipes, scratch, &targets, (texels, bins))?;
+        self.bins = bins;
+        Ok(Some(std::mem::replace(&mut self.bound, bound)))
+    }
+
+    /// Records the build of the lists for this frame's receivers, through the light's `frusta`
+    /// view-projections in frame coordinates (one, or a cube's six). Depth and normal must be in
     /// `ShaderResource` state; the map's buffers are visible to storage reads afterwards.
     pub fn record(
         &mut self,
         enc: &mut Encoder<'_>,
         constants: &RayTraceConstants,
         push: &MapPush,
+        frusta: &[glam::Mat4],
     ) -> Result<(), PassError> {
-        enc.update_buffer(&self.constants, 0, bytemuck::bytes_of(constants))?;
+        if frusta.len() != self.config.frusta() as usize {
+            return Err(PassError::InvalidConfig(format!(
+                "the primitive map holds {} frusta, the light gave {}",
+                self.config.frusta(),
+                frusta.len()
+            )));
+        }
+        let mut all = [frusta[0]; 6];
+        all[..frusta.len()].copy_from_slice(frusta);
+        let map_constants = MapConstants {
+            ray: *constants,
+            frusta: all,
+        };
+        enc.update_buffer(&self.constants, 0, bytemuck::bytes_of(&map_constants))?;
         let n = self.config.size;
+        let cube = self.config.cube;
         let push = MapPush {
             size: n,
             triangles: self.triangles,
@@ -727,6 +938,9 @@ impl PrimitiveMap {
             tile_threads: BIN_THREADS,
             guard: u32::from(self.config.guard),
             cull: u32::from(self.config.receiver_culling),
+            faces: self.config.frusta(),
+            pairs: if cube { self.bins } else { 0 },
+            texels: self.config.texels() as u32,
             ..*push
         };
         let with_mode = |mode| MapPush { mode, ..push };
@@ -739,7 +953,7 @@ impl PrimitiveMap {
             after: S::CopyDest,
         }]);
         enc.fill_buffer(&self.receivers, 0);
-        enc.fill_buffer(&self.scratch.counts, 0);
+        enc.fill_buffer(&self.bound.scratch.counts, 0);
         if self.config.guard {
             enc.fill_buffer(&self.entries, GUARD_VALUE);
         }
@@ -747,32 +961,30 @@ impl PrimitiveMap {
             before: S::CopyDest,
             after: S::UnorderedAccess,
         }]);
-        enc.dispatch(
-            &self.fit,
-            &self.fit_group,
-            bytemuck::bytes_of(&with_mode(0)),
-            [1, 1, 1],
-        )?;
+        let fit = |enc: &mut Encoder<'_>, mode| {
+            enc.dispatch(
+                &self.pipes.fit,
+                &self.fit_group,
+                bytemuck::bytes_of(&with_mode(mode)),
+                [1, 1, 1],
+            )
+        };
+        fit(enc, 0)?;
         enc.barriers(&[Barrier::Uav]);
         enc.dispatch(
-            &self.receivers_pipeline,
+            &self.pipes.receivers,
             &self.receivers_group,
             bytemuck::bytes_of(&with_mode(0)),
             pixels,
         )?;
         enc.barriers(&[Barrier::Uav]);
-        enc.dispatch(
-            &self.fit,
-            &self.fit_group,
-            bytemuck::bytes_of(&with_mode(1)),
-            [1, 1, 1],
-        )?;
+        fit(enc, 1)?;
         enc.barriers(&[Barrier::Uav]);
         enc.end_pass();
 
         enc.begin_pass("primitive map: receivers");
         enc.dispatch(
-            &self.receivers_pipeline,
+            &self.pipes.receivers,
             &self.receivers_group,
             bytemuck::bytes_of(&with_mode(1)),
             pixels,
@@ -782,13 +994,13 @@ impl PrimitiveMap {
 
         enc.begin_pass("primitive map: setup");
         enc.dispatch(
-            &self.setup,
-            &self.setup_group,
+            &self.pipes.setup,
+            &self.bound.setup_group,
             bytemuck::bytes_of(&push),
             [(self.triangles + 1).div_ceil(64), 1, 1],
         )?;
         enc.barriers(&[Barrier::Uav]);
-        self.tile_scan.record(enc, &self.scan)?;
+        self.bound.tile_scan.record(enc, &self.pipes.scan)?;
         enc.end_pass();
 
         let label = self.path.label();
@@ -797,7 +1009,7 @@ impl PrimitiveMap {
         enc.end_pass();
 
         enc.begin_pass("primitive map: scan");
-        self.offset_scan.record(enc, &self.scan)?;
+        self.bound.offset_scan.record(enc, &self.pipes.scan)?;
         enc.end_pass();
 
         enc.begin_pass(&format!("primitive map: fill ({label})"));
@@ -807,11 +1019,11 @@ impl PrimitiveMap {
     }
 
     fn record_bin(&self, enc: &mut Encoder<'_>, push: &MapPush) -> Result<(), PassError> {
-        match &self.binner {
+        match &self.pipes.binner {
             Binner::Compute(p) => {
                 enc.dispatch(
                     p,
-                    &self.bin_group,
+                    &self.bound.bin_group,
                     bytemuck::bytes_of(push),
                     [BIN_THREADS / 64, 1, 1],
                 )?;
@@ -820,7 +1032,7 @@ impl PrimitiveMap {
                 enc.begin_rendering((self.config.size, self.config.size), &[], None);
                 enc.draw(
                     p,
-                    &self.bin_group,
+                    &self.bound.bin_group,
                     bytemuck::bytes_of(push),
                     self.triangles * 3,
                 )?;
@@ -832,7 +1044,7 @@ impl PrimitiveMap {
     }
 
     /// Writes the map statistics into the state, and the occupancy view when the map draws one, and copies
-    /// the state into `state_readback` (host-readable once the frame completed).
+    /// the state into `state_readback` (host-readable once the frame completed; as large as the state).
     pub fn record_occupancy(
         &self,
         enc: &mut Encoder<'_>,
@@ -845,14 +1057,15 @@ impl PrimitiveMap {
             after: S::UnorderedAccess,
         }]);
         let n = self.config.size;
-        let push = [n, u32::from(self.occupancy_view)];
-        // Each invocation tallies a 2x2 quad of texels.
-        let groups = n.div_ceil(16);
+        let texels = self.config.texels();
+        let push = [n, u32::from(self.occupancy_view), texels as u32];
+        // Each invocation tallies a 2x2 quad of texels, in rows of N.
+        let rows = texels.div_ceil(u64::from(n)) as u32;
         enc.dispatch(
-            &self.occupancy_pipeline,
+            &self.pipes.occupancy,
             &self.occupancy_group,
             bytemuck::cast_slice(&push),
-            [groups, groups, 1],
+            [n.div_ceil(16), rows.div_ceil(16), 1],
         )?;
         enc.barriers(&[Barrier::Global {
             before: S::UnorderedAccess,

@@ -60,7 +60,10 @@ impl ViewVolume {
         }
         let mut planes = box_planes(lo, hi);
         planes.extend(&self.camera);
-        planes.extend(clip_planes(light.view_proj().as_dmat4()));
+        // A point light's cube faces cover every direction: only its range bounds it.
+        if !matches!(light, Light::Point { .. }) {
+            planes.extend(clip_planes(light.view_proj().as_dmat4()));
+        }
         // Quick rejection: the whole box outside one plane.
         let corners: Vec<DVec3> = (0..8)
             .map(|i| {

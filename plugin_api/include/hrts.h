@@ -9,7 +9,7 @@
 
 // Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 // version differs.
-#define HRTS_API_VERSION ((5 << 22) | (3 << 12))
+#define HRTS_API_VERSION ((5 << 22) | (4 << 12))
 
 // The most lights one context shades (`hrts_configure_lights`); a point light counts once.
 #define HRTS_MAX_LIGHTS 64
@@ -167,8 +167,11 @@ enum HrtsLightType
   // Spot light at `position` pointing along `direction`: the engine's perspective `view_proj`, or, when
   // `view_proj` is all zeros, frusta the plugin fits to `outer_cone` and `range`.
   HRTS_LIGHT_TYPE_SPOT = 1,
-  // Point light at `position`, shining in every direction within `range`: the plugin shadows it
-  // through the six cube faces around it and writes their minimum to the light's output layer.
+  // Point light at `position`, shining in every direction within `range`. With hard shadows (or none)
+  // and compute binning, the plugin builds the six cube faces around it as one primitive map (each
+  // pixel's ray looks up the face its direction from the light falls in; faces share the map's
+  // texels in proportion to their rays) and traces it once; otherwise it shadows it through the six
+  // faces as frusta and writes their minimum to the light's output layer.
   HRTS_LIGHT_TYPE_POINT = 2,
 };
 #ifndef __cplusplus
@@ -557,6 +560,10 @@ typedef struct HrtsConfig {
   // Entries the primitive map's lists start with (default 0: estimated from map_size and the
   // triangles). An engine that knows its scene can size them and avoid the frame of a growth.
   uint32_t map_initial_entries;
+  // (Triangle, face) pairs a point light's cube map starts with (default 0: two per triangle, at least
+  // 1024). A frame that keeps more traces the light exhaustively (exact, slower; `bin_pairs` in the
+  // frame report) and the pairs grow to fit from the next frame on.
+  uint32_t map_initial_pairs;
 } HrtsConfig;
 
 // One draw of the geometry.
@@ -872,7 +879,8 @@ typedef struct HrtsFrameReport {
   // geometry or targets call that changed nothing of this light leaves it as it was.
   uint32_t light_builds;
   // Frusta the light was shadowed through this frame: those of its frusta (1, or the cube faces of a
-  // point light (6) or of a wide spot light (5)) that may hold a receiver in view within its range.
+  // point light (6) or of a wide spot light (5)) that may hold a receiver in view within its range. A
+  // hard point light built as one cube map counts as 1.
   // Statistics and pass times above are summed over them, memory over every frustum (the longest
   // list is the longest of any; `map_to_texels` is the first recorded frustum's).
   uint32_t frusta;
@@ -895,6 +903,12 @@ typedef struct HrtsFrameReport {
   // pass and the output-copy call, which takes it to `output_layout_after`), and the configuration does
   // not read the final output back through `extra_outputs`.
   HrtsBool output_direct;
+  // A point light shadowed as one cube map: the (triangle, face) pairs its setup kept this frame (0
+  // for other lights). Past `bin_pair_capacity`, the frame traced every ray of the light against every
+  // triangle (exact, slower) and the pairs grow to fit from the next frame on.
+  uint32_t bin_pairs;
+  // The (triangle, face) pairs the light's cube map held this frame.
+  uint32_t bin_pair_capacity;
 } HrtsFrameReport;
 
 // Every result, in value order.

@@ -35,6 +35,23 @@ pub(crate) struct TargetSource {
     pub(crate) output_usage: ImageUsage,
 }
 
+/// How a light is shadowed in a frame: through how many frusta, and whether its one frustum is a point
+/// light's cube map.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct LightShape {
+    pub(crate) frusta: usize,
+    pub(crate) cube: bool,
+}
+
+impl Default for LightShape {
+    fn default() -> Self {
+        Self {
+            frusta: 1,
+            cube: false,
+        }
+    }
+}
+
 /// The passes of one light: one pipeline per frustum it is shadowed through and, for several, the
 /// minimum over their outputs.
 pub(crate) struct LightPasses {
@@ -198,6 +215,12 @@ impl LightSchedule {
                 HrtsLightDecision::OutOfView,
                 format!("{kind}: no frustum holds a receiver in view within range; lit"),
             ),
+            (_, 1) if self.names == passes::CUBE_MAP_NAME => (
+                HrtsLightDecision::Shadowed,
+                format!(
+                    "{kind}: receivers in view within range; its six cube faces built as one map"
+                ),
+            ),
             (_, 1) => (
                 HrtsLightDecision::Shadowed,
                 format!("{kind}: its frustum holds receivers in view"),
@@ -235,8 +258,9 @@ pub(crate) struct Context {
     pub(crate) readback_frame: Option<u64>,
     /// How many times each light's passes were built.
     pub(crate) light_builds: Vec<u32>,
-    /// How many frusta each light was last given (its passes hold one pipeline per frustum).
-    pub(crate) frusta: Vec<usize>,
+    /// How each light was last shadowed: its frusta (its passes hold one pipeline per frustum), and
+    /// whether its one frustum is a point light's cube map.
+    pub(crate) frusta: Vec<LightShape>,
     /// Which frusta the last `frames_in_flight` frames recorded, oldest first.
     pub(crate) schedules: std::collections::VecDeque<FrameSchedule>,
     /// The message of the last call if it failed.
@@ -281,7 +305,7 @@ impl Context {
             last_frame: None,
             readback_frame: None,
             light_builds: vec![0],
-            frusta: vec![1],
+            frusta: vec![LightShape::default()],
             schedules: Default::default(),
             last_error: None,
         })
@@ -354,7 +378,7 @@ impl Context {
             }
         }
         self.light_builds.resize(lights.len(), 0);
-        self.frusta.resize(lights.len(), 1);
+        self.frusta.resize(lights.len(), LightShape::default());
         self.lights = lights;
         Ok(())
     }
@@ -409,7 +433,7 @@ impl Context {
 
     /// Takes each light's number of frusta this frame: a light whose number changed (a spot light turned
     /// point light, say) has its passes rebuilt.
-    pub(crate) fn set_frusta(&mut self, frusta: &[usize]) {
+    pub(crate) fn set_frusta(&mut self, frusta: &[LightShape]) {
         let mut replaced = Vec::new();
         for (i, (&new, old)) in frusta.iter().zip(&mut self.frusta).enumerate() {
             if new != *old {
@@ -666,7 +690,7 @@ impl Context {
             .built
             .as_mut()
             .ok_or_else(|| ApiError::new(HrtsResult::ErrorInternal, "passes not built"))?;
-        for (i, ((slot, config), &frusta)) in built
+        for (i, ((slot, config), &shape)) in built
             .lights
             .iter_mut()
             .zip(lights)
@@ -685,15 +709,17 @@ impl Context {
                         depth: &built.depth,
                         normal: &built.normal,
                         surface: built.surface,
-                        direct_output: layer.filter(|_| frusta == 1),
+                        direct_output: layer.filter(|_| shape.frusta == 1),
                     };
-                    let frusta = (0..frusta)
+                    let mut config = *config;
+                    config.map.cube = shape.cube;
+                    let frusta = (0..shape.frusta)
                         .map(|_| {
                             ShadowPipeline::with_shared_geometry(
                                 device,
                                 built.shared.clone(),
                                 &inputs,
-                                *config,
+                                config,
                             )
                         })
                         .collect::<Result<Vec<_>, _>>()?;
@@ -904,6 +930,8 @@ impl Context {
         out.receiver_pixels = sum(|r| r.stats.receiver_pixels);
         out.receiver_texels = sum(|r| r.stats.receiver_texels);
         out.triangles_binned = sum(|r| r.stats.triangles_binned);
+        out.bin_pairs = sum(|r| r.stats.pairs);
+        out.bin_pair_capacity = sum(|r| r.stats.pair_capacity);
         out.map_to_texels = reports
             .first()
             .map_or([0.0; 16], |r| r.map_to_texels.to_cols_array());

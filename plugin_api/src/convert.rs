@@ -1,5 +1,6 @@
 //! Conversion between the C types and the Rust ones, checking every value.
 
+use crate::context::LightShape;
 use crate::error::{check_size, invalid, ApiError, ApiResult};
 use crate::types::*;
 use glam::{Mat4, Vec3};
@@ -206,12 +207,48 @@ pub(crate) struct FrameLight {
 }
 
 impl FrameLight {
-    /// The name of frustum `frustum` in reports: a point light's cube face, a wide spot light's face.
+    /// The name of frustum `frustum` in reports: a point light's cube face, a wide spot light's face, a
+    /// point light's whole cube.
     pub(crate) fn frustum_name(&self, frustum: usize) -> &'static str {
+        if self.is_cube() {
+            return passes::CUBE_MAP_NAME[0];
+        }
         passes::frustum_names(self.frusta.len())
             .get(frustum)
             .copied()
             .unwrap_or("whole")
+    }
+
+    /// Whether the light is a point light shadowed as one cube map.
+    pub(crate) fn is_cube(&self) -> bool {
+        matches!(self.frusta.as_slice(), [one] if matches!(one.light, Light::Point { .. }))
+    }
+
+    /// How the light is shadowed: its frusta, and whether the one is a cube.
+    pub(crate) fn shape(&self) -> LightShape {
+        LightShape {
+            frusta: self.frusta.len(),
+            cube: self.is_cube(),
+        }
+    }
+
+    /// The light as `config` shadows it: a point light whose configuration allows it
+    /// ([`ShadowConfig::shadows_point_as_cube`]) as one cube map instead of its six faces.
+    pub(crate) fn shadowed_as(mut self, config: &ShadowConfig) -> Self {
+        if self.kind == HrtsLightType::Point && config.shadows_point_as_cube() {
+            if let Some(first) = self.frusta.first().cloned() {
+                if let Some(position) = first.light.position() {
+                    self.frusta = vec![FrameInputs {
+                        light: Light::Point {
+                            position,
+                            range: self.range,
+                        },
+                        ..first
+                    }];
+                }
+            }
+        }
+        self
     }
 }
 
@@ -444,6 +481,8 @@ pub(crate) fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
             guard: c.guard_entries != 0,
             receiver_culling: c.debug_bin_all_texels == 0,
             initial_entries: c.map_initial_entries,
+            cube: false,
+            initial_pairs: c.map_initial_pairs,
         },
         ..ShadowConfig::default()
     };
@@ -508,6 +547,7 @@ pub(crate) fn config_to_c(config: &ShadowConfig) -> ApiResult<HrtsConfig> {
         guard_entries: config.map.guard.into(),
         debug_bin_all_texels: (!config.map.receiver_culling).into(),
         map_initial_entries: config.map.initial_entries,
+        map_initial_pairs: config.map.initial_pairs,
     })
 }
 

@@ -2,7 +2,7 @@
 //! the copy of each light's visibility into the engine's output, and resource read-backs.
 
 use crate::context::{Built, Context, FrameProgress, OpenFrame};
-use crate::convert::{frame_bounds, frame_inputs, pass_from_index, resource_id};
+use crate::convert::{frame_bounds, frame_inputs, pass_from_index, resource_id, FrameLight};
 use crate::error::{check_size, invalid, ApiError, ApiResult};
 use crate::geometry::deformed_meshes;
 use crate::types::*;
@@ -44,6 +44,11 @@ impl Context {
                 self.lights.len()
             )));
         }
+        let inputs: Vec<FrameLight> = inputs
+            .into_iter()
+            .zip(&self.lights)
+            .map(|(light, config)| light.shadowed_as(config))
+            .collect();
         let mut used_layouts = Vec::new();
         if mask & DEPTH_NORMAL_READERS != 0 {
             used_layouts.push(("depth_layout", f.depth_layout));
@@ -94,7 +99,7 @@ impl Context {
         if !continues {
             self.begin_frame(f.frame_index)?;
         }
-        self.set_frusta(&inputs.iter().map(|l| l.frusta.len()).collect::<Vec<_>>());
+        self.set_frusta(&inputs.iter().map(FrameLight::shape).collect::<Vec<_>>());
         // A frame's later calls (same camera and lights) record the frusta its first call chose.
         let kept = self
             .schedules

@@ -6,7 +6,7 @@ use std::ffi::c_char;
 
 /// Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 /// version differs.
-pub const HRTS_API_VERSION: u32 = 5 << 22 | 3 << 12;
+pub const HRTS_API_VERSION: u32 = 5 << 22 | 4 << 12;
 
 /// A flag in the C structs: 0 is false, any other value true. (A Rust `bool` would make any byte but 0
 /// and 1 undefined behaviour when the engine writes it.)
@@ -258,8 +258,11 @@ pub enum HrtsLightType {
     /// Spot light at `position` pointing along `direction`: the engine's perspective `view_proj`, or, when
     /// `view_proj` is all zeros, frusta the plugin fits to `outer_cone` and `range`.
     Spot = 1,
-    /// Point light at `position`, shining in every direction within `range`: the plugin shadows it
-    /// through the six cube faces around it and writes their minimum to the light's output layer.
+    /// Point light at `position`, shining in every direction within `range`. With hard shadows (or none)
+    /// and compute binning, the plugin builds the six cube faces around it as one primitive map (each
+    /// pixel's ray looks up the face its direction from the light falls in; faces share the map's
+    /// texels in proportion to their rays) and traces it once; otherwise it shadows it through the six
+    /// faces as frusta and writes their minimum to the light's output layer.
     Point = 2,
 }
 
@@ -465,6 +468,10 @@ pub struct HrtsConfig {
     /// Entries the primitive map's lists start with (default 0: estimated from map_size and the
     /// triangles). An engine that knows its scene can size them and avoid the frame of a growth.
     pub map_initial_entries: u32,
+    /// (Triangle, face) pairs a point light's cube map starts with (default 0: two per triangle, at least
+    /// 1024). A frame that keeps more traces the light exhaustively (exact, slower; `bin_pairs` in the
+    /// frame report) and the pairs grow to fit from the next frame on.
+    pub map_initial_pairs: u32,
 }
 
 /// One draw of the geometry.
@@ -801,7 +808,8 @@ pub struct HrtsFrameReport {
     /// geometry or targets call that changed nothing of this light leaves it as it was.
     pub light_builds: u32,
     /// Frusta the light was shadowed through this frame: those of its frusta (1, or the cube faces of a
-    /// point light (6) or of a wide spot light (5)) that may hold a receiver in view within its range.
+    /// point light (6) or of a wide spot light (5)) that may hold a receiver in view within its range. A
+    /// hard point light built as one cube map counts as 1.
     /// Statistics and pass times above are summed over them, memory over every frustum (the longest
     /// list is the longest of any; `map_to_texels` is the first recorded frustum's).
     pub frusta: u32,
@@ -824,6 +832,12 @@ pub struct HrtsFrameReport {
     /// pass and the output-copy call, which takes it to `output_layout_after`), and the configuration does
     /// not read the final output back through `extra_outputs`.
     pub output_direct: HrtsBool,
+    /// A point light shadowed as one cube map: the (triangle, face) pairs its setup kept this frame (0
+    /// for other lights). Past `bin_pair_capacity`, the frame traced every ray of the light against every
+    /// triangle (exact, slower) and the pairs grow to fit from the next frame on.
+    pub bin_pairs: u32,
+    /// The (triangle, face) pairs the light's cube map held this frame.
+    pub bin_pair_capacity: u32,
 }
 
 /// A copy of a plugin resource into an engine buffer, recorded after a complete frame.

@@ -1,6 +1,6 @@
 //! A glTF scene's lights through the plugin, as the scene's plan says (`host_demo::scene_plan`), on
 //! lavapipe: every shadowed light against the exact reference (a point light given to the plugin as a
-//! point light: the minimum over the cube faces it records), a scene whose lights need nothing records no
+//! point light: hard, its six cube faces built as one map; sized, the minimum over the faces it records), a scene whose lights need nothing records no
 //! plugin pass, and changing one light reruns only that light's passes.
 
 mod common;
@@ -335,17 +335,19 @@ fn closed_room(lamp: Vec3) -> SceneFile {
     )
 }
 
-/// A point light given to the plugin as a point light (the C ABI's `HRTS_LIGHT_TYPE_POINT`, no matrix):
-/// the plugin shadows it through its six cube faces and writes their minimum to the light's one layer,
-/// which matches the exact reference; the report covers the six faces.
-#[test]
-fn a_native_point_light_matches_the_exact_reference() {
-    let device = device();
-    let lamp = Vec3::new(0.15, 2.5, 0.1);
+/// The closed room's lamp given to the plugin as a point light (the C ABI's `HRTS_LIGHT_TYPE_POINT`, no
+/// matrix) under `config`, rendered `frames` times: per frame, its map statistics and its layer against the
+/// exact reference.
+fn native_point_frames(
+    device: &Device,
+    lamp: Vec3,
+    config: ShadowConfig,
+    frames: usize,
+) -> Vec<(passes::MapStats, common::VisibilityComparison)> {
     let file = closed_room(lamp);
     let camera = camera(&file);
     let mut plugin = PluginRenderer::for_scene(
-        &device,
+        device,
         &file.scene,
         WIDTH,
         HEIGHT,
@@ -353,28 +355,8 @@ fn a_native_point_light_matches_the_exact_reference() {
         host_demo::gbuffer::GBufferLayout::ANALYSIS,
     )
     .expect("plugin");
-    let config = ShadowConfig {
-        mode: ShadowMode::Hard,
-        antialiasing: false,
-        ..settings(false).base
-    };
-    plugin
-        .configure_lights(&device, &[config])
-        .expect("configure");
+    plugin.configure_lights(device, &[config]).expect("configure");
     let matrices = CameraMatrices::of_camera(&camera, WIDTH, HEIGHT);
-    let mut frame = None;
-    for _ in 0..2 {
-        frame = Some(
-            plugin
-                .render_c_lights(&device, &matrices, vec![c_point_light(lamp, 0.0)])
-                .expect("frame"),
-        );
-    }
-    let frame = frame.expect("a frame");
-    let report = &frame.lights[0].report;
-    assert_eq!(report.stats.texels_past_capacity, 0);
-    assert!(report.stats.receiver_pixels > 0);
-    let (_, layers) = plugin.read_frame(&device).expect("read back");
     let rs = RefScene::new(&file.scene);
     let params = scene_visibility_params(
         &file.scene,
@@ -386,14 +368,65 @@ fn a_native_point_light_matches_the_exact_reference() {
         },
     );
     let r = reference_visibility(&rs, &params);
-    let c = compare_with_reference(&r, &layers[0], None, None);
-    println!(
-        "native point light: {} pixels, {} shadowed, {} near an edge, {} mismatches; {:?}",
-        c.pixels, c.shadowed, c.near_edge, c.mismatches, report.stats
-    );
-    assert_eq!(c.non_finite, 0);
-    assert_eq!(c.mismatches, 0, "(x, y, exact, gpu): {:?}", c.examples);
+    (0..frames)
+        .map(|_| {
+            let frame = plugin
+                .render_c_lights(device, &matrices, vec![c_point_light(lamp, 0.0)])
+                .expect("frame");
+            let report = &frame.lights[0].report;
+            let (_, layers) = plugin.read_frame(device).expect("read back");
+            let c = compare_with_reference(&r, &layers[0], None, None);
+            println!(
+                "native point light: {} pixels, {} shadowed, {} near an edge, {} mismatches; {}; {:?}",
+                c.pixels, c.shadowed, c.near_edge, c.mismatches, frame.lights[0].decision, report.stats
+            );
+            assert_eq!(c.non_finite, 0);
+            assert_eq!(c.mismatches, 0, "(x, y, exact, gpu): {:?}", c.examples);
+            (report.stats, c)
+        })
+        .collect()
+}
+
+/// A hard point light given to the plugin as a point light: the plugin builds its six cube faces as one
+/// map and writes the light's one layer, which matches the exact reference.
+#[test]
+fn a_native_point_light_matches_the_exact_reference() {
+    let device = device();
+    let config = ShadowConfig {
+        mode: ShadowMode::Hard,
+        antialiasing: false,
+        ..settings(false).base
+    };
+    let frames = native_point_frames(&device, Vec3::new(0.15, 2.5, 0.1), config, 2);
+    let (stats, c) = &frames[1];
+    assert_eq!(stats.texels_past_capacity, 0);
+    assert!(stats.receiver_pixels > 0);
+    assert!(stats.pairs > 0 && stats.pairs <= stats.pair_capacity, "{stats:?}");
     assert!(c.shadowed >= 200, "{} shadowed pixels", c.shadowed);
+    assert_no_validation_errors(&device);
+}
+
+/// A point light's cube map that keeps more (triangle, face) pairs than it holds: that frame traces the
+/// light's rays exhaustively and stays exact, and the pairs grow to fit from the next frame on.
+#[test]
+fn a_cube_map_outgrowing_its_pairs_stays_exact_and_grows() {
+    let device = device();
+    let mut config = ShadowConfig {
+        mode: ShadowMode::Hard,
+        antialiasing: false,
+        static_light: false,
+        ..settings(false).base
+    };
+    config.map.initial_pairs = 8;
+    let frames = native_point_frames(&device, Vec3::new(0.15, 2.5, 0.1), config, 3);
+    let (first, _) = &frames[0];
+    assert_eq!(first.pair_capacity, 8);
+    assert!(first.pairs > 8, "{first:?}");
+    for (stats, c) in &frames[1..] {
+        assert!(stats.pair_capacity >= stats.pairs, "{stats:?}");
+        assert_eq!(stats.pairs, first.pairs, "{stats:?}");
+        assert!(c.shadowed >= 200);
+    }
     assert_no_validation_errors(&device);
 }
 

@@ -490,7 +490,11 @@ fn shadowed(
         config,
         frame_plan: FramePlan::derive(config.plan_request()),
         light: c_light,
-        frusta: passes::frustum_names(frusta),
+        frusta: if matches!(light.kind, LightKind::Point { .. }) && config.shadows_point_as_cube() {
+            &passes::CUBE_MAP_NAME
+        } else {
+            passes::frustum_names(frusta)
+        },
     }))
 }
 

@@ -234,7 +234,7 @@ impl ShadowPipeline {
                     timer: device.create_timer(48)?,
                     stats_readback: device.create_buffer(
                         "map state read-back",
-                        std::mem::size_of::<MapState>() as u64,
+                        u64::from(config.map.frusta()) * std::mem::size_of::<MapState>() as u64,
                         BufferUsage::COPY_DST,
                         MemoryLocation::GpuToCpu,
                     )?,
@@ -273,6 +273,7 @@ impl ShadowPipeline {
             frame: None,
             last_frame: None,
             needed_entries: 0,
+            needed_pairs: 0,
             retired: RetireQueue::default(),
             pending_uav: None,
             statuses: Vec::new(),

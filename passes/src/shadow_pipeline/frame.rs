@@ -5,7 +5,7 @@ use super::{
 };
 use crate::frame_plan::{PassId, PassStatus, ResourceId, ResourceSet, SkipReason};
 use crate::gpu_types::{MapPush, PcssConstants, RayTraceConstants};
-use crate::light::LightFrame;
+use crate::light::{Light, LightFrame};
 use crate::prim_buffer::PrimBufferClaim;
 use crate::primitive_map::FaceMode;
 use crate::ray_trace::{RAY_OFFSET_FLOAT_BOUND, RAY_OFFSET_PIXELS};
@@ -27,6 +27,18 @@ impl ShadowPipeline {
             ));
         }
         let cfg = self.config.map;
+        let point = matches!(inputs.light, Light::Point { .. });
+        if point != cfg.cube {
+            return Err(PassError::InvalidConfig(if point {
+                "a point light needs a pipeline whose primitive map is a cube (PrimitiveMapConfig::cube)"
+                    .into()
+            } else {
+                format!(
+                    "this pipeline's primitive map is a point light's cube; the frame gave a {} light",
+                    inputs.light.kind_name()
+                )
+            }));
+        }
         if light.position.is_some() && cfg.faces == FaceMode::FrontOnly {
             return Err(PassError::InvalidConfig(
                 "a front-only primitive map needs a directional light: store both faces for a spot light"
@@ -44,7 +56,6 @@ impl ShadowPipeline {
         Ok(FrameConstants {
             light,
             map: MapPush {
-                light_view_proj: light.view_proj,
                 to_light: (-dir).extend(if light.position.is_some() { 1.0 } else { 0.0 }),
                 size: cfg.size,
                 front_only,
@@ -142,6 +153,7 @@ impl ShadowPipeline {
             // a later one may have too (its completion marker says so).
             if let Some(state) = self.newest_completed_map_state(completed_before(index, frames))? {
                 self.needed_entries = state.totals.y;
+                self.needed_pairs = state.grid.z;
             }
         }
         let claim = match (self.plan.runs(PassId::PrimBuffer), open) {

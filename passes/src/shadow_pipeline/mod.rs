@@ -27,7 +27,7 @@ use crate::hybrid::{BlendPass, LerpFactorPass};
 use crate::light::{rebased, Light, LightFrame};
 use crate::pcss::PcssPass;
 use crate::prim_buffer::{Geometry, SharedGeometry};
-use crate::primitive_map::{BinningPath, PrimitiveMap};
+use crate::primitive_map::{BinningPath, PrimitiveMap, ScratchBindings};
 use crate::ray_trace::RayTracePass;
 use crate::retire::RetireQueue;
 use crate::shadow_map::ShadowMapPass;
@@ -75,10 +75,15 @@ struct FrameSlot {
 }
 
 /// What growing the primitive map replaced, held while frames in flight may still use it.
-struct RetiredMapEntries {
-    _entries: Buffer,
-    _bin_group: BindGroup,
-    _ray_group: Option<BindGroup>,
+enum RetiredMap {
+    Entries {
+        _entries: Buffer,
+        _bin_group: BindGroup,
+        _ray_group: Option<BindGroup>,
+    },
+    Pairs {
+        _bindings: Box<ScratchBindings>,
+    },
 }
 
 /// The passes of one view of one light, and the resources the plan allocates for them.
@@ -107,7 +112,9 @@ pub struct ShadowPipeline {
     last_frame: Option<u64>,
     /// List entries the newest completed map build needed (grows the map before the next build).
     needed_entries: u32,
-    retired: RetireQueue<RetiredMapEntries>,
+    /// (Triangle, face) pairs the newest completed build of a point light's map kept (grows it likewise).
+    needed_pairs: u32,
+    retired: RetireQueue<RetiredMap>,
     /// Whether storage writes were recorded and not yet followed by a UAV barrier, and the plan's
     /// resources among what they wrote.
     pending_uav: Option<ResourceSet>,

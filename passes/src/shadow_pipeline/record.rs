@@ -1,6 +1,6 @@
 //! Recording a frame's passes, in linear order, with the barriers between them.
 
-use super::{FrameInputs, FrameState, RetiredMapEntries, ShadowPipeline};
+use super::{FrameInputs, FrameState, RetiredMap, ShadowPipeline};
 use crate::frame_plan::{PassId, PassStatus, ResourceSet};
 use crate::gpu_types::ShadowMapPush;
 use crate::PassError;
@@ -236,7 +236,7 @@ impl ShadowPipeline {
             PassId::PrimitiveMap => {
                 self.grow_map(enc.device(), frame.index)?;
                 if let Some(map) = self.map.as_mut() {
-                    map.record(enc, &c.ray, &c.map)?;
+                    map.record(enc, &c.ray, &c.map, c.light.frusta())?;
                 }
             }
             PassId::Occupancy => {
@@ -296,24 +296,34 @@ impl ShadowPipeline {
         Ok(())
     }
 
-    /// Grows the primitive map's entries to what the newest completed build needed, and rebinds the ray
-    /// trace to them; the replaced objects are held until the frames before `frame` completed.
+    /// Grows the primitive map's entries and (triangle, face) pairs to what the newest completed build
+    /// needed, and rebinds the ray trace to the entries; the replaced objects are held until the frames
+    /// before `frame` completed.
     fn grow_map(&mut self, device: &Device, frame: u64) -> Result<(), PassError> {
         let Some(map) = self.map.as_mut() else {
             return Ok(());
         };
+        let mut retired = Vec::new();
         if let Some((entries, bin_group)) = map.grow(device, self.needed_entries)? {
             let ray_group = match self.ray.as_mut() {
                 Some(ray) => Some(ray.rebind_entries(device, map)?),
                 None => None,
             };
-            let retired = RetiredMapEntries {
+            retired.push(RetiredMap::Entries {
                 _entries: entries,
                 _bin_group: bin_group,
                 _ray_group: ray_group,
-            };
-            if let Some(last_user) = frame.checked_sub(1) {
-                self.retired.retire(last_user, retired);
+            });
+        }
+        let pool = self.shared.map_scratch();
+        if let Some(bound) = map.grow_pairs(device, pool, self.shared.prims(), self.needed_pairs)? {
+            retired.push(RetiredMap::Pairs {
+                _bindings: Box::new(bound),
+            });
+        }
+        if let Some(last_user) = frame.checked_sub(1) {
+            for r in retired {
+                self.retired.retire(last_user, r);
             }
         }
         Ok(())

@@ -160,7 +160,7 @@ impl ShadowPipeline {
             }
         }
         newest
-            .map(|(_, s)| Ok(bytemuck::pod_read_unaligned(s.stats_readback.read()?)))
+            .map(|(_, s)| Ok(read_states(s)?[0]))
             .transpose()
     }
 
@@ -169,16 +169,16 @@ impl ShadowPipeline {
         slot: &FrameSlot,
         timings: Vec<PassTiming>,
     ) -> Result<FrameReport, PassError> {
-        let state = match slot.map_state_recorded {
-            true => bytemuck::pod_read_unaligned(slot.stats_readback.read()?),
-            false => MapState::zeroed(),
+        let states = match slot.map_state_recorded {
+            true => read_states(slot)?,
+            false => vec![MapState::zeroed()],
         };
         let resources = self.resources();
         Ok(FrameReport {
             timings,
             binning_path: self.binning_path,
-            stats: MapStats::from_state(&state),
-            map_to_texels: state.to_texels,
+            stats: MapStats::from_states(&states),
+            map_to_texels: states[0].to_texels,
             passes: slot.statuses.clone(),
             resources,
             output: self.plan.final_output(),
@@ -186,6 +186,21 @@ impl ShadowPipeline {
             prim_triangles_rebuilt: slot.frame.map_or(0, |f| self.shared.triangles_rebuilt(f)),
         })
     }
+}
+
+/// The map states of every frustum a slot's frame read back (at least one).
+fn read_states(slot: &FrameSlot) -> Result<Vec<MapState>, PassError> {
+    let bytes = slot.stats_readback.read()?;
+    let states: Vec<MapState> = bytes
+        .chunks_exact(std::mem::size_of::<MapState>())
+        .map(bytemuck::pod_read_unaligned)
+        .collect();
+    if states.is_empty() {
+        return Err(PassError::InvalidConfig(
+            "the map state read-back holds no state".into(),
+        ));
+    }
+    Ok(states)
 }
 
 /// Whether the GPU has run frame `frame`'s recording in `slot` to its end (its completion marker).
