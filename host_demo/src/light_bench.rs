@@ -236,7 +236,11 @@ fn measure_light(
             .map(|r| u64::from(r.stats.texels_past_capacity))
             .sum(),
         passes: pass_medians(&frames[1..]),
-        scratch_bytes: reports.iter().map(|r| r.map_scratch_bytes).max().unwrap_or(0),
+        scratch_bytes: reports
+            .iter()
+            .map(|r| r.map_scratch_bytes)
+            .max()
+            .unwrap_or(0),
     })
 }
 

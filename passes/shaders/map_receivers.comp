@@ -13,6 +13,8 @@
 //   per texel the largest depth key of its ray origins: a triangle farther from the light than all of them
 //   cannot shadow the texel, and a texel without ray origins needs no list at all. The texels first
 //   marked are counted (the map's texels with receivers).
+// - mode 2 (texels): each pixel's texel alone, exactly as mode 1 writes it, for a ray trace whose pixel
+//   texels another light's build overwrote since (the lights share them).
 // Each invocation places a 2x2 quad of pixels; the per-frustum counters are reduced per subgroup, then per
 // workgroup, so that one global atomic per frustum and 16x16 pixels reaches memory (every pixel of the
 // frame would otherwise contend for the same few words), and a subgroup whose receivers share one texel
@@ -138,6 +140,9 @@ void main() {
         uvec2 texel = uvec2(clamp(ivec2(floor(pr.xy)), ivec2(0), ivec2(last)));
         uint index = texel_index(faces[f].grid, texel);
         pixel_texel[pixel] = index;
+        if (pc.mode == 2u) {
+            continue;
+        }
         // Largest depth key of the texel, rounded up by its error bound (and the bound's own rounding).
         uint reach = ordered(pr.depth + pr.depth_err * 2.0);
         add(f, uvec4(1u, ordered(max(pr.xy_err.x, pr.xy_err.y)), reach, 0u));

@@ -241,12 +241,14 @@ impl PrimitiveMapConfig {
         }
         if self.cube && !matches!(self.binning, BinningRequest::Auto | BinningRequest::Compute) {
             return Err(PassError::InvalidConfig(
-                "a point light's cube map is binned in compute: request auto or compute binning".into(),
+                "a point light's cube map is binned in compute: request auto or compute binning"
+                    .into(),
             ));
         }
         if self.cube && self.faces == FaceMode::FrontOnly {
             return Err(PassError::InvalidConfig(
-                "a front-only primitive map needs a directional light, not a point light's cube".into(),
+                "a front-only primitive map needs a directional light, not a point light's cube"
+                    .into(),
             ));
         }
         if self.entry_budget < MIN_ENTRY_BUDGET {
@@ -384,7 +386,20 @@ pub struct MapScratchPool {
     current: std::sync::Mutex<Option<std::sync::Arc<MapScratch>>>,
     /// The receiver map (one `u32` per texel) shared by the maps that draw no occupancy view.
     receivers: std::sync::Mutex<Option<std::sync::Arc<Buffer>>>,
+    /// The pixel texels (one `u32` per screen pixel) shared by the maps, with the id of the map that last
+    /// recorded a write of them.
+    pixel_texels: std::sync::Mutex<Option<SharedTexels>>,
 }
+
+/// Screen-size pixel texels shared by the maps over one geometry, and which map last recorded their write.
+#[derive(Clone)]
+pub struct SharedTexels {
+    buffer: std::sync::Arc<Buffer>,
+    writer: std::sync::Arc<std::sync::atomic::AtomicU64>,
+}
+
+/// Source of [`PrimitiveMap`] ids (0 marks pixel texels no map wrote yet).
+static NEXT_MAP_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
 
 impl MapScratchPool {
     /// Scratch with counts for `texels` texels, `bins` bin triangles and `owners` (triangle, face) owners:
@@ -462,7 +477,30 @@ impl MapScratchPool {
         Ok(receivers)
     }
 
-    /// GPU bytes of the pool's current scratch and receiver map (0 before any map asked for them).
+    /// Pixel texels for `pixels` pixels: the pool's, or new ones as large.
+    fn pixel_texels(&self, device: &Device, pixels: u64) -> Result<SharedTexels, PassError> {
+        let mut current = self
+            .pixel_texels
+            .lock()
+            .map_err(|_| PassError::InvalidConfig("map scratch pool poisoned".into()))?;
+        if let Some(t) = current.as_ref().filter(|t| t.buffer.size() >= pixels * 4) {
+            return Ok(t.clone());
+        }
+        let texels = SharedTexels {
+            buffer: std::sync::Arc::new(storage_buffer(
+                device,
+                "primitive map pixel texels",
+                pixels * 4,
+                BufferUsage::COPY_DST | BufferUsage::COPY_SRC,
+            )?),
+            writer: std::sync::Arc::new(std::sync::atomic::AtomicU64::new(0)),
+        };
+        *current = Some(texels.clone());
+        Ok(texels)
+    }
+
+    /// GPU bytes of the pool's current scratch, receiver map and pixel texels (0 before any map asked for
+    /// them).
     pub fn bytes(&self) -> u64 {
         let scratch = self
             .current
@@ -476,7 +514,13 @@ impl MapScratchPool {
             .ok()
             .and_then(|r| r.as_ref().map(|r| r.size()))
             .unwrap_or(0);
-        scratch + receivers
+        let texels = self
+            .pixel_texels
+            .lock()
+            .ok()
+            .and_then(|t| t.as_ref().map(|t| t.buffer.size()))
+            .unwrap_or(0);
+        scratch + receivers + texels
     }
 }
 
@@ -567,8 +611,13 @@ impl ScratchBindings {
             &s.tile_offsets,
             bins + 1,
         )?;
-        let offset_scan =
-            PrefixScan::new(device, &pipes.scan, &s.counts, t.offsets, (texels + 1) as u32)?;
+        let offset_scan = PrefixScan::new(
+            device,
+            &pipes.scan,
+            &s.counts,
+            t.offsets,
+            (texels + 1) as u32,
+        )?;
         Ok(Self {
             scratch,
             setup_group,
@@ -601,8 +650,13 @@ pub struct PrimitiveMap {
     /// largest depth key of the texel's origins. Shared by the maps over the same geometry (the pool's),
     /// unless the map draws an occupancy view, which reads it after the build.
     receivers: std::sync::Arc<Buffer>,
-    /// One `u32` per screen pixel: the texel of its ray origin (or a no-ray / outside marker).
-    pub pixel_texels: Buffer,
+    /// One `u32` per screen pixel: the texel of its ray origin (or a no-ray / outside marker). Shared by
+    /// the maps over the same geometry (the pool's): see [`PrimitiveMap::record_pixel_texels`].
+    pixel_texels: SharedTexels,
+    /// This map's mark in the pixel texels' record of their last writer.
+    id: u64,
+    /// The push constants of the last build recorded (its pixel texels are rewritten from them).
+    last_push: Option<MapPush>,
     /// One `u32` per texel, plus one: texel t's list is `entries[offsets[t] .. offsets[t + 1]]`.
     pub offsets: Buffer,
     /// The lists' triangle indices (capacity `u32`, plus the guard words in guard mode).
@@ -638,11 +692,9 @@ impl PrimitiveMap {
         } else {
             inputs.scratch.receivers(device, texels)?
         };
-        let pixel_texels = storage(
-            "primitive map pixel texels",
-            u64::from(width) * u64::from(height) * 4,
-            copy,
-        )?;
+        let pixel_texels = inputs
+            .scratch
+            .pixel_texels(device, u64::from(width) * u64::from(height))?;
         let offsets = storage("primitive map list offsets", (texels + 1) * 4, copy)?;
         let capacity = config.starting_entries(caps, inputs.triangles);
         let entries = Self::create_entries(device, &config, capacity)?;
@@ -668,7 +720,7 @@ impl PrimitiveMap {
                 Resource::Image(inputs.normal),
                 Resource::Buffer(&state),
                 Resource::Buffer(&receivers),
-                Resource::Buffer(&pixel_texels),
+                Resource::Buffer(&pixel_texels.buffer),
             ],
         )?;
         let occupancy_group = device.create_bind_group(
@@ -707,6 +759,8 @@ impl PrimitiveMap {
             state,
             receivers,
             pixel_texels,
+            id: NEXT_MAP_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+            last_push: None,
             offsets,
             entries,
             occupancy,
@@ -821,21 +875,16 @@ impl PrimitiveMap {
         self.capacity
     }
 
-    /// Bytes the map holds on the GPU (its share of the build scratch aside: see
-    /// [`PrimitiveMap::scratch`]).
+    /// Bytes the map holds on the GPU (the scratch it shares with the other maps over its geometry aside:
+    /// see [`MapScratchPool::bytes`]).
     pub fn bytes(&self) -> u64 {
-        [&self.state, &self.pixel_texels, &self.offsets, &self.entries]
+        [&self.state, &self.offsets, &self.entries]
             .iter()
             .map(|b| b.size())
             .sum::<u64>()
             + self
                 .occupancy_view()
                 .map_or(0, |v| v.byte_size() + self.receivers.size())
-    }
-
-    /// The build scratch the map shares with the other maps over its geometry.
-    pub fn scratch(&self) -> &MapScratch {
-        &self.bound.scratch
     }
 
     /// The occupancy view, when the map draws one.
@@ -982,6 +1031,10 @@ impl PrimitiveMap {
         enc.barriers(&[Barrier::Uav]);
         enc.end_pass();
 
+        self.last_push = Some(push);
+        self.pixel_texels
+            .writer
+            .store(self.id, std::sync::atomic::Ordering::Relaxed);
         enc.begin_pass("primitive map: receivers");
         enc.dispatch(
             &self.pipes.receivers,
@@ -1014,6 +1067,38 @@ impl PrimitiveMap {
 
         enc.begin_pass(&format!("primitive map: fill ({label})"));
         self.record_bin(enc, &with_mode(1))?;
+        enc.end_pass();
+        Ok(())
+    }
+
+    /// The buffer of the pixel texels the ray trace reads (one `u32` per screen pixel).
+    pub fn pixel_texels(&self) -> &Buffer {
+        &self.pixel_texels.buffer
+    }
+
+    /// Before a ray trace through this map: when another map over the same geometry recorded a write of
+    /// the shared pixel texels since this map's build (an engine that records every light's map before
+    /// every light's ray trace), rewrites this map's pixel texels exactly as its build wrote them (the
+    /// receivers pass in its texels-only mode). Nothing otherwise, the usual case of lights recorded one
+    /// after another.
+    pub fn record_pixel_texels(&mut self, enc: &mut Encoder<'_>) -> Result<(), PassError> {
+        let Some(push) = self.last_push else {
+            return Ok(());
+        };
+        let writer = &self.pixel_texels.writer;
+        if writer.load(std::sync::atomic::Ordering::Relaxed) == self.id {
+            return Ok(());
+        }
+        writer.store(self.id, std::sync::atomic::Ordering::Relaxed);
+        enc.begin_pass("primitive map: pixel texels");
+        enc.barriers(&[Barrier::Uav]);
+        enc.dispatch(
+            &self.pipes.receivers,
+            &self.receivers_group,
+            bytemuck::bytes_of(&MapPush { mode: 2, ..push }),
+            [self.screen.0.div_ceil(16), self.screen.1.div_ceil(16), 1],
+        )?;
+        enc.barriers(&[Barrier::Uav]);
         enc.end_pass();
         Ok(())
     }

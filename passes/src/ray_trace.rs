@@ -115,7 +115,7 @@ impl RayTracePass {
                 Resource::Image(inputs.depth),
                 Resource::Image(inputs.normal),
                 b(&inputs.map.state),
-                b(&inputs.map.pixel_texels),
+                b(inputs.map.pixel_texels()),
                 b(&inputs.map.offsets),
                 b(&inputs.map.entries),
                 b(inputs.prims),

@@ -790,8 +790,9 @@ pub struct HrtsFrameReport {
     /// Bytes of the prim buffer (triangles in frame coordinates; 0 if the plan has none), shared by the
     /// context's lights.
     pub prim_buffer_bytes: u64,
-    /// Bytes of the primitive map's build scratch (per-triangle bin items, per-texel counts), shared by the
-    /// maps of the context's lights and frusta (0 if the light has no primitive map).
+    /// Bytes of the primitive map's scratch (per-triangle bin items, per-texel counts and receivers, and the
+    /// screen-size texel of each pixel's ray origin), shared by the maps of the context's lights and frusta
+    /// (0 if the light has no primitive map).
     pub map_scratch_bytes: u64,
     /// Entries the lists could hold this frame (they grow to fit from the next frame on).
     pub entry_capacity: u32,

@@ -1252,9 +1252,11 @@ static void engine_depth(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
 /* ---------- the output written directly ---------- */
 /* With an R32_SFLOAT output that also has STORAGE usage, each light's last pass writes its layer (no copy):
  * the visibility equals the copied one bit for bit for a sun (hard, and hybrid: the blend's output), a point
- * light (the minimum over its faces), and a point light and a spot light whose ranges reach nothing (their
- * layers filled with 1), recorded in one call and split as an engine splits a frame; the report says which
- * lights wrote directly. */
+ * light (one cube map, or the minimum over its faces), and a point light and a spot light whose ranges reach
+ * nothing (their layers filled with 1), recorded in one call, split as an engine splits a frame, and pass by
+ * pass; the report says which lights wrote directly. Pass by pass, every light's map is built before any
+ * ray trace: the lights share their pixel texels, so a ray trace whose texels a later build overwrote
+ * rewrites them first ('primitive map: pixel texels'); every way equals the one-call frame bit for bit. */
 static void output_direct(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
     enum { PX = W * H, N = 4 };
     setup_camera(0.0);
@@ -1269,10 +1271,11 @@ static void output_direct(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) 
     Img direct = make_image(VK_FORMAT_R32_SFLOAT,
                             VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
                             LAYERS);
-    static float want[N * PX], got[N * PX];
+    static float want[N * PX], got[N * PX], one_call[N * PX];
     for (int m = 0; m < 2; m++)
-        for (int split = 0; split < 2; split++) {
+        for (int split = 0; split < 3; split++) {
             uint32_t directs[2] = {0, 0};
+            uint32_t rewritten = 0;
             for (int d = 0; d < 2; d++) {
                 out_img = d ? direct : copied;
                 HrtsContext *ctx = create_context(vk, 1);
@@ -1281,12 +1284,15 @@ static void output_direct(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) 
                 HrtsResult r = configure_all(ctx, N, modes[m]);
                 if (r == HRTS_RESULT_OK) r = hrts_set_geometry_cpu(ctx, g);
                 if (r == HRTS_RESULT_OK) r = hrts_set_targets(ctx, &t);
-                if (r == HRTS_RESULT_OK) r = split ? run_frame_in_parts(ctx, d ? got : want, 0) : run_frame(ctx, d ? got : want);
+                if (r == HRTS_RESULT_OK)
+                    r = split ? run_frame_in_parts(ctx, d ? got : want, split == 2) : run_frame(ctx, d ? got : want);
                 CHECK(r == HRTS_RESULT_OK, "direct output %d: %s", d, hrts_last_error(ctx));
                 for (uint32_t l = 0; l < N && r == HRTS_RESULT_OK; l++) {
                     HrtsFrameReport rep;
                     CHECK(report(ctx, next_frame - 1, l, &rep) == HRTS_RESULT_OK, "report: %s", hrts_last_error(ctx));
                     directs[d] += rep.output_direct != 0;
+                    for (uint32_t p = 0; p < rep.pass_count; p++)
+                        rewritten += d && strcmp(rep.passes[p].name, "primitive map: pixel texels") == 0;
                 }
                 if (d && modes[m] == HRTS_SHADOW_MODE_HARD && r == HRTS_RESULT_OK) {
                     /* the sun's final output is the engine's layer: it is read there, not back from the plugin */
@@ -1298,13 +1304,20 @@ static void output_direct(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) 
                 CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
             }
             out_img = copied;
-            int differ = 0;
+            int differ = 0, differ_one_call = 0;
             for (int i = 0; i < N * PX; i++) differ += memcmp(&want[i], &got[i], sizeof(float)) != 0;
+            if (!split) memcpy(one_call, got, sizeof one_call);
+            for (int i = 0; i < N * PX; i++) differ_one_call += memcmp(&one_call[i], &got[i], sizeof(float)) != 0;
+            const char *how = split == 2 ? "pass by pass" : split ? "split frame" : "one call";
+            printf("  %s: pixel texels rewritten before %u ray traces, %d px differ from the one-call frame\n", how,
+                   rewritten, differ_one_call);
+            CHECK(differ_one_call == 0 && (split == 2 ? rewritten >= 1 : rewritten == 0),
+                  "shared pixel texels: %u rewritten, %d px differ from one call", rewritten, differ_one_call);
             int lit = 0;
             for (int i = 2 * PX; i < 4 * PX; i++) lit += got[i] == 1.0f;
             printf("output written directly (%s, %s): %u of %d lights direct (%u with a copy), %d px differ from the copied "
                    "output, the unreached lights' layers %d of %d px lit\n",
-                   modes[m] == HRTS_SHADOW_MODE_HARD ? "hard" : "hybrid", split ? "split frame" : "one call", directs[1],
+                   modes[m] == HRTS_SHADOW_MODE_HARD ? "hard" : "hybrid", how, directs[1],
                    N, directs[0], differ, lit, 2 * PX);
             CHECK(directs[1] == N && directs[0] == 0 && differ == 0 && lit == 2 * PX,
                   "direct output: %u direct, %d px differ, %d lit", directs[1], differ, lit);

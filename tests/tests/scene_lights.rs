@@ -355,7 +355,9 @@ fn native_point_frames(
         host_demo::gbuffer::GBufferLayout::ANALYSIS,
     )
     .expect("plugin");
-    plugin.configure_lights(device, &[config]).expect("configure");
+    plugin
+        .configure_lights(device, &[config])
+        .expect("configure");
     let matrices = CameraMatrices::of_camera(&camera, WIDTH, HEIGHT);
     let rs = RefScene::new(&file.scene);
     let params = scene_visibility_params(
@@ -401,7 +403,10 @@ fn a_native_point_light_matches_the_exact_reference() {
     let (stats, c) = &frames[1];
     assert_eq!(stats.texels_past_capacity, 0);
     assert!(stats.receiver_pixels > 0);
-    assert!(stats.pairs > 0 && stats.pairs <= stats.pair_capacity, "{stats:?}");
+    assert!(
+        stats.pairs > 0 && stats.pairs <= stats.pair_capacity,
+        "{stats:?}"
+    );
     assert!(c.shadowed >= 200, "{} shadowed pixels", c.shadowed);
     assert_no_validation_errors(&device);
 }

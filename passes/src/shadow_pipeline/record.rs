@@ -247,6 +247,9 @@ impl ShadowPipeline {
                 }
             }
             PassId::RayTrace => {
+                if let Some(map) = self.map.as_mut() {
+                    map.record_pixel_texels(enc)?;
+                }
                 self.outputs_to_uav(enc, pass);
                 if let Some(ray) = self.ray.as_mut() {
                     ray.record(enc, &c.ray)?;

@@ -38,8 +38,9 @@ pub struct FrameReport {
     pub resources: Vec<ResourceReport>,
     /// The resource [`ShadowPipeline::output`] holds.
     pub output: ResourceId,
-    /// GPU bytes of the primitive map's build scratch, shared by the maps of every light over the same
-    /// geometry (not in `resources`; 0 without a primitive map).
+    /// GPU bytes of the primitive map's scratch (build scratch, receiver map, screen-size pixel texels),
+    /// shared by the maps of every light over the same geometry (not in `resources`; 0 without a primitive
+    /// map).
     pub map_scratch_bytes: u64,
     /// Triangles whose prim-buffer slots the frame rewrote, whichever light's pipeline recorded the build
     /// (0 when the prim buffer was up to date).
@@ -79,10 +80,12 @@ impl ShadowPipeline {
             .collect()
     }
 
-    /// GPU bytes of the primitive-map build scratch this pipeline shares with the other lights' (0 without
-    /// a primitive map).
+    /// GPU bytes of the primitive-map scratch this pipeline shares with the other lights' (the build
+    /// scratch, the receiver map and the screen-size pixel texels; 0 without a primitive map).
     pub fn map_scratch_bytes(&self) -> u64 {
-        self.map.as_ref().map_or(0, |m| m.scratch().bytes())
+        self.map
+            .as_ref()
+            .map_or(0, |_| self.shared.map_scratch().bytes())
     }
 
     /// The binning path of the primitive map (what the device would use when the plan has none).
@@ -159,9 +162,7 @@ impl ShadowPipeline {
                 newest = Some((frame, s));
             }
         }
-        newest
-            .map(|(_, s)| Ok(read_states(s)?[0]))
-            .transpose()
+        newest.map(|(_, s)| Ok(read_states(s)?[0])).transpose()
     }
 
     fn report_with(
