@@ -403,6 +403,48 @@ mod tests {
         }
     }
 
+    #[test]
+    fn a_point_light_frame_holds_its_six_faces_in_frame_coordinates() {
+        let origin = DVec3::new(1e4, 0.0, -2e3);
+        let position = Vec3::new(10_003.0, 2.0, -1_998.5);
+        let f = LightFrame::new(
+            &Light::Point {
+                position,
+                range: Some(8.0),
+            },
+            origin,
+        )
+        .unwrap();
+        assert_eq!(f.frusta().len(), 6);
+        let p = (position.as_dvec3() - origin).as_vec3();
+        assert_eq!(f.position, Some(p));
+        // Each face sees the point one unit along its axis at its centre, in front of the light.
+        let axes = [
+            Vec3::X,
+            Vec3::NEG_X,
+            Vec3::Y,
+            Vec3::NEG_Y,
+            Vec3::Z,
+            Vec3::NEG_Z,
+        ];
+        for (m, axis) in f.frusta().iter().zip(axes) {
+            let c = *m * (p + axis).extend(1.0);
+            assert!(c.w > 0.0 && (c.x / c.w).abs() < 1e-3 && (c.y / c.w).abs() < 1e-3);
+        }
+        // Every direction lies strictly inside the face of its largest component.
+        let d = Vec3::new(0.7, -0.7, 0.69).normalize();
+        let c = f.frusta()[0] * (p + d).extend(1.0);
+        assert!((c.x / c.w).abs() < 1.0 && (c.y / c.w).abs() < 1.0);
+        assert!(LightFrame::new(
+            &Light::Point {
+                position,
+                range: Some(-1.0),
+            },
+            origin
+        )
+        .is_err());
+    }
+
     fn lin(f: &LightFrame, world: Vec3, origin: DVec3) -> f32 {
         let c = f
             .view_proj

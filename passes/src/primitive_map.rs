@@ -1290,6 +1290,40 @@ mod tests {
     }
 
     #[test]
+    fn a_cube_map_shares_n_squared_texels_and_bins_in_compute() {
+        let c = caps(ConservativeRasterTier::Tier3, true);
+        let cube = PrimitiveMapConfig {
+            cube: true,
+            ..PrimitiveMapConfig::default()
+        };
+        assert!(cube.validate(&c).is_ok());
+        assert_eq!(cube.frusta(), 6);
+        assert_eq!(cube.texels(), 1024 * 1024 + 6 * 17 * 17);
+        assert_eq!(PrimitiveMapConfig::default().texels(), 1024 * 1024);
+        // Two (triangle, face) pairs per triangle, at least 1024, unless given.
+        assert_eq!(cube.starting_pairs(10_000), 20_000);
+        assert_eq!(cube.starting_pairs(10), 1024);
+        let given = PrimitiveMapConfig {
+            initial_pairs: 8,
+            ..cube
+        };
+        assert_eq!(given.starting_pairs(10_000), 8);
+        assert_eq!(PrimitiveMapConfig::default().starting_pairs(10_000), 10_000);
+        for binning in [
+            BinningRequest::Hardware,
+            BinningRequest::Software,
+            BinningRequest::EmulateTier1,
+        ] {
+            assert!(PrimitiveMapConfig { binning, ..cube }.validate(&c).is_err());
+        }
+        let front = PrimitiveMapConfig {
+            faces: FaceMode::FrontOnly,
+            ..cube
+        };
+        assert!(front.validate(&c).is_err());
+    }
+
+    #[test]
     fn config_limits() {
         let c = caps(ConservativeRasterTier::NotSupported, true);
         let ok = PrimitiveMapConfig::default();

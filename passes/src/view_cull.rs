@@ -188,6 +188,22 @@ mod tests {
     }
 
     #[test]
+    fn a_point_light_as_one_cube_is_culled_by_its_range_alone() {
+        let view = ViewVolume::new(
+            camera(Vec3::new(0.0, 2.0, 9.0), Vec3::new(0.0, 2.0, 0.0)),
+            Some(ROOM),
+        );
+        let cube = |range| Light::Point {
+            position: Vec3::new(0.0, 2.0, 9.95),
+            range,
+        };
+        // Behind the camera: kept while some face meets the view, culled once its range ends before it.
+        assert!(view.meets(&cube(None), None));
+        assert!(view.meets(&cube(Some(3.0)), Some(3.0)));
+        assert!(!view.meets(&cube(Some(0.5)), Some(0.5)));
+    }
+
+    #[test]
     fn without_a_box_every_frustum_is_kept() {
         let view = ViewVolume::new(camera(Vec3::ZERO, Vec3::NEG_Z), None);
         let faces = point_light_faces(Vec3::new(0.0, 0.0, 100.0), None);
