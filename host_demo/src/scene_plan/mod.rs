@@ -246,6 +246,10 @@ impl ScenePlan {
                 .position(|l| l.scene_light == i)
                 .unwrap_or_default();
             let _ = match shadowed.frusta {
+                faces if faces == passes::CUBE_MAP_NAME => writeln!(
+                    s,
+                    "      plugin light {index}: one cube map (its six faces built as one primitive map by the plugin; faces without a receiver in view get no grid)"
+                ),
                 [_] => writeln!(s, "      plugin light {index}: one frustum"),
                 faces => writeln!(
                     s,
