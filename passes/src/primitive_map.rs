@@ -401,6 +401,32 @@ pub struct SharedTexels {
 /// Source of [`PrimitiveMap`] ids (0 marks pixel texels no map wrote yet).
 static NEXT_MAP_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
 
+/// The value in `slot` if `fits` accepts it, else `make`'s from the value there (if any), which then
+/// takes the slot.
+fn shared_in<T: Clone>(
+    slot: &std::sync::Mutex<Option<T>>,
+    fits: impl Fn(&T) -> bool,
+    make: impl FnOnce(Option<&T>) -> Result<T, PassError>,
+) -> Result<T, PassError> {
+    let mut current = slot
+        .lock()
+        .map_err(|_| PassError::InvalidConfig("map scratch pool poisoned".into()))?;
+    if let Some(value) = current.as_ref().filter(|v| fits(v)) {
+        return Ok(value.clone());
+    }
+    let value = make(current.as_ref())?;
+    *current = Some(value.clone());
+    Ok(value)
+}
+
+/// `bytes` of the value in `slot` (0 when empty).
+fn bytes_in<T>(slot: &std::sync::Mutex<Option<T>>, bytes: impl Fn(&T) -> u64) -> u64 {
+    slot.lock()
+        .ok()
+        .and_then(|v| v.as_ref().map(&bytes))
+        .unwrap_or(0)
+}
+
 impl MapScratchPool {
     /// Scratch with counts for `texels` texels, `bins` bin triangles and `owners` (triangle, face) owners:
     /// the pool's, or a new one as large as the largest asked for so far.
@@ -411,47 +437,40 @@ impl MapScratchPool {
         bins: u32,
         owners: u32,
     ) -> Result<std::sync::Arc<MapScratch>, PassError> {
-        let mut current = self
-            .current
-            .lock()
-            .map_err(|_| PassError::InvalidConfig("map scratch pool poisoned".into()))?;
-        if let Some(s) = current
-            .as_ref()
-            .filter(|s| s.texels >= texels && s.bins >= bins && s.owners >= owners)
-        {
-            return Ok(s.clone());
-        }
-        let (texels, bins, owners) = current.as_ref().map_or((texels, bins, owners), |s| {
-            (s.texels.max(texels), s.bins.max(bins), s.owners.max(owners))
-        });
-        let storage = |name, bytes, usage| storage_buffer(device, name, bytes, usage);
-        let scratch = std::sync::Arc::new(MapScratch {
-            bin_tris: storage(
-                "primitive map bin triangles",
-                u64::from(bins) * BIN_TRI_BYTES,
-                BufferUsage::default(),
-            )?,
-            tile_offsets: storage(
-                "primitive map tile offsets",
-                (u64::from(bins) + 1) * 4,
-                BufferUsage::default(),
-            )?,
-            pair_owners: storage(
-                "primitive map pair owners",
-                u64::from(owners) * 4,
-                BufferUsage::default(),
-            )?,
-            counts: storage(
-                "primitive map counts",
-                (texels + 1) * 4,
-                BufferUsage::COPY_DST | BufferUsage::COPY_SRC,
-            )?,
-            texels,
-            bins,
-            owners,
-        });
-        *current = Some(scratch.clone());
-        Ok(scratch)
+        let fits = |s: &std::sync::Arc<MapScratch>| {
+            s.texels >= texels && s.bins >= bins && s.owners >= owners
+        };
+        shared_in(&self.current, fits, |old| {
+            let (texels, bins, owners) = old.map_or((texels, bins, owners), |s| {
+                (s.texels.max(texels), s.bins.max(bins), s.owners.max(owners))
+            });
+            let storage = |name, bytes, usage| storage_buffer(device, name, bytes, usage);
+            Ok(std::sync::Arc::new(MapScratch {
+                bin_tris: storage(
+                    "primitive map bin triangles",
+                    u64::from(bins) * BIN_TRI_BYTES,
+                    BufferUsage::default(),
+                )?,
+                tile_offsets: storage(
+                    "primitive map tile offsets",
+                    (u64::from(bins) + 1) * 4,
+                    BufferUsage::default(),
+                )?,
+                pair_owners: storage(
+                    "primitive map pair owners",
+                    u64::from(owners) * 4,
+                    BufferUsage::default(),
+                )?,
+                counts: storage(
+                    "primitive map counts",
+                    (texels + 1) * 4,
+                    BufferUsage::COPY_DST | BufferUsage::COPY_SRC,
+                )?,
+                texels,
+                bins,
+                owners,
+            }))
+        })
     }
 
     /// A receiver map of at least `texels` texels: the pool's, or a new one as large.
@@ -460,67 +479,45 @@ impl MapScratchPool {
         device: &Device,
         texels: u64,
     ) -> Result<std::sync::Arc<Buffer>, PassError> {
-        let mut current = self
-            .receivers
-            .lock()
-            .map_err(|_| PassError::InvalidConfig("map scratch pool poisoned".into()))?;
-        if let Some(r) = current.as_ref().filter(|r| r.size() >= texels * 4) {
-            return Ok(r.clone());
-        }
-        let receivers = std::sync::Arc::new(storage_buffer(
-            device,
-            "primitive map receivers",
-            texels * 4,
-            BufferUsage::COPY_DST | BufferUsage::COPY_SRC,
-        )?);
-        *current = Some(receivers.clone());
-        Ok(receivers)
+        shared_in(
+            &self.receivers,
+            |r| r.size() >= texels * 4,
+            |_| {
+                Ok(std::sync::Arc::new(storage_buffer(
+                    device,
+                    "primitive map receivers",
+                    texels * 4,
+                    BufferUsage::COPY_DST | BufferUsage::COPY_SRC,
+                )?))
+            },
+        )
     }
 
     /// Pixel texels for `pixels` pixels: the pool's, or new ones as large.
     fn pixel_texels(&self, device: &Device, pixels: u64) -> Result<SharedTexels, PassError> {
-        let mut current = self
-            .pixel_texels
-            .lock()
-            .map_err(|_| PassError::InvalidConfig("map scratch pool poisoned".into()))?;
-        if let Some(t) = current.as_ref().filter(|t| t.buffer.size() >= pixels * 4) {
-            return Ok(t.clone());
-        }
-        let texels = SharedTexels {
-            buffer: std::sync::Arc::new(storage_buffer(
-                device,
-                "primitive map pixel texels",
-                pixels * 4,
-                BufferUsage::COPY_DST | BufferUsage::COPY_SRC,
-            )?),
-            writer: std::sync::Arc::new(std::sync::atomic::AtomicU64::new(0)),
-        };
-        *current = Some(texels.clone());
-        Ok(texels)
+        shared_in(
+            &self.pixel_texels,
+            |t| t.buffer.size() >= pixels * 4,
+            |_| {
+                Ok(SharedTexels {
+                    buffer: std::sync::Arc::new(storage_buffer(
+                        device,
+                        "primitive map pixel texels",
+                        pixels * 4,
+                        BufferUsage::COPY_DST | BufferUsage::COPY_SRC,
+                    )?),
+                    writer: std::sync::Arc::new(std::sync::atomic::AtomicU64::new(0)),
+                })
+            },
+        )
     }
 
     /// GPU bytes of the pool's current scratch, receiver map and pixel texels (0 before any map asked for
     /// them).
     pub fn bytes(&self) -> u64 {
-        let scratch = self
-            .current
-            .lock()
-            .ok()
-            .and_then(|c| c.as_ref().map(|s| s.bytes()))
-            .unwrap_or(0);
-        let receivers = self
-            .receivers
-            .lock()
-            .ok()
-            .and_then(|r| r.as_ref().map(|r| r.size()))
-            .unwrap_or(0);
-        let texels = self
-            .pixel_texels
-            .lock()
-            .ok()
-            .and_then(|t| t.as_ref().map(|t| t.buffer.size()))
-            .unwrap_or(0);
-        scratch + receivers + texels
+        bytes_in(&self.current, |s| s.bytes())
+            + bytes_in(&self.receivers, |r| r.size())
+            + bytes_in(&self.pixel_texels, |t| t.buffer.size())
     }
 }
 
