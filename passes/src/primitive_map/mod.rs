@@ -1,0 +1,617 @@
+//! The deep primitive map, with no fixed depth: exact variable-length per-texel lists of the triangles
+//! that may shadow each texel's ray origins, in a light-space grid fitted to what the camera sees.
+//!
+//! Per frame, all on the GPU (no host round trip):
+//! 1. receivers: every pixel's shadow-ray origin is placed in light space; the map is fitted to their
+//!    bounds, and each texel records whether it holds ray origins and how deep the deepest one lies;
+//! 2. setup: each triangle is culled (zero area with two equal vertices, back-facing in front-only mode,
+//!    outside every receiver texel, or farther from the light than every ray origin) or projected, with a
+//!    rigorous bound on its projection error, and split into 4×4-texel tiles of its bounding box;
+//! 3. count, scan, fill: the (triangle, texel) pairs that pass the exact conservative overlap test are
+//!    counted per texel, the counts are prefix-summed into list offsets, and the lists are filled. Memory
+//!    is proportional to the entries; nothing is ever dropped. Texels whose list would pass the entry
+//!    capacity are traced exhaustively (exact, slower), reported, and the capacity grows for the next frame
+//!    within the memory budget.
+//!
+//! The count and fill run in a compute shader (load-balanced over tiles) or, for the tier-fallback paths,
+//! through the rasterizer: hardware conservative raster at the device's tier, the geometry-shader software
+//! path, or tier-1 emulation. Every path applies the same exact test and builds the same lists.
+//!
+//! Reads: prim buffer, depth, normal. Writes: receiver map, per-pixel texels, list offsets, list entries,
+//! map state (fit, statistics); occupancy image (occupancy pass).
+
+use crate::gpu_types::{constant_buffer, MapConstants, MapPush, MapState, RayTraceConstants};
+use crate::scan::ScanPipeline;
+use crate::{shader, PassError};
+use rhi::{
+    Barrier, BindGroup, BindingKind, Buffer, BufferUsage, ComputePipeline, Device, Encoder, Format,
+    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, ImageUsage, MemoryLocation, Resource,
+    ResourceState as S,
+};
+
+mod config;
+mod scratch;
+
+pub use config::{
+    choose_binning_path, BinningPath, BinningRequest, FaceMode, PrimitiveMapConfig,
+    DEFAULT_ENTRY_BUDGET, GUARD_VALUE, GUARD_WORDS, MIN_ENTRY_BUDGET,
+};
+use scratch::{storage_buffer, BindTargets, SharedTexels};
+pub use scratch::{MapScratch, MapScratchPool, ScratchBindings};
+
+/// Threads of the compute binning dispatch (a grid-stride loop over the bin items).
+const BIN_THREADS: u32 = 64 * 4096;
+
+/// Source of [`PrimitiveMap`] ids (0 marks pixel texels no map wrote yet).
+static NEXT_MAP_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+
+/// What the map's passes read from outside it.
+pub struct PrimitiveMapInputs<'a> {
+    /// The prim buffer.
+    pub prims: &'a Buffer,
+    /// Triangles in the prim buffer.
+    pub triangles: u32,
+    /// Depth (`ShaderResource` state when the map is built).
+    pub depth: &'a Image,
+    /// Camera-facing geometric normal, w = 0 on background (`ShaderResource` state).
+    pub normal: &'a Image,
+    /// Whether the occupancy pass draws the N×N occupancy view, besides the statistics it always
+    /// gathers.
+    pub occupancy_view: bool,
+    /// Where the map takes its build scratch from (one pool per geometry).
+    pub scratch: &'a MapScratchPool,
+}
+
+/// The binning pipelines of the path in use.
+pub(super) enum Binner {
+    Compute(ComputePipeline),
+    Raster(GraphicsPipeline),
+}
+
+/// The map's pipelines.
+pub(super) struct MapPipelines {
+    pub(super) fit: ComputePipeline,
+    pub(super) receivers: ComputePipeline,
+    pub(super) setup: ComputePipeline,
+    pub(super) scan: ScanPipeline,
+    pub(super) binner: Binner,
+    pub(super) occupancy: ComputePipeline,
+}
+
+/// The primitive map's resources and passes.
+pub struct PrimitiveMap {
+    config: PrimitiveMapConfig,
+    path: BinningPath,
+    triangles: u32,
+    screen: (u32, u32),
+    capacity: u32,
+    /// Bin triangles the scratch bindings hold: the triangles, or a cube's (triangle, face) pairs.
+    bins: u32,
+    pipes: MapPipelines,
+    fit_group: BindGroup,
+    receivers_group: BindGroup,
+    occupancy_group: BindGroup,
+    bound: ScratchBindings,
+    constants: Buffer,
+    /// The map's per-frame state: one [`MapState`] per frustum (fitted transform and grid; the totals and
+    /// statistics in the first).
+    pub state: Buffer,
+    /// One `u32` per texel, used while the map is built: 0 where no ray origin lies, else the ordered
+    /// largest depth key of the texel's origins. Shared by the maps over the same geometry (the pool's),
+    /// unless the map draws an occupancy view, which reads it after the build.
+    receivers: std::sync::Arc<Buffer>,
+    /// One `u32` per screen pixel: the texel of its ray origin (or a no-ray / outside marker). Shared by
+    /// the maps over the same geometry (the pool's): see [`PrimitiveMap::record_pixel_texels`].
+    pixel_texels: SharedTexels,
+    /// This map's mark in the pixel texels' record of their last writer.
+    id: u64,
+    /// The push constants of the last build recorded (its pixel texels are rewritten from them).
+    last_push: Option<MapPush>,
+    /// One `u32` per texel, plus one: texel t's list is `entries[offsets[t] .. offsets[t + 1]]`.
+    pub offsets: Buffer,
+    /// The lists' triangle indices (capacity `u32`, plus the guard words in guard mode).
+    pub entries: Buffer,
+    /// `RGBA8` occupancy view: N×N, or 1×1 and never written without `occupancy_view`.
+    occupancy: Image,
+    occupancy_view: bool,
+}
+
+impl PrimitiveMap {
+    /// Creates the map for `inputs`, with the binning path chosen from the device's capabilities.
+    pub fn new(
+        device: &Device,
+        inputs: &PrimitiveMapInputs<'_>,
+        config: PrimitiveMapConfig,
+    ) -> Result<Self, PassError> {
+        let caps = device.capabilities();
+        config.validate(caps)?;
+        let path = choose_binning_path(caps, config.binning)?;
+        let n = config.size;
+        let texels = config.texels();
+        let (width, height) = (inputs.depth.width(), inputs.depth.height());
+        let storage = |name, bytes, usage| storage_buffer(device, name, bytes, usage);
+        let copy = BufferUsage::COPY_DST | BufferUsage::COPY_SRC;
+        let constants = constant_buffer::<MapConstants>(device, "primitive map constants")?;
+        let state = storage(
+            "primitive map state",
+            u64::from(config.frusta()) * std::mem::size_of::<MapState>() as u64,
+            copy,
+        )?;
+        let receivers = if inputs.occupancy_view {
+            std::sync::Arc::new(storage("primitive map receivers", texels * 4, copy)?)
+        } else {
+            inputs.scratch.receivers(device, texels)?
+        };
+        let pixel_texels = inputs
+            .scratch
+            .pixel_texels(device, u64::from(width) * u64::from(height))?;
+        let offsets = storage("primitive map list offsets", (texels + 1) * 4, copy)?;
+        let capacity = config.starting_entries(caps, inputs.triangles);
+        let entries = Self::create_entries(device, &config, capacity)?;
+        let view_size = if inputs.occupancy_view { n } else { 1 };
+        let occupancy = device.create_image(&ImageDesc {
+            name: "primitive map occupancy",
+            format: Format::Rgba8Unorm,
+            width: view_size,
+            height: view_size,
+            layers: 1,
+            usage: ImageUsage::STORAGE | ImageUsage::COPY_SRC,
+        })?;
+        let pipes = Self::pipelines(device, path)?;
+        let fit_group = device.create_bind_group(
+            pipes.fit.layout(),
+            &[Resource::Buffer(&state), Resource::Buffer(&constants)],
+        )?;
+        let receivers_group = device.create_bind_group(
+            pipes.receivers.layout(),
+            &[
+                Resource::Buffer(&constants),
+                Resource::Image(inputs.depth),
+                Resource::Image(inputs.normal),
+                Resource::Buffer(&state),
+                Resource::Buffer(&receivers),
+                Resource::Buffer(&pixel_texels.buffer),
+            ],
+        )?;
+        let occupancy_group = device.create_bind_group(
+            pipes.occupancy.layout(),
+            &[
+                Resource::Buffer(&offsets),
+                Resource::Buffer(&receivers),
+                Resource::Image(&occupancy),
+                Resource::Buffer(&state),
+            ],
+        )?;
+        let bins = config.starting_pairs(inputs.triangles);
+        let owners = if config.cube { bins } else { 0 };
+        let scratch = inputs.scratch.get(device, texels, bins, owners)?;
+        let targets = BindTargets {
+            prims: inputs.prims,
+            state: &state,
+            receivers: &receivers,
+            offsets: &offsets,
+            entries: &entries,
+        };
+        let bound = ScratchBindings::new(device, &pipes, scratch, &targets, (texels, bins))?;
+        Ok(Self {
+            config,
+            path,
+            triangles: inputs.triangles,
+            screen: (width, height),
+            capacity,
+            bins,
+            pipes,
+            fit_group,
+            receivers_group,
+            occupancy_group,
+            bound,
+            constants,
+            state,
+            receivers,
+            pixel_texels,
+            id: NEXT_MAP_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+            last_push: None,
+            offsets,
+            entries,
+            occupancy,
+            occupancy_view: inputs.occupancy_view,
+        })
+    }
+
+    fn pipelines(device: &Device, path: BinningPath) -> Result<MapPipelines, PassError> {
+        let push = std::mem::size_of::<MapPush>() as u32;
+        let buffers = |count| vec![BindingKind::StorageBuffer; count];
+        Ok(MapPipelines {
+            fit: device.create_compute_pipeline(
+                "map fit",
+                &shader("map_fit.comp")?,
+                &[BindingKind::StorageBuffer, BindingKind::UniformBuffer],
+                push,
+            )?,
+            receivers: device.create_compute_pipeline(
+                "map receivers",
+                &shader("map_receivers.comp")?,
+                &[
+                    BindingKind::UniformBuffer,
+                    BindingKind::SampledImage,
+                    BindingKind::SampledImage,
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
+                ],
+                push,
+            )?,
+            setup: device.create_compute_pipeline(
+                "map setup",
+                &shader("map_setup.comp")?,
+                &buffers(5),
+                push,
+            )?,
+            scan: ScanPipeline::new(device)?,
+            binner: match path {
+                BinningPath::Compute => Binner::Compute(device.create_compute_pipeline(
+                    "map bin",
+                    &shader("map_bin.comp")?,
+                    &buffers(8),
+                    push,
+                )?),
+                raster => Binner::Raster(Self::raster_pipeline(device, raster)?),
+            },
+            occupancy: device.create_compute_pipeline(
+                "occupancy",
+                &shader("occupancy.comp")?,
+                &[
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageImage,
+                    BindingKind::StorageBuffer,
+                ],
+                std::mem::size_of::<[u32; 3]>() as u32,
+            )?,
+        })
+    }
+
+    fn create_entries(
+        device: &Device,
+        config: &PrimitiveMapConfig,
+        capacity: u32,
+    ) -> Result<Buffer, PassError> {
+        let guard = if config.guard { GUARD_WORDS } else { 0 };
+        Ok(device.create_buffer(
+            "primitive map list entries",
+            (u64::from(capacity) + u64::from(guard)) * 4,
+            BufferUsage::STORAGE | BufferUsage::COPY_DST | BufferUsage::COPY_SRC,
+            MemoryLocation::GpuOnly,
+        )?)
+    }
+
+    fn raster_pipeline(device: &Device, path: BinningPath) -> Result<GraphicsPipeline, PassError> {
+        let caps = device.capabilities();
+        let (geometry, extra) = match path {
+            BinningPath::Software => (Some(shader("prim_map_sw.geom")?), None),
+            BinningPath::EmulatedTier1 { .. } => {
+                let extra = (0.5 - caps.primitive_overestimation_size)
+                    .clamp(0.0, caps.max_extra_primitive_overestimation_size);
+                (Some(shader("prim_map_snap.geom")?), Some(extra))
+            }
+            _ => (None, Some(0.0)),
+        };
+        Ok(device.create_graphics_pipeline(&GraphicsPipelineDesc {
+            name: "primitive map raster",
+            vertex: &shader("prim_map.vert")?,
+            geometry: geometry.as_deref(),
+            fragment: &shader("prim_map_raster.frag")?,
+            bindings: &[BindingKind::StorageBuffer; 5],
+            push_constant_size: std::mem::size_of::<MapPush>() as u32,
+            color_formats: &[],
+            depth: None,
+            conservative_extra_overestimation: extra,
+            depth_clamp: false,
+        })?)
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &PrimitiveMapConfig {
+        &self.config
+    }
+
+    /// The binning path in use.
+    pub fn path(&self) -> BinningPath {
+        self.path
+    }
+
+    /// Entries the lists can hold now.
+    pub fn capacity(&self) -> u32 {
+        self.capacity
+    }
+
+    /// Bytes the map holds on the GPU (the scratch it shares with the other maps over its geometry aside:
+    /// see [`MapScratchPool::bytes`]).
+    pub fn bytes(&self) -> u64 {
+        [&self.state, &self.offsets, &self.entries]
+            .iter()
+            .map(|b| b.size())
+            .sum::<u64>()
+            + self
+                .occupancy_view()
+                .map_or(0, |v| v.byte_size() + self.receivers.size())
+    }
+
+    /// The occupancy view, when the map draws one.
+    pub fn occupancy_view(&self) -> Option<&Image> {
+        self.occupancy_view.then_some(&self.occupancy)
+    }
+
+    /// The occupancy pass's image (1×1 and never written without the view), for its barriers.
+    pub fn occupancy_target(&self) -> &Image {
+        &self.occupancy
+    }
+
+    /// Grows the entry capacity to hold `needed` entries (with a quarter to spare, within the budget), when a
+    /// frame needed more than it had. When the entries were reallocated it returns the buffer and bind group
+    /// they replaced (frames in flight may still use them: drop them once those completed), and whatever
+    /// else reads [`PrimitiveMap::entries`] must be rebound.
+    pub fn grow(
+        &mut self,
+        device: &Device,
+        needed: u32,
+    ) -> Result<Option<(Buffer, BindGroup)>, PassError> {
+        let max = self.config.max_entries(device.capabilities());
+        if needed <= self.capacity || self.capacity >= max {
+            return Ok(None);
+        }
+        let capacity = (u64::from(needed) * 5 / 4).min(u64::from(max)) as u32;
+        let entries = Self::create_entries(device, &self.config, capacity)?;
+        let (layout, binding) = match &self.pipes.binner {
+            Binner::Compute(p) => (p.layout(), 5),
+            Binner::Raster(p) => (p.layout(), 4),
+        };
+        let group = device.rebound(layout, &self.bound.bin_group, binding, &entries)?;
+        self.capacity = capacity;
+        Ok(Some((
+            std::mem::replace(&mut self.entries, entries),
+            std::mem::replace(&mut self.bound.bin_group, group),
+        )))
+    }
+
+    /// Grows a cube map's (triangle, face) pairs to hold `needed` (with a quarter to spare, at most six per
+    /// triangle), when a frame kept more than it held, taking larger scratch from `pool` and binding the
+    /// prim buffer `prims` anew. Returns the bindings replaced (frames in flight may still use them: drop
+    /// them once those completed).
+    pub fn grow_pairs(
+        &mut self,
+        device: &Device,
+        pool: &MapScratchPool,
+        prims: &Buffer,
+        needed: u32,
+    ) -> Result<Option<ScratchBindings>, PassError> {
+        let most = self.triangles.saturating_mul(6);
+        if !self.config.cube || needed <= self.bins || self.bins >= most {
+            return Ok(None);
+        }
+        let bins = (u64::from(needed) * 5 / 4).min(u64::from(most)) as u32;
+        let texels = self.config.texels();
+        let scratch = pool.get(device, texels, bins, bins)?;
+        let targets = BindTargets {
+            prims,
+            state: &self.state,
+            receivers: &self.receivers,
+            offsets: &self.offsets,
+            entries: &self.entries,
+        };
+        let bound = ScratchBindings::new(device, &self.pipes, scratch, &targets, (texels, bins))?;
+        self.bins = bins;
+        Ok(Some(std::mem::replace(&mut self.bound, bound)))
+    }
+
+    /// Records the build of the lists for this frame's receivers, through the light's `frusta`
+    /// view-projections in frame coordinates (one, or a cube's six). Depth and normal must be in
+    /// `ShaderResource` state; the map's buffers are visible to storage reads afterwards.
+    pub fn record(
+        &mut self,
+        enc: &mut Encoder<'_>,
+        constants: &RayTraceConstants,
+        push: &MapPush,
+        frusta: &[glam::Mat4],
+    ) -> Result<(), PassError> {
+        if frusta.len() != self.config.frusta() as usize {
+            return Err(PassError::InvalidConfig(format!(
+                "the primitive map holds {} frusta, the light gave {}",
+                self.config.frusta(),
+                frusta.len()
+            )));
+        }
+        let mut all = [frusta[0]; 6];
+        all[..frusta.len()].copy_from_slice(frusta);
+        let map_constants = MapConstants {
+            ray: *constants,
+            frusta: all,
+        };
+        enc.update_buffer(&self.constants, 0, bytemuck::bytes_of(&map_constants))?;
+        let n = self.config.size;
+        let cube = self.config.cube;
+        let push = MapPush {
+            size: n,
+            triangles: self.triangles,
+            capacity: self.capacity,
+            tile_threads: BIN_THREADS,
+            guard: u32::from(self.config.guard),
+            cull: u32::from(self.config.receiver_culling),
+            faces: self.config.frusta(),
+            pairs: if cube { self.bins } else { 0 },
+            texels: self.config.texels() as u32,
+            ..*push
+        };
+        let with_mode = |mode| MapPush { mode, ..push };
+        // Each invocation of the receiver pass places a 2x2 quad; a workgroup covers 16x16 pixels.
+        let pixels = [self.screen.0.div_ceil(16), self.screen.1.div_ceil(16), 1];
+
+        enc.begin_pass("primitive map: fit");
+        enc.barriers(&[Barrier::Global {
+            before: S::UnorderedAccess,
+            after: S::CopyDest,
+        }]);
+        enc.fill_buffer(&self.receivers, 0);
+        enc.fill_buffer(&self.bound.scratch.counts, 0);
+        if self.config.guard {
+            enc.fill_buffer(&self.entries, GUARD_VALUE);
+        }
+        enc.barriers(&[Barrier::Global {
+            before: S::CopyDest,
+            after: S::UnorderedAccess,
+        }]);
+        let fit = |enc: &mut Encoder<'_>, mode| {
+            enc.dispatch(
+                &self.pipes.fit,
+                &self.fit_group,
+                bytemuck::bytes_of(&with_mode(mode)),
+                [1, 1, 1],
+            )
+        };
+        fit(enc, 0)?;
+        enc.barriers(&[Barrier::Uav]);
+        enc.dispatch(
+            &self.pipes.receivers,
+            &self.receivers_group,
+            bytemuck::bytes_of(&with_mode(0)),
+            pixels,
+        )?;
+        enc.barriers(&[Barrier::Uav]);
+        fit(enc, 1)?;
+        enc.barriers(&[Barrier::Uav]);
+        enc.end_pass();
+
+        self.last_push = Some(push);
+        self.pixel_texels
+            .writer
+            .store(self.id, std::sync::atomic::Ordering::Relaxed);
+        enc.begin_pass("primitive map: receivers");
+        enc.dispatch(
+            &self.pipes.receivers,
+            &self.receivers_group,
+            bytemuck::bytes_of(&with_mode(1)),
+            pixels,
+        )?;
+        enc.barriers(&[Barrier::Uav]);
+        enc.end_pass();
+
+        enc.begin_pass("primitive map: setup");
+        enc.dispatch(
+            &self.pipes.setup,
+            &self.bound.setup_group,
+            bytemuck::bytes_of(&push),
+            [(self.triangles + 1).div_ceil(64), 1, 1],
+        )?;
+        enc.barriers(&[Barrier::Uav]);
+        self.bound.tile_scan.record(enc, &self.pipes.scan)?;
+        enc.end_pass();
+
+        let label = self.path.label();
+        enc.begin_pass(&format!("primitive map: count ({label})"));
+        self.record_bin(enc, &with_mode(0))?;
+        enc.end_pass();
+
+        enc.begin_pass("primitive map: scan");
+        self.bound.offset_scan.record(enc, &self.pipes.scan)?;
+        enc.end_pass();
+
+        enc.begin_pass(&format!("primitive map: fill ({label})"));
+        self.record_bin(enc, &with_mode(1))?;
+        enc.end_pass();
+        Ok(())
+    }
+
+    /// The buffer of the pixel texels the ray trace reads (one `u32` per screen pixel).
+    pub fn pixel_texels(&self) -> &Buffer {
+        &self.pixel_texels.buffer
+    }
+
+    /// Before a ray trace through this map: when another map over the same geometry recorded a write of
+    /// the shared pixel texels since this map's build (an engine that records every light's map before
+    /// every light's ray trace), rewrites this map's pixel texels exactly as its build wrote them (the
+    /// receivers pass in its texels-only mode). Nothing otherwise, the usual case of lights recorded one
+    /// after another.
+    pub fn record_pixel_texels(&mut self, enc: &mut Encoder<'_>) -> Result<(), PassError> {
+        let Some(push) = self.last_push else {
+            return Ok(());
+        };
+        let writer = &self.pixel_texels.writer;
+        if writer.load(std::sync::atomic::Ordering::Relaxed) == self.id {
+            return Ok(());
+        }
+        writer.store(self.id, std::sync::atomic::Ordering::Relaxed);
+        enc.begin_pass("primitive map: pixel texels");
+        enc.barriers(&[Barrier::Uav]);
+        enc.dispatch(
+            &self.pipes.receivers,
+            &self.receivers_group,
+            bytemuck::bytes_of(&MapPush { mode: 2, ..push }),
+            [self.screen.0.div_ceil(16), self.screen.1.div_ceil(16), 1],
+        )?;
+        enc.barriers(&[Barrier::Uav]);
+        enc.end_pass();
+        Ok(())
+    }
+
+    fn record_bin(&self, enc: &mut Encoder<'_>, push: &MapPush) -> Result<(), PassError> {
+        match &self.pipes.binner {
+            Binner::Compute(p) => {
+                enc.dispatch(
+                    p,
+                    &self.bound.bin_group,
+                    bytemuck::bytes_of(push),
+                    [BIN_THREADS / 64, 1, 1],
+                )?;
+            }
+            Binner::Raster(p) => {
+                enc.begin_rendering((self.config.size, self.config.size), &[], None);
+                enc.draw(
+                    p,
+                    &self.bound.bin_group,
+                    bytemuck::bytes_of(push),
+                    self.triangles * 3,
+                )?;
+                enc.end_rendering();
+            }
+        }
+        enc.barriers(&[Barrier::Uav]);
+        Ok(())
+    }
+
+    /// Writes the map statistics into the state, and the occupancy view when the map draws one, and copies
+    /// the state into `state_readback` (host-readable once the frame completed; as large as the state).
+    pub fn record_occupancy(
+        &self,
+        enc: &mut Encoder<'_>,
+        state_readback: &Buffer,
+    ) -> Result<(), PassError> {
+        enc.begin_pass("occupancy");
+        enc.barriers(&[Barrier::Image {
+            image: &self.occupancy,
+            before: S::Undefined,
+            after: S::UnorderedAccess,
+        }]);
+        let n = self.config.size;
+        let texels = self.config.texels();
+        let push = [n, u32::from(self.occupancy_view), texels as u32];
+        // Each invocation tallies a 2x2 quad of texels, in rows of N.
+        let rows = texels.div_ceil(u64::from(n)) as u32;
+        enc.dispatch(
+            &self.pipes.occupancy,
+            &self.occupancy_group,
+            bytemuck::cast_slice(&push),
+            [n.div_ceil(16), rows.div_ceil(16), 1],
+        )?;
+        enc.barriers(&[Barrier::Global {
+            before: S::UnorderedAccess,
+            after: S::CopySource,
+        }]);
+        enc.copy_buffer(&self.state, state_readback)?;
+        enc.barriers(&[Barrier::Global {
+            before: S::CopyDest,
+            after: S::HostRead,
+        }]);
+        enc.end_pass();
+        Ok(())
+    }
+}
