@@ -56,10 +56,16 @@ void main() {
         }
         uint stride = pc.size;
         if (pc.faces > 1u) {
+            uint left = pc.texels - base;
+            if (left == 0u) {
+                // No texel left (the shares' rounding never uses up the minimum grids' spare texels at the
+                // sizes validated): the face gets no grid and its rays are traced exhaustively, exact.
+                continue;
+            }
             uint share = uint(float(pc.size) * sqrt(float(rays_f) / float(max(rays, 1u))));
             n = min(n, max(share, min_grid));
-            n = max(min(n, uint(sqrt(float(pc.texels - base)))), 1u);
-            while (n > 1u && n * n > pc.texels - base) {
+            n = max(min(n, uint(sqrt(float(left)))), 1u);
+            while (n > 1u && n * n > left) {
                 n -= 1u;
             }
             stride = n;

@@ -129,10 +129,11 @@ void main() {
             }
             continue;
         }
-        if (!traced || !inside) {
+        if (!traced || !inside || faces[f].fit.x == 0.0) {
             // Outside a light's one frustum: lit. A point light's faces cover every direction, so a ray
-            // origin outside its own face (never seen) is traced exhaustively: exact.
-            pixel_texel[pixel] = traced && pc.faces == 1u ? TEXEL_OUTSIDE : TEXEL_NO_RAY;
+            // origin outside its own face, or in a face the fit left without a grid (neither is ever seen),
+            // is traced exhaustively: exact.
+            pixel_texel[pixel] = traced && !inside && pc.faces == 1u ? TEXEL_OUTSIDE : TEXEL_NO_RAY;
             continue;
         }
         Projected pr = project(faces[f].to_texels, o, perspective);
