@@ -561,7 +561,7 @@ typedef struct HrtsConfig {
   // triangles). An engine that knows its scene can size them and avoid the frame of a growth.
   uint32_t map_initial_entries;
   // (Triangle, face) pairs a point light's cube map starts with (default 0: two per triangle, at least
-  // 1024). A frame that keeps more traces the light exhaustively (exact, slower; `bin_pairs` in the
+  // 1024; at most six per triangle). A frame that keeps more traces the light exhaustively (exact, slower; `bin_pairs` in the
   // frame report) and the pairs grow to fit from the next frame on.
   uint32_t map_initial_pairs;
 } HrtsConfig;

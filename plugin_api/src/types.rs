@@ -469,7 +469,7 @@ pub struct HrtsConfig {
     /// triangles). An engine that knows its scene can size them and avoid the frame of a growth.
     pub map_initial_entries: u32,
     /// (Triangle, face) pairs a point light's cube map starts with (default 0: two per triangle, at least
-    /// 1024). A frame that keeps more traces the light exhaustively (exact, slower; `bin_pairs` in the
+    /// 1024; at most six per triangle). A frame that keeps more traces the light exhaustively (exact, slower; `bin_pairs` in the
     /// frame report) and the pairs grow to fit from the next frame on.
     pub map_initial_pairs: u32,
 }

@@ -200,7 +200,7 @@ impl PrimitiveMapConfig {
                 self.size
             )));
         }
-        let grid = u64::from(self.size) * u64::from(self.size) * 4 + 4;
+        let grid = (self.texels() + 1) * 4;
         if grid > caps.max_storage_buffer_range {
             return Err(PassError::InvalidConfig(format!(
                 "primitive map size {}: its {} bytes of list offsets exceed the device's largest storage \
@@ -250,12 +250,12 @@ impl PrimitiveMapConfig {
     }
 
     /// Bin triangles a map over `triangles` triangles starts with: one per triangle, or for a cube
-    /// [`PrimitiveMapConfig::initial_pairs`] (it grows to what frames keep).
+    /// [`PrimitiveMapConfig::initial_pairs`], at most six per triangle (it grows to what frames keep).
     pub fn starting_pairs(&self, triangles: u32) -> u32 {
         match (self.cube, self.initial_pairs) {
             (false, _) => triangles,
             (true, 0) => triangles.saturating_mul(2).max(1024),
-            (true, given) => given,
+            (true, given) => given.min(triangles.saturating_mul(6)).max(1),
         }
     }
 
@@ -426,6 +426,11 @@ mod tests {
             ..cube
         };
         assert_eq!(given.starting_pairs(10_000), 8);
+        let huge = PrimitiveMapConfig {
+            initial_pairs: u32::MAX,
+            ..cube
+        };
+        assert_eq!(huge.starting_pairs(10_000), 60_000);
         assert_eq!(PrimitiveMapConfig::default().starting_pairs(10_000), 10_000);
         for binning in [
             BinningRequest::Hardware,
