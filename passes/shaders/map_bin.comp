@@ -4,9 +4,14 @@
 // bin triangle's bounding box, found by binary search in the scanned tile offsets, so a large triangle (a
 // ground plane, a wall) is spread over many threads instead of stalling one. A tile the triangle cannot
 // reach is skipped whole (bin_tile_overlaps), and a texel's receiver word is read only where the triangle
-// overlaps it. A light of one frustum has one
-// bin triangle per prim-buffer triangle; a point light one per (triangle, face) pair its setup kept.
-// mode 0 counts the accepted (triangle, texel) pairs, mode 1 stores them (map_store.glsl).
+// overlaps it. A light of one frustum has one bin triangle per prim-buffer triangle; a point light one per
+// (triangle, face) pair its setup kept.
+// mode 0 counts the accepted (triangle, texel) pairs (map_store.glsl) and appends them to the pair list;
+// mode 1 stores them: from the pair list when it holds every pair the count accepted (one walk in all),
+// else by walking the tiles again.
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_shader_subgroup_basic : require
 #include "map_state.glsl"
 #include "map_push.glsl"
 #include "map_bin.glsl"
@@ -18,44 +23,80 @@ layout(set = 0, binding = 2) readonly buffer Receivers { uint receiver[]; };
 layout(set = 0, binding = 3) buffer Counts { uint counts[]; };
 layout(set = 0, binding = 4) readonly buffer Offsets { uint offsets[]; };
 layout(set = 0, binding = 5) writeonly buffer Entries { uint entries[]; };
-layout(set = 0, binding = 6) readonly buffer State { MapState faces[]; };
+layout(set = 0, binding = 6) buffer State { MapState faces[]; };
 layout(set = 0, binding = 7) readonly buffer PairOwners { uint pair_owner[]; };
+layout(set = 0, binding = 8) buffer PairList { uvec2 pair_list[]; };
 layout(push_constant) uniform Push { MapPush pc; };
 #include "map_store.glsl"
 
+// The pairs this invocation accepted in its tile (count mode), appended to the pair list together with the
+// rest of its subgroup's: one atomic per subgroup and round.
+uint accepted[16];
+
 void main() {
     uint bins = pc.faces == 1u ? pc.triangles : min(faces[0].grid.z, pc.pairs);
+    uint listed = faces[0].totals.x;
+    if (pc.mode == 1u && pc.list_capacity > 0u && listed <= pc.list_capacity) {
+        // Fill from the pair list the count wrote: no second walk.
+        for (uint i = gl_GlobalInvocationID.x; i < listed; i += pc.tile_threads) {
+            uvec2 p = pair_list[i];
+            bin_store(p.x, p.y);
+        }
+        return;
+    }
     uint items = tile_offsets[bins];
-    for (uint item = gl_GlobalInvocationID.x; item < items; item += pc.tile_threads) {
-        // The last bin triangle whose first item is at or before `item` (those without items share
-        // their successor's offset and are never found).
-        uint lo = 0u, hi = bins;
-        while (hi - lo > 1u) {
-            uint mid = (lo + hi) / 2u;
-            if (tile_offsets[mid] <= item) {
-                lo = mid;
-            } else {
-                hi = mid;
+    // Rounds of one item per invocation; every invocation of a workgroup runs every round of its
+    // workgroup (the subgroup operations below need the whole subgroup).
+    for (uint round_base = gl_WorkGroupID.x * gl_WorkGroupSize.x; round_base < items;
+         round_base += pc.tile_threads) {
+        uint item = round_base + gl_LocalInvocationID.x;
+        uint count = 0u;
+        uint tri = 0u;
+        if (item < items) {
+            // The last bin triangle whose first item is at or before `item` (those without items share
+            // their successor's offset and are never found).
+            uint lo = 0u, hi = bins;
+            while (hi - lo > 1u) {
+                uint mid = (lo + hi) / 2u;
+                if (tile_offsets[mid] <= item) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            BinTri bt = bin_tris[lo];
+            uint owner = pc.faces == 1u ? lo : pair_owner[lo];
+            tri = owner & 0x1FFFFFFFu;
+            uvec4 grid = faces[owner >> 29].grid;
+            uint k = item - tile_offsets[lo];
+            uvec2 bmin = uvec2(bt.info.x & 0xFFFFu, bt.info.x >> 16);
+            uvec2 bmax = uvec2(bt.info.y & 0xFFFFu, bt.info.y >> 16);
+            uvec2 t0 = bmin + uvec2(k % bt.info.w, k / bt.info.w) * BIN_TILE;
+            uvec2 t1 = min(t0 + (BIN_TILE - 1u), bmax);
+            // The tile's texel centres span [t0, t1] + 0.5.
+            if (bin_tile_overlaps(bt, (vec2(t0) + vec2(t1)) * 0.5 + 0.5, (vec2(t1) - vec2(t0)) * 0.5)) {
+                for (uint y = t0.y; y <= t1.y; ++y) {
+                    for (uint x = t0.x; x <= t1.x; ++x) {
+                        uint texel = texel_index(grid, uvec2(x, y));
+                        if (bin_accepts(bt, texel, vec2(x, y) + 0.5, pc.cull != 0u)) {
+                            bin_store(tri, texel);
+                            accepted[count] = texel;
+                            count += 1u;
+                        }
+                    }
+                }
             }
         }
-        BinTri bt = bin_tris[lo];
-        uint owner = pc.faces == 1u ? lo : pair_owner[lo];
-        uint tri = owner & 0x1FFFFFFFu;
-        uvec4 grid = faces[owner >> 29].grid;
-        uint k = item - tile_offsets[lo];
-        uvec2 bmin = uvec2(bt.info.x & 0xFFFFu, bt.info.x >> 16);
-        uvec2 bmax = uvec2(bt.info.y & 0xFFFFu, bt.info.y >> 16);
-        uvec2 t0 = bmin + uvec2(k % bt.info.w, k / bt.info.w) * BIN_TILE;
-        uvec2 t1 = min(t0 + (BIN_TILE - 1u), bmax);
-        // The tile's texel centres span [t0, t1] + 0.5.
-        if (!bin_tile_overlaps(bt, (vec2(t0) + vec2(t1)) * 0.5 + 0.5, (vec2(t1) - vec2(t0)) * 0.5)) {
-            continue;
-        }
-        for (uint y = t0.y; y <= t1.y; ++y) {
-            for (uint x = t0.x; x <= t1.x; ++x) {
-                uint texel = texel_index(grid, uvec2(x, y));
-                if (bin_accepts(bt, texel, vec2(x, y) + 0.5, pc.cull != 0u)) {
-                    bin_store(tri, texel);
+        if (pc.mode == 0u && pc.list_capacity > 0u) {
+            uint total = subgroupAdd(count);
+            uint first = 0u;
+            if (subgroupElect() && total > 0u) {
+                first = atomicAdd(faces[0].totals.x, total);
+            }
+            uint at = subgroupBroadcastFirst(first) + subgroupExclusiveAdd(count);
+            for (uint j = 0u; j < count; ++j) {
+                if (at + j < pc.list_capacity) {
+                    pair_list[at + j] = uvec2(tri, accepted[j]);
                 }
             }
         }

@@ -12,5 +12,5 @@ struct MapPush {
     uint faces;             // frusta in the map: 1, or 6 for a point light's cube faces
     uint pairs;             // (triangle, face) pairs the bin items hold (a point light's map)
     uint texels;            // texels of the map's grids together
-    uint pad;
+    uint list_capacity;     // (triangle, texel) pairs the pair list holds (compute binning; 0: none)
 };

@@ -11,7 +11,7 @@ struct MapState {
                         // with a ray inside the light's frustum, counted by the bounds pass
     vec4 fit;           // x: 1 when the map has receivers, y: texels per side of the fitted grid (at most
                         // N; fewer when few rays need it, see map_fit.comp), zw: unused
-    uvec4 totals;       // x: bin items (4x4 tiles of triangle bounding boxes), y: entries needed,
+    uvec4 totals;       // x: (triangle, texel) pairs the count appended to the pair list, y: entries needed,
                         // z: entry capacity, w: triangles kept by the setup's culling
     uvec4 stats;        // x: texels with a list, y: longest list, z: texels past the capacity (traced
                         // exhaustively), w: texels with receivers

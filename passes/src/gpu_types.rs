@@ -68,8 +68,8 @@ pub struct MapPush {
     pub pairs: u32,
     /// Texels of the map's grids together.
     pub texels: u32,
-    /// Padding.
-    pub pad: u32,
+    /// (Triangle, texel) pairs the compute binning's pair list holds (0: none).
+    pub list_capacity: u32,
 }
 
 /// Constants of the primitive map's passes: the ray trace's (the receivers trace the same rays), and the
@@ -129,7 +129,8 @@ pub struct MapState {
     /// x: 1 when the map has receivers, y: texels per side of the fitted grid (N, or fewer with receiver
     /// culling when few rays need it).
     pub fit: Vec4,
-    /// x: bin items, y: entries needed, z: entry capacity, w: triangles binned (kept by the culling).
+    /// x: (triangle, texel) pairs the compute count appended to the pair list, y: entries needed, z: entry
+    /// capacity, w: triangles binned (kept by the culling).
     pub totals: UVec4,
     /// x: texels with a list, y: longest list, z: texels past the capacity, w: texels with receivers.
     pub stats: UVec4,

@@ -36,7 +36,7 @@ pub use config::{
     choose_binning_path, BinningPath, BinningRequest, FaceMode, PrimitiveMapConfig,
     DEFAULT_ENTRY_BUDGET, GUARD_VALUE, GUARD_WORDS, MIN_ENTRY_BUDGET,
 };
-use scratch::{storage_buffer, BindTargets, SharedTexels};
+use scratch::{storage_buffer, BindTargets, SharedTexels, PAIR_BYTES};
 pub use scratch::{MapScratch, MapScratchPool, ScratchBindings};
 
 /// Threads of the compute binning dispatch (a grid-stride loop over the bin items).
@@ -191,6 +191,8 @@ impl PrimitiveMap {
             receivers: &receivers,
             offsets: &offsets,
             entries: &entries,
+            pool: inputs.scratch,
+            entry_capacity: capacity,
         };
         let bound = ScratchBindings::new(device, &pipes, scratch, &targets, (texels, bins))?;
         Ok(Self {
@@ -252,7 +254,7 @@ impl PrimitiveMap {
                 BinningPath::Compute => Binner::Compute(device.create_compute_pipeline(
                     "map bin",
                     &shader("map_bin.comp")?,
-                    &buffers(8),
+                    &buffers(9),
                     push,
                 )?),
                 raster => Binner::Raster(Self::raster_pipeline(device, raster)?),
@@ -348,30 +350,49 @@ impl PrimitiveMap {
     }
 
     /// Grows the entry capacity to hold `needed` entries (with a quarter to spare, within the budget), when a
-    /// frame needed more than it had. When the entries were reallocated it returns the buffer and bind group
-    /// they replaced (frames in flight may still use them: drop them once those completed), and whatever
-    /// else reads [`PrimitiveMap::entries`] must be rebound.
+    /// frame needed more than it had, with a pair list as large from `pool` and the prim buffer `prims`
+    /// bound anew. When the entries were reallocated it returns the buffer and bindings they replaced
+    /// (frames in flight may still use them: drop them once those completed), and whatever else reads
+    /// [`PrimitiveMap::entries`] must be rebound.
     pub fn grow(
         &mut self,
         device: &Device,
+        pool: &MapScratchPool,
+        prims: &Buffer,
         needed: u32,
-    ) -> Result<Option<(Buffer, BindGroup)>, PassError> {
+    ) -> Result<Option<(Buffer, ScratchBindings)>, PassError> {
         let max = self.config.max_entries(device.capabilities());
         if needed <= self.capacity || self.capacity >= max {
             return Ok(None);
         }
         let capacity = (u64::from(needed) * 5 / 4).min(u64::from(max)) as u32;
         let entries = Self::create_entries(device, &self.config, capacity)?;
-        let (layout, binding) = match &self.pipes.binner {
-            Binner::Compute(p) => (p.layout(), 5),
-            Binner::Raster(p) => (p.layout(), 4),
-        };
-        let group = device.rebound(layout, &self.bound.bin_group, binding, &entries)?;
+        let old = std::mem::replace(&mut self.entries, entries);
         self.capacity = capacity;
-        Ok(Some((
-            std::mem::replace(&mut self.entries, entries),
-            std::mem::replace(&mut self.bound.bin_group, group),
-        )))
+        let bound = self.rebind(device, pool, prims, self.bound.scratch.clone())?;
+        Ok(Some((old, bound)))
+    }
+
+    /// Binds `scratch` (and a pair list for the entry capacity) anew; returns the bindings replaced.
+    fn rebind(
+        &mut self,
+        device: &Device,
+        pool: &MapScratchPool,
+        prims: &Buffer,
+        scratch: std::sync::Arc<MapScratch>,
+    ) -> Result<ScratchBindings, PassError> {
+        let targets = BindTargets {
+            prims,
+            state: &self.state,
+            receivers: &self.receivers,
+            offsets: &self.offsets,
+            entries: &self.entries,
+            pool,
+            entry_capacity: self.capacity,
+        };
+        let sizes = (self.config.texels(), self.bins);
+        let bound = ScratchBindings::new(device, &self.pipes, scratch, &targets, sizes)?;
+        Ok(std::mem::replace(&mut self.bound, bound))
     }
 
     /// Grows a cube map's (triangle, face) pairs to hold `needed` (with a quarter to spare, at most six per
@@ -390,18 +411,9 @@ impl PrimitiveMap {
             return Ok(None);
         }
         let bins = (u64::from(needed) * 5 / 4).min(u64::from(most)) as u32;
-        let texels = self.config.texels();
-        let scratch = pool.get(device, texels, bins, bins)?;
-        let targets = BindTargets {
-            prims,
-            state: &self.state,
-            receivers: &self.receivers,
-            offsets: &self.offsets,
-            entries: &self.entries,
-        };
-        let bound = ScratchBindings::new(device, &self.pipes, scratch, &targets, (texels, bins))?;
+        let scratch = pool.get(device, self.config.texels(), bins, bins)?;
         self.bins = bins;
-        Ok(Some(std::mem::replace(&mut self.bound, bound)))
+        self.rebind(device, pool, prims, scratch).map(Some)
     }
 
     /// Records the build of the lists for this frame's receivers, through the light's `frusta`
@@ -440,6 +452,9 @@ impl PrimitiveMap {
             faces: self.config.frusta(),
             pairs: if cube { self.bins } else { 0 },
             texels: self.config.texels() as u32,
+            list_capacity: self.bound.pair_list.as_ref().map_or(0, |l| {
+                (l.size() / PAIR_BYTES).min(u64::from(u32::MAX)) as u32
+            }),
             ..*push
         };
         let with_mode = |mode| MapPush { mode, ..push };

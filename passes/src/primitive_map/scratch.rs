@@ -10,6 +10,9 @@ use rhi::{BindGroup, Buffer, BufferUsage, Device, MemoryLocation, Resource};
 /// Bytes of one bin triangle (`BinTri` in `map_bin.glsl`).
 const BIN_TRI_BYTES: u64 = 64;
 
+/// Bytes of one (triangle, texel) pair of the pair list (`map_bin.comp`).
+pub(super) const PAIR_BYTES: u64 = 8;
+
 /// A GPU-only storage buffer of `bytes` (at least 4) with `usage` besides storage.
 pub(super) fn storage_buffer(
     device: &Device,
@@ -67,6 +70,8 @@ pub struct MapScratchPool {
     /// The pixel texels (one `u32` per screen pixel) shared by the maps, with the id of the map that last
     /// recorded a write of them.
     pixel_texels: std::sync::Mutex<Option<SharedTexels>>,
+    /// The compute binning's pair list: the (triangle, texel) pairs the count accepted, 8 bytes each.
+    pair_list: std::sync::Mutex<Option<std::sync::Arc<Buffer>>>,
 }
 
 /// Screen-size pixel texels shared by the maps over one geometry, and which map last recorded their write.
@@ -191,18 +196,42 @@ impl MapScratchPool {
         )
     }
 
-    /// GPU bytes of the pool's current scratch, receiver map and pixel texels (0 before any map asked for
-    /// them).
+    /// A pair list of at least `pairs` pairs: the pool's, or a new one as large.
+    pub(super) fn pair_list(
+        &self,
+        device: &Device,
+        pairs: u32,
+    ) -> Result<std::sync::Arc<Buffer>, PassError> {
+        let bytes = u64::from(pairs) * PAIR_BYTES;
+        shared_in(
+            &self.pair_list,
+            |l| l.size() >= bytes,
+            |_| {
+                Ok(std::sync::Arc::new(storage_buffer(
+                    device,
+                    "primitive map pair list",
+                    bytes,
+                    BufferUsage::default(),
+                )?))
+            },
+        )
+    }
+
+    /// GPU bytes of the pool's current scratch, receiver map, pixel texels and pair list (0 before any
+    /// map asked for them).
     pub fn bytes(&self) -> u64 {
         bytes_in(&self.current, |s| s.bytes())
             + bytes_in(&self.receivers, |r| r.size())
             + bytes_in(&self.pixel_texels, |t| t.buffer.size())
+            + bytes_in(&self.pair_list, |l| l.size())
     }
 }
 
 /// What a map binds of its scratch: replaced together when a point light's map outgrows its pairs.
 pub struct ScratchBindings {
     pub(super) scratch: std::sync::Arc<MapScratch>,
+    /// The compute binning's pair list (none for the raster paths).
+    pub(super) pair_list: Option<std::sync::Arc<Buffer>>,
     pub(super) setup_group: BindGroup,
     pub(super) bin_group: BindGroup,
     pub(super) tile_scan: PrefixScan,
@@ -216,10 +245,14 @@ pub(super) struct BindTargets<'a> {
     pub(super) receivers: &'a Buffer,
     pub(super) offsets: &'a Buffer,
     pub(super) entries: &'a Buffer,
+    /// The pool the pair list comes from, and the pairs it must hold (the entry capacity).
+    pub(super) pool: &'a MapScratchPool,
+    pub(super) entry_capacity: u32,
 }
 
 impl ScratchBindings {
-    /// Binds `scratch` for a map of `texels` texels and `bins` bin triangles.
+    /// Binds `scratch` for a map of `texels` texels and `bins` bin triangles, with a pair list from the
+    /// pool as large as the map's entry capacity (compute binning).
     pub(super) fn new(
         device: &Device,
         pipes: &MapPipelines,
@@ -239,20 +272,27 @@ impl ScratchBindings {
                 b(&s.pair_owners),
             ],
         )?;
+        let mut pair_list = None;
         let bin_group = match &pipes.binner {
-            Binner::Compute(p) => device.create_bind_group(
-                p.layout(),
-                &[
-                    b(&s.bin_tris),
-                    b(&s.tile_offsets),
-                    b(t.receivers),
-                    b(&s.counts),
-                    b(t.offsets),
-                    b(t.entries),
-                    b(t.state),
-                    b(&s.pair_owners),
-                ],
-            )?,
+            Binner::Compute(p) => {
+                let list = t.pool.pair_list(device, t.entry_capacity)?;
+                let group = device.create_bind_group(
+                    p.layout(),
+                    &[
+                        b(&s.bin_tris),
+                        b(&s.tile_offsets),
+                        b(t.receivers),
+                        b(&s.counts),
+                        b(t.offsets),
+                        b(t.entries),
+                        b(t.state),
+                        b(&s.pair_owners),
+                        b(&list),
+                    ],
+                )?;
+                pair_list = Some(list);
+                group
+            }
             Binner::Raster(p) => device.create_bind_group(
                 p.layout(),
                 &[
@@ -280,6 +320,7 @@ impl ScratchBindings {
         )?;
         Ok(Self {
             scratch,
+            pair_list,
             setup_group,
             bin_group,
             tile_scan,

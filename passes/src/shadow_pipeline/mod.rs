@@ -78,7 +78,7 @@ struct FrameSlot {
 enum RetiredMap {
     Entries {
         _entries: Buffer,
-        _bin_group: BindGroup,
+        _bindings: Box<ScratchBindings>,
         _ray_group: Option<BindGroup>,
     },
     Pairs {

@@ -307,18 +307,20 @@ impl ShadowPipeline {
             return Ok(());
         };
         let mut retired = Vec::new();
-        if let Some((entries, bin_group)) = map.grow(device, self.needed_entries)? {
+        let pool = self.shared.map_scratch();
+        if let Some((entries, bindings)) =
+            map.grow(device, pool, self.shared.prims(), self.needed_entries)?
+        {
             let ray_group = match self.ray.as_mut() {
                 Some(ray) => Some(ray.rebind_entries(device, map)?),
                 None => None,
             };
             retired.push(RetiredMap::Entries {
                 _entries: entries,
-                _bin_group: bin_group,
+                _bindings: Box::new(bindings),
                 _ray_group: ray_group,
             });
         }
-        let pool = self.shared.map_scratch();
         if let Some(bound) = map.grow_pairs(device, pool, self.shared.prims(), self.needed_pairs)? {
             retired.push(RetiredMap::Pairs {
                 _bindings: Box::new(bound),
