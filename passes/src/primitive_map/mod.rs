@@ -458,8 +458,6 @@ impl PrimitiveMap {
             ..*push
         };
         let with_mode = |mode| MapPush { mode, ..push };
-        // Each invocation of the receiver pass places a 2x2 quad; a workgroup covers 16x16 pixels.
-        let pixels = [self.screen.0.div_ceil(16), self.screen.1.div_ceil(16), 1];
 
         enc.begin_pass("primitive map: fit");
         enc.barriers(&[Barrier::Global {
@@ -485,12 +483,7 @@ impl PrimitiveMap {
         };
         fit(enc, 0)?;
         enc.barriers(&[Barrier::Uav]);
-        enc.dispatch(
-            &self.pipes.receivers,
-            &self.receivers_group,
-            bytemuck::bytes_of(&with_mode(0)),
-            pixels,
-        )?;
+        self.dispatch_receivers(enc, &push, 0)?;
         enc.barriers(&[Barrier::Uav]);
         fit(enc, 1)?;
         enc.barriers(&[Barrier::Uav]);
@@ -501,12 +494,7 @@ impl PrimitiveMap {
             .writer
             .store(self.id, std::sync::atomic::Ordering::Relaxed);
         enc.begin_pass("primitive map: receivers");
-        enc.dispatch(
-            &self.pipes.receivers,
-            &self.receivers_group,
-            bytemuck::bytes_of(&with_mode(1)),
-            pixels,
-        )?;
+        self.dispatch_receivers(enc, &push, 1)?;
         enc.barriers(&[Barrier::Uav]);
         enc.end_pass();
 
@@ -557,14 +545,26 @@ impl PrimitiveMap {
         writer.store(self.id, std::sync::atomic::Ordering::Relaxed);
         enc.begin_pass("primitive map: pixel texels");
         enc.barriers(&[Barrier::Uav]);
+        self.dispatch_receivers(enc, &push, 2)?;
+        enc.barriers(&[Barrier::Uav]);
+        enc.end_pass();
+        Ok(())
+    }
+
+    /// Records the receivers pass over the screen in `mode` (0: bounds, 1: mark, 2: pixel texels alone).
+    fn dispatch_receivers(
+        &self,
+        enc: &mut Encoder<'_>,
+        push: &MapPush,
+        mode: u32,
+    ) -> Result<(), PassError> {
+        // Each invocation places a 2x2 quad; a workgroup covers 16x16 pixels.
         enc.dispatch(
             &self.pipes.receivers,
             &self.receivers_group,
-            bytemuck::bytes_of(&MapPush { mode: 2, ..push }),
+            bytemuck::bytes_of(&MapPush { mode, ..*push }),
             [self.screen.0.div_ceil(16), self.screen.1.div_ceil(16), 1],
         )?;
-        enc.barriers(&[Barrier::Uav]);
-        enc.end_pass();
         Ok(())
     }
 
