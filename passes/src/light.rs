@@ -45,19 +45,7 @@ impl Light {
     pub fn view_proj(&self) -> Mat4 {
         match *self {
             Self::Directional { view_proj, .. } | Self::Spot { view_proj, .. } => view_proj,
-            Self::Point { .. } => self.frusta()[0],
-        }
-    }
-
-    /// The view-projection of each frustum the light is shadowed through (world coordinates): its one, or
-    /// a point light's six cube faces (+X, -X, +Y, -Y, +Z, -Z).
-    pub fn frusta(&self) -> Vec<Mat4> {
-        match *self {
-            Self::Directional { view_proj, .. } | Self::Spot { view_proj, .. } => vec![view_proj],
-            Self::Point { position, range } => point_light_faces(position, range)
-                .iter()
-                .map(Light::view_proj)
-                .collect(),
+            Self::Point { position, range } => point_light_faces(position, range)[0].view_proj(),
         }
     }
 
