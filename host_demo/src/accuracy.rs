@@ -282,3 +282,68 @@ pub fn compare_with_reference(
     }
     c
 }
+
+/// Outcome of comparing GPU area shadows with the exact reference of the same light samples.
+#[derive(Debug, Default, Clone, PartialEq)]
+pub struct AreaComparison {
+    /// Pixels compared (every pixel of the frame).
+    pub pixels: usize,
+    /// Pixels with a sample within the reference's tolerance of an edge or plane (counted, not compared).
+    pub unstable: usize,
+    /// Stable pixels whose GPU visible count differs from the reference's.
+    pub mismatches: usize,
+    /// Stable pixels in a penumbra (some samples visible, some not) by the reference.
+    pub penumbra: usize,
+    /// Stable pixels fully shadowed by the reference.
+    pub umbra: usize,
+    /// NaN or Inf, or a value that is no multiple of 1 / samples, in the GPU output.
+    pub non_finite: usize,
+    /// First mismatching pixels `(x, y, reference count, GPU count)`.
+    pub examples: Vec<(u32, u32, u32, f32)>,
+}
+
+/// Compares GPU area-shadow visibility (`visibility`, row-major, the visible fraction of `samples`) with
+/// the exact reference of the same sample directions: the light of `view` of angular radius
+/// `angular_radius`, sampled by [`passes::area::area_sample_directions`].
+pub fn compare_area(
+    rs: &RefScene,
+    view: &View,
+    angular_radius: f32,
+    samples: u32,
+    visibility: &[f32],
+) -> AreaComparison {
+    let directions: Vec<DVec3> =
+        passes::area::area_sample_directions(view.light.direction, angular_radius, samples)
+            .iter()
+            .map(|w| w.as_dvec3())
+            .collect();
+    let r = reference::area_reference(rs, &visibility_params(view), &directions);
+    let mut c = AreaComparison::default();
+    for (i, &v) in visibility.iter().enumerate() {
+        c.pixels += 1;
+        let count = v * samples as f32;
+        if !count.is_finite() || (count - count.round()).abs() > 1e-3 {
+            c.non_finite += 1;
+            continue;
+        }
+        if !r.stable[i] {
+            c.unstable += 1;
+            continue;
+        }
+        let expected = r.visible[i];
+        if expected == 0 {
+            c.umbra += 1;
+        } else if expected < samples {
+            c.penumbra += 1;
+        }
+        if count.round() as u32 != expected {
+            c.mismatches += 1;
+            if c.examples.len() < 8 {
+                let w = view.width as usize;
+                c.examples
+                    .push(((i % w) as u32, (i / w) as u32, expected, count));
+            }
+        }
+    }
+    c
+}

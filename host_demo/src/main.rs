@@ -409,7 +409,7 @@ fn closed_interior(model: &Scene, args: &RenderArgs) -> Result<Option<Interior>>
     let reference = RefScene::new(model);
     let enclosure = Enclosure::probe(&reference, &model.bounds());
     let angular_radius = match args.soft.mode {
-        ShadowMode::Hybrid => args.soft.angular_radius,
+        ShadowMode::Hybrid | ShadowMode::Area => args.soft.angular_radius,
         _ => 0.0,
     };
     let aspect = args.width as f32 / args.height as f32;
@@ -436,9 +436,10 @@ fn closed_interior(model: &Scene, args: &RenderArgs) -> Result<Option<Interior>>
     let light_text = match (args.light_dir, light.kind.position()) {
         (None, Some(position)) => {
             match args.soft.mode {
-                ShadowMode::Soft => bail!(
-                    "--mode soft: the point light inside a closed scene is shadowed hard or hybrid; pass \
-                     --light-dir for a sun with soft shadows"
+                ShadowMode::Soft | ShadowMode::Area => bail!(
+                    "--mode {}: the point light inside a closed scene is shadowed hard or hybrid; pass \
+                     --light-dir for a sun with soft shadows",
+                    args.soft.mode.name()
                 ),
                 ShadowMode::None => light.casts_shadows = false,
                 ShadowMode::Hard | ShadowMode::Hybrid => {}

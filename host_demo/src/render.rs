@@ -7,9 +7,9 @@ use crate::plugin::PluginRenderer;
 use crate::{focus_bounds, View};
 use anyhow::{Context, Result};
 use passes::{
-    BinningRequest, FaceMode, FrameReport, HybridConfig, PassId, PassStatus, PcssConfig,
-    PenumbraFilter, PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig, ShadowMapConfig,
-    ShadowMode, SkipReason,
+    AreaConfig, BinningRequest, FaceMode, FrameReport, HybridConfig, PassId, PassStatus,
+    PcssConfig, PenumbraFilter, PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig,
+    ShadowMapConfig, ShadowMode, SkipReason,
 };
 use rhi::Device;
 use scene::Scene;
@@ -21,7 +21,8 @@ use std::path::Path;
 /// map, shrinking PCSS).
 #[derive(Debug, Clone, clap::Args)]
 pub struct SoftShadowArgs {
-    /// Shadow mode of the light: none, hard (ray traced), soft (PCSS) or hybrid.
+    /// Shadow mode of the light: none, hard (ray traced), soft (PCSS), hybrid, or area (exact soft shadows:
+    /// the visible fraction of `--area-samples` light samples per pixel).
     #[arg(long, default_value = "hybrid", value_parser = parse_mode)]
     pub mode: ShadowMode,
     /// Turn off FXAA over the ray-traced shadow.
@@ -33,7 +34,8 @@ pub struct SoftShadowArgs {
     /// PCSS penumbra filter: shrinking or standard.
     #[arg(long, default_value = "shrinking", value_parser = parse_filter)]
     pub filter: PenumbraFilter,
-    /// Angular radius of the directional light in radians (PCSS light size); inside a closed model, the
+    /// Angular radius of the directional light in radians (the light size of PCSS, the hybrid and area
+    /// shadows); inside a closed model, the
     /// point light is a sphere this wide seen from the floor below it.
     #[arg(long, default_value_t = 0.02)]
     pub angular_radius: f32,
@@ -49,6 +51,9 @@ pub struct SoftShadowArgs {
     /// Hybrid PHS, percentage of hard shadow.
     #[arg(long, default_value_t = 4.0)]
     pub phs: f32,
+    /// Area shadows: light samples per pixel (1 to 128).
+    #[arg(long, default_value_t = passes::DEFAULT_AREA_SAMPLES)]
+    pub area_samples: u32,
 }
 
 impl Default for SoftShadowArgs {
@@ -63,6 +68,7 @@ impl Default for SoftShadowArgs {
             pcf_taps: 32,
             wss: None,
             phs: 4.0,
+            area_samples: passes::DEFAULT_AREA_SAMPLES,
         }
     }
 }
@@ -122,6 +128,9 @@ impl SoftShadowArgs {
                 world_space_scale: self.wss.unwrap_or(default_world_space_scale),
                 hard_shadow_percentage: self.phs,
             },
+            area: AreaConfig {
+                samples: self.area_samples,
+            },
             ..ShadowConfig::default()
         }
     }
@@ -148,6 +157,7 @@ fn demo_outputs(mode: ShadowMode, occupancy_view: bool) -> ResourceSet {
     let outputs = match mode {
         ShadowMode::None => ResourceSet::EMPTY,
         ShadowMode::Hard => ResourceSet::of(&[R::RtVisibility, R::BlockerDistance]),
+        ShadowMode::Area => ResourceSet::of(&[R::RtVisibility]),
         ShadowMode::Soft => ResourceSet::of(&[R::ShadowMapVisibility, R::Pcss]),
         ShadowMode::Hybrid => ResourceSet::of(&[
             R::RtVisibility,
@@ -158,8 +168,7 @@ fn demo_outputs(mode: ShadowMode, occupancy_view: bool) -> ResourceSet {
             R::Hybrid,
         ]),
     };
-    let traced = matches!(mode, ShadowMode::Hard | ShadowMode::Hybrid);
-    if traced && occupancy_view {
+    if mode.traces_rays() && occupancy_view {
         outputs.with(R::Occupancy)
     } else {
         outputs
@@ -477,6 +486,10 @@ pub fn render_to_folder(
     let settings = match s.mode {
         ShadowMode::None => "nothing to compute: every pixel lit".to_owned(),
         ShadowMode::Hard => fxaa,
+        ShadowMode::Area => format!(
+            "{} light samples per pixel, angular radius {}",
+            config.area.samples, config.pcss.angular_radius
+        ),
         ShadowMode::Soft => soft,
         ShadowMode::Hybrid => format!(
             "{fxaa}, {soft}, WSS {:.3}, PHS {}",
@@ -604,8 +617,9 @@ pub fn parse_mode(s: &str) -> Result<ShadowMode, String> {
         "hard" => Ok(ShadowMode::Hard),
         "soft" => Ok(ShadowMode::Soft),
         "hybrid" => Ok(ShadowMode::Hybrid),
+        "area" => Ok(ShadowMode::Area),
         _ => Err(format!(
-            "unknown shadow mode '{s}' (none, hard, soft, hybrid)"
+            "unknown shadow mode '{s}' (none, hard, soft, hybrid, area)"
         )),
     }
 }

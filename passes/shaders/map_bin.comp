@@ -67,18 +67,24 @@ void main() {
             BinTri bt = bin_tris[lo];
             uint owner = pc.faces == 1u ? lo : pair_owner[lo];
             tri = owner & 0x1FFFFFFFu;
-            uvec4 grid = faces[owner >> 29].grid;
+            uint face = owner >> 29;
+            uvec4 grid = faces[face].grid;
+            // Area shadows: the footprint's widening rate, and the deepest ray origin of the frustum.
+            float widen_rate = faces[face].fit.z;
+            float deepest = unordered(faces[face].receivers.z);
             uint k = item - tile_offsets[lo];
             uvec2 bmin = uvec2(bt.info.x & 0xFFFFu, bt.info.x >> 16);
             uvec2 bmax = uvec2(bt.info.y & 0xFFFFu, bt.info.y >> 16);
             uvec2 t0 = bmin + uvec2(k % bt.info.w, k / bt.info.w) * BIN_TILE;
             uvec2 t1 = min(t0 + (BIN_TILE - 1u), bmax);
             // The tile's texel centres span [t0, t1] + 0.5.
-            if (bin_tile_overlaps(bt, (vec2(t0) + vec2(t1)) * 0.5 + 0.5, (vec2(t1) - vec2(t0)) * 0.5)) {
+            float widest = widen_rate == 0.0 ? 0.0 : penumbra_texels(bt, deepest, widen_rate);
+            if (bin_tile_overlaps(bt, (vec2(t0) + vec2(t1)) * 0.5 + 0.5, (vec2(t1) - vec2(t0)) * 0.5,
+                                  widest)) {
                 for (uint y = t0.y; y <= t1.y; ++y) {
                     for (uint x = t0.x; x <= t1.x; ++x) {
                         uint texel = texel_index(grid, uvec2(x, y));
-                        if (bin_accepts(bt, texel, vec2(x, y) + 0.5, pc.cull != 0u)) {
+                        if (bin_accepts(bt, texel, vec2(x, y) + 0.5, pc.cull != 0u, widen_rate, deepest)) {
                             bin_store(tri, texel);
                             accepted[count] = texel;
                             count += 1u;

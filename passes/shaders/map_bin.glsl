@@ -27,8 +27,10 @@ struct BinTri {
 
 float cross2(vec2 a, vec2 b) { return a.x * b.y - a.y * b.x; }
 
-bool bin_overlaps(BinTri t, vec2 centre) {
-    float grow = 0.5 + t.cmd.z;
+// `widen`: texels by which the triangle's footprint grows besides its margin (area shadows: the penumbra
+// it may cast on the texel's receivers; 0 for hard shadows).
+bool bin_overlaps(BinTri t, vec2 centre, float widen) {
+    float grow = 0.5 + t.cmd.z + widen;
     vec2 a = t.ab.xy, b = t.ab.zw, c = t.cmd.xy;
     if (t.info.z == MODE_TRIANGLE) {
         vec2 e0 = b - a, e1 = c - b, e2 = a - c;
@@ -58,6 +60,12 @@ bool bin_overlaps(BinTri t, vec2 centre) {
 // Unit roundoff of f32.
 #define BIN_U 5.9604645e-8
 
+// Area shadows: texels by which triangle `t`'s footprint widens for receivers down to depth key `reach`, at
+// `widen_rate` texels per unit of depth key (rounded up past the product's rounding).
+float penumbra_texels(BinTri t, float reach, float widen_rate) {
+    return max(reach - t.cmd.w, 0.0) * widen_rate * (1.0 + 1.0 / 65536.0);
+}
+
 // A bound on the rounding of evaluating the edge function of edge `e` from point `a` (or, with a = 0, a
 // homogeneous line of coefficients e) anywhere within `h` of `c`, in the texel test or in the tile test
 // below: both evaluate the same affine function, so their difference is at most twice this.
@@ -68,10 +76,11 @@ float bin_rounding(vec2 e, vec2 a, vec2 c, vec2 h) {
 
 // Whether any texel centre within `h` (per axis) of `c` may be accepted by bin_overlaps: each edge
 // function's best value over that box (its value at `c` plus the half-extent times its gradient) is tested
-// with the texel test's growth and both evaluations' rounding. Conservative: a tile it rejects holds no
+// with the texel test's growth (`widen`: the largest of the tile's texels) and both evaluations' rounding.
+// Conservative: a tile it rejects holds no
 // texel bin_overlaps accepts, so the binning skips the tile's texels without changing any list.
-bool bin_tile_overlaps(BinTri t, vec2 c, vec2 h) {
-    float grow = 0.5 + t.cmd.z;
+bool bin_tile_overlaps(BinTri t, vec2 c, vec2 h, float widen) {
+    float grow = 0.5 + t.cmd.z + widen;
     vec2 a = t.ab.xy, b = t.ab.zw, cc = t.cmd.xy;
     if (t.info.z == MODE_TRIANGLE) {
         vec2 e0 = b - a, e1 = cc - b, e2 = a - cc;

@@ -80,6 +80,17 @@ void main() {
         fit[3][1] = -lo.y * s.y;
         faces[f].to_texels = fit * frusta[f];
         faces[f].fit.x = 1.0;
+        if (pc.penumbra > 0.0) {
+            // Area shadows (orthographic light): a shadow ray within the light's angular radius r of its
+            // axis moves at most tan(r) sideways per unit it climbs towards the light, so its texel moves
+            // at most tan(r) |row x or y| / |row z| texels per unit of depth key it climbs. The relative and
+            // absolute terms cover the rounding of the rows and of the axes' orthogonality.
+            mat4 m = faces[f].to_texels;
+            float rx = length(vec3(m[0][0], m[1][0], m[2][0]));
+            float ry = length(vec3(m[0][1], m[1][1], m[2][1]));
+            float rz = length(vec3(m[0][2], m[1][2], m[2][2]));
+            faces[f].fit.z = (pc.penumbra * (1.0 + 1.0 / 4096.0) + 1e-6) * max(rx, ry) / rz;
+        }
         faces[f].grid.xy = uvec2(base, stride);
         if (pc.faces > 1u) {
             base += n * n;

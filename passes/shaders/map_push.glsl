@@ -1,4 +1,4 @@
-// Mirrors passes::gpu_types::MapPush (64 bytes): push constants of the primitive-map passes.
+// Mirrors passes::gpu_types::MapPush (80 bytes): push constants of the primitive-map passes.
 struct MapPush {
     vec4 to_light;          // xyz: direction towards the light (directional); w: 1 for a spot light
     uint size;              // N: texels per side
@@ -13,4 +13,6 @@ struct MapPush {
     uint pairs;             // (triangle, face) pairs the bin items hold (a point light's map)
     uint texels;            // texels of the map's grids together
     uint list_capacity;     // (triangle, texel) pairs the pair list holds (compute binning; 0: none)
+    float penumbra;         // area shadows: tan(angular radius) of the light (0: hard, no widening)
+    uint pad0, pad1, pad2;
 };

@@ -236,8 +236,12 @@ uint setup(uint f, vec3 v0, vec3 v1, vec3 v2, out BinTri bt) {
     // reaches tens of thousands of texels.
     vec2 reach = max(max(abs(p[0].xy), abs(p[1].xy)), max(abs(p[2].xy), vec2(n)));
     margin += err + 16.0 * U * max(reach.x, reach.y);
-    vec2 lo = min(min(p[0].xy, p[1].xy), p[2].xy) - margin;
-    vec2 hi = max(max(p[0].xy, p[1].xy), p[2].xy) + margin;
+    // Area shadows: the bounding box also holds the texels the triangle's penumbra can reach on the
+    // frustum's deepest ray origin (map_store.glsl widens per texel, by the texel's own deepest one).
+    float widest = faces[f].fit.z == 0.0 ? 0.0
+        : max(unordered(faces[f].receivers.z) - min_depth, 0.0) * faces[f].fit.z * (1.0 + 1.0 / 65536.0);
+    vec2 lo = min(min(p[0].xy, p[1].xy), p[2].xy) - (margin + widest);
+    vec2 hi = max(max(p[0].xy, p[1].xy), p[2].xy) + (margin + widest);
     bool far = any(greaterThan(abs(vec4(lo, hi)), vec4(FAR_TEXELS)));
     if (far && perspective) {
         return clipped_setup(n, h, min_depth, ACCEPT_MARGIN + 2.0 * unordered(faces[f].receivers.y), bt);
@@ -300,8 +304,12 @@ void main() {
         v1 = tris[index].v[1].xyz;
         v2 = tris[index].v[2].xyz;
         // Zero area with two equal vertices, or a back face in front-only mode: culled in every frustum.
+        // Area shadows keep a triangle that faces any direction of the light's cone: within its angular
+        // radius r of facing (sin r < tan r = penumbra, with room for the rounding).
+        vec3 c = cross(v1 - v0, v2 - v0);
+        float facing = pc.penumbra == 0.0 ? 0.0 : -pc.penumbra * (1.0 + 1.0 / 1024.0) * length(c);
         live = v0 != v1 && v1 != v2 && v2 != v0
-            && (pc.front_only == 0u || dot(cross(v1 - v0, v2 - v0), pc.to_light.xyz) > 0.0);
+            && (pc.front_only == 0u || dot(c, pc.to_light.xyz) > facing);
     }
     bool kept = false;
     if (pc.faces == 1u) {

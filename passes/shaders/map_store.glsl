@@ -4,18 +4,33 @@
 // Whether `texel`, centred at `centre`, gets triangle `t`: it overlaps the triangle, and (with `cull`) a
 // ray origin lies in it and the triangle is not wholly farther from the light than all of them. The
 // includer's `receiver[texel]` is the texel's word of the receiver map: 0 without a ray origin, else the
-// ordered largest depth key (plus its error) of its ray origins; it is read only for overlapped texels.
-// Without `cull`, every overlapped texel is accepted (a debug mode whose lists tests compare with exact
-// binning).
-bool bin_accepts(BinTri t, uint texel, vec2 centre, bool cull) {
-    if (!bin_overlaps(t, centre)) {
-        return false;
+// ordered largest depth key (plus its error) of its ray origins; for hard shadows it is read only for
+// overlapped texels. Without `cull`, every overlapped texel is accepted (a debug mode whose lists tests
+// compare with exact binning).
+// Area shadows (`widen_rate` > 0, texels per unit of depth key, map_fit.comp): the footprint grows by the
+// penumbra the triangle can cast on the texel's deepest receiver (the whole map's, `deepest`, without
+// `cull`): a shadow ray that climbs from depth z to the triangle's nearest depth moves sideways by at most
+// (z - nearest) * widen_rate texels.
+bool bin_accepts(BinTri t, uint texel, vec2 centre, bool cull, float widen_rate, float deepest) {
+    if (widen_rate == 0.0) {
+        if (!bin_overlaps(t, centre, 0.0)) {
+            return false;
+        }
+        if (!cull) {
+            return true;
+        }
+        uint word = receiver[texel];
+        return word != 0u && t.cmd.w <= unordered(word);
     }
-    if (!cull) {
-        return true;
+    float reach = deepest;
+    if (cull) {
+        uint word = receiver[texel];
+        if (word == 0u || t.cmd.w > unordered(word)) {
+            return false;
+        }
+        reach = unordered(word);
     }
-    uint word = receiver[texel];
-    return word != 0u && t.cmd.w <= unordered(word);
+    return bin_overlaps(t, centre, penumbra_texels(t, reach, widen_rate));
 }
 
 // Counts (mode 0) or stores (mode 1) triangle `tri` in the list of `texel`.

@@ -19,17 +19,27 @@ pub enum ShadowMode {
     /// The talk's hybrid: `lerp(ray-traced, PCSS, L)` with `L` from the ray-traced blocker distance.
     #[default]
     Hybrid,
+    /// Exact soft shadows of a sized light: the visible fraction of a fixed set of light samples per pixel,
+    /// each tested exactly against the triangles of the pixel's list in a primitive map whose footprints
+    /// are widened by the penumbra they cast (no shadow map, no filter, no denoiser).
+    Area,
 }
 
 impl ShadowMode {
-    /// "none", "hard", "soft" or "hybrid".
+    /// "none", "hard", "soft", "hybrid" or "area".
     pub fn name(self) -> &'static str {
         match self {
             Self::None => "none",
             Self::Hard => "hard",
             Self::Soft => "soft",
             Self::Hybrid => "hybrid",
+            Self::Area => "area",
         }
+    }
+
+    /// Whether the mode traces shadow rays through the primitive map (hard, hybrid and area).
+    pub fn traces_rays(self) -> bool {
+        matches!(self, Self::Hard | Self::Hybrid | Self::Area)
     }
 }
 
@@ -218,7 +228,7 @@ impl PlanRequest {
         match self.mode {
             ShadowMode::None => ResourceId::Lit,
             ShadowMode::Hard if self.antialiasing => ResourceId::RtAntialiased,
-            ShadowMode::Hard => ResourceId::RtVisibility,
+            ShadowMode::Hard | ShadowMode::Area => ResourceId::RtVisibility,
             ShadowMode::Soft => ResourceId::Pcss,
             ShadowMode::Hybrid => ResourceId::Hybrid,
         }
@@ -486,6 +496,20 @@ mod tests {
             filter: PenumbraFilter::Shrinking,
             extra_outputs: ResourceSet::EMPTY,
         })
+    }
+
+    #[test]
+    fn area_runs_the_map_and_its_ray_trace_alone_and_ignores_antialiasing() {
+        for aa in [false, true] {
+            let p = plan(ShadowMode::Area, aa);
+            assert_eq!(
+                p.passes(),
+                &[P::PrimBuffer, P::PrimitiveMap, P::Occupancy, P::RayTrace]
+            );
+            assert_eq!(p.final_output(), R::RtVisibility);
+            assert!(!p.resources().contains(R::BlockerDistance));
+            assert!(!p.resources().contains(R::ShadowMap));
+        }
     }
 
     #[test]

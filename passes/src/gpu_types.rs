@@ -70,6 +70,11 @@ pub struct MapPush {
     pub texels: u32,
     /// (Triangle, texel) pairs the compute binning's pair list holds (0: none).
     pub list_capacity: u32,
+    /// Area shadows: the tangent of the light's angular radius, by which a triangle's footprint widens per
+    /// unit of depth above a receiver (0: hard shadows, no widening).
+    pub penumbra: f32,
+    /// Padding.
+    pub pad: [u32; 3],
 }
 
 /// Constants of the primitive map's passes: the ray trace's (the receivers trace the same rays), and the
@@ -94,7 +99,8 @@ pub struct RayTraceConstants {
     pub light_view_proj: Mat4,
     /// Camera position in frame coordinates (xyz).
     pub camera_pos: Vec4,
-    /// Direction the light travels (xyz, unit).
+    /// Direction the light travels (xyz, unit); w: area shadows, the tangent of the light's angular radius
+    /// (0: hard shadows).
     pub light_dir: Vec4,
     /// Screen width, height, map N, unused.
     pub dims: UVec4,
@@ -127,7 +133,8 @@ pub struct MapState {
     /// depth key of the ray origins, w: pixels with a ray inside the light's frustum (bounds pass).
     pub receivers: UVec4,
     /// x: 1 when the map has receivers, y: texels per side of the fitted grid (N, or fewer with receiver
-    /// culling when few rays need it).
+    /// culling when few rays need it), z: area shadows: texels a triangle's footprint widens per unit of
+    /// depth key above a receiver (0: hard shadows).
     pub fit: Vec4,
     /// x: (triangle, texel) pairs the compute count appended to the pair list, y: entries needed, z: entry
     /// capacity, w: triangles binned (kept by the culling).
@@ -283,11 +290,24 @@ pub struct HybridPush {
     pub hard_shadow_percentage: f32,
 }
 
+/// The area trace's light samples (`area_samples.glsl`), built by [`crate::area::area_samples`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct AreaSamples {
+    /// xyz: the unit direction towards the light's centre; w: a bound on the distance of every sample
+    /// direction from it.
+    pub center: Vec4,
+    /// The sample directions towards the light (xyz, unit; w unused); the first `samples` are used.
+    pub dirs: [Vec4; crate::area::MAX_AREA_SAMPLES as usize],
+}
+
 const _: () = {
     assert!(std::mem::size_of::<GpuTriangle>() == 48);
     assert!(std::mem::size_of::<PrimBufferPush>() == 112);
     assert!(std::mem::offset_of!(PrimBufferPush, first_index) == 64);
-    assert!(std::mem::size_of::<MapPush>() == 64);
+    assert!(std::mem::size_of::<MapPush>() == 80);
+    assert!(std::mem::offset_of!(MapPush, penumbra) == 64);
+    assert!(std::mem::size_of::<AreaSamples>() == 2064);
     assert!(std::mem::offset_of!(MapPush, size) == 16);
     assert!(std::mem::size_of::<RayTraceConstants>() == 320);
     assert!(std::mem::offset_of!(RayTraceConstants, light_pos) == 208);

@@ -4,6 +4,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod area;
 mod error;
 pub mod frame_plan;
 pub mod fxaa;
@@ -24,6 +25,7 @@ pub mod shadow_pipeline;
 pub mod surface;
 pub mod view_cull;
 
+pub use area::{AreaConfig, DEFAULT_AREA_SAMPLES, MAX_AREA_SAMPLES};
 pub use error::PassError;
 pub use frame_plan::{
     FramePlan, PassId, PassStatus, PenumbraFilter, PlanRequest, ResourceId, ResourceSet,

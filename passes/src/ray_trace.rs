@@ -1,9 +1,10 @@
-//! Per-pixel shadow rays through the deep primitive map: visibility (1 = lit) and blocker distance.
+//! Per-pixel shadow rays through the deep primitive map: visibility (1 = lit) and blocker distance; or, for
+//! area shadows, the visible fraction of the light's samples (`area_trace.comp`).
 //!
 //! Reads: depth, normal, the primitive map (state, per-pixel texels, list offsets and entries), prim buffer,
-//! constants. Writes: visibility, blocker distance.
+//! constants (and the light samples, area shadows). Writes: visibility, blocker distance (hard rays only).
 
-use crate::gpu_types::{constant_buffer, RayTraceConstants};
+use crate::gpu_types::{constant_buffer, AreaSamples, RayTraceConstants};
 use crate::primitive_map::PrimitiveMap;
 use crate::{shader, PassError};
 use rhi::{
@@ -35,11 +36,25 @@ pub struct RayTraceInputs<'a> {
     pub prims: &'a Buffer,
 }
 
+/// What the ray trace computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RayTraceKind {
+    /// One shadow ray per pixel: hard visibility, and the blocker distance if `blocker_distance`.
+    Hard {
+        /// Whether the blocker distance is written.
+        blocker_distance: bool,
+    },
+    /// The visible fraction of an area light's samples ([`crate::area`]).
+    Area,
+}
+
 /// The ray-trace pass and its outputs.
 pub struct RayTracePass {
     pipeline: ComputePipeline,
     group: BindGroup,
     constants: Buffer,
+    /// The area trace's light samples (area shadows only).
+    samples: Option<Buffer>,
     /// `R32_SFLOAT` visibility, 1 = lit.
     pub visibility: Image,
     /// `R32_SFLOAT` distance from the ray origin to the nearest blocker; 0 where the receiver faces away
@@ -51,15 +66,19 @@ pub struct RayTracePass {
 
 impl RayTracePass {
     /// Creates `width` x `height` outputs: the visibility (`visibility` when given), and the blocker distance
-    /// if `blocker_distance`.
+    /// if `kind` asks for it.
     pub fn new(
         device: &Device,
         inputs: &RayTraceInputs<'_>,
         width: u32,
         height: u32,
-        blocker_distance: bool,
+        kind: RayTraceKind,
         visibility: Option<Image>,
     ) -> Result<Self, PassError> {
+        let blocker_distance = kind
+            == RayTraceKind::Hard {
+                blocker_distance: true,
+            };
         let out = |name| ImageDesc {
             name,
             format: Format::R32Float,
@@ -72,27 +91,40 @@ impl RayTracePass {
             Some(image) => image,
             None => device.create_image(&out("rt visibility"))?,
         };
-        let (blocker_distance, unused_blocker) = if blocker_distance {
-            (
+        let (blocker_distance, unused_blocker) = match kind {
+            RayTraceKind::Area => (None, None),
+            RayTraceKind::Hard { .. } if blocker_distance => (
                 Some(device.create_image(&out("rt blocker distance"))?),
                 None,
-            )
-        } else {
-            let unused = ImageDesc {
-                width: 1,
-                height: 1,
-                ..out("rt blocker distance (not stored)")
-            };
-            (None, Some(device.create_image(&unused)?))
+            ),
+            RayTraceKind::Hard { .. } => {
+                let unused = ImageDesc {
+                    width: 1,
+                    height: 1,
+                    ..out("rt blocker distance (not stored)")
+                };
+                (None, Some(device.create_image(&unused)?))
+            }
         };
-        let blocker_binding = blocker_distance
-            .as_ref()
-            .or(unused_blocker.as_ref())
-            .ok_or_else(|| PassError::InvalidConfig("no blocker image".into()))?;
+        let samples = match kind {
+            RayTraceKind::Area => Some(constant_buffer::<AreaSamples>(
+                device,
+                "area light samples",
+            )?),
+            RayTraceKind::Hard { .. } => None,
+        };
         let constants = constant_buffer::<RayTraceConstants>(device, "ray trace constants")?;
+        let (shader_name, last_binding) = match kind {
+            RayTraceKind::Area => ("area_trace.comp", BindingKind::UniformBuffer),
+            RayTraceKind::Hard { .. } => ("ray_trace.comp", BindingKind::StorageImage),
+        };
         let pipeline = device.create_compute_pipeline(
-            "ray trace",
-            &shader("ray_trace.comp")?,
+            if samples.is_some() {
+                "area trace"
+            } else {
+                "ray trace"
+            },
+            &shader(shader_name)?,
             &[
                 BindingKind::UniformBuffer,
                 BindingKind::SampledImage,
@@ -103,11 +135,18 @@ impl RayTracePass {
                 BindingKind::StorageBuffer,
                 BindingKind::StorageBuffer,
                 BindingKind::StorageImage,
-                BindingKind::StorageImage,
+                last_binding,
             ],
             0,
         )?;
         let b = Resource::Buffer;
+        let last = match (&samples, &blocker_distance, &unused_blocker) {
+            (Some(samples), _, _) => b(samples),
+            (None, Some(image), _) | (None, None, Some(image)) => Resource::Image(image),
+            (None, None, None) => {
+                return Err(PassError::InvalidConfig("no blocker image".into()));
+            }
+        };
         let group = device.create_bind_group(
             pipeline.layout(),
             &[
@@ -120,13 +159,14 @@ impl RayTracePass {
                 b(&inputs.map.entries),
                 b(inputs.prims),
                 Resource::Image(&visibility),
-                Resource::Image(blocker_binding),
+                last,
             ],
         )?;
         Ok(Self {
             pipeline,
             group,
             constants,
+            samples,
             visibility,
             blocker_distance,
             unused_blocker,
@@ -149,15 +189,28 @@ impl RayTracePass {
         Ok(std::mem::replace(&mut self.group, group))
     }
 
-    /// Records the constants' update (into the command buffer) and the pass.
+    /// Records the constants' update (into the command buffer) and the pass; an area trace also updates
+    /// its light samples from `samples`.
     pub fn record(
         &mut self,
         enc: &mut Encoder<'_>,
         constants: &RayTraceConstants,
+        samples: Option<&AreaSamples>,
     ) -> Result<(), PassError> {
         let mut constants = *constants;
         constants.misc.z = u32::from(self.blocker_distance.is_some());
         enc.update_buffer(&self.constants, 0, bytemuck::bytes_of(&constants))?;
+        match (&self.samples, samples) {
+            (Some(buffer), Some(samples)) => {
+                enc.update_buffer(buffer, 0, bytemuck::bytes_of(samples))?;
+            }
+            (None, None) => {}
+            _ => {
+                return Err(PassError::InvalidConfig(
+                    "light samples are given to an area trace, and to it alone".into(),
+                ))
+            }
+        }
         enc.begin_pass("ray trace");
         if let Some(unused) = &self.unused_blocker {
             // Bound as a storage image, so in the storage layout, though never written.

@@ -9,7 +9,7 @@
 
 // Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 // version differs.
-#define HRTS_API_VERSION ((5 << 22) | (4 << 12))
+#define HRTS_API_VERSION ((5 << 22) | (5 << 12))
 
 // The most lights one context shades (`hrts_configure_lights`); a point light counts once.
 #define HRTS_MAX_LIGHTS 64
@@ -147,6 +147,10 @@ enum HrtsShadowMode
   HRTS_SHADOW_MODE_SOFT = 2,
   // The talk's hybrid: lerp(ray-traced, PCSS, saturate(BD / WSS * PHS)).
   HRTS_SHADOW_MODE_HYBRID = 3,
+  // Exact soft shadows of a sized directional light (`pcss_angular_radius`): the visible fraction of
+  // `area_samples` light samples per pixel, each tested exactly against the triangles the primitive map
+  // lists, widened by their penumbra. Noise-free and deterministic; compute binning only.
+  HRTS_SHADOW_MODE_AREA = 4,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -564,6 +568,8 @@ typedef struct HrtsConfig {
   // 1024; at most six per triangle). A frame that keeps more traces the light exhaustively (exact, slower; `bin_pairs` in the
   // frame report) and the pairs grow to fit from the next frame on.
   uint32_t map_initial_pairs;
+  // Area shadows: light samples per pixel, 1..=128 (default 64).
+  uint32_t area_samples;
 } HrtsConfig;
 
 // One draw of the geometry.

@@ -379,11 +379,12 @@ fn taps(value: u32, field: &str) -> ApiResult<u32> {
 }
 
 /// `HrtsShadowMode` values and the modes they name (both directions use this one table).
-const MODES: [(u32, ShadowMode); 4] = [
+const MODES: [(u32, ShadowMode); 5] = [
     (HrtsShadowMode::None as u32, ShadowMode::None),
     (HrtsShadowMode::Hard as u32, ShadowMode::Hard),
     (HrtsShadowMode::Soft as u32, ShadowMode::Soft),
     (HrtsShadowMode::Hybrid as u32, ShadowMode::Hybrid),
+    (HrtsShadowMode::Area as u32, ShadowMode::Area),
 ];
 
 /// `HrtsFaces` values.
@@ -506,6 +507,10 @@ pub(crate) fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
         "hybrid_hard_shadow_percentage",
     )?;
     config.pcss.validate()?;
+    config.area.samples = c.area_samples;
+    if mode == ShadowMode::Area {
+        config.area.validate(config.pcss.angular_radius)?;
+    }
     Ok(config)
 }
 
@@ -548,6 +553,7 @@ pub(crate) fn config_to_c(config: &ShadowConfig) -> ApiResult<HrtsConfig> {
         debug_bin_all_texels: (!config.map.receiver_culling).into(),
         map_initial_entries: config.map.initial_entries,
         map_initial_pairs: config.map.initial_pairs,
+        area_samples: config.area.samples,
     })
 }
 

@@ -6,7 +6,7 @@ use std::ffi::c_char;
 
 /// Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 /// version differs.
-pub const HRTS_API_VERSION: u32 = 5 << 22 | 4 << 12;
+pub const HRTS_API_VERSION: u32 = 5 << 22 | 5 << 12;
 
 /// A flag in the C structs: 0 is false, any other value true. (A Rust `bool` would make any byte but 0
 /// and 1 undefined behaviour when the engine writes it.)
@@ -247,6 +247,10 @@ pub enum HrtsShadowMode {
     Soft = 2,
     /// The talk's hybrid: lerp(ray-traced, PCSS, saturate(BD / WSS * PHS)).
     Hybrid = 3,
+    /// Exact soft shadows of a sized directional light (`pcss_angular_radius`): the visible fraction of
+    /// `area_samples` light samples per pixel, each tested exactly against the triangles the primitive map
+    /// lists, widened by their penumbra. Noise-free and deterministic; compute binning only.
+    Area = 4,
 }
 
 /// Light type.
@@ -472,6 +476,8 @@ pub struct HrtsConfig {
     /// 1024; at most six per triangle). A frame that keeps more traces the light exhaustively (exact, slower; `bin_pairs` in the
     /// frame report) and the pairs grow to fit from the next frame on.
     pub map_initial_pairs: u32,
+    /// Area shadows: light samples per pixel, 1..=128 (default 64).
+    pub area_samples: u32,
 }
 
 /// One draw of the geometry.

@@ -12,7 +12,10 @@
 //!   hybrid ray-traced shadows);
 //! - [`soft_visibility`]: soft-shadow ground truth, the visible fraction of an
 //!   [`AreaLight`] per pixel by stratified Monte Carlo with a stated error bound,
-//!   exact where the light's cone is provably clear.
+//!   exact where the light's cone is provably clear;
+//! - [`area_reference`]: the visible count of a fixed set of light samples per pixel, each sample an
+//!   exact hard shadow ray, with the pixels whose every sample is decided beyond the tolerance marked
+//!   stable (what the GPU's area shadows must match exactly).
 //!
 //! All are built on [`intersect_watertight`] (Woop, Benthin and Wald's watertight
 //! ray/triangle test), exact orientation predicates, and a BVH over the scene
@@ -29,6 +32,7 @@
 
 #![forbid(unsafe_code)]
 
+mod area;
 mod exact;
 mod geometry;
 mod predicates;
@@ -40,6 +44,7 @@ mod visibility;
 #[cfg(test)]
 mod tests;
 
+pub use area::{area_reference, AreaReference};
 pub use geometry::{intersect_watertight, line_segment_distance};
 pub use predicates::{certainly_blocked, contact_shadow_start};
 pub use ref_scene::RefScene;

@@ -1,14 +1,16 @@
 //! Creating a pipeline: the passes and resources its frame plan needs.
 
 use super::{FrameSlot, ShadowConfig, ShadowInputs, ShadowPipeline, MAX_FRAMES_IN_FLIGHT};
-use crate::frame_plan::{FramePlan, HardEdge, PassId, PenumbraFilter, ResourceId, ResourceSet};
+use crate::frame_plan::{
+    FramePlan, HardEdge, PassId, PenumbraFilter, ResourceId, ResourceSet, ShadowMode,
+};
 use crate::fxaa::FxaaPass;
 use crate::gpu_types::MapState;
 use crate::hybrid::{BlendPass, LerpFactorPass};
 use crate::pcss::{PcssInputs, PcssKind, PcssPass};
 use crate::prim_buffer::{Geometry, SharedGeometry};
 use crate::primitive_map::{choose_binning_path, BinningPath, PrimitiveMap, PrimitiveMapInputs};
-use crate::ray_trace::{RayTraceInputs, RayTracePass};
+use crate::ray_trace::{RayTraceInputs, RayTraceKind, RayTracePass};
 use crate::retire::RetireQueue;
 use crate::screen_pass::visibility_image;
 use crate::shadow_map::ShadowMapPass;
@@ -73,6 +75,16 @@ impl ShadowPipeline {
         let caps = device.capabilities();
         config.map.validate(caps)?;
         config.shadow_map.validate(caps)?;
+        if config.mode == ShadowMode::Area {
+            config.area.validate(config.pcss.angular_radius)?;
+            if choose_binning_path(caps, config.map.binning)? != BinningPath::Compute {
+                return Err(PassError::InvalidConfig(
+                    "area shadows widen each triangle's footprint per texel, which compute binning does: \
+                     request BinningRequest::Compute or Auto"
+                        .into(),
+                ));
+            }
+        }
         config.pcss.validate()?;
         config.hybrid.validate()?;
         let plan = FramePlan::derive(config.plan_request());
@@ -139,8 +151,15 @@ impl ShadowPipeline {
                 },
                 width,
                 height,
-                plan.writes(PassId::RayTrace)
-                    .contains(ResourceId::BlockerDistance),
+                if config.mode == ShadowMode::Area {
+                    RayTraceKind::Area
+                } else {
+                    RayTraceKind::Hard {
+                        blocker_distance: plan
+                            .writes(PassId::RayTrace)
+                            .contains(ResourceId::BlockerDistance),
+                    }
+                },
                 direct_for(ResourceId::RtVisibility),
             )?),
             _ => None,

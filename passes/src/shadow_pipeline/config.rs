@@ -1,6 +1,7 @@
 //! What a pipeline is asked to compute ([`ShadowConfig`]), for which camera and light ([`FrameInputs`]),
 //! from which engine images ([`ShadowInputs`]).
 
+use crate::area::AreaConfig;
 use crate::frame_plan::{PlanRequest, ResourceSet, ShadowMode};
 use crate::hybrid::HybridConfig;
 use crate::light::Light;
@@ -27,7 +28,7 @@ pub struct FrameInputs {
     pub light: Light,
 }
 
-/// What the pipeline computes and how: the requested outputs (per light: none, hard, soft or hybrid;
+/// What the pipeline computes and how: the requested outputs (per light: none, hard, soft, hybrid or area;
 /// antialiasing), what may be cached across frames, and the settings of each technique.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShadowConfig {
@@ -49,6 +50,8 @@ pub struct ShadowConfig {
     pub pcss: PcssConfig,
     /// The hybrid blend.
     pub hybrid: HybridConfig,
+    /// Area shadows (the light's size is `pcss.angular_radius`, as for PCSS and the hybrid).
+    pub area: AreaConfig,
     /// Resources to produce besides the final output (comparison views, debug images, a host G-buffer
     /// drawing the prim buffer). Empty by default.
     pub extra_outputs: ResourceSet,
@@ -73,6 +76,7 @@ impl Default for ShadowConfig {
             shadow_map: ShadowMapConfig::default(),
             pcss: PcssConfig::default(),
             hybrid: HybridConfig::default(),
+            area: AreaConfig::default(),
             extra_outputs: ResourceSet::EMPTY,
             frames_in_flight: 3,
         }

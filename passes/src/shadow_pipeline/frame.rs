@@ -3,7 +3,8 @@
 use super::{
     camera_in_frame, camera_relative, FrameConstants, FrameInputs, FrameState, ShadowPipeline,
 };
-use crate::frame_plan::{PassId, PassStatus, ResourceId, ResourceSet, SkipReason};
+use crate::area::area_samples;
+use crate::frame_plan::{PassId, PassStatus, ResourceId, ResourceSet, ShadowMode, SkipReason};
 use crate::gpu_types::{MapPush, PcssConstants, RayTraceConstants};
 use crate::light::{Light, LightFrame};
 use crate::prim_buffer::PrimBufferClaim;
@@ -53,19 +54,35 @@ impl ShadowPipeline {
         let surface =
             surface::surface_vector(inputs.proj, self.depth_format, self.normal_precision);
         let pc = self.config.pcss;
+        let area = self.config.mode == ShadowMode::Area;
+        if area && light.position.is_some() {
+            return Err(PassError::InvalidConfig(format!(
+                "area shadows are computed for directional lights; this frame gave a {} light (use mode hybrid or soft for it)",
+                inputs.light.kind_name()
+            )));
+        }
+        let penumbra = if area { pc.angular_radius.tan() } else { 0.0 };
         Ok(FrameConstants {
             light,
+            area: area.then(|| {
+                Box::new(area_samples(
+                    dir,
+                    pc.angular_radius,
+                    self.config.area.samples,
+                ))
+            }),
             map: MapPush {
                 to_light: (-dir).extend(if light.position.is_some() { 1.0 } else { 0.0 }),
                 size: cfg.size,
                 front_only,
+                penumbra,
                 ..MapPush::zeroed()
             },
             ray: RayTraceConstants {
                 inv_view_proj_rel,
                 light_view_proj: light.view_proj,
                 camera_pos: camera_frame.extend(1.0),
-                light_dir: dir.extend(0.0),
+                light_dir: dir.extend(penumbra),
                 dims: UVec4::new(self.width, self.height, cfg.size, 0),
                 offset: Vec4::new(
                     radians_per_pixel,
@@ -73,7 +90,12 @@ impl ShadowPipeline {
                     RAY_OFFSET_FLOAT_BOUND,
                     self.depth_format.depth_quantum(),
                 ),
-                misc: UVec4::new(front_only, self.geometry().triangle_count(), 0, 0),
+                misc: UVec4::new(
+                    front_only,
+                    self.geometry().triangle_count(),
+                    0,
+                    if area { self.config.area.samples } else { 0 },
+                ),
                 light_pos: light.position.map_or(Vec4::ZERO, |p| p.extend(1.0)),
                 view_to_world,
                 surface_mode: self.surface_mode,

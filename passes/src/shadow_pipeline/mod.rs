@@ -22,7 +22,7 @@ pub use report::{FrameReport, ResourceReport};
 
 use crate::frame_plan::{FramePlan, PassId, PassStatus, ResourceId, ResourceSet};
 use crate::fxaa::FxaaPass;
-use crate::gpu_types::{MapPush, PcssConstants, RayTraceConstants};
+use crate::gpu_types::{AreaSamples, MapPush, PcssConstants, RayTraceConstants};
 use crate::hybrid::{BlendPass, LerpFactorPass};
 use crate::light::{rebased, Light, LightFrame};
 use crate::pcss::PcssPass;
@@ -42,6 +42,8 @@ struct FrameConstants {
     map: MapPush,
     ray: RayTraceConstants,
     pcss: PcssConstants,
+    /// The light samples of an area trace (area shadows only).
+    area: Option<Box<AreaSamples>>,
 }
 
 /// A frame begun and being recorded.

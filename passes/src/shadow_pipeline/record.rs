@@ -252,7 +252,7 @@ impl ShadowPipeline {
                 }
                 self.outputs_to_uav(enc, pass);
                 if let Some(ray) = self.ray.as_mut() {
-                    ray.record(enc, &c.ray)?;
+                    ray.record(enc, &c.ray, c.area.as_deref())?;
                 }
             }
             PassId::ShadowMapTest => {

@@ -1,0 +1,64 @@
+//! The exact reference of area shadows with a fixed set of light samples: per pixel, how many of the sample
+//! directions reach the light, each decided by [`reference_visibility`] as a hard shadow ray of its own, and
+//! whether every one of them is decided beyond the tolerance (a stable pixel).
+
+use glam::DVec3;
+
+use crate::{reference_visibility, Light, PixelClass, RefScene, VisibilityParams};
+
+/// Visible sample counts of every pixel; row-major with `y = 0` the top row, like
+/// [`crate::VisibilityReference`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct AreaReference {
+    /// Framebuffer width in pixels.
+    pub width: u32,
+    /// Framebuffer height in pixels.
+    pub height: u32,
+    /// Samples per pixel.
+    pub samples: u32,
+    /// Samples that reach the light (all of them on background pixels).
+    pub visible: Vec<u32>,
+    /// Whether no sample of the pixel is [`PixelClass::Ambiguous`]: its count is exact.
+    pub stable: Vec<bool>,
+    /// Whether the camera ray hits nothing.
+    pub background: Vec<bool>,
+}
+
+/// The visible count of each pixel of `params`' view over the sample directions `towards_light` (each the
+/// direction from a receiver *towards* the light, as the area trace holds them; `params.light` is
+/// replaced). A sample is visible where [`reference_visibility`] calls the pixel lit for a directional light
+/// travelling along its opposite.
+pub fn area_reference(
+    scene: &RefScene,
+    params: &VisibilityParams,
+    towards_light: &[DVec3],
+) -> AreaReference {
+    let pixels = params.width as usize * params.height as usize;
+    let mut out = AreaReference {
+        width: params.width,
+        height: params.height,
+        samples: towards_light.len() as u32,
+        visible: vec![0; pixels],
+        stable: vec![true; pixels],
+        background: vec![false; pixels],
+    };
+    for &w in towards_light {
+        let per_sample = VisibilityParams {
+            light: Light::Directional { direction: -w },
+            ..*params
+        };
+        let r = reference_visibility(scene, &per_sample);
+        for (i, class) in r.class.iter().enumerate() {
+            match class {
+                PixelClass::Background => {
+                    out.background[i] = true;
+                    out.visible[i] += 1;
+                }
+                PixelClass::Lit => out.visible[i] += 1,
+                PixelClass::Shadowed => {}
+                PixelClass::Ambiguous => out.stable[i] = false,
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,261 @@
+//! Area shadows (exact soft shadows of a sized directional light) on lavapipe, against the exact
+//! reference of the same light samples: every sample of every stable pixel decided as the reference decides
+//! it (0 mismatched counts), on contact, thin plates and a fence of slats, foliage cards, overlapping
+//! occluders, a closed mesh through shared edges, the demo scene translated 1e4 from the origin, and tiny
+//! and large lights. Each comparison must see penumbra pixels (a test that cannot fail is no test). The
+//! output is deterministic bit for bit, and invalid light sizes and sample counts are rejected with a
+//! clear error.
+
+mod common;
+
+use common::{assert_no_validation_errors, device, plate_and_box_view};
+use glam::Vec3;
+use host_demo::accuracy::{compare_area, AreaComparison};
+use host_demo::{FrameImages, ShadowRenderer, View};
+use passes::{
+    AreaConfig, BinningRequest, FaceMode, FrameReport, PcssConfig, PrimitiveMapConfig,
+    ShadowConfig, ShadowMode,
+};
+use reference::RefScene;
+use rhi::Device;
+use scene::hard_cases::{family, Family, HardCase};
+use scene::{Camera, DirectionalLight, Scene};
+
+/// Test frames are downscaled from the hard cases' 193x145 so that the reference's N passes stay short.
+const WIDTH: u32 = 96;
+const HEIGHT: u32 = 72;
+
+fn area_config(angular_radius: f32, samples: u32, faces: FaceMode) -> ShadowConfig {
+    ShadowConfig {
+        mode: ShadowMode::Area,
+        antialiasing: false,
+        map: PrimitiveMapConfig {
+            size: 128,
+            faces,
+            binning: BinningRequest::Compute,
+            ..PrimitiveMapConfig::default()
+        },
+        pcss: PcssConfig {
+            angular_radius,
+            ..PcssConfig::default()
+        },
+        area: AreaConfig { samples },
+        ..ShadowConfig::default()
+    }
+}
+
+fn render(device: &Device, view: &View, config: ShadowConfig) -> (FrameReport, FrameImages) {
+    let geometry = view.upload(device).expect("upload");
+    let mut r =
+        ShadowRenderer::new(device, geometry, view.width, view.height, config).expect("renderer");
+    let report = r.render(device, &view.frame_inputs()).expect("render");
+    (report, r.read_back(device, false).expect("read back"))
+}
+
+/// Renders `view` in area mode and compares it with the reference; asserts exactness, at least
+/// `min_penumbra` stable penumbra pixels to judge, and at most a quarter of the frame unstable.
+fn check(
+    device: &Device,
+    name: &str,
+    view: &View,
+    (angular_radius, samples): (f32, u32),
+    faces: FaceMode,
+    min_penumbra: usize,
+) -> AreaComparison {
+    let config = area_config(angular_radius, samples, faces);
+    let (report, images) = render(device, view, config);
+    let rs = RefScene::new(&view.scene);
+    let c = compare_area(&rs, view, angular_radius, samples, &images.output);
+    println!(
+        "{name}: r {angular_radius}, {samples} samples: {} px, {} unstable, {} penumbra, {} umbra, {} mismatches; map {} entries, longest list {}, {} texels past capacity",
+        c.pixels, c.unstable, c.penumbra, c.umbra, c.mismatches, report.stats.entries,
+        report.stats.longest_list, report.stats.texels_past_capacity
+    );
+    assert_eq!(c.non_finite, 0, "{name}: values that are no count");
+    assert_eq!(
+        c.mismatches, 0,
+        "{name}: stable pixels whose visible count differs (x, y, reference, GPU): {:?}",
+        c.examples
+    );
+    assert!(
+        c.penumbra >= min_penumbra,
+        "{name}: only {} stable penumbra pixels judged",
+        c.penumbra
+    );
+    assert!(
+        c.unstable * 4 <= c.pixels,
+        "{name}: {} of {} pixels unstable",
+        c.unstable,
+        c.pixels
+    );
+    assert_no_validation_errors(device);
+    c
+}
+
+/// The hard case `name` of family `f`, framed as `host_demo hardcases` frames it, at the test size.
+fn hard_case_view(f: Family, name: &str) -> (View, FaceMode) {
+    let case: HardCase = family(f, &common::models())
+        .into_iter()
+        .find(|c| c.name == name)
+        .unwrap_or_else(|| panic!("no hard case named {name}"));
+    let scene = case.scene.expect("scene");
+    let mut view = View::framed(scene, WIDTH, HEIGHT);
+    view.light = DirectionalLight::new(case.light_direction).expect("light");
+    if let Some(camera) = case.camera {
+        view.camera = camera;
+    }
+    let faces = if case.map.front_faces_only {
+        FaceMode::FrontOnly
+    } else {
+        FaceMode::Both
+    };
+    (view, faces)
+}
+
+#[test]
+fn contact_shadows_match_the_reference_sample_for_sample() {
+    let device = device();
+    let name = "contact 80°";
+    let (view, faces) = hard_case_view(Family::Contact, name);
+    check(&device, name, &view, (0.1, 32), faces, 20);
+}
+
+#[test]
+fn thin_plates_fence_slats_and_foliage_cards() {
+    let device = device();
+    for name in ["thin closed plates", "foliage cards"] {
+        let (view, faces) = hard_case_view(Family::ThinGeometry, name);
+        check(&device, name, &view, (0.1, 32), faces, 20);
+    }
+}
+
+#[test]
+fn a_closed_mesh_leaks_no_sample_through_its_shared_edges() {
+    let device = device();
+    let name = "closed UV sphere (front faces only)";
+    let (view, faces) = hard_case_view(Family::SharedEdges, name);
+    assert_eq!(faces, FaceMode::FrontOnly);
+    check(&device, name, &view, (0.1, 32), faces, 20);
+}
+
+/// Two plates overlapping as seen from the light at different heights: where both cover parts of the
+/// light, the samples they block together (occluder fusion) are counted once.
+#[test]
+fn overlapping_occluders_fuse() {
+    let device = device();
+    let mut scene = Scene::default();
+    for (name, min, max) in [
+        (
+            "ground",
+            Vec3::new(-3.0, -0.05, -3.0),
+            Vec3::new(3.0, 0.0, 3.0),
+        ),
+        (
+            "low plate",
+            Vec3::new(-1.0, 0.6, -0.8),
+            Vec3::new(0.2, 0.62, 0.4),
+        ),
+        (
+            "high plate",
+            Vec3::new(-0.3, 1.2, -0.3),
+            Vec3::new(0.9, 1.22, 0.9),
+        ),
+    ] {
+        scene.append(&Scene::axis_box(name, min, max));
+    }
+    let mut view = plate_and_box_view(WIDTH, HEIGHT);
+    view.scene = scene;
+    check(
+        &device,
+        "overlapping plates",
+        &view,
+        (0.1, 64),
+        FaceMode::Both,
+        20,
+    );
+}
+
+#[test]
+fn tiny_and_large_lights() {
+    let device = device();
+    let mut view = plate_and_box_view(WIDTH, HEIGHT);
+    let large = check(
+        &device,
+        "large light",
+        &view,
+        (0.2, 128),
+        FaceMode::Both,
+        20,
+    );
+    // A penumbra 15 mm wide, the plate's shadow edge seen from half a metre (6 mm pixels).
+    view.camera = Camera {
+        position: Vec3::new(-0.275, 0.5, 1.3),
+        target: Vec3::new(-0.275, 0.0, 0.9),
+        up: Vec3::Y,
+        fov_y_radians: 45f32.to_radians(),
+        near: 0.01,
+    };
+    let tiny = check(
+        &device,
+        "tiny light",
+        &view,
+        (0.005, 16),
+        FaceMode::Both,
+        20,
+    );
+    assert!(large.penumbra > 0 && tiny.penumbra > 0);
+}
+
+#[test]
+fn the_demo_scene_1e4_from_the_origin() {
+    let device = device();
+    let name = "translated by 1e4";
+    let (view, faces) = hard_case_view(Family::Scale, name);
+    check(&device, name, &view, (0.3, 32), faces, 20);
+}
+
+#[test]
+fn the_same_input_gives_the_same_output_bit_for_bit() {
+    let device = device();
+    let view = plate_and_box_view(WIDTH, HEIGHT);
+    let config = area_config(0.05, 64, FaceMode::Both);
+    let a = render(&device, &view, config).1.output;
+    let b = render(&device, &view, config).1.output;
+    assert!(a.iter().any(|&v| v > 0.0 && v < 1.0), "no penumbra");
+    assert_eq!(
+        a.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+        b.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+    );
+    assert_no_validation_errors(&device);
+}
+
+#[test]
+fn invalid_light_sizes_and_sample_counts_are_rejected() {
+    let device = device();
+    let view = plate_and_box_view(32, 24);
+    for (radius, samples, what) in [
+        (0.0, 32, "angular radius"),
+        (f32::NAN, 32, "angular radius"),
+        (2.0, 32, "angular radius"),
+        (0.02, 0, "light samples"),
+        (0.02, 129, "light samples"),
+    ] {
+        let geometry = view.upload(&device).expect("upload");
+        let config = area_config(radius, samples, FaceMode::Both);
+        let err = ShadowRenderer::new(&device, geometry, view.width, view.height, config)
+            .err()
+            .unwrap_or_else(|| panic!("r {radius}, {samples} samples accepted"))
+            .to_string();
+        assert!(err.contains(what), "{err}");
+    }
+    // Area shadows need compute binning.
+    let geometry = view.upload(&device).expect("upload");
+    let mut config = area_config(0.02, 32, FaceMode::Both);
+    config.map.binning = BinningRequest::Software;
+    let err = ShadowRenderer::new(&device, geometry, view.width, view.height, config)
+        .err()
+        .expect("software binning accepted")
+        .to_string();
+    assert!(err.contains("compute binning"), "{err}");
+    assert_no_validation_errors(&device);
+}
