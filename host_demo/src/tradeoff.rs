@@ -1,6 +1,6 @@
 //! `host_demo tradeoff`: what accuracy costs in time, for the shadows users see. Every method and setting
-//! the plugin offers (classic shadow maps, PCF, PCSS, ray-traced hard shadows, the hybrid) renders one view
-//! through the C ABI. Each result is compared with a ground-truth soft shadow: the visible fraction of the
+//! the plugin offers (classic shadow maps, PCF, PCSS, ray-traced hard shadows, the hybrid, area shadows)
+//! renders one view through the C ABI. Each result is compared with a ground-truth soft shadow: the visible fraction of the
 //! light's extent per pixel, integrated on the CPU by stratified Monte Carlo over the exact f64 scene
 //! (`reference::soft_visibility`). The sweep reports error metrics users know, GPU time and memory, and
 //! writes CSV, JSON, an error-against-time plot with the Pareto front marked, and a strip of error maps.
@@ -13,7 +13,7 @@ use crate::report::{model_view, render_frames};
 use crate::View;
 use anyhow::{bail, Context, Result};
 use passes::{
-    HybridConfig, PcssConfig, PenumbraFilter, PrimitiveMapConfig, ResourceId, ResourceSet,
+    AreaConfig, HybridConfig, PcssConfig, PenumbraFilter, PrimitiveMapConfig, ResourceId, ResourceSet,
     ShadowConfig, ShadowMapConfig, ShadowMode,
 };
 use plotters::prelude::*;
@@ -75,6 +75,9 @@ pub struct Method {
     passes: &'static [&'static str],
 }
 
+/// The method families, in the order of the plot's legend and the error maps.
+const FAMILIES: [&str; 6] = ["shadow map", "PCF", "PCSS", "ray traced", "hybrid", "area"];
+
 const SHADOW_MAP_PASSES: &[&str] = &["shadow map"];
 const SOFT_PASSES: &[&str] = &["shadow map", "PCSS"];
 const TRACED_PASSES: &[&str] = &["primitive map", "occupancy", "ray trace", "FXAA"];
@@ -90,8 +93,8 @@ const HYBRID_PASSES: &[&str] = &[
 ];
 
 /// The sweep: shadow maps 1K–8K with the classic test and with PCF, PCSS (standard and shrinking, two tap
-/// counts, two map sizes), ray-traced hard shadows with and without FXAA, and the hybrid over several WSS
-/// and PHS. `wss` is the scene's default world-space scale.
+/// counts, two map sizes), ray-traced hard shadows with and without FXAA, the hybrid over several WSS
+/// and PHS, and area shadows with 16 to 128 light samples. `wss` is the scene's default world-space scale.
 pub fn methods(angular_radius: f32, wss: f32) -> Vec<Method> {
     let pcss = |filter, search: u32, pcf: u32| PcssConfig {
         angular_radius,
@@ -203,6 +206,22 @@ pub fn methods(angular_radius: f32, wss: f32) -> Vec<Method> {
             },
             output: Output::Final,
             passes: HYBRID_PASSES,
+        });
+    }
+    // Exact soft shadows: the visible fraction of N fixed light samples, no filter.
+    for samples in [16, 32, 64, 128] {
+        out.push(Method {
+            family: "area",
+            name: format!("{samples} samples, 1024² map"),
+            config: ShadowConfig {
+                mode: ShadowMode::Area,
+                map: PrimitiveMapConfig::default(),
+                pcss: pcss(PenumbraFilter::Standard, 16, 32),
+                area: AreaConfig { samples },
+                ..base
+            },
+            output: Output::Final,
+            passes: TRACED_PASSES,
         });
     }
     out
@@ -546,15 +565,15 @@ impl Sweep {
             .x_desc("GPU ms (log scale)")
             .y_desc("mean absolute error of visibility")
             .draw()?;
-        let families = ["shadow map", "PCF", "PCSS", "ray traced", "hybrid"];
         let colours = [
             RGBColor(120, 120, 120),
             RGBColor(31, 119, 180),
             RGBColor(44, 160, 44),
             RGBColor(214, 39, 40),
             RGBColor(148, 103, 189),
+            RGBColor(255, 127, 14),
         ];
-        for (family, colour) in families.iter().zip(colours) {
+        for (family, colour) in FAMILIES.iter().zip(colours) {
             let points: Vec<(f64, f64)> = finite
                 .iter()
                 .filter(|r| r.family == *family)
@@ -590,7 +609,7 @@ impl Sweep {
         let scale = self.width.div_ceil(640).max(1);
         let (w, h) = (self.width / scale, self.height / scale);
         let mut picks: Vec<usize> = Vec::new();
-        for family in ["shadow map", "PCF", "PCSS", "ray traced", "hybrid"] {
+        for family in FAMILIES {
             if let Some((i, _)) = self
                 .rows
                 .iter()

@@ -1,7 +1,8 @@
 //! `host_demo tradeoff` on a contact-hardening scene (a plate high above the ground and a box standing on
 //! it), on lavapipe: the numbers are checked, never the timings. The ground-truth soft shadow converges;
 //! soft shadows beat hard ones against it; the hybrid beats the hard shadow it starts from; more PCSS taps
-//! and the standard penumbra move PCSS towards the truth; the outputs (CSV, JSON, the Pareto plot, the
+//! and the standard penumbra move PCSS towards the truth; area shadows at 64 samples beat every other
+//! family, and more samples move them towards the truth; the outputs (CSV, JSON, the Pareto plot, the
 //! error maps) are written and consistent with the table.
 
 mod common;
@@ -116,6 +117,21 @@ fn soft_shadows_approach_the_truth_and_the_outputs_are_written() {
     // The standard penumbra, which straddles the hard edge as a physical one does, beats the shrinking
     // one, which grows inwards only.
     assert!(error("PCSS 3072², standard, 16+32 taps") < error("PCSS 3072², shrinking, 16+32 taps"));
+    // Area shadows: exact soft shadows at 64 samples are closer to the truth than every other family's
+    // best, and more samples never move them away from it (beyond the truth's own noise).
+    let area = [16, 32, 64, 128].map(|n| error(&format!("area {n} samples, 1024² map")));
+    for family in ["shadow map", "PCF", "PCSS", "ray traced", "hybrid"] {
+        assert!(
+            area[2] < best(family),
+            "area 64 samples {} ≥ best {family} {}",
+            area[2],
+            best(family)
+        );
+    }
+    assert!(
+        area.windows(2).all(|w| w[1] <= w[0] + noise) && area[3] < area[0],
+        "area errors by 16, 32, 64, 128 samples: {area:?}"
+    );
     for row in sweep.rows() {
         assert!(
             row.mean_abs_error.is_finite()
