@@ -60,12 +60,22 @@ pub struct BenchArgs {
     /// normals), with the G-buffer's and the plugin's GPU ms on each model.
     #[arg(long, conflicts_with = "lights")]
     pub gbuffer: bool,
+    /// Instead of the shadow table: exact soft shadows (mode area) against PCSS with an 8K shadow map on
+    /// each model, with lists and memory, and how their cost grows with the light's size and samples.
+    #[arg(long, conflicts_with_all = ["lights", "gbuffer"])]
+    pub area: bool,
+    /// With --area: the light's angular radius in radians.
+    #[arg(long, default_value_t = 0.02)]
+    pub angular_radius: f32,
+    /// With --area: light samples per pixel.
+    #[arg(long, default_value_t = passes::DEFAULT_AREA_SAMPLES)]
+    pub area_samples: u32,
 }
 
 /// One benchmark model: a file of `../shared/models`, how it is shown, and the talk's GTX 980 times (ms)
 /// for its three models.
-struct Model {
-    file: &'static str,
+pub(crate) struct Model {
+    pub(crate) file: &'static str,
     ground: bool,
     /// Camera position and target (default: framed).
     camera: Option<(Vec3, Vec3)>,
@@ -179,7 +189,23 @@ pub fn median_of(t: &BTreeMap<String, f64>, prefixes: &[&str]) -> Option<f64> {
         .sum()
 }
 
-fn view_of(model: &Model, models: &Path, args: &BenchArgs) -> Result<View> {
+/// The models folder of `args` (`--models`, else the shared one).
+pub(crate) fn models_folder(args: &BenchArgs) -> Result<PathBuf> {
+    match &args.models {
+        Some(dir) => Ok(dir.clone()),
+        None => scene::models_dir().map_err(anyhow::Error::msg),
+    }
+}
+
+/// The benchmark models `--only` keeps.
+pub(crate) fn chosen_models(args: &BenchArgs) -> Vec<&'static Model> {
+    MODELS
+        .iter()
+        .filter(|m| args.only.is_empty() || args.only.iter().any(|o| m.file.contains(o.as_str())))
+        .collect()
+}
+
+pub(crate) fn view_of(model: &Model, models: &Path, args: &BenchArgs) -> Result<View> {
     let path = models.join(model.file);
     let mut scene =
         scene::load_obj(&path).with_context(|| format!("loading {}", path.display()))?;
@@ -202,7 +228,7 @@ fn view_of(model: &Model, models: &Path, args: &BenchArgs) -> Result<View> {
     Ok(view)
 }
 
-fn frames_of(
+pub(crate) fn frames_of(
     device: &Device,
     view: &View,
     config: ShadowConfig,
@@ -357,15 +383,9 @@ fn scene_row(m: &Measured) -> String {
 
 /// Runs every model and returns the Markdown tables.
 pub fn run_bench(device: &Device, args: &BenchArgs) -> Result<String> {
-    let models = match &args.models {
-        Some(dir) => dir.clone(),
-        None => scene::models_dir().map_err(anyhow::Error::msg)?,
-    };
+    let models = models_folder(args)?;
     let caps = device.capabilities();
-    let chosen: Vec<&Model> = MODELS
-        .iter()
-        .filter(|m| args.only.is_empty() || args.only.iter().any(|o| m.file.contains(o.as_str())))
-        .collect();
+    let chosen = chosen_models(args);
     let bar = crate::progress(chosen.len() as u64, "bench");
     let mut measured = Vec::new();
     for model in chosen {
@@ -411,16 +431,10 @@ pub fn run_bench(device: &Device, args: &BenchArgs) -> Result<String> {
 /// The G-buffer table: per model, the demo's G-buffer pass and the plugin's passes (medians, ms) with the
 /// analysis G-buffer and with a compact one.
 pub fn run_gbuffer_bench(device: &Device, args: &BenchArgs) -> Result<String> {
-    let models = match &args.models {
-        Some(dir) => dir.clone(),
-        None => scene::models_dir().map_err(anyhow::Error::msg)?,
-    };
+    let models = models_folder(args)?;
     let caps = device.capabilities();
     let compact = GBufferLayout::compact(device);
-    let chosen: Vec<&Model> = MODELS
-        .iter()
-        .filter(|m| args.only.is_empty() || args.only.iter().any(|o| m.file.contains(o.as_str())))
-        .collect();
+    let chosen = chosen_models(args);
     let mut out = format!(
         "Device: {} ({}); {}×{}, default settings (hybrid); medians of {} frames after the first (GPU \
          timestamps, ms). G-buffer as first required: position and world normal RGBA32F, D32 depth (32 bytes \
@@ -481,13 +495,12 @@ pub fn run_gbuffer_bench(device: &Device, args: &BenchArgs) -> Result<String> {
 /// Entry point of the subcommand: prints the tables and writes them to `out` if given.
 pub fn run_cli(device: &Device, args: &BenchArgs, out: Option<&Path>) -> Result<()> {
     let tables = if args.lights {
-        let models = match &args.models {
-            Some(dir) => dir.clone(),
-            None => scene::models_dir().map_err(anyhow::Error::msg)?,
-        };
+        let models = models_folder(args)?;
         crate::light_bench::run_light_bench(device, args, &models)?
     } else if args.gbuffer {
         run_gbuffer_bench(device, args)?
+    } else if args.area {
+        crate::area_bench::run_area_bench(device, args)?
     } else {
         run_bench(device, args)?
     };

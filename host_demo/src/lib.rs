@@ -10,6 +10,7 @@
 //! light what ran, what was kept and why; [`shading`] sums the lights into the shaded image.
 
 pub mod accuracy;
+pub mod area_bench;
 pub mod bench;
 pub mod compare;
 pub mod gbuffer;
