@@ -16,7 +16,9 @@
 // Each edge function is linear in w, and every sample lies within `spread` of the centre direction C, so
 // E(w) lies within |n| spread of E(C): a triangle is rejected for every sample, or taken as blocking every
 // sample, with one evaluation, exactly as the per-sample evaluation would decide (the margin covers the
-// rounding of both). Only triangles across the penumbra's edge are tested sample by sample.
+// rounding of both). Only triangles across the penumbra's edge are tested sample by sample, and only on
+// the samples still open that lie near their projection (candidates): a sample outside the grown bounding
+// box of the projected vertices lies far outside the triangle, where the per-sample test says no.
 // A sample towards which the receiver's normal does not face is blocked, as the reference has it.
 #include "triangle.glsl"
 #include "ray_trace_constants.glsl"
@@ -57,6 +59,33 @@ vec3 edge_normal(vec3 p, vec3 q, vec3 rp, vec3 rq) {
     return swap ? -n : n;
 }
 
+// The samples the triangle of vertices a, b, c (relative to the ray origin) may hide: with every vertex in
+// front (towards the light's side of the plane through the origin orthogonal to the centre C), those whose
+// gnomonic coordinates may lie in the bounding box of the vertices' (grown by far more than its rounding);
+// else every sample.
+uvec4 candidates(vec3 a, vec3 b, vec3 c) {
+    vec3 h = vec3(dot(a, samples.center.xyz), dot(b, samples.center.xyz), dot(c, samples.center.xyz));
+    if (!all(greaterThan(h, vec3(0.0)))) {
+        return all_samples;
+    }
+    vec3 eu = samples.axis_u.xyz, ev = samples.axis_v.xyz;
+    vec3 gu = vec3(dot(a, eu), dot(b, eu), dot(c, eu)) / h;
+    vec3 gv = vec3(dot(a, ev), dot(b, ev), dot(c, ev)) / h;
+    vec2 lo = vec2(min(min(gu.x, gu.y), gu.z), min(min(gv.x, gv.y), gv.z));
+    vec2 hi = vec2(max(max(gu.x, gu.y), gu.z), max(max(gv.x, gv.y), gv.z));
+    float extent = samples.axis_u.w;
+    float grow = 1e-4 * (extent + max(max(abs(lo.x), abs(lo.y)), max(abs(hi.x), abs(hi.y))));
+    lo -= grow;
+    hi += grow;
+    if (any(greaterThan(lo, vec2(extent))) || any(lessThan(hi, vec2(-extent)))) {
+        return uvec4(0u);
+    }
+    float last = float(SAMPLE_GRID - 1u);
+    uvec2 first = uvec2(clamp(floor((lo + extent) * samples.axis_v.w), vec2(0.0), vec2(last)));
+    uvec2 final = uvec2(clamp(floor((hi + extent) * samples.axis_v.w), vec2(0.0), vec2(last)));
+    return samples.u_range[first.x * SAMPLE_GRID + final.x] & samples.v_range[first.y * SAMPLE_GRID + final.y];
+}
+
 void consider(uint index) {
     if (index >= uint(tris.length())) {
         return;
@@ -87,10 +116,17 @@ void consider(uint index) {
         blocked = all_samples;  // it covers every sample
         return;
     }
-    for (uint i = 0u; i < sample_count; ++i) {
-        vec3 w = samples.dirs[i].xyz;
-        if (dot(na, w) >= 0.0 && dot(nb, w) >= 0.0 && dot(nc, w) >= 0.0) {
-            blocked[i >> 5u] |= 1u << (i & 31u);
+    // The samples still open that it may hide, tested one by one.
+    uvec4 open = candidates(a, b, c) & all_samples & ~blocked;
+    for (uint word = 0u; word < 4u; ++word) {
+        uint bits = open[word];
+        while (bits != 0u) {
+            uint bit = findLSB(bits);
+            bits &= bits - 1u;
+            vec3 w = samples.dirs[word * 32u + bit].xyz;
+            if (dot(na, w) >= 0.0 && dot(nb, w) >= 0.0 && dot(nc, w) >= 0.0) {
+                blocked[word] |= 1u << bit;
+            }
         }
     }
 }

@@ -15,7 +15,8 @@
 
 use crate::gpu_types::AreaSamples;
 use crate::PassError;
-use glam::{DVec3, Vec3, Vec4};
+use bytemuck::Zeroable;
+use glam::{DVec3, UVec4, Vec3};
 
 /// Most light samples per pixel (the bits of the shader's sample mask).
 pub const MAX_AREA_SAMPLES: u32 = 128;
@@ -79,22 +80,72 @@ pub fn area_sample_directions(direction: Vec3, angular_radius: f32, samples: u32
         .collect()
 }
 
-/// The area trace's sample table for `direction`, `angular_radius` and `samples`: the directions, and
-/// a bound on how far any of them lies from the central direction towards the light as the GPU holds it
-/// (`-direction` normalised in f32), with room for the rounding of the shader's bounds.
+/// Cells per side of the grid over the samples' gnomonic coordinates ([`area_samples`]).
+pub const SAMPLE_GRID: u32 = 8;
+
+/// The area trace's sample table for `direction`, `angular_radius` and `samples`: the directions; a bound on
+/// how far any of them lies from the central direction towards the light as the GPU holds it (`-direction`
+/// normalised in f32), with room for the rounding of the shader's bounds; and a grid over their gnomonic
+/// coordinates.
+///
+/// The grid: a direction `w` has gnomonic coordinates `(w.u / w.C, w.v / w.C)` in the plane of axes `u`, `v`
+/// orthogonal to the centre `C`. A triangle whose vertices all lie in front (`r.C > 0` from the ray origin)
+/// projects there onto the triangle of its projected vertices, so only samples inside that triangle's
+/// bounding box can be hidden by it. The table lists, for every range of grid columns (and of rows), the
+/// samples that may lie in it; each sample is listed in every cell within 1/1000 of the grid's extent of
+/// it, so that the shader's rounding of a cell index never loses a sample.
 pub fn area_samples(direction: Vec3, angular_radius: f32, samples: u32) -> AreaSamples {
     let center = (-direction).normalize();
     let dirs = area_sample_directions(direction, angular_radius, samples);
+    let c = center.as_dvec3();
     let spread = dirs
         .iter()
-        .map(|w| (w.as_dvec3() - center.as_dvec3()).length())
+        .map(|w| (w.as_dvec3() - c).length())
         .fold(0.0, f64::max);
+    let (u, v) = c.any_orthonormal_pair();
+    let (u, v) = (u.as_vec3(), v.as_vec3());
+    let gnomonic: Vec<(f64, f64)> = dirs
+        .iter()
+        .map(|w| {
+            let w = w.as_dvec3();
+            let h = w.dot(c);
+            (w.dot(u.as_dvec3()) / h, w.dot(v.as_dvec3()) / h)
+        })
+        .collect();
+    let extent = gnomonic
+        .iter()
+        .map(|&(x, y)| x.abs().max(y.abs()))
+        .fold(0.0, f64::max)
+        * (1.0 + 1e-3)
+        + 1e-9;
+    let grid = f64::from(SAMPLE_GRID);
+    let scale = grid / (2.0 * extent);
+    let margin = extent * 1e-3;
+    let cells = |x: f64| {
+        let cell = |x: f64| ((x + extent) * scale).floor().clamp(0.0, grid - 1.0) as u32;
+        (cell(x - margin), cell(x + margin))
+    };
     let mut table = AreaSamples {
         center: center.extend((spread * (1.0 + 1e-4) + 1e-6) as f32),
-        dirs: [Vec4::ZERO; MAX_AREA_SAMPLES as usize],
+        axis_u: u.extend(extent as f32),
+        axis_v: v.extend(scale as f32),
+        ..AreaSamples::zeroed()
     };
-    for (slot, w) in table.dirs.iter_mut().zip(&dirs) {
-        *slot = w.extend(0.0);
+    for (i, (w, &(gu, gv))) in dirs.iter().zip(&gnomonic).enumerate() {
+        table.dirs[i] = w.extend(0.0);
+        let bit = |mask: &mut UVec4| mask[i / 32] |= 1 << (i % 32);
+        for (ranges, (first, last)) in [
+            (&mut table.u_range, cells(gu)),
+            (&mut table.v_range, cells(gv)),
+        ] {
+            for a in 0..SAMPLE_GRID {
+                for b in a..SAMPLE_GRID {
+                    if a <= last && first <= b {
+                        bit(&mut ranges[(a * SAMPLE_GRID + b) as usize]);
+                    }
+                }
+            }
+        }
     }
     table
 }
@@ -130,8 +181,41 @@ mod tests {
     fn the_table_bounds_the_spread_of_its_directions() {
         let t = area_samples(Vec3::NEG_Y, 0.02, 16);
         assert!(t.center.w > 0.019 && t.center.w < 0.021, "{}", t.center.w);
-        assert_eq!(t.dirs[16], Vec4::ZERO);
+        assert_eq!(t.dirs[16], glam::Vec4::ZERO);
         assert!(t.dirs[15].truncate().length() > 0.99);
+    }
+
+    /// Every sample is listed in the grid ranges that hold its gnomonic coordinates, as the shader computes
+    /// a cell; the whole grid lists every sample once; no range lists a sample that lies far from it.
+    #[test]
+    fn the_grid_lists_each_sample_in_the_cells_around_it() {
+        let n = 64;
+        let t = area_samples(Vec3::new(0.2, -1.0, 0.4), 0.05, n);
+        let g = SAMPLE_GRID as usize;
+        let all = t.u_range[g - 1];
+        assert_eq!(all.x.count_ones() + all.y.count_ones(), n);
+        assert_eq!(t.v_range[g - 1], all);
+        let (c, u, v) = (
+            t.center.truncate(),
+            t.axis_u.truncate(),
+            t.axis_v.truncate(),
+        );
+        let (extent, scale) = (t.axis_u.w, t.axis_v.w);
+        let cell = |x: f32| ((x + extent) * scale).floor().clamp(0.0, g as f32 - 1.0) as usize;
+        let mut narrow = 0;
+        for i in 0..n as usize {
+            let w = t.dirs[i].truncate();
+            let (gu, gv) = (w.dot(u) / w.dot(c), w.dot(v) / w.dot(c));
+            assert!(gu.abs() <= extent && gv.abs() <= extent);
+            let (a, b) = (cell(gu), cell(gv));
+            let listed = |m: UVec4| m[i / 32] & (1 << (i % 32)) != 0;
+            assert!(listed(t.u_range[a * g + a]) && listed(t.v_range[b * g + b]));
+            // Listed in at most its own cell and a neighbour.
+            let cells = (0..g).filter(|&k| listed(t.u_range[k * g + k])).count();
+            assert!((1..=2).contains(&cells));
+            narrow += usize::from(cells == 1);
+        }
+        assert!(narrow > n as usize / 2);
     }
 
     #[test]
