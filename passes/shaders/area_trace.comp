@@ -41,6 +41,12 @@ layout(set = 0, binding = 8, r32f) uniform writeonly image2D visibility;
 layout(set = 0, binding = 9) uniform Samples { AreaSamples samples; };
 #include "shadow_ray.glsl"
 
+// The workgroup's copy of the sample table's directions and grid ranges: the trace reads them at indices
+// that differ from pixel to pixel, which a uniform buffer serves one index at a time.
+shared vec3 sample_dirs[128];
+shared uvec4 u_ranges[SAMPLE_GRID * SAMPLE_GRID];
+shared uvec4 v_ranges[SAMPLE_GRID * SAMPLE_GRID];
+
 vec3 origin;
 uint sample_count;
 uvec4 all_samples;  // bit i of word i / 32: sample i exists
@@ -83,7 +89,7 @@ uvec4 candidates(vec3 a, vec3 b, vec3 c) {
     float last = float(SAMPLE_GRID - 1u);
     uvec2 first = uvec2(clamp(floor((lo + extent) * samples.axis_v.w), vec2(0.0), vec2(last)));
     uvec2 final = uvec2(clamp(floor((hi + extent) * samples.axis_v.w), vec2(0.0), vec2(last)));
-    return samples.u_range[first.x * SAMPLE_GRID + final.x] & samples.v_range[first.y * SAMPLE_GRID + final.y];
+    return u_ranges[first.x * SAMPLE_GRID + final.x] & v_ranges[first.y * SAMPLE_GRID + final.y];
 }
 
 void consider(uint index) {
@@ -123,7 +129,7 @@ void consider(uint index) {
         while (bits != 0u) {
             uint bit = findLSB(bits);
             bits &= bits - 1u;
-            vec3 w = samples.dirs[word * 32u + bit].xyz;
+            vec3 w = sample_dirs[word * 32u + bit];
             if (dot(na, w) >= 0.0 && dot(nb, w) >= 0.0 && dot(nc, w) >= 0.0) {
                 blocked[word] |= 1u << bit;
             }
@@ -136,6 +142,14 @@ bool all_blocked() {
 }
 
 void main() {
+    sample_count = k.misc.w;
+    uint lid = gl_LocalInvocationIndex;
+    for (uint i = lid; i < sample_count; i += 64u) {
+        sample_dirs[i] = samples.dirs[i].xyz;
+    }
+    u_ranges[lid] = samples.u_range[lid];     // 64 ranges, one per invocation of the 8x8 workgroup
+    v_ranges[lid] = samples.v_range[lid];
+    barrier();
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (px.x >= int(k.dims.x) || px.y >= int(k.dims.y)) {
         return;
@@ -152,13 +166,12 @@ void main() {
         imageStore(visibility, px, vec4(1.0));
         return;
     }
-    sample_count = k.misc.w;
     all_samples = uvec4(0u);
     blocked = uvec4(0u);
     vec3 n = shadow_ray_normal;
     for (uint i = 0u; i < sample_count; ++i) {
         all_samples[i >> 5u] |= 1u << (i & 31u);
-        if (dot(n, samples.dirs[i].xyz) <= 0.0) {
+        if (dot(n, sample_dirs[i]) <= 0.0) {
             blocked[i >> 5u] |= 1u << (i & 31u);
         }
     }
