@@ -16,9 +16,10 @@
 // Each edge function is linear in w, and every sample lies within `spread` of the centre direction C, so
 // E(w) lies within |n| spread of E(C): a triangle is rejected for every sample, or taken as blocking every
 // sample, with one evaluation, exactly as the per-sample evaluation would decide (the margin covers the
-// rounding of both). Only triangles across the penumbra's edge are tested sample by sample, and only on
-// the samples still open that lie near their projection (candidates): a sample outside the grown bounding
-// box of the projected vertices lies far outside the triangle, where the per-sample test says no.
+// rounding of both). For a triangle across the penumbra's edge, the exact edge table of Schwarz and
+// Stamminger's bitmask soft shadows (passes::area::AreaEdgeTable) gives each edge's kept samples, certain
+// beyond every rounding; only the samples still open that a table cell is uncertain about are tested one by
+// one. Every sample is decided as the per-sample test alone decides it.
 // A sample towards which the receiver's normal does not face is blocked, as the reference has it.
 #include "triangle.glsl"
 #include "ray_trace_constants.glsl"
@@ -39,13 +40,12 @@ layout(set = 0, binding = 6) readonly buffer Entries { uint entries[]; };
 layout(set = 0, binding = 7) readonly buffer Prims { Triangle tris[]; };
 layout(set = 0, binding = 8, r32f) uniform writeonly image2D visibility;
 layout(set = 0, binding = 9) uniform Samples { AreaSamples samples; };
+layout(set = 0, binding = 10) readonly buffer EdgeTable { uvec4 edge_table[]; };
 #include "shadow_ray.glsl"
 
-// The workgroup's copy of the sample table's directions and grid ranges: the trace reads them at indices
-// that differ from pixel to pixel, which a uniform buffer serves one index at a time.
+// The workgroup's copy of the sample directions: the trace reads them at indices that differ from pixel to
+// pixel, which a uniform buffer serves one index at a time.
 shared vec3 sample_dirs[128];
-shared uvec4 u_ranges[SAMPLE_GRID * SAMPLE_GRID];
-shared uvec4 v_ranges[SAMPLE_GRID * SAMPLE_GRID];
 
 vec3 origin;
 uint sample_count;
@@ -65,31 +65,27 @@ vec3 edge_normal(vec3 p, vec3 q, vec3 rp, vec3 rq) {
     return swap ? -n : n;
 }
 
-// The samples the triangle of vertices a, b, c (relative to the ray origin) may hide: with every vertex in
-// front (towards the light's side of the plane through the origin orthogonal to the centre C), those whose
-// gnomonic coordinates may lie in the bounding box of the vertices' (grown by far more than its rounding);
-// else every sample.
-uvec4 candidates(vec3 a, vec3 b, vec3 c) {
-    vec3 h = vec3(dot(a, samples.center.xyz), dot(b, samples.center.xyz), dot(c, samples.center.xyz));
-    if (!all(greaterThan(h, vec3(0.0)))) {
-        return all_samples;
+// The edge table's samples for the edge plane of normal n (oriented inwards): `inside`, those every line of
+// its cell keeps; `maybe`, those it keeps or is uncertain about (passes::area::AreaEdgeTable). An edge
+// whose line has no direction in the light's frame (its plane holds C's axis, within rounding) leaves every
+// sample uncertain.
+void edge_masks(vec3 n, out uvec4 inside, out uvec4 maybe) {
+    float a = dot(n, samples.axis_u.xyz), b = dot(n, samples.axis_v.xyz), c = dot(n, samples.center.xyz);
+    float l = sqrt(a * a + b * b);
+    if (!(l > 0.0)) {
+        inside = uvec4(0u);
+        maybe = all_samples;
+        return;
     }
-    vec3 eu = samples.axis_u.xyz, ev = samples.axis_v.xyz;
-    vec3 gu = vec3(dot(a, eu), dot(b, eu), dot(c, eu)) / h;
-    vec3 gv = vec3(dot(a, ev), dot(b, ev), dot(c, ev)) / h;
-    vec2 lo = vec2(min(min(gu.x, gu.y), gu.z), min(min(gv.x, gv.y), gv.z));
-    vec2 hi = vec2(max(max(gu.x, gu.y), gu.z), max(max(gv.x, gv.y), gv.z));
-    float extent = samples.axis_u.w;
-    float grow = 1e-4 * (extent + max(max(abs(lo.x), abs(lo.y)), max(abs(hi.x), abs(hi.y))));
-    lo -= grow;
-    hi += grow;
-    if (any(greaterThan(lo, vec2(extent))) || any(lessThan(hi, vec2(-extent)))) {
-        return uvec4(0u);
-    }
-    float last = float(SAMPLE_GRID - 1u);
-    uvec2 first = uvec2(clamp(floor((lo + extent) * samples.axis_v.w), vec2(0.0), vec2(last)));
-    uvec2 final = uvec2(clamp(floor((hi + extent) * samples.axis_v.w), vec2(0.0), vec2(last)));
-    return u_ranges[first.x * SAMPLE_GRID + final.x] & v_ranges[first.y * SAMPLE_GRID + final.y];
+    // The diamond angle of (a, b), in [0, 4): monotonic in the angle, without atan's loose precision.
+    float t = b >= 0.0 ? (a >= 0.0 ? b / (a + b) : 1.0 - a / (-a + b))
+                       : (a < 0.0 ? 2.0 - b / (-a - b) : 3.0 + a / (a - b));
+    uint angle = min(uint(t * (float(EDGE_ANGLES) / 4.0)), EDGE_ANGLES - 1u);
+    float d = -c / l;
+    uint offset = uint(clamp(floor((d + samples.axis_u.w) * samples.axis_v.w), 0.0, float(EDGE_OFFSETS - 1u)));
+    uint cell = 2u * (angle * EDGE_OFFSETS + offset);
+    inside = edge_table[cell];
+    maybe = inside | edge_table[cell + 1u];
 }
 
 void consider(uint index) {
@@ -122,8 +118,15 @@ void consider(uint index) {
         blocked = all_samples;  // it covers every sample
         return;
     }
-    // The samples still open that it may hide, tested one by one.
-    uvec4 open = candidates(a, b, c) & all_samples & ~blocked;
+    // The edge table decides most samples at once; the samples still open that it is uncertain about are
+    // tested one by one.
+    uvec4 in_a, in_b, in_c, maybe_a, maybe_b, maybe_c;
+    edge_masks(na, in_a, maybe_a);
+    edge_masks(nb, in_b, maybe_b);
+    edge_masks(nc, in_c, maybe_c);
+    uvec4 hidden = in_a & in_b & in_c & all_samples;
+    uvec4 open = maybe_a & maybe_b & maybe_c & all_samples & ~hidden & ~blocked;
+    blocked |= hidden;
     for (uint word = 0u; word < 4u; ++word) {
         uint bits = open[word];
         while (bits != 0u) {
@@ -147,8 +150,6 @@ void main() {
     for (uint i = lid; i < sample_count; i += 64u) {
         sample_dirs[i] = samples.dirs[i].xyz;
     }
-    u_ranges[lid] = samples.u_range[lid];     // 64 ranges, one per invocation of the 8x8 workgroup
-    v_ranges[lid] = samples.v_range[lid];
     barrier();
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (px.x >= int(k.dims.x) || px.y >= int(k.dims.y)) {

@@ -297,15 +297,11 @@ pub struct AreaSamples {
     /// xyz: the unit direction towards the light's centre C; w: a bound on the distance of every sample
     /// direction from it.
     pub center: Vec4,
-    /// xyz: the first axis of the sample grid's plane (unit, orthogonal to C); w: the grid's half-extent
-    /// in gnomonic coordinates (w.axis_u / w.C, w.axis_v / w.C).
+    /// xyz: the first axis of the light's frame (unit, orthogonal to C); w: the half-extent of the edge
+    /// table's line offsets ([`crate::area::AreaEdgeTable`]).
     pub axis_u: Vec4,
-    /// xyz: the second axis; w: grid cells per gnomonic unit.
+    /// xyz: the second axis; w: offset cells per gnomonic unit.
     pub axis_v: Vec4,
-    /// `u_range[a * GRID + b]`: the samples whose gnomonic u may lie in grid columns `a..=b`.
-    pub u_range: [UVec4; (crate::area::SAMPLE_GRID * crate::area::SAMPLE_GRID) as usize],
-    /// `v_range[a * GRID + b]`: the samples whose gnomonic v may lie in grid rows `a..=b`.
-    pub v_range: [UVec4; (crate::area::SAMPLE_GRID * crate::area::SAMPLE_GRID) as usize],
     /// The sample directions towards the light (xyz, unit; w unused); the first `samples` are used.
     pub dirs: [Vec4; crate::area::MAX_AREA_SAMPLES as usize],
 }
@@ -316,8 +312,8 @@ const _: () = {
     assert!(std::mem::offset_of!(PrimBufferPush, first_index) == 64);
     assert!(std::mem::size_of::<MapPush>() == 80);
     assert!(std::mem::offset_of!(MapPush, penumbra) == 64);
-    assert!(std::mem::size_of::<AreaSamples>() == 4144);
-    assert!(std::mem::offset_of!(AreaSamples, dirs) == 2096);
+    assert!(std::mem::size_of::<AreaSamples>() == 2096);
+    assert!(std::mem::offset_of!(AreaSamples, dirs) == 48);
     assert!(std::mem::offset_of!(MapPush, size) == 16);
     assert!(std::mem::size_of::<RayTraceConstants>() == 320);
     assert!(std::mem::offset_of!(RayTraceConstants, light_pos) == 208);

@@ -4,11 +4,12 @@
 //! Reads: depth, normal, the primitive map (state, per-pixel texels, list offsets and entries), prim buffer,
 //! constants (and the light samples, area shadows). Writes: visibility, blocker distance (hard rays only).
 
+use crate::area::area_edge_table;
 use crate::gpu_types::{constant_buffer, AreaSamples, RayTraceConstants};
 use crate::primitive_map::PrimitiveMap;
 use crate::{shader, PassError};
 use rhi::{
-    Barrier, BindGroup, BindingKind, Buffer, ComputePipeline, Device, Encoder, Format, Image,
+    Barrier, BindGroup, BindingKind, Buffer, BufferUsage, ComputePipeline, Device, Encoder, Format, Image,
     ImageDesc, ImageUsage, Resource, ResourceState as S,
 };
 
@@ -37,7 +38,7 @@ pub struct RayTraceInputs<'a> {
 }
 
 /// What the ray trace computes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum RayTraceKind {
     /// One shadow ray per pixel: hard visibility, and the blocker distance if `blocker_distance`.
     Hard {
@@ -45,7 +46,12 @@ pub enum RayTraceKind {
         blocker_distance: bool,
     },
     /// The visible fraction of an area light's samples ([`crate::area`]).
-    Area,
+    Area {
+        /// The light's angular radius (radians).
+        angular_radius: f32,
+        /// Light samples per pixel.
+        samples: u32,
+    },
 }
 
 /// The ray-trace pass and its outputs.
@@ -53,8 +59,8 @@ pub struct RayTracePass {
     pipeline: ComputePipeline,
     group: BindGroup,
     constants: Buffer,
-    /// The area trace's light samples (area shadows only).
-    samples: Option<Buffer>,
+    /// The area trace's light samples, and its edge table (area shadows only).
+    samples: Option<(Buffer, Buffer)>,
     /// `R32_SFLOAT` visibility, 1 = lit.
     pub visibility: Image,
     /// `R32_SFLOAT` distance from the ray origin to the nearest blocker; 0 where the receiver faces away
@@ -92,7 +98,7 @@ impl RayTracePass {
             None => device.create_image(&out("rt visibility"))?,
         };
         let (blocker_distance, unused_blocker) = match kind {
-            RayTraceKind::Area => (None, None),
+            RayTraceKind::Area { .. } => (None, None),
             RayTraceKind::Hard { .. } if blocker_distance => (
                 Some(device.create_image(&out("rt blocker distance"))?),
                 None,
@@ -107,61 +113,62 @@ impl RayTracePass {
             }
         };
         let samples = match kind {
-            RayTraceKind::Area => Some(constant_buffer::<AreaSamples>(
-                device,
-                "area light samples",
-            )?),
+            RayTraceKind::Area {
+                angular_radius,
+                samples,
+            } => Some((
+                constant_buffer::<AreaSamples>(device, "area light samples")?,
+                device.create_buffer_init(
+                    "area edge table",
+                    bytemuck::cast_slice(&area_edge_table(angular_radius, samples).cells),
+                    BufferUsage::STORAGE,
+                )?,
+            )),
             RayTraceKind::Hard { .. } => None,
         };
         let constants = constant_buffer::<RayTraceConstants>(device, "ray trace constants")?;
-        let (shader_name, last_binding) = match kind {
-            RayTraceKind::Area => ("area_trace.comp", BindingKind::UniformBuffer),
-            RayTraceKind::Hard { .. } => ("ray_trace.comp", BindingKind::StorageImage),
-        };
-        let pipeline = device.create_compute_pipeline(
-            if samples.is_some() {
-                "area trace"
-            } else {
-                "ray trace"
-            },
-            &shader(shader_name)?,
-            &[
-                BindingKind::UniformBuffer,
-                BindingKind::SampledImage,
-                BindingKind::SampledImage,
-                BindingKind::StorageBuffer,
-                BindingKind::StorageBuffer,
-                BindingKind::StorageBuffer,
-                BindingKind::StorageBuffer,
-                BindingKind::StorageBuffer,
-                BindingKind::StorageImage,
-                last_binding,
-            ],
-            0,
-        )?;
+        let mut kinds = vec![
+            BindingKind::UniformBuffer,
+            BindingKind::SampledImage,
+            BindingKind::SampledImage,
+            BindingKind::StorageBuffer,
+            BindingKind::StorageBuffer,
+            BindingKind::StorageBuffer,
+            BindingKind::StorageBuffer,
+            BindingKind::StorageBuffer,
+            BindingKind::StorageImage,
+        ];
         let b = Resource::Buffer;
-        let last = match (&samples, &blocker_distance, &unused_blocker) {
-            (Some(samples), _, _) => b(samples),
-            (None, Some(image), _) | (None, None, Some(image)) => Resource::Image(image),
+        let mut resources = vec![
+            b(&constants),
+            Resource::Image(inputs.depth),
+            Resource::Image(inputs.normal),
+            b(&inputs.map.state),
+            b(inputs.map.pixel_texels()),
+            b(&inputs.map.offsets),
+            b(&inputs.map.entries),
+            b(inputs.prims),
+            Resource::Image(&visibility),
+        ];
+        match (&samples, &blocker_distance, &unused_blocker) {
+            (Some((samples, table)), _, _) => {
+                kinds.extend([BindingKind::UniformBuffer, BindingKind::StorageBuffer]);
+                resources.extend([b(samples), b(table)]);
+            }
+            (None, Some(image), _) | (None, None, Some(image)) => {
+                kinds.push(BindingKind::StorageImage);
+                resources.push(Resource::Image(image));
+            }
             (None, None, None) => {
                 return Err(PassError::InvalidConfig("no blocker image".into()));
             }
+        }
+        let (name, shader_name) = match kind {
+            RayTraceKind::Area { .. } => ("area trace", "area_trace.comp"),
+            RayTraceKind::Hard { .. } => ("ray trace", "ray_trace.comp"),
         };
-        let group = device.create_bind_group(
-            pipeline.layout(),
-            &[
-                b(&constants),
-                Resource::Image(inputs.depth),
-                Resource::Image(inputs.normal),
-                b(&inputs.map.state),
-                b(inputs.map.pixel_texels()),
-                b(&inputs.map.offsets),
-                b(&inputs.map.entries),
-                b(inputs.prims),
-                Resource::Image(&visibility),
-                last,
-            ],
-        )?;
+        let pipeline = device.create_compute_pipeline(name, &shader(shader_name)?, &kinds, 0)?;
+        let group = device.create_bind_group(pipeline.layout(), &resources)?;
         Ok(Self {
             pipeline,
             group,
@@ -201,7 +208,7 @@ impl RayTracePass {
         constants.misc.z = u32::from(self.blocker_distance.is_some());
         enc.update_buffer(&self.constants, 0, bytemuck::bytes_of(&constants))?;
         match (&self.samples, samples) {
-            (Some(buffer), Some(samples)) => {
+            (Some((buffer, _)), Some(samples)) => {
                 enc.update_buffer(buffer, 0, bytemuck::bytes_of(samples))?;
             }
             (None, None) => {}

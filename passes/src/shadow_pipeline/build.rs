@@ -152,7 +152,10 @@ impl ShadowPipeline {
                 width,
                 height,
                 if config.mode == ShadowMode::Area {
-                    RayTraceKind::Area
+                    RayTraceKind::Area {
+                        angular_radius: config.pcss.angular_radius,
+                        samples: config.area.samples,
+                    }
                 } else {
                     RayTraceKind::Hard {
                         blocker_distance: plan
