@@ -83,9 +83,15 @@ void edge_masks(vec3 n, out uvec4 inside, out uvec4 maybe) {
     uint angle = min(uint(t * (float(EDGE_ANGLES) / 4.0)), EDGE_ANGLES - 1u);
     float d = -c / l;
     uint offset = uint(clamp(floor((d + samples.axis_u.w) * samples.axis_v.w), 0.0, float(EDGE_OFFSETS - 1u)));
-    uint cell = 2u * (angle * EDGE_OFFSETS + offset);
-    inside = edge_table[cell];
-    maybe = inside | edge_table[cell + 1u];
+    uint cell = angle * EDGE_OFFSETS + offset;
+    if (sample_count <= 64u) {
+        uvec4 words = edge_table[cell];     // up to 64 samples: inside's and uncertain's two words
+        inside = uvec4(words.xy, 0u, 0u);
+        maybe = inside | uvec4(words.zw, 0u, 0u);
+    } else {
+        inside = edge_table[2u * cell];
+        maybe = inside | edge_table[2u * cell + 1u];
+    }
 }
 
 void consider(uint index) {

@@ -137,9 +137,33 @@ pub const EDGE_OFFSETS: u32 = 64;
 /// light's frame); the offsets' extent is in `AreaSamples::axis_u.w`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AreaEdgeTable {
-    /// `cells[2 (a M + o)]`: the samples every line of direction cell `a` and offset cell `o` keeps;
-    /// `cells[2 (a M + o) + 1]`: those it is uncertain about (`M` = [`EDGE_OFFSETS`]).
-    pub cells: Vec<UVec4>,
+    /// Light samples per pixel.
+    pub samples: u32,
+    /// `inside[a M + o]`: the samples every line of direction cell `a` and offset cell `o` keeps (`M` =
+    /// [`EDGE_OFFSETS`]).
+    pub inside: Vec<UVec4>,
+    /// `uncertain[a M + o]`: the samples some line of the cell may keep or drop.
+    pub uncertain: Vec<UVec4>,
+}
+
+impl AreaEdgeTable {
+    /// The table as the area trace reads it: one `uvec4` a cell (inside's and uncertain's first two words)
+    /// for up to 64 samples, else two (inside, uncertain).
+    pub fn gpu_words(&self) -> Vec<UVec4> {
+        if self.samples <= 64 {
+            self.inside
+                .iter()
+                .zip(&self.uncertain)
+                .map(|(i, u)| UVec4::new(i.x, i.y, u.x, u.y))
+                .collect()
+        } else {
+            self.inside
+                .iter()
+                .zip(&self.uncertain)
+                .flat_map(|(&i, &u)| [i, u])
+                .collect()
+        }
+    }
 }
 
 /// The half-extent of the edge table's offsets: beyond every sample's gnomonic radius by the decision
@@ -187,7 +211,8 @@ pub fn area_edge_table(angular_radius: f32, samples: u32) -> AreaEdgeTable {
     let step_t = 4.0 / f64::from(EDGE_ANGLES);
     let step_d = 2.0 * extent / f64::from(EDGE_OFFSETS);
     let tau = std::f64::consts::TAU;
-    let mut cells = vec![UVec4::ZERO; (2 * EDGE_ANGLES * EDGE_OFFSETS) as usize];
+    let mut inside = vec![UVec4::ZERO; (EDGE_ANGLES * EDGE_OFFSETS) as usize];
+    let mut uncertain = inside.clone();
     for a in 0..EDGE_ANGLES {
         let lo = diamond_to_angle(f64::from(a) * step_t - widen_t);
         let hi = diamond_to_angle(f64::from(a + 1) * step_t + widen_t);
@@ -214,19 +239,23 @@ pub fn area_edge_table(angular_radius: f32, samples: u32) -> AreaEdgeTable {
             } else {
                 -extent + f64::from(o + 1) * step_d + widen_d
             };
-            let cell = 2 * (a * EDGE_OFFSETS + o) as usize;
+            let cell = (a * EDGE_OFFSETS + o) as usize;
             for (i, &point) in points.iter().enumerate() {
                 let (bottom, top) = range(point);
                 let bit = 1 << (i % 32);
                 if bottom - d_hi >= margin {
-                    cells[cell][i / 32] |= bit;
+                    inside[cell][i / 32] |= bit;
                 } else if top - d_lo > -margin {
-                    cells[cell + 1][i / 32] |= bit;
+                    uncertain[cell][i / 32] |= bit;
                 }
             }
         }
     }
-    AreaEdgeTable { cells }
+    AreaEdgeTable {
+        samples,
+        inside,
+        uncertain,
+    }
 }
 
 #[cfg(test)]
@@ -271,6 +300,7 @@ mod tests {
         for (r, n) in [(0.02f32, 64u32), (0.3, 128), (0.005, 16)] {
             let t = area_samples(Vec3::new(0.3, -1.0, 0.2), r, n);
             let table = area_edge_table(r, n);
+            let words = table.gpu_words();
             let (c, u, v) = (
                 t.center.truncate(),
                 t.axis_u.truncate(),
@@ -307,12 +337,19 @@ mod tests {
                 let o = ((d + t.axis_u.w) * t.axis_v.w)
                     .floor()
                     .clamp(0.0, EDGE_OFFSETS as f32 - 1.0) as u32;
-                let cell = 2 * (k * EDGE_OFFSETS + o) as usize;
+                let cell = (k * EDGE_OFFSETS + o) as usize;
+                
+                let (cell_inside, cell_uncertain) = if n <= 64 {
+                    let w = words[cell];
+                    (UVec4::new(w.x, w.y, 0, 0), UVec4::new(w.z, w.w, 0, 0))
+                } else {
+                    (words[2 * cell], words[2 * cell + 1])
+                };
                 for i in 0..n as usize {
                     let keeps = normal.dot(t.dirs[i].truncate()) >= 0.0;
                     let bit = 1 << (i % 32);
-                    let inside = table.cells[cell][i / 32] & bit != 0;
-                    let uncertain = table.cells[cell + 1][i / 32] & bit != 0;
+                    let inside = cell_inside[i / 32] & bit != 0;
+                    let uncertain = cell_uncertain[i / 32] & bit != 0;
                     assert!(!(inside && uncertain));
                     total += 1;
                     if !uncertain {

@@ -120,7 +120,7 @@ impl RayTracePass {
                 constant_buffer::<AreaSamples>(device, "area light samples")?,
                 device.create_buffer_init(
                     "area edge table",
-                    bytemuck::cast_slice(&area_edge_table(angular_radius, samples).cells),
+                    bytemuck::cast_slice(&area_edge_table(angular_radius, samples).gpu_words()),
                     BufferUsage::STORAGE,
                 )?,
             )),
