@@ -13,8 +13,8 @@ use crate::report::{model_view, render_frames};
 use crate::View;
 use anyhow::{bail, Context, Result};
 use passes::{
-    AreaConfig, HybridConfig, PcssConfig, PenumbraFilter, PrimitiveMapConfig, ResourceId, ResourceSet,
-    ShadowConfig, ShadowMapConfig, ShadowMode,
+    AreaConfig, HybridConfig, PcssConfig, PenumbraFilter, PrimitiveMapConfig, ResourceId,
+    ResourceSet, ShadowConfig, ShadowMapConfig, ShadowMode,
 };
 use plotters::prelude::*;
 use reference::{reference_visibility, soft_visibility, AreaLight, RefScene, SoftParams};

@@ -241,7 +241,7 @@ fn plan_prints_every_light_without_a_device() {
     for expected in [
         "lights: 5, 4 shadowed by the plugin",
         "[0] sun: directional",
-        "-> hybrid (sized light: PCSS with pcss_angular_radius 0.01 rad",
+        "-> area (sized sun: exact soft shadows, the visible fraction of 64 light samples within 0.01 rad",
         "[1] rim: directional",
         "-> hard (zero-size light",
         "[2] spot: spot at",
@@ -343,7 +343,7 @@ fn scene_render_reports_what_each_light_ran_and_kept() {
     for light in second {
         assert_eq!(light["light_builds"], 1, "{light}");
         assert_eq!(light["pass_status"]["prim buffer"], "UP_TO_DATE", "{light}");
-        let expected = if light["mode"] == "hard" {
+        let expected = if light["mode"] == "hard" || light["mode"] == "area" {
             "NOT_IN_PLAN"
         } else {
             "UP_TO_DATE"
@@ -359,7 +359,11 @@ fn scene_render_reports_what_each_light_ran_and_kept() {
     }
     assert_eq!(second[1]["scene_light"], "rim");
     assert!(second[1]["resource_bytes"].get("shadow map").is_none());
-    assert!(second[0]["resource_bytes"]["shadow map"].as_u64().unwrap() > 0);
+    // The sized sun has exact area shadows (no shadow map); the sized spot light the hybrid.
+    assert_eq!(second[0]["mode"], "area");
+    assert!(second[0]["resource_bytes"].get("shadow map").is_none());
+    assert_eq!(second[2]["mode"], "hybrid");
+    assert!(second[2]["resource_bytes"]["shadow map"].as_u64().unwrap() > 0);
 
     // As the scene says: the cart moves, so the prim buffer is rebuilt (by the first light, shared by
     // the others) and every shadow map re-rendered.
@@ -371,7 +375,8 @@ fn scene_render_reports_what_each_light_ran_and_kept() {
         assert_eq!(light["pass_status"]["prim buffer"], "SHARED", "{light}");
         assert_eq!(light["light_builds"], 1, "{light}");
     }
-    assert_eq!(second[0]["pass_status"]["shadow map"], "RAN");
+    assert_eq!(second[0]["pass_status"]["ray trace"], "RAN");
+    assert_eq!(second[2]["pass_status"]["shadow map"], "RAN");
 }
 
 /// Options out of range are refused before any GPU work, naming the flag, the value and the range.

@@ -338,7 +338,7 @@ mod tests {
                     .floor()
                     .clamp(0.0, EDGE_OFFSETS as f32 - 1.0) as u32;
                 let cell = (k * EDGE_OFFSETS + o) as usize;
-                
+
                 let (cell_inside, cell_uncertain) = if n <= 64 {
                     let w = words[cell];
                     (UVec4::new(w.x, w.y, 0, 0), UVec4::new(w.z, w.w, 0, 0))
@@ -358,7 +358,10 @@ mod tests {
                     }
                 }
             }
-            assert!(decided * 10 > total * 8, "r {r}: {decided} of {total} decided");
+            assert!(
+                decided * 10 > total * 8,
+                "r {r}: {decided} of {total} decided"
+            );
         }
     }
 

@@ -9,8 +9,8 @@ use crate::gpu_types::{constant_buffer, AreaSamples, RayTraceConstants};
 use crate::primitive_map::PrimitiveMap;
 use crate::{shader, PassError};
 use rhi::{
-    Barrier, BindGroup, BindingKind, Buffer, BufferUsage, ComputePipeline, Device, Encoder, Format, Image,
-    ImageDesc, ImageUsage, Resource, ResourceState as S,
+    Barrier, BindGroup, BindingKind, Buffer, BufferUsage, ComputePipeline, Device, Encoder, Format,
+    Image, ImageDesc, ImageUsage, Resource, ResourceState as S,
 };
 
 /// Ray-origin offset along the receiver's normal, in pixels of footprint at the receiver's distance.

@@ -137,7 +137,8 @@ impl LightPlan {
         match self.light.size {
             LightSize::Zero => "hard (zero-size light: exact ray-traced hard shadows; no shadow map, no PCSS)".to_owned(),
             LightSize::AngularRadius(a) => format!(
-                "hybrid (sized light: PCSS with pcss_angular_radius {a} rad, blended with the exact ray trace)"
+                "area (sized sun: exact soft shadows, the visible fraction of {} light samples within {a} rad, each tested against the exact triangles; no shadow map)",
+                shadowed.config.area.samples
             ),
             LightSize::Radius(r) => format!(
                 "hybrid (sized light: PCSS with pcss_spot_radius {r} m, blended with the exact ray trace{})",
@@ -478,7 +479,8 @@ fn shadowed(
     match light.size {
         LightSize::Zero => config.mode = ShadowMode::Hard,
         LightSize::AngularRadius(a) => {
-            config.mode = ShadowMode::Hybrid;
+            // Exact soft shadows; the hybrid and PCSS stay available through the configuration.
+            config.mode = ShadowMode::Area;
             config.pcss.angular_radius = a;
         }
         LightSize::Radius(r) => {
@@ -608,12 +610,13 @@ mod tests {
     }
 
     #[test]
-    fn a_sized_light_gets_the_hybrid_with_its_size() {
+    fn a_sized_sun_gets_area_shadows_and_a_sized_spot_the_hybrid() {
         let p = only(ground_and_box(vec![sun(LightSize::AngularRadius(0.03))]));
         let s = p.shadowed().expect("shadowed");
-        assert_eq!(s.config.mode, ShadowMode::Hybrid);
+        assert_eq!(s.config.mode, ShadowMode::Area);
         assert_eq!(s.config.pcss.angular_radius, 0.03);
-        assert!(s.frame_plan.runs(PassId::ShadowMap) && s.frame_plan.runs(PassId::Blend));
+        assert!(s.frame_plan.runs(PassId::RayTrace) && !s.frame_plan.runs(PassId::ShadowMap));
+        assert!(p.describe_decision().starts_with("area"));
         let p = only(ground_and_box(vec![spot(
             Vec3::new(0.0, 4.0, 0.0),
             Vec3::NEG_Y,
@@ -787,7 +790,7 @@ mod tests {
         assert_eq!(
             decisions,
             [
-                ("sun", Some(ShadowMode::Hybrid), 1),
+                ("sun", Some(ShadowMode::Area), 1),
                 ("rim", Some(ShadowMode::Hard), 1),
                 ("spot", Some(ShadowMode::Hybrid), 1),
                 ("fill", None, 0),
