@@ -2978,6 +2978,45 @@ int main(void) {
     int diff_rt = differing(rt, vis, W * H);
     printf("ray-traced visibility read back from the hybrid frame: %d px differ from the hard-mode output\n", diff_rt);
     CHECK(diff_rt == 0, "read-back ray-traced visibility differs in %d px", diff_rt);
+    /* area shadows: the visible fraction of area_samples light samples, each tested exactly. A light of
+     * 1e-4 rad casts penumbrae far below a pixel: the counts are the exact hard shadow outside near-edge
+     * pixels. A light of 0.05 rad has penumbrae of whole counts k / 64, inside [0, 1]. Invalid sizes and
+     * sample counts are refused with a message naming them. */
+    HrtsConfig area = config(HRTS_SHADOW_MODE_AREA);
+    CHECK(area.area_samples == 64, "area_samples default %u", area.area_samples);
+    area.pcss_angular_radius = 1e-4f;
+    CHECK(hrts_configure(ctx, &area) == HRTS_RESULT_OK, "configure area: %s", hrts_last_error(ctx));
+    static float area_vis[W * H];
+    phase = "area frame";
+    CHECK(run_frame(ctx, area_vis) == HRTS_RESULT_OK, "record area: %s", hrts_last_error(ctx));
+    CHECK(report(ctx, next_frame - 1, 0, &rep) == HRTS_RESULT_OK, "report: %s", hrts_last_error(ctx));
+    CHECK(rep.pass_status[HRTS_PASS_RAY_TRACE] == HRTS_PASS_STATUS_RAN && rep.pass_status[HRTS_PASS_SHADOW_MAP] == HRTS_PASS_STATUS_NOT_IN_PLAN &&
+              rep.pass_status[HRTS_PASS_PCSS] == HRTS_PASS_STATUS_NOT_IN_PLAN && rep.output_resource == HRTS_RESOURCE_RT_VISIBILITY,
+          "area report: the map and its trace alone");
+    int ne_a, sh_a, lit_a;
+    int mismatches_area = count_mismatches(area_vis, tol, &sun, &ne_a, &sh_a, &lit_a);
+    printf("area, 1e-4 rad: %d mismatches with the exact hard shadow outside %d near-edge pixels\n", mismatches_area, ne_a);
+    CHECK(mismatches_area == 0, "a tiny area light differs from the hard shadow in %d px", mismatches_area);
+    area.pcss_angular_radius = 0.05f;
+    CHECK(hrts_configure(ctx, &area) == HRTS_RESULT_OK, "configure area: %s", hrts_last_error(ctx));
+    CHECK(run_frame(ctx, area_vis) == HRTS_RESULT_OK, "record area: %s", hrts_last_error(ctx));
+    int penumbra = 0, not_counts = 0;
+    for (int i = 0; i < W * H; i++) {
+        float k = area_vis[i] * 64.0f;
+        if (!(area_vis[i] >= 0.0f && area_vis[i] <= 1.0f) || k != floorf(k)) not_counts++;
+        if (area_vis[i] > 0.0f && area_vis[i] < 1.0f) penumbra++;
+    }
+    printf("area, 0.05 rad, 64 samples: %d penumbra pixels, %d values that are no count\n", penumbra, not_counts);
+    CHECK(not_counts == 0 && penumbra > 100, "area: %d penumbra px, %d not k/64", penumbra, not_counts);
+    HrtsConfig bad = area;
+    bad.area_samples = 0;
+    CHECK(hrts_configure(ctx, &bad) != HRTS_RESULT_OK && strstr(hrts_last_error(ctx), "light samples"), "area_samples 0 accepted");
+    bad = area;
+    bad.area_samples = 129;
+    CHECK(hrts_configure(ctx, &bad) != HRTS_RESULT_OK && strstr(hrts_last_error(ctx), "light samples"), "area_samples 129 accepted");
+    bad = area;
+    bad.pcss_angular_radius = 2.0f;
+    CHECK(hrts_configure(ctx, &bad) != HRTS_RESULT_OK && strstr(hrts_last_error(ctx), "angular radius"), "area radius 2 rad accepted");
     CHECK(hrts_configure(ctx, &cfg) == HRTS_RESULT_OK, "configure back: %s", hrts_last_error(ctx));
 
     /* the same scene from the engine's own Vulkan buffers: float4 positions (stride 16) at byte offset 64,
