@@ -42,7 +42,7 @@ pub use prim_buffer::{
 };
 pub use primitive_map::{
     choose_binning_path, BinningPath, BinningRequest, FaceMode, PrimitiveMapConfig,
-    DEFAULT_ENTRY_BUDGET, GUARD_VALUE, GUARD_WORDS, MIN_ENTRY_BUDGET,
+    DEFAULT_ENTRY_BUDGET, GUARD_VALUE, GUARD_WORDS, MIN_ENTRY_BUDGET, MIN_FITTED_ENTRIES,
 };
 pub use shadow_map::ShadowMapConfig;
 pub use shadow_pipeline::{

@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{assert_no_validation_errors, device, plate_and_box_view};
+use common::{assert_no_validation_errors, axis_boxes, device, plate_and_box_view, GROUND};
 use glam::Vec3;
 use host_demo::accuracy::{compare_area, AreaComparison};
 use host_demo::{FrameImages, ShadowRenderer, View};
@@ -19,7 +19,7 @@ use passes::{
 use reference::RefScene;
 use rhi::Device;
 use scene::hard_cases::{family, Family, HardCase};
-use scene::{Camera, DirectionalLight, Scene};
+use scene::{Camera, DirectionalLight};
 
 /// Test frames are downscaled from the hard cases' 193x145 so that the reference's N passes stay short.
 const WIDTH: u32 = 96;
@@ -92,14 +92,14 @@ fn check(
     c
 }
 
-/// The hard case `name` of family `f`, framed as `host_demo hardcases` frames it, at the test size.
-fn hard_case_view(f: Family, name: &str) -> (View, FaceMode) {
+/// The hard case `name` of family `f`, framed as `host_demo hardcases` frames it at the test size, checked
+/// with a light of `angular_radius` and `samples` samples (at least 20 stable penumbra pixels).
+fn check_hard_case(f: Family, name: &str, (angular_radius, samples): (f32, u32)) {
     let case: HardCase = family(f, &common::models())
         .into_iter()
         .find(|c| c.name == name)
         .unwrap_or_else(|| panic!("no hard case named {name}"));
-    let scene = case.scene.expect("scene");
-    let mut view = View::framed(scene, WIDTH, HEIGHT);
+    let mut view = View::framed(case.scene.expect("scene"), WIDTH, HEIGHT);
     view.light = DirectionalLight::new(case.light_direction).expect("light");
     if let Some(camera) = case.camera {
         view.camera = camera;
@@ -109,33 +109,28 @@ fn hard_case_view(f: Family, name: &str) -> (View, FaceMode) {
     } else {
         FaceMode::Both
     };
-    (view, faces)
+    check(&device(), name, &view, (angular_radius, samples), faces, 20);
 }
 
 #[test]
 fn contact_shadows_match_the_reference_sample_for_sample() {
-    let device = device();
-    let name = "contact 80°";
-    let (view, faces) = hard_case_view(Family::Contact, name);
-    check(&device, name, &view, (0.1, 32), faces, 20);
+    check_hard_case(Family::Contact, "contact 80°", (0.1, 32));
 }
 
 #[test]
 fn thin_plates_fence_slats_and_foliage_cards() {
-    let device = device();
-    for name in ["thin closed plates", "foliage cards"] {
-        let (view, faces) = hard_case_view(Family::ThinGeometry, name);
-        check(&device, name, &view, (0.1, 32), faces, 20);
-    }
+    check_hard_case(Family::ThinGeometry, "thin closed plates", (0.1, 32));
+    check_hard_case(Family::ThinGeometry, "foliage cards", (0.1, 32));
 }
 
+/// The sphere is closed and stored front faces only: a sample through a shared edge must still be blocked.
 #[test]
 fn a_closed_mesh_leaks_no_sample_through_its_shared_edges() {
-    let device = device();
-    let name = "closed UV sphere (front faces only)";
-    let (view, faces) = hard_case_view(Family::SharedEdges, name);
-    assert_eq!(faces, FaceMode::FrontOnly);
-    check(&device, name, &view, (0.1, 32), faces, 20);
+    check_hard_case(
+        Family::SharedEdges,
+        "closed UV sphere (front faces only)",
+        (0.1, 32),
+    );
 }
 
 /// Two plates overlapping as seen from the light at different heights: where both cover parts of the
@@ -143,13 +138,8 @@ fn a_closed_mesh_leaks_no_sample_through_its_shared_edges() {
 #[test]
 fn overlapping_occluders_fuse() {
     let device = device();
-    let mut scene = Scene::default();
-    for (name, min, max) in [
-        (
-            "ground",
-            Vec3::new(-3.0, -0.05, -3.0),
-            Vec3::new(3.0, 0.0, 3.0),
-        ),
+    let scene = axis_boxes(&[
+        GROUND,
         (
             "low plate",
             Vec3::new(-1.0, 0.6, -0.8),
@@ -160,9 +150,7 @@ fn overlapping_occluders_fuse() {
             Vec3::new(-0.3, 1.2, -0.3),
             Vec3::new(0.9, 1.22, 0.9),
         ),
-    ] {
-        scene.append(&Scene::axis_box(name, min, max));
-    }
+    ]);
     let mut view = plate_and_box_view(WIDTH, HEIGHT);
     view.scene = scene;
     check(
@@ -208,10 +196,7 @@ fn tiny_and_large_lights() {
 
 #[test]
 fn the_demo_scene_1e4_from_the_origin() {
-    let device = device();
-    let name = "translated by 1e4";
-    let (view, faces) = hard_case_view(Family::Scale, name);
-    check(&device, name, &view, (0.3, 32), faces, 20);
+    check_hard_case(Family::Scale, "translated by 1e4", (0.3, 32));
 }
 
 #[test]

@@ -40,7 +40,7 @@ fn assert_past_capacity_is_safe_and_exact(
     images: &FrameImages,
 ) {
     let st = report.stats;
-    let n = 128usize;
+    let texels = images.list_offsets.len() - 1;
     let capacity = st.capacity as usize;
     assert_eq!(images.list_entries.len(), capacity + GUARD_WORDS as usize);
     let written = images.list_entries[capacity..]
@@ -52,7 +52,7 @@ fn assert_past_capacity_is_safe_and_exact(
         "{written} guard words were written past the capacity"
     );
     // Past capacity: exactly the texels whose list ends beyond it, shown red.
-    let past: Vec<usize> = (0..n * n)
+    let past: Vec<usize> = (0..texels)
         .filter(|&t| {
             images.list_offsets[t + 1] as usize > capacity
                 && images.list_offsets[t + 1] > images.list_offsets[t]
@@ -62,7 +62,7 @@ fn assert_past_capacity_is_safe_and_exact(
     for &t in &past {
         assert_eq!(images.occupancy[t], [255, 0, 0, 255], "texel {t}");
     }
-    assert_eq!(st.entries, images.list_offsets[n * n]);
+    assert_eq!(st.entries, images.list_offsets[texels]);
     // The fallback keeps the ray-traced result exact.
     let v = compare_visibility(rs, view, images);
     println!(
@@ -122,6 +122,44 @@ fn lists_grow_to_fit_the_next_frame() {
         assert_eq!(
             images.visibility, first_images.visibility,
             "growing changed the shadow"
+        );
+        assert_past_capacity_is_safe_and_exact(&rs, &view, report, images);
+    }
+    assert_no_validation_errors(&device);
+}
+
+/// Lists sized by what they occupy: a map whose starting estimate (two entries per texel of a 1024² map)
+/// far exceeds what the view needs shrinks to half again the entries a frame needed, and stays exact.
+#[test]
+fn lists_shrink_to_what_they_occupy() {
+    let device = device();
+    let view = View::framed(scene::procedural_default(), 160, 120);
+    let rs = RefScene::new(&view.scene);
+    let config = PrimitiveMapConfig {
+        size: 1024,
+        guard: true,
+        ..Default::default()
+    };
+    let runs = frames(&device, &view, config, 3);
+    let (first, first_images) = &runs[0];
+    let needed = first.stats.entries;
+    assert!(
+        u64::from(needed) * 2 < u64::from(first.stats.capacity),
+        "{:?}",
+        first.stats
+    );
+    for (report, images) in &runs[1..] {
+        let st = report.stats;
+        assert_eq!(st.entries, needed);
+        assert_eq!(st.texels_past_capacity, 0, "{st:?}");
+        assert_eq!(
+            st.capacity,
+            (needed * 3 / 2).max(passes::MIN_FITTED_ENTRIES),
+            "{st:?}"
+        );
+        assert_eq!(
+            images.visibility, first_images.visibility,
+            "shrinking changed the shadow"
         );
         assert_past_capacity_is_safe_and_exact(&rs, &view, report, images);
     }

@@ -576,7 +576,9 @@ fn assert_only_changed_reran(
             light.shadowed.config.mode,
             light.shadowed.config.static_light,
         ) {
-            (ShadowMode::Hard, _) => PassStatus::Skipped(SkipReason::NotRequested),
+            (ShadowMode::Hard | ShadowMode::Area, _) => {
+                PassStatus::Skipped(SkipReason::NotRequested)
+            }
             (_, true) => PassStatus::Skipped(SkipReason::UpToDate),
             (_, false) => PassStatus::Ran,
         };

@@ -45,6 +45,9 @@ const BIN_THREADS: u32 = 64 * 4096;
 /// Source of [`PrimitiveMap`] ids (0 marks pixel texels no map wrote yet).
 static NEXT_MAP_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
 
+/// The fewest entries [`PrimitiveMap::fit_entries`] shrinks a map's lists to (256 KiB).
+pub const MIN_FITTED_ENTRIES: u32 = 65536;
+
 /// What the map's passes read from outside it.
 pub struct PrimitiveMapInputs<'a> {
     /// The prim buffer.
@@ -349,12 +352,17 @@ impl PrimitiveMap {
         &self.occupancy
     }
 
-    /// Grows the entry capacity to hold `needed` entries (with a quarter to spare, within the budget), when a
-    /// frame needed more than it had, with a pair list as large from `pool` and the prim buffer `prims`
-    /// bound anew. When the entries were reallocated it returns the buffer and bindings they replaced
-    /// (frames in flight may still use them: drop them once those completed), and whatever else reads
-    /// [`PrimitiveMap::entries`] must be rebound.
-    pub fn grow(
+    /// Sizes the entry capacity by what the lists occupy: grows it to hold `needed` entries (with a quarter
+    /// to spare, within the budget) when a frame needed more than it had; shrinks it to half again what a
+    /// frame needed (at least [`MIN_FITTED_ENTRIES`], and the entries the configuration starts with when
+    /// it gives them) when that frame used under half of it, so that a
+    /// light holds what its lists need rather than the starting estimate, and a changing view does not
+    /// reallocate every frame. `needed` 0 (no completed frame, or one without receivers) changes nothing.
+    /// The pair list is taken from `pool` for the new capacity and the prim buffer `prims` bound anew. When
+    /// the entries were reallocated it returns the buffer and bindings they replaced (frames in flight may
+    /// still use them: drop them once those completed), and whatever else reads [`PrimitiveMap::entries`]
+    /// must be rebound.
+    pub fn fit_entries(
         &mut self,
         device: &Device,
         pool: &MapScratchPool,
@@ -362,10 +370,17 @@ impl PrimitiveMap {
         needed: u32,
     ) -> Result<Option<(Buffer, ScratchBindings)>, PassError> {
         let max = self.config.max_entries(device.capabilities());
-        if needed <= self.capacity || self.capacity >= max {
+        let capacity = if needed > self.capacity && self.capacity < max {
+            (u64::from(needed) * 5 / 4).min(u64::from(max)) as u32
+        } else if needed > 0 && u64::from(needed) * 2 < u64::from(self.capacity) {
+            let floor = MIN_FITTED_ENTRIES.max(self.config.initial_entries);
+            (u64::from(needed) * 3 / 2).max(u64::from(floor)) as u32
+        } else {
+            return Ok(None);
+        };
+        if capacity == self.capacity {
             return Ok(None);
         }
-        let capacity = (u64::from(needed) * 5 / 4).min(u64::from(max)) as u32;
         let entries = Self::create_entries(device, &self.config, capacity)?;
         let old = std::mem::replace(&mut self.entries, entries);
         self.capacity = capacity;

@@ -299,8 +299,8 @@ impl ShadowPipeline {
         Ok(())
     }
 
-    /// Grows the primitive map's entries and (triangle, face) pairs to what the newest completed build
-    /// needed, and rebinds the ray trace to the entries; the replaced objects are held until the frames
+    /// Fits the primitive map's entries (grown or shrunk, [`PrimitiveMap::fit_entries`]) and grows its
+    /// (triangle, face) pairs to what the newest completed build needed, and rebinds the ray trace to the entries; the replaced objects are held until the frames
     /// before `frame` completed.
     fn grow_map(&mut self, device: &Device, frame: u64) -> Result<(), PassError> {
         let Some(map) = self.map.as_mut() else {
@@ -309,7 +309,7 @@ impl ShadowPipeline {
         let mut retired = Vec::new();
         let pool = self.shared.map_scratch();
         if let Some((entries, bindings)) =
-            map.grow(device, pool, self.shared.prims(), self.needed_entries)?
+            map.fit_entries(device, pool, self.shared.prims(), self.needed_entries)?
         {
             let ray_group = match self.ray.as_mut() {
                 Some(ray) => Some(ray.rebind_entries(device, map)?),

@@ -60,24 +60,33 @@ pub fn render(
     (report, images)
 }
 
+/// A scene of named axis-aligned boxes `(name, min, max)`.
+pub fn axis_boxes(boxes: &[(&str, Vec3, Vec3)]) -> Scene {
+    let mut s = Scene::default();
+    for &(name, min, max) in boxes {
+        s.append(&Scene::axis_box(name, min, max));
+    }
+    s
+}
+
+/// The 6 m ground square, 5 cm thick, with its top at y = 0.
+pub const GROUND: (&str, Vec3, Vec3) = (
+    "ground",
+    Vec3::new(-3.0, -0.05, -3.0),
+    Vec3::new(3.0, 0.0, 3.0),
+);
+
 /// A ground plane, a thin horizontal plate 1.5 m above it and a box standing on it.
 pub fn plate_and_box() -> Scene {
-    let mut s = Scene::default();
-    for (name, min, max) in [
-        (
-            "ground",
-            Vec3::new(-3.0, -0.05, -3.0),
-            Vec3::new(3.0, 0.0, 3.0),
-        ),
+    let s = axis_boxes(&[
+        GROUND,
         (
             "plate",
             Vec3::new(-2.0, 1.5, -0.6),
             Vec3::new(-0.8, 1.52, 0.6),
         ),
         ("box", Vec3::new(0.8, 0.0, -0.3), Vec3::new(1.4, 0.8, 0.3)),
-    ] {
-        s.append(&Scene::axis_box(name, min, max));
-    }
+    ]);
     s.validate().expect("valid test scene");
     s
 }
