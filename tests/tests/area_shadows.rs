@@ -242,5 +242,19 @@ fn invalid_light_sizes_and_sample_counts_are_rejected() {
         .expect("software binning accepted")
         .to_string();
     assert!(err.contains("compute binning"), "{err}");
+    // Area shadows are directional: a spot light's frame is refused, naming the light.
+    let geometry = view.upload(&device).expect("upload");
+    let config = area_config(0.02, 32, FaceMode::Both);
+    let mut r =
+        ShadowRenderer::new(&device, geometry, view.width, view.height, config).expect("renderer");
+    let mut inputs = view.frame_inputs();
+    let position = Vec3::new(0.0, 4.0, 0.0);
+    inputs.light = passes::spot_light_frusta(position, Vec3::NEG_Y, 0.5, Some(10.0))[0];
+    let err = r
+        .render(&device, &inputs)
+        .err()
+        .expect("spot light accepted")
+        .to_string();
+    assert!(err.contains("directional") && err.contains("spot"), "{err}");
     assert_no_validation_errors(&device);
 }
