@@ -252,8 +252,7 @@ fn invalid_light_sizes_and_sample_counts_are_rejected() {
     inputs.light = passes::spot_light_frusta(position, Vec3::NEG_Y, 0.5, Some(10.0))[0];
     let err = r
         .render(&device, &inputs)
-        .err()
-        .expect("spot light accepted")
+        .expect_err("spot light accepted")
         .to_string();
     assert!(err.contains("directional") && err.contains("spot"), "{err}");
     assert_no_validation_errors(&device);
