@@ -264,7 +264,11 @@ impl ScenePlan {
                 s,
                 "      config: mode {}, FXAA {}, static_light {}, dynamic_geometry {}, map {}², shadow map {}",
                 c.mode.name(),
-                if c.antialiasing { "on" } else { "off" },
+                if shadowed.frame_plan.runs(passes::PassId::Fxaa) {
+                    "on"
+                } else {
+                    "off"
+                },
                 c.static_light,
                 !c.static_geometry,
                 c.map.size,
