@@ -81,10 +81,6 @@ impl RayTracePass {
         kind: RayTraceKind,
         visibility: Option<Image>,
     ) -> Result<Self, PassError> {
-        let blocker_distance = kind
-            == RayTraceKind::Hard {
-                blocker_distance: true,
-            };
         let out = |name| ImageDesc {
             name,
             format: Format::R32Float,
@@ -99,11 +95,15 @@ impl RayTracePass {
         };
         let (blocker_distance, unused_blocker) = match kind {
             RayTraceKind::Area { .. } => (None, None),
-            RayTraceKind::Hard { .. } if blocker_distance => (
+            RayTraceKind::Hard {
+                blocker_distance: true,
+            } => (
                 Some(device.create_image(&out("rt blocker distance"))?),
                 None,
             ),
-            RayTraceKind::Hard { .. } => {
+            RayTraceKind::Hard {
+                blocker_distance: false,
+            } => {
                 let unused = ImageDesc {
                     width: 1,
                     height: 1,
