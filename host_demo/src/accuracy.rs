@@ -286,7 +286,7 @@ pub fn compare_with_reference(
 /// Outcome of comparing GPU area shadows with the exact reference of the same light samples.
 #[derive(Debug, Default, Clone, PartialEq)]
 pub struct AreaComparison {
-    /// Pixels compared (every pixel of the frame).
+    /// Pixels compared (every pixel of the frame, or those considered).
     pub pixels: usize,
     /// Pixels with a sample within the reference's tolerance of an edge or plane (counted, not compared).
     pub unstable: usize,
@@ -318,8 +318,23 @@ pub fn compare_area(
             .map(|w| w.as_dvec3())
             .collect();
     let r = reference::area_reference(rs, &visibility_params(view), &directions);
+    compare_area_counts(&r, visibility, None)
+}
+
+/// Compares GPU area-shadow visibility (`visibility`, row-major, the visible fraction of the reference's
+/// samples) with the reference's visible counts, on the pixels it marks stable; with `considered`, only
+/// on the pixels it marks (a spot light's cone, say).
+pub fn compare_area_counts(
+    r: &reference::AreaReference,
+    visibility: &[f32],
+    considered: Option<&[bool]>,
+) -> AreaComparison {
+    let samples = r.samples;
     let mut c = AreaComparison::default();
     for (i, &v) in visibility.iter().enumerate() {
+        if considered.is_some_and(|m| !m[i]) {
+            continue;
+        }
         c.pixels += 1;
         let count = v * samples as f32;
         if !count.is_finite() || (count - count.round()).abs() > 1e-3 {
@@ -339,7 +354,7 @@ pub fn compare_area(
         if count.round() as u32 != expected {
             c.mismatches += 1;
             if c.examples.len() < 8 {
-                let w = view.width as usize;
+                let w = r.width as usize;
                 c.examples
                     .push(((i % w) as u32, (i / w) as u32, expected, count));
             }

@@ -64,12 +64,17 @@ pub struct BenchArgs {
     /// each model, with lists and memory, and how their cost grows with the light's size and samples.
     #[arg(long, conflicts_with_all = ["lights", "gbuffer"])]
     pub area: bool,
-    /// With --area: the light's angular radius in radians.
+    /// With --area: the light's angular radius in radians (with --lights --emitter-size: the sun's).
     #[arg(long, default_value_t = 0.02)]
     pub angular_radius: f32,
-    /// With --area: light samples per pixel.
+    /// With --area, or --lights --emitter-size: light samples per pixel.
     #[arg(long, default_value_t = passes::DEFAULT_AREA_SAMPLES)]
     pub area_samples: u32,
+    /// With --lights: sized lights with exact soft shadows (mode area) instead of hard ones: spot and
+    /// point lights get a spherical emitter of this fraction of the scene's bounding radius, the sun
+    /// --angular-radius. 0: zero-size lights (hard shadows).
+    #[arg(long, default_value_t = 0.0, requires = "lights")]
+    pub emitter_size: f32,
 }
 
 /// One benchmark model: a file of `../shared/models`, how it is shown, and the talk's GTX 980 times (ms)

@@ -14,7 +14,7 @@ use crate::scene_render::SceneRenderer;
 use crate::CameraMatrices;
 use anyhow::{Context, Result};
 use glam::Vec3;
-use passes::{ResourceId, ShadowConfig, ShadowMode};
+use passes::{AreaConfig, ResourceId, ShadowConfig, ShadowMode};
 use rhi::Device;
 use scene::{Aabb, Camera, LightKind, LightSize, SceneFile, SceneLight};
 use std::fmt::Write as _;
@@ -57,14 +57,24 @@ fn at(bounds: &Aabb, f: Vec3) -> Vec3 {
     bounds.min + f * (bounds.max - bounds.min)
 }
 
+/// The sizes of the benchmark's lights: `None` for zero-size lights, else the sun's angular radius and the
+/// spot and point lights' emitter radius (scene units).
+type Sizes = Option<(f32, f32)>;
+
 /// The benchmark's lights for a scene whose bounds are `bounds`: name and light.
-fn lights(scene: &LightScene, bounds: &Aabb) -> Vec<(String, SceneLight)> {
+fn lights(scene: &LightScene, bounds: &Aabb, sizes: Sizes) -> Vec<(String, SceneLight)> {
     let light = |name: &str, kind: LightKind| SceneLight {
         name: name.into(),
+        size: match (sizes, &kind) {
+            (None, _) => LightSize::Zero,
+            (Some((angular, _)), LightKind::Directional { .. }) => {
+                LightSize::AngularRadius(angular)
+            }
+            (Some((_, radius)), _) => LightSize::Radius(radius),
+        },
         kind,
         color: Vec3::ONE,
         intensity: 100.0,
-        size: LightSize::Zero,
         casts_shadows: true,
         is_static: true,
     };
@@ -188,6 +198,9 @@ fn measure_light(
     let settings = PlanSettings {
         base: ShadowConfig {
             antialiasing: false,
+            area: AreaConfig {
+                samples: args.area_samples,
+            },
             ..ShadowConfig::default()
         },
         width: args.width,
@@ -261,6 +274,7 @@ fn measure_native_points(
     positions: &[Vec3],
     name: String,
     args: &BenchArgs,
+    emitter_radius: Option<f32>,
 ) -> Result<LightCost> {
     let mut plugin = PluginRenderer::for_scene(
         device,
@@ -271,11 +285,16 @@ fn measure_native_points(
         GBufferLayout::ANALYSIS,
     )?;
     plugin.write_outputs_directly();
-    let config = ShadowConfig {
+    let mut config = ShadowConfig {
         mode: ShadowMode::Hard,
         antialiasing: false,
         ..ShadowConfig::default()
     };
+    if let Some(radius) = emitter_radius {
+        config.mode = ShadowMode::Area;
+        config.pcss.spot_radius = radius;
+        config.area.samples = args.area_samples;
+    }
     plugin.configure_lights(device, &vec![config; positions.len()])?;
     let matrices = CameraMatrices::of_camera(camera, args.width, args.height);
     let lights: Vec<_> = positions.iter().map(|&p| c_point_light(p, 0.0)).collect();
@@ -319,7 +338,7 @@ fn measure_native_points(
 pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Result<String> {
     let caps = device.capabilities();
     let mut out = format!(
-        "Device: {} ({}); {}×{}, hard shadows (zero-size lights), no FXAA; one light at a time, planned as \
+        "Device: {} ({}); {}×{}, {}, no FXAA; one light at a time, planned as \
          `render --scene` plans it; GPU ms = median over {} frames after the first of the light's passes \
          summed over its frusta (the shared prim buffer excluded); memory = the light's own resources (each light \
          writes its layer of an R32F storage output directly; the build scratch shared by all lights is listed \
@@ -330,6 +349,14 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
         caps.driver,
         args.width,
         args.height,
+        if args.emitter_size > 0.0 {
+            format!(
+                "exact soft shadows (mode area, {} samples; light sizes below)",
+                args.area_samples
+            )
+        } else {
+            "hard shadows (zero-size lights)".to_owned()
+        },
         args.frames.max(2) - 1
     );
     let chosen: Vec<&LightScene> = SCENES
@@ -341,6 +368,7 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
         .map(|s| 2 + s.points.len() + usize::from(args.point_lights > 0))
         .sum();
     let bar = crate::progress(total as u64, "bench --lights");
+    let mut sizes_line = String::new();
     let mut per_pass = String::from(
         "\nPer pass (median ms over the same frames, summed over the light's frusta):\n\n",
     );
@@ -363,8 +391,17 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
             camera: Some(camera),
             skipped_primitives: 0,
         };
+        let emitter_radius = (args.emitter_size > 0.0).then(|| args.emitter_size * bounds.radius());
+        let sizes = emitter_radius.map(|r| (args.angular_radius, r));
+        if let Some(r) = emitter_radius {
+            let _ = writeln!(
+                sizes_line,
+                "- {}: emitter radius {r:.4} (scene units), sun {} rad",
+                scene_case.file, args.angular_radius
+            );
+        }
         let mut costs = Vec::new();
-        for (name, light) in lights(scene_case, &bounds) {
+        for (name, light) in lights(scene_case, &bounds, sizes) {
             bar.set_message(format!("{} {name}", scene_case.file));
             costs.push(measure_light(
                 device,
@@ -400,6 +437,7 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
                 &positions,
                 format!("{n} point lights, native, all together"),
                 args,
+                emitter_radius,
             )?);
         }
         let sun = costs[0].gpu_ms;
@@ -437,6 +475,10 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
         }
     }
     bar.finish_and_clear();
+    if !sizes_line.is_empty() {
+        out.push_str("\nLight sizes:\n\n");
+        out.push_str(&sizes_line);
+    }
     out.push_str(&per_pass);
     Ok(out)
 }

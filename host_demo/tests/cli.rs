@@ -248,7 +248,8 @@ fn plan_prints_every_light_without_a_device() {
         "[3] fill: point",
         "-> no pass (casts no shadows): visibility 1",
         "[4] cart_lamp: point",
-        "plugin light 3: 6 frusta fitted by the plugin (+X, -X, +Y, -Y, +Z, -Z)",
+        "-> area (sized point light: exact soft shadows, the visible fraction of 64 samples of its emitter of radius 0.1 m",
+        "plugin light 3: one cube map (its six faces built as one primitive map by the plugin",
         "dynamic (not static: cart_body, cart_load)",
     ] {
         assert!(
@@ -325,12 +326,13 @@ fn scene_render_reports_what_each_light_ran_and_kept() {
     assert_eq!(frames.len(), 2);
     let second = frames[1]["lights"].as_array().expect("lights");
     assert_eq!(second.len(), 4);
-    // The lamp is one plugin light: the plugin fits six faces and says which it recorded.
+    // The lamp is one plugin light with area shadows: its six faces as one cube map.
     let lamp = &second[3];
     assert_eq!(lamp["scene_light"], "cart_lamp");
+    assert_eq!(lamp["mode"], "area", "{lamp}");
     assert_eq!(
         lamp["frusta_recorded"].as_u64().unwrap() + lamp["frusta_culled"].as_u64().unwrap(),
-        6,
+        1,
         "{lamp}"
     );
     assert!(
@@ -359,14 +361,17 @@ fn scene_render_reports_what_each_light_ran_and_kept() {
     }
     assert_eq!(second[1]["scene_light"], "rim");
     assert!(second[1]["resource_bytes"].get("shadow map").is_none());
-    // The sized sun has exact area shadows (no shadow map); the sized spot light the hybrid.
-    assert_eq!(second[0]["mode"], "area");
-    assert!(second[0]["resource_bytes"].get("shadow map").is_none());
-    assert_eq!(second[2]["mode"], "hybrid");
-    assert!(second[2]["resource_bytes"]["shadow map"].as_u64().unwrap() > 0);
+    // The sized sun and the sized spot light have exact area shadows (no shadow map).
+    for sized in [&second[0], &second[2]] {
+        assert_eq!(sized["mode"], "area", "{sized}");
+        assert!(
+            sized["resource_bytes"].get("shadow map").is_none(),
+            "{sized}"
+        );
+    }
 
     // As the scene says: the cart moves, so the prim buffer is rebuilt (by the first light, shared by
-    // the others) and every shadow map re-rendered.
+    // the others) and every primitive map rebuilt.
     let (stdout, json) = render_example(&dir, false);
     assert!(stdout.contains("dynamic (not static: cart_body, cart_load)"));
     let second = json["frames"][1]["lights"].as_array().expect("lights");
@@ -376,7 +381,7 @@ fn scene_render_reports_what_each_light_ran_and_kept() {
         assert_eq!(light["light_builds"], 1, "{light}");
     }
     assert_eq!(second[0]["pass_status"]["ray trace"], "RAN");
-    assert_eq!(second[2]["pass_status"]["shadow map"], "RAN");
+    assert_eq!(second[2]["pass_status"]["primitive map"], "RAN");
 }
 
 /// Options out of range are refused before any GPU work, naming the flag, the value and the range.

@@ -1,8 +1,9 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Exact soft shadows of a sized directional light: per pixel, which of the light's N sample directions
-// (area_samples.glsl, the same for every pixel) reach the light, tested against every triangle of the
-// pixel's texel list in a primitive map whose footprints are widened by their penumbra (map_store.glsl).
+// Exact soft shadows of a sized light: per pixel, which of the light's N samples (a directional light's
+// sample directions, the same for every pixel; a spot or point light's points on its emitter's disc facing
+// the pixel; area_samples.glsl) it reaches, tested against every triangle of the pixel's texel list in a
+// primitive map whose footprints are widened by their penumbra (map_store.glsl).
 // The visibility is the visible fraction, k / N: no noise, no filter, the same output for the same input.
 //
 // The ray test is the triple-product form of the watertight test, for all N directions from the pixel's
@@ -48,6 +49,7 @@ layout(set = 0, binding = 10) readonly buffer EdgeTable { uvec4 edge_table[]; };
 shared vec3 sample_dirs[128];
 
 vec3 origin;
+bool local;         // a spot or point light (the emitter's disc), else a directional light (a cone)
 uint sample_count;
 uvec4 all_samples;  // bit i of word i / 32: sample i exists
 uvec4 blocked;      // bit i: sample i is blocked
@@ -94,8 +96,71 @@ void edge_masks(vec3 n, out uvec4 inside, out uvec4 maybe) {
     }
 }
 
+// A spot or point light: the samples are the points s = P + u U + v V of the emitter's disc through its
+// centre P facing the ray origin (U, V: the disc's axes scaled by its radius; (u, v): the unit-disc offsets
+// in sample_dirs[i].xy). With w = s - o = C + u U + v V (C = P - o), the segment from o to s crosses the
+// triangle iff w reaches it (the three edge functions, as for a direction) and s lies beyond its plane:
+// the crossing's parameter is 1 / (alpha + beta + gamma), below 1 iff N.(s - p0) has the sign of D (N the
+// triangle's normal, D = N.(p0 - o)). Each of the four is affine in (u, v), so each is evaluated as
+// f0 + u fu + v fv, a shared edge's exactly negated; over the unit disc it lies within |(fu, fv)| of f0,
+// which rejects the triangle or takes it as blocking every sample with one evaluation, exactly as the
+// per-sample evaluation decides (the margin covers the rounding of both).
+vec3 disc_c, disc_u, disc_v;
+
+vec3 affine(vec3 n) {
+    return vec3(dot(n, disc_c), dot(n, disc_u), dot(n, disc_v));
+}
+
+// Whether f0 + u fu + v fv is negative (`sign` -1) or positive (+1) over the whole unit disc, beyond the
+// rounding of evaluating it at any sample.
+bool disc_sign(vec3 f, float sign) {
+    float spread = length(f.yz) * (1.0 + DECIDE_MARGIN) + DECIDE_MARGIN * (abs(f.x) + abs(f.y) + abs(f.z));
+    return sign * f.x > spread;
+}
+
+void consider_local(uint index) {
+    vec3 p0 = tris[index].v[0].xyz, p1 = tris[index].v[1].xyz, p2 = tris[index].v[2].xyz;
+    precise vec3 a = p0 - origin;
+    precise vec3 b = p1 - origin;
+    precise vec3 c = p2 - origin;
+    vec3 na = edge_normal(p1, p2, b, c);
+    vec3 nb = edge_normal(p2, p0, c, a);
+    vec3 nc = edge_normal(p0, p1, a, b);
+    precise float det = dot(a, na);
+    if (det == 0.0) {
+        return;
+    }
+    float orient = det < 0.0 ? -1.0 : 1.0;
+    precise vec3 normal = orient * cross(p1 - p0, p2 - p0);
+    vec3 fa = orient * affine(na), fb = orient * affine(nb), fc = orient * affine(nc);
+    precise vec3 fp = vec3(dot(normal, k.light_pos.xyz - p0), dot(normal, disc_u), dot(normal, disc_v));
+    if (disc_sign(fa, -1.0) || disc_sign(fb, -1.0) || disc_sign(fc, -1.0) || disc_sign(fp, -1.0)) {
+        return;     // every sample misses it
+    }
+    if (disc_sign(fa, 1.0) && disc_sign(fb, 1.0) && disc_sign(fc, 1.0) && disc_sign(fp, 1.0)) {
+        blocked = all_samples;  // it blocks every sample
+        return;
+    }
+    for (uint word = 0u; word < 4u; ++word) {
+        uint bits = all_samples[word] & ~blocked[word];
+        while (bits != 0u) {
+            uint bit = findLSB(bits);
+            bits &= bits - 1u;
+            vec2 s = sample_dirs[word * 32u + bit].xy;
+            if (fa.x + s.x * fa.y + s.y * fa.z >= 0.0 && fb.x + s.x * fb.y + s.y * fb.z >= 0.0
+                && fc.x + s.x * fc.y + s.y * fc.z >= 0.0 && fp.x + s.x * fp.y + s.y * fp.z > 0.0) {
+                blocked[word] |= 1u << bit;
+            }
+        }
+    }
+}
+
 void consider(uint index) {
     if (index >= uint(tris.length())) {
+        return;
+    }
+    if (local) {
+        consider_local(index);
         return;
     }
     vec3 p0 = tris[index].v[0].xyz, p1 = tris[index].v[1].xyz, p2 = tris[index].v[2].xyz;
@@ -176,9 +241,27 @@ void main() {
     all_samples = uvec4(0u);
     blocked = uvec4(0u);
     vec3 n = shadow_ray_normal;
+    local = k.light_pos.w != 0.0;
+    // A spot or point light's samples lie on the emitter's disc facing the receiver: its axes are the
+    // rotation taking +Y to the direction from the receiver (not the offset ray origin) towards the light,
+    // applied to +X and +Z (reference::disc_basis). Each sample's facing is judged from the receiver too.
+    vec3 to_centre = k.light_pos.xyz - shadow_ray_receiver;
+    if (local) {
+        disc_c = k.light_pos.xyz - origin;
+        vec3 d = normalize(to_centre);
+        float inv = 1.0 / (1.0 + d.y);
+        vec3 t1 = vec3(1.0, 0.0, 0.0), t2 = vec3(0.0, 0.0, -1.0);
+        if (!isinf(inv) && !isnan(inv)) {
+            t1 = vec3(1.0 - d.x * d.x * inv, -d.x, -d.x * d.z * inv);
+            t2 = vec3(-d.z * d.x * inv, -d.z, 1.0 - d.z * d.z * inv);
+        }
+        disc_u = k.light_dir.w * t1;
+        disc_v = k.light_dir.w * t2;
+    }
     for (uint i = 0u; i < sample_count; ++i) {
         all_samples[i >> 5u] |= 1u << (i & 31u);
-        if (dot(n, sample_dirs[i]) <= 0.0) {
+        vec3 w = local ? to_centre + sample_dirs[i].x * disc_u + sample_dirs[i].y * disc_v : sample_dirs[i];
+        if (dot(n, w) <= 0.0) {
             blocked[i >> 5u] |= 1u << (i & 31u);
         }
     }

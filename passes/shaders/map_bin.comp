@@ -69,8 +69,8 @@ void main() {
             tri = owner & 0x1FFFFFFFu;
             uint face = owner >> 29;
             uvec4 grid = faces[face].grid;
-            // Area shadows: the footprint's widening rate, and the deepest ray origin of the frustum.
-            float widen_rate = faces[face].fit.z;
+            // Area shadows: the footprint's widening, and the deepest ray origin of the frustum.
+            vec2 widen = faces[face].fit.zw;
             float deepest = unordered(faces[face].receivers.z);
             uint k = item - tile_offsets[lo];
             uvec2 bmin = uvec2(bt.info.x & 0xFFFFu, bt.info.x >> 16);
@@ -78,13 +78,13 @@ void main() {
             uvec2 t0 = bmin + uvec2(k % bt.info.w, k / bt.info.w) * BIN_TILE;
             uvec2 t1 = min(t0 + (BIN_TILE - 1u), bmax);
             // The tile's texel centres span [t0, t1] + 0.5.
-            float widest = widen_rate == 0.0 ? 0.0 : penumbra_texels(bt, deepest, widen_rate);
+            float widest = widen.x == 0.0 ? 0.0 : penumbra_texels(bt, deepest, widen);
             if (bin_tile_overlaps(bt, (vec2(t0) + vec2(t1)) * 0.5 + 0.5, (vec2(t1) - vec2(t0)) * 0.5,
                                   widest)) {
                 for (uint y = t0.y; y <= t1.y; ++y) {
                     for (uint x = t0.x; x <= t1.x; ++x) {
                         uint texel = texel_index(grid, uvec2(x, y));
-                        if (bin_accepts(bt, texel, vec2(x, y) + 0.5, pc.cull != 0u, widen_rate, deepest)) {
+                        if (bin_accepts(bt, texel, vec2(x, y) + 0.5, pc.cull != 0u, widen, deepest)) {
                             bin_store(tri, texel);
                             accepted[count] = texel;
                             count += 1u;

@@ -60,10 +60,28 @@ bool bin_overlaps(BinTri t, vec2 centre, float widen) {
 // Unit roundoff of f32.
 #define BIN_U 5.9604645e-8
 
-// Area shadows: texels by which triangle `t`'s footprint widens for receivers down to depth key `reach`, at
-// `widen_rate` texels per unit of depth key (rounded up past the product's rounding).
-float penumbra_texels(BinTri t, float reach, float widen_rate) {
-    return max(reach - t.cmd.w, 0.0) * widen_rate * (1.0 + 1.0 / 65536.0);
+// Area shadows: texels by which the footprint of a triangle whose nearest depth key is `nearest` widens for
+// receivers down to depth key `reach`; `widen` is the frustum's fit.zw (map_fit.comp), rounded up past the
+// arithmetic's rounding.
+// Directional light (widen.y = 0): widen.x texels per unit of depth key the shadow ray climbs.
+// Spot or point light (widen.y = the emitter's depth extent E > 0, widen.x = its reach K in texels): a point
+// q at depth key w(q) >= nearest of a segment from a receiver at depth key w_x to the emitter lies
+// t K / w(q) texels from the receiver's texel, where w(q) = (1 - t) w_x + t w(d) with w(d) <= E gives
+// t <= (w_x - w(q)) / (w_x - E); so at most K (w_x - nearest) / ((w_x - E) nearest) for the texel's
+// deepest receiver w_x = reach (the bound grows with w_x and falls with w(q) once nearest > E, which the
+// setup's depth floor guarantees). A triangle listed everywhere (nearest <= 0) does not widen.
+float penumbra_span(float reach, float nearest, vec2 widen) {
+    if (widen.y == 0.0) {
+        return max(reach - nearest, 0.0) * widen.x * (1.0 + 1.0 / 65536.0);
+    }
+    if (!(nearest > widen.y) || reach <= nearest) {
+        return 0.0;
+    }
+    return widen.x * (reach - nearest) / ((reach - widen.y) * nearest) * (1.0 + 1.0 / 1024.0);
+}
+
+float penumbra_texels(BinTri t, float reach, vec2 widen) {
+    return penumbra_span(reach, t.cmd.w, widen);
 }
 
 // A bound on the rounding of evaluating the edge function of edge `e` from point `a` (or, with a = 0, a

@@ -91,6 +91,24 @@ void main() {
             float rz = length(vec3(m[0][2], m[1][2], m[2][2]));
             faces[f].fit.z = (pc.penumbra * (1.0 + 1.0 / 4096.0) + 1e-6) * max(rx, ry) / rz;
         }
+        if (pc.emitter_radius > 0.0) {
+            // Area shadows of a spot or point light of emitter radius R (passes::area::LocalAreaReach): a point
+            // q = x + t (s - x) of a segment from a receiver x to an emitter point s = P + d (|d| <= R) lies
+            // t |(row_x - T row_w) . d| / w(q) <= t R |row_x - T row_w| / w(q) texels from x's texel T along
+            // x (rows: the linear part of to_texels; likewise y). Over the grid's texels, with one texel of
+            // slack, |row_x - T row_w| is largest at an end: fit.z is R times the largest such norm, and
+            // fit.w the emitter's depth extent R |row_w| (map_bin.glsl's penumbra_span takes t / w(q) from
+            // there).
+            mat4 m = faces[f].to_texels;
+            vec3 rx = vec3(m[0][0], m[1][0], m[2][0]);
+            vec3 ry = vec3(m[0][1], m[1][1], m[2][1]);
+            vec3 rw = vec3(m[0][3], m[1][3], m[2][3]);
+            float far_end = float(n) + 1.0;
+            float widest = max(max(length(rx + rw), length(rx - far_end * rw)),
+                               max(length(ry + rw), length(ry - far_end * rw)));
+            faces[f].fit.z = pc.emitter_radius * widest * (1.0 + 1.0 / 1024.0);
+            faces[f].fit.w = pc.emitter_radius * length(rw) * (1.0 + 1.0 / 1024.0);
+        }
         faces[f].grid.xy = uvec2(base, stride);
         if (pc.faces > 1u) {
             base += n * n;

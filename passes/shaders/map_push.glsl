@@ -1,6 +1,7 @@
 // Mirrors passes::gpu_types::MapPush (80 bytes): push constants of the primitive-map passes.
 struct MapPush {
-    vec4 to_light;          // xyz: direction towards the light (directional); w: 1 for a spot light
+    vec4 to_light;          // directional: xyz the direction towards the light, w 0; spot or point light:
+                            // xyz its position (frame coordinates), w 1
     uint size;              // N: texels per side
     uint mode;              // pass-specific mode
     uint front_only;        // 1: keep only triangles facing the light
@@ -13,6 +14,8 @@ struct MapPush {
     uint pairs;             // (triangle, face) pairs the bin items hold (a point light's map)
     uint texels;            // texels of the map's grids together
     uint list_capacity;     // (triangle, texel) pairs the pair list holds (compute binning; 0: none)
-    float penumbra;         // area shadows: tan(angular radius) of the light (0: hard, no widening)
-    uint pad0, pad1, pad2;
+    float penumbra;         // area shadows, directional: tan(angular radius) of the light (0: otherwise)
+    float emitter_radius;   // area shadows, spot or point light: the emitter's radius (0: otherwise)
+    float near_radius;      // ... triangles nearer the light than this go into every texel with receivers
+    float depth_floor;      // ... no point of a farther triangle below this depth key blocks a receiver
 };

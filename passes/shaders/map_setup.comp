@@ -10,7 +10,10 @@
 // so they never hit), back faces in front-only mode, triangles outside the receivers' texels, triangles
 // wholly farther from the light than every ray origin, and, for a perspective light, triangles wholly on or
 // behind the light's plane. Triangles that cross that plane keep exactly their part in front of it
-// (clipped_setup).
+// (clipped_setup). Area shadows widen each footprint by the penumbra it can cast (map_bin.glsl's
+// penumbra_span); for a spot or point light, triangles within the near radius of its centre are listed in
+// every texel with receivers, and farther ones are culled below a depth floor that grows with their
+// distance from the light (passes::area::LocalAreaReach).
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_basic : require
@@ -117,8 +120,11 @@ bool clipped_box(float n, vec3 l[3], vec3 slack, float orientation, out vec2 lo,
 // and both signs are accepted: the projection is then a band around one line. The bounding box clips the
 // map square to the three half-planes with one more texel of slack and grows by one texel, which absorbs
 // the rounding of the clip. With a known orientation, each edge's error bound is folded into that edge
-// (its constant term), and the edges are stored oriented.
-uint clipped_setup(float n, HPoint h[3], float min_depth, float margin_base, inout BinTri bt) {
+// (its constant term), and the edges are stored oriented. `box_widen`: an area light's widest penumbra
+// (texels), by which the bounding box grows (each texel's own widening is added by the binning).
+// Area shadows of a spot or point light keep the part in front of the plane too: their setup has already
+// culled what lies below its depth floor, and a part nearer the plane than the floor only adds texels.
+uint clipped_setup(float n, HPoint h[3], float min_depth, float margin_base, float box_widen, inout BinTri bt) {
     Line lines[3] = Line[3](edge_line(h[1], h[2]), edge_line(h[2], h[0]), edge_line(h[0], h[1]));
     precise float d = dot(h[0].h, lines[0].l);
     float d_err = (dot(h[0].err, abs(lines[0].l)) + dot(abs(h[0].h), lines[0].e)
@@ -167,7 +173,8 @@ uint clipped_setup(float n, HPoint h[3], float min_depth, float margin_base, ino
     } else {
         margin += extra;    // either orientation: one margin for the three edges, tested both ways
     }
-    float g = 1.5 + margin;    // half a texel, the margin, and the clip's one texel of slack
+    // Half a texel, the margin, the clip's one texel of slack, and an area light's widest penumbra.
+    float g = 1.5 + margin + box_widen;
     vec3 slack = g * vec3(abs(l[0].x) + abs(l[0].y), abs(l[1].x) + abs(l[1].y), abs(l[2].x) + abs(l[2].y));
     vec2 lo = vec2(1.0 / 0.0), hi = vec2(-1.0 / 0.0);
     bool any_part = false;
@@ -194,8 +201,28 @@ uint clipped_setup(float n, HPoint h[3], float min_depth, float margin_base, ino
     return tiles.x * tiles.y;
 }
 
-// The bin item of the triangle (v0, v1, v2) in frustum `f`: its tiles (0: culled).
-uint setup(uint f, vec3 v0, vec3 v1, vec3 v2, out BinTri bt) {
+// A lower bound on the distance from `p` to the triangle (a, b, c): the larger of the distances to its
+// bounding box and to its plane (the plane's only for a well-shaped triangle, whose normal's rounding is
+// small), each lowered past its rounding.
+float distance_below(vec3 p, vec3 a, vec3 b, vec3 c) {
+    vec3 lo = min(min(a, b), c), hi = max(max(a, b), c);
+    float scale = max(max(max(abs(p.x), abs(p.y)), abs(p.z)),
+                      max(max(abs(lo.x), abs(lo.y)), max(max(abs(lo.z), abs(hi.x)), max(abs(hi.y), abs(hi.z)))));
+    float box = length(max(max(lo - p, p - hi), vec3(0.0)));
+    vec3 e0 = b - a, e1 = c - a;
+    vec3 nrm = cross(e0, e1);
+    float plane = 0.0;
+    if (length(nrm) > 1e-3 * length(e0) * length(e1)) {
+        plane = abs(dot(normalize(nrm), p - a)) * (1.0 - 1e-3);
+    }
+    return max(box, plane) - 1e-5 * scale;
+}
+
+// The bin item of the triangle (v0, v1, v2) in frustum `f`: its tiles (0: culled). Area shadows of a spot
+// or point light: `distance` is a lower bound on the triangle's distance from the light's centre; within
+// the near radius, the triangle is listed in every texel of the frustum's grid with receivers.
+uint setup(uint f, vec3 v0, vec3 v1, vec3 v2, float distance, out BinTri bt) {
+    bool near = pc.emitter_radius > 0.0 && distance < pc.near_radius;
     bt.ab = vec4(0.0);
     bt.cmd = vec4(0.0);
     bt.info = uvec4(0u);
@@ -205,14 +232,29 @@ uint setup(uint f, vec3 v0, vec3 v1, vec3 v2, out BinTri bt) {
     }
     mat4 to_texels = faces[f].to_texels;
     float n = faces[f].fit.y;
+    int last = int(n) - 1;
+    if (near) {
+        // Never culled by depth (nearest below every key) and never widened: the whole grid.
+        bt.cmd.zw = vec2(ACCEPT_MARGIN, -1.0 / 0.0);
+        uint side = (uint(last) + BIN_TILE) / BIN_TILE;
+        bt.info = uvec4(0u, pack_texel(ivec2(last)), MODE_COVER, side);
+        return side * side;
+    }
     bool perspective = pc.to_light.w != 0.0;
+    // Area shadows of a spot or point light: a point of this triangle that blocks a receiver of the
+    // frustum lies at least `distance` from the light, within the angle from the frustum's axis that makes
+    // the depth floor of the near radius (passes::area::LocalAreaReach), so its depth key is at least
+    // distance * depth_floor / near_radius: the triangle is culled below that and widened as no nearer.
+    float floor_key = pc.emitter_radius > 0.0
+        ? distance * (pc.depth_floor / pc.near_radius) * (1.0 - 1.0 / 1048576.0) : 0.0;
     float margin = ACCEPT_MARGIN + 2.0 * unordered(faces[f].receivers.y);
     HPoint h[3];
     bool reaches_plane = false;
     if (perspective) {
         h = HPoint[3](project_h(to_texels, v0), project_h(to_texels, v1), project_h(to_texels, v2));
-        if (h[0].h.z + h[0].err.z <= 0.0 && h[1].h.z + h[1].err.z <= 0.0 && h[2].h.z + h[2].err.z <= 0.0) {
-            return 0u;  // wholly on or behind the light's plane: it blocks no segment in front of it
+        if (h[0].h.z + h[0].err.z <= floor_key && h[1].h.z + h[1].err.z <= floor_key
+            && h[2].h.z + h[2].err.z <= floor_key) {
+            return 0u;  // wholly on or behind the light's plane (or its floor): it blocks no segment
         }
         reaches_plane = h[0].h.z - h[0].err.z <= 0.0 || h[1].h.z - h[1].err.z <= 0.0
                      || h[2].h.z - h[2].err.z <= 0.0;
@@ -221,13 +263,19 @@ uint setup(uint f, vec3 v0, vec3 v1, vec3 v2, out BinTri bt) {
                                   project(to_texels, v2, perspective));
     float min_depth = min(min(p[0].depth - p[0].depth_err, p[1].depth - p[1].depth_err),
                           p[2].depth - p[2].depth_err);
-    if (pc.cull != 0u && min_depth > unordered(faces[f].receivers.z)) {
+    if (pc.emitter_radius > 0.0) {
+        min_depth = max(min_depth, floor_key);
+    }
+    float deepest = unordered(faces[f].receivers.z);
+    if (pc.cull != 0u && min_depth > deepest) {
         return 0u;  // behind every ray origin as seen from the light
     }
+    // Area shadows: the bounding box also holds the texels the triangle's penumbra can reach on the
+    // frustum's deepest ray origin (map_store.glsl widens per texel, by the texel's own deepest one).
+    float widest = faces[f].fit.z == 0.0 ? 0.0 : penumbra_span(deepest, min_depth, faces[f].fit.zw);
     if (reaches_plane) {
-        return clipped_setup(n, h, min_depth, margin, bt);
+        return clipped_setup(n, h, min_depth, margin, widest, bt);
     }
-    int last = int(n) - 1;
     uint mode = MODE_COVER;
     float err = max(max(max(p[0].xy_err.x, p[0].xy_err.y), max(p[1].xy_err.x, p[1].xy_err.y)),
                     max(p[2].xy_err.x, p[2].xy_err.y));
@@ -236,15 +284,12 @@ uint setup(uint f, vec3 v0, vec3 v1, vec3 v2, out BinTri bt) {
     // reaches tens of thousands of texels.
     vec2 reach = max(max(abs(p[0].xy), abs(p[1].xy)), max(abs(p[2].xy), vec2(n)));
     margin += err + 16.0 * U * max(reach.x, reach.y);
-    // Area shadows: the bounding box also holds the texels the triangle's penumbra can reach on the
-    // frustum's deepest ray origin (map_store.glsl widens per texel, by the texel's own deepest one).
-    float widest = faces[f].fit.z == 0.0 ? 0.0
-        : max(unordered(faces[f].receivers.z) - min_depth, 0.0) * faces[f].fit.z * (1.0 + 1.0 / 65536.0);
     vec2 lo = min(min(p[0].xy, p[1].xy), p[2].xy) - (margin + widest);
     vec2 hi = max(max(p[0].xy, p[1].xy), p[2].xy) + (margin + widest);
     bool far = any(greaterThan(abs(vec4(lo, hi)), vec4(FAR_TEXELS)));
     if (far && perspective) {
-        return clipped_setup(n, h, min_depth, ACCEPT_MARGIN + 2.0 * unordered(faces[f].receivers.y), bt);
+        return clipped_setup(n, h, min_depth, ACCEPT_MARGIN + 2.0 * unordered(faces[f].receivers.y), widest,
+                             bt);
     }
     if (any(greaterThan(lo, vec2(float(last) + 1.0))) || any(lessThan(hi, vec2(0.0)))) {
         return 0u;  // outside the map: no ray origin projects there
@@ -311,11 +356,14 @@ void main() {
         live = v0 != v1 && v1 != v2 && v2 != v0
             && (pc.front_only == 0u || dot(c, pc.to_light.xyz) > facing);
     }
+    // Area shadows of a spot or point light: how near the light's centre the triangle may come (within the
+    // near radius it may block any receiver; passes::area::LocalAreaReach).
+    float distance = live && pc.emitter_radius > 0.0 ? distance_below(pc.to_light.xyz, v0, v1, v2) : 0.0;
     bool kept = false;
     if (pc.faces == 1u) {
         if (index < pc.triangles) {
             BinTri bt = BinTri(vec4(0.0), vec4(0.0), uvec4(0u), vec4(0.0));
-            uint tiles = live ? setup(0u, v0, v1, v2, bt) : 0u;
+            uint tiles = live ? setup(0u, v0, v1, v2, distance, bt) : 0u;
             bin_tris[index] = bt;
             tile_counts[index] = tiles;
             kept = tiles > 0u;
@@ -327,7 +375,7 @@ void main() {
         // subgroup and face reserves the slots of the pairs kept.
         for (uint f = 0u; f < pc.faces; ++f) {
             BinTri bt = BinTri(vec4(0.0), vec4(0.0), uvec4(0u), vec4(0.0));
-            uint tiles = live ? setup(f, v0, v1, v2, bt) : 0u;
+            uint tiles = live ? setup(f, v0, v1, v2, distance, bt) : 0u;
             bool keep = tiles > 0u;
             uint count = subgroupAdd(keep ? 1u : 0u);
             uint first = 0u;

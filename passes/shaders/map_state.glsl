@@ -10,8 +10,10 @@ struct MapState {
                         // projection, z: ordered max depth key (plus error) of the ray origins, w: pixels
                         // with a ray inside the light's frustum, counted by the bounds pass
     vec4 fit;           // x: 1 when the map has receivers, y: texels per side of the fitted grid (at most
-                        // N; fewer when few rays need it, see map_fit.comp), z: area shadows: texels a
-                        // footprint widens per unit of depth key above a receiver (0: hard), w: unused
+                        // N; fewer when few rays need it, see map_fit.comp), z: area shadows: directional,
+                        // texels a footprint widens per unit of depth key above a receiver; spot or point
+                        // light, the emitter's reach in texels (0: hard), w: area shadows of a spot or
+                        // point light, the emitter's depth extent (0: otherwise)
     uvec4 totals;       // x: (triangle, texel) pairs the count appended to the pair list, y: entries needed,
                         // z: entry capacity, w: triangles kept by the setup's culling
     uvec4 stats;        // x: texels with a list, y: longest list, z: texels past the capacity (traced

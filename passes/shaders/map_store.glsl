@@ -7,12 +7,11 @@
 // ordered largest depth key (plus its error) of its ray origins; for hard shadows it is read only for
 // overlapped texels. Without `cull`, every overlapped texel is accepted (a debug mode whose lists tests
 // compare with exact binning).
-// Area shadows (`widen_rate` > 0, texels per unit of depth key, map_fit.comp): the footprint grows by the
-// penumbra the triangle can cast on the texel's deepest receiver (the whole map's, `deepest`, without
-// `cull`): a shadow ray that climbs from depth z to the triangle's nearest depth moves sideways by at most
-// (z - nearest) * widen_rate texels.
-bool bin_accepts(BinTri t, uint texel, vec2 centre, bool cull, float widen_rate, float deepest) {
-    if (widen_rate == 0.0) {
+// Area shadows (`widen` = the frustum's fit.zw, x > 0; map_fit.comp): the footprint grows by the penumbra
+// the triangle can cast on the texel's deepest receiver (the whole map's, `deepest`, without `cull`;
+// map_bin.glsl's penumbra_span).
+bool bin_accepts(BinTri t, uint texel, vec2 centre, bool cull, vec2 widen, float deepest) {
+    if (widen.x == 0.0) {
         if (!bin_overlaps(t, centre, 0.0)) {
             return false;
         }
@@ -30,7 +29,7 @@ bool bin_accepts(BinTri t, uint texel, vec2 centre, bool cull, float widen_rate,
         }
         reach = unordered(word);
     }
-    return bin_overlaps(t, centre, penumbra_texels(t, reach, widen_rate));
+    return bin_overlaps(t, centre, penumbra_texels(t, reach, widen));
 }
 
 // Counts (mode 0) or stores (mode 1) triangle `tri` in the list of `texel`.

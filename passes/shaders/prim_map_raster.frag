@@ -24,7 +24,7 @@ void main() {
         return;
     }
     uint texel = t.y * pc.size + t.x;
-    if (!bin_accepts(bt, texel, vec2(t) + 0.5, pc.cull != 0u, 0.0, 0.0)) {
+    if (!bin_accepts(bt, texel, vec2(t) + 0.5, pc.cull != 0u, vec2(0.0), 0.0)) {
         return;
     }
     bin_store(tri, texel);

@@ -5,7 +5,8 @@ struct RayTraceConstants {
     mat4 light_view_proj;       // light view-projection in frame coordinates
     vec4 camera_pos;            // xyz: camera in frame coordinates
     vec4 light_dir;             // xyz: direction the light travels (unit); w: area shadows: tan(angular
-                                // radius) of the light (0: hard shadows)
+                                // radius) of a directional light, a spot or point light's emitter radius
+                                // (0: hard shadows)
     uvec4 dims;                 // screen width, height, primitive map N, unused
     vec4 offset;                // x: radians per pixel, y: offset in pixels, z: relative float bound of |P|,
                                 // w: one step of a normalized depth format (0 for float depth)

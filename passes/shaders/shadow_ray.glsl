@@ -15,8 +15,10 @@ const int SHADOW_RAY_TRACE = 0;     // trace o + t * dir, 0 < t < t_max
 const int SHADOW_RAY_LIT = 1;       // no ray: background, or the receiver is at the emitter
 const int SHADOW_RAY_FACING_AWAY = 2;   // no ray: the visible side faces away from the light
 
-// The receiver's normal (world space, towards the camera), set by shadow_ray once it found a receiver.
+// The receiver's normal (world space, towards the camera) and point (frame coordinates, before the ray
+// origin's offset), set by shadow_ray once it found a receiver.
 vec3 shadow_ray_normal = vec3(0.0);
+vec3 shadow_ray_receiver = vec3(0.0);
 
 int shadow_ray(ivec2 px, out vec3 o, out vec3 dir, out float t_max) {
     o = vec3(0.0);
@@ -30,14 +32,18 @@ int shadow_ray(ivec2 px, out vec3 o, out vec3 dir, out float t_max) {
         return SHADOW_RAY_LIT;
     }
     vec3 p = k.camera_pos.xyz + rel;
+    shadow_ray_receiver = p;
     bool spot = k.light_pos.w != 0.0;
     vec3 to_light = spot ? k.light_pos.xyz - p : -k.light_dir.xyz;
     shadow_ray_normal = n;
     if (k.light_dir.w > 0.0) {
-        // Area shadows: the receiver faces away from every direction of the light's cone (angular radius r,
-        // tan r = light_dir.w) only when its normal, within its own precision, turns more than r past
-        // perpendicular; the area trace decides each sample's facing itself.
-        float sin_r = k.light_dir.w / sqrt(1.0 + k.light_dir.w * k.light_dir.w);
+        // Area shadows: the receiver faces away from every direction of the light's cone (angular radius r:
+        // tan r = light_dir.w for a directional light; a spot or point light's emitter of radius
+        // light_dir.w seen from distance d, sin r <= light_dir.w / d) only when its normal, within its own
+        // precision, turns more than r past perpendicular; the area trace decides each sample's facing
+        // itself.
+        float sin_r = spot ? min(k.light_dir.w / length(to_light), 1.0)
+                           : k.light_dir.w / sqrt(1.0 + k.light_dir.w * k.light_dir.w);
         if (dot(n, normalize(to_light)) < -(sin_r + k.surface.z) * (1.0 + 1.0 / 1024.0) - 1e-6) {
             return SHADOW_RAY_FACING_AWAY;
         }

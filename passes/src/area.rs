@@ -12,10 +12,20 @@
 //! sideways by at most `tan(r)` per unit of depth it climbs towards the light, so a triangle whose nearest
 //! point lies `h` above a texel's deepest receiver can only block rays of that texel if its footprint comes
 //! within `h tan(r)` of the texel (`map_bin.glsl`).
+//!
+//! A spot or point light has a spherical emitter of radius `R` around its position `P`. Each pixel takes
+//! `N` points on the disc of radius `R` through `P` facing it ([`local_area_offsets`]: the same offsets on
+//! the unit disc for every pixel, placed by a basis that turns smoothly with the direction to the light),
+//! and counts the segments from its ray origin to them that no triangle crosses. The light's perspective
+//! map (a spot light's frustum, a point light's six cube faces as one map) widens each footprint by the
+//! texels a segment can move across while it climbs from the receiver to the triangle's depth
+//! (`R (1/w_tri - 1/w_recv)` in the image plane, bounded in `map_bin.glsl`); triangles within
+//! [`LocalAreaReach::near_radius`] of `P` are listed in every texel with receivers.
 
 use crate::gpu_types::AreaSamples;
 use crate::PassError;
-use glam::{DVec3, UVec4, Vec3, Vec4};
+use bytemuck::Zeroable;
+use glam::{DVec2, DVec3, DVec4, Mat4, UVec4, Vec2, Vec3, Vec4};
 
 /// Most light samples per pixel (the bits of the shader's sample mask).
 pub const MAX_AREA_SAMPLES: u32 = 128;
@@ -115,6 +125,89 @@ pub fn area_samples(direction: Vec3, angular_radius: f32, samples: u32) -> AreaS
         *slot = w.extend(0.0);
     }
     table
+}
+
+/// The `samples` points of a spot or point light's emitter, as offsets on the unit disc: equal-area rings
+/// (`radius sqrt((i + 1/2) / N)`) turned by the golden angle, computed in f64 and rounded to f32 (the GPU and
+/// the reference use these values). A pixel at `x` places them on the disc of the emitter's radius `R`
+/// through the light's centre `P`, facing it: `P + R (u t1 + v t2)` with `(t1, t2)` the rotation taking +Y
+/// to the unit direction from `x` to `P` applied to +X and +Z (`reference::disc_basis`).
+pub fn local_area_offsets(samples: u32) -> Vec<Vec2> {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..samples)
+        .map(|i| {
+            let r = ((f64::from(i) + 0.5) / f64::from(samples)).sqrt();
+            let phi = golden * f64::from(i);
+            DVec2::new(r * phi.cos(), r * phi.sin()).as_vec2()
+        })
+        .collect()
+}
+
+/// The area trace's per-frame sample table of a spot or point light: the unit-disc offsets
+/// ([`local_area_offsets`]) in the directions' slots (xy); the centre and axes are unused.
+pub fn local_area_samples(samples: u32) -> AreaSamples {
+    let mut table = AreaSamples::zeroed();
+    for (slot, o) in table.dirs.iter_mut().zip(local_area_offsets(samples)) {
+        *slot = Vec4::new(o.x, o.y, 0.0, 0.0);
+    }
+    table
+}
+
+/// Where a spot or point light's emitter reaches in one perspective frustum of its primitive map (area
+/// shadows). A receiver `x` of the frustum sees the emitter (radius `R`, centre `P`) along segments to points
+/// within `R` of `P`. A point `q` of such a segment that lies `rho >= near_radius` from `P` is within angle
+/// `theta = asin(R / near_radius)` of the direction from `P` to `x`, so within `alpha + theta` of the
+/// frustum's axis (`alpha`: its widest direction), and its depth key is at least
+/// `|axis row| near_radius cos(alpha + theta)` = `depth_floor`. With `theta = (pi/2 - alpha) / 3`, the floor
+/// is about twice the emitter's own depth extent, which keeps the per-texel widening of `map_bin.glsl`
+/// bounded. Triangles nearer than `near_radius` are listed in every texel with receivers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LocalAreaReach {
+    /// Distance from the light's centre within which a triangle goes into every texel.
+    pub near_radius: f32,
+    /// The depth key below which no point of a farther triangle can block a receiver of the frustum.
+    pub depth_floor: f32,
+}
+
+/// The reach of an emitter of `radius` at `position` into the perspective frustum `view_proj` (both in the
+/// same coordinates), or an error when the frustum is too wide (its widest direction within 3° of its plane).
+pub fn local_area_reach(
+    view_proj: Mat4,
+    position: Vec3,
+    radius: f32,
+) -> Result<LocalAreaReach, PassError> {
+    let m = view_proj.as_dmat4();
+    let row_w = m.row(3).truncate();
+    let scale = row_w.length();
+    let inv = m.inverse();
+    let p = position.as_dvec3();
+    let axis = row_w / scale;
+    let mut widest = 0.0f64;
+    for (x, y) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)] {
+        let h = inv * DVec4::new(x, y, 0.5, 1.0);
+        let d = (h.truncate() / h.w - p).normalize();
+        widest = widest.max(d.dot(axis).clamp(-1.0, 1.0).acos());
+    }
+    let alpha = widest * (1.0 + 1e-3) + 1e-4;
+    let theta = (std::f64::consts::FRAC_PI_2 - alpha) / 3.0;
+    if !(radius > 0.0 && radius.is_finite()) {
+        return Err(PassError::InvalidConfig(format!(
+            "area shadows of a spot or point light need an emitter radius above 0 (pcss spot_radius), not \
+             {radius}: a light of no size has hard shadows (mode hard)"
+        )));
+    }
+    if !(scale.is_finite() && theta > 1f64.to_radians()) {
+        return Err(PassError::InvalidConfig(format!(
+            "area shadows of a spot light need a frustum narrower than 174° across its corners (this one \
+             spans {:.1}°): give a narrower view_proj, or the light without one (the plugin fits it)",
+            2.0 * widest.to_degrees()
+        )));
+    }
+    let near = f64::from(radius) / theta.sin();
+    Ok(LocalAreaReach {
+        near_radius: (near * (1.0 + 1e-4)) as f32,
+        depth_floor: (scale * near * (alpha + theta).cos() * (1.0 - 1e-4)) as f32,
+    })
 }
 
 /// Directions of a triangle edge's line in the edge table (over the "diamond angle" of its normal, in
@@ -283,6 +376,31 @@ mod tests {
         assert_eq!(inner, 32);
         // Deterministic.
         assert_eq!(dirs, area_sample_directions(direction, r, 64));
+    }
+
+    #[test]
+    fn local_offsets_fill_the_unit_disc_evenly() {
+        let o = local_area_offsets(64);
+        assert_eq!(o.len(), 64);
+        assert!(o.iter().all(|p| p.length() < 1.0));
+        assert_eq!(o.iter().filter(|p| p.length_squared() < 0.5).count(), 32);
+        assert_eq!(local_area_samples(64).dirs[63].truncate().truncate(), o[63]);
+        assert_eq!(local_area_samples(64).dirs[64], Vec4::ZERO);
+    }
+
+    /// A cube face (just over 90°) keeps its floor near twice the emitter's radius; a 176° frustum is
+    /// refused.
+    #[test]
+    fn the_local_reach_of_a_cube_face_and_a_too_wide_frustum() {
+        let p = Vec3::new(1.0, 2.0, 3.0);
+        let face = crate::light::point_light_faces(p, None)[2].view_proj();
+        let r = local_area_reach(face, p, 0.1).expect("reach");
+        assert!(r.near_radius > 0.4 && r.near_radius < 0.6, "{r:?}");
+        assert!(r.depth_floor > 0.18 && r.depth_floor < 0.21, "{r:?}");
+        let wide = Mat4::perspective_infinite_rh(176f32.to_radians(), 1.0, 0.01)
+            * Mat4::look_to_rh(p, Vec3::NEG_Y, Vec3::Z);
+        assert!(local_area_reach(wide, p, 0.1).is_err());
+        assert!(local_area_reach(face, p, 0.0).is_err());
     }
 
     #[test]

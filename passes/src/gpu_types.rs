@@ -44,7 +44,8 @@ pub struct PrimBufferPush {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub struct MapPush {
-    /// Direction towards the light (xyz, directional); w: 1 for a spot light.
+    /// Directional light: the direction towards it (xyz), w 0. Spot or point light: its position in frame
+    /// coordinates (xyz), w 1.
     pub to_light: Vec4,
     /// Map size N.
     pub size: u32,
@@ -70,11 +71,17 @@ pub struct MapPush {
     pub texels: u32,
     /// (Triangle, texel) pairs the compute binning's pair list holds (0: none).
     pub list_capacity: u32,
-    /// Area shadows: the tangent of the light's angular radius, by which a triangle's footprint widens per
-    /// unit of depth above a receiver (0: hard shadows, no widening).
+    /// Area shadows of a directional light: the tangent of the light's angular radius, by which a
+    /// triangle's footprint widens per unit of depth above a receiver (0: otherwise).
     pub penumbra: f32,
-    /// Padding.
-    pub pad: [u32; 3],
+    /// Area shadows of a spot or point light: the emitter's radius (frame units; 0: otherwise).
+    pub emitter_radius: f32,
+    /// Area shadows of a spot or point light: triangles nearer the light than this are listed in every
+    /// texel with receivers ([`crate::area::LocalAreaReach`]).
+    pub near_radius: f32,
+    /// Area shadows of a spot or point light: a depth key below which no point of a farther triangle can
+    /// block a receiver of the frustum ([`crate::area::LocalAreaReach`]).
+    pub depth_floor: f32,
 }
 
 /// Constants of the primitive map's passes: the ray trace's (the receivers trace the same rays), and the
@@ -99,8 +106,8 @@ pub struct RayTraceConstants {
     pub light_view_proj: Mat4,
     /// Camera position in frame coordinates (xyz).
     pub camera_pos: Vec4,
-    /// Direction the light travels (xyz, unit); w: area shadows, the tangent of the light's angular radius
-    /// (0: hard shadows).
+    /// Direction the light travels (xyz, unit); w: area shadows, the tangent of a directional light's
+    /// angular radius or a spot or point light's emitter radius (0: hard shadows).
     pub light_dir: Vec4,
     /// Screen width, height, map N, unused.
     pub dims: UVec4,
@@ -133,8 +140,9 @@ pub struct MapState {
     /// depth key of the ray origins, w: pixels with a ray inside the light's frustum (bounds pass).
     pub receivers: UVec4,
     /// x: 1 when the map has receivers, y: texels per side of the fitted grid (N, or fewer with receiver
-    /// culling when few rays need it), z: area shadows: texels a triangle's footprint widens per unit of
-    /// depth key above a receiver (0: hard shadows).
+    /// culling when few rays need it), z: area shadows of a directional light: texels a triangle's
+    /// footprint widens per unit of depth key above a receiver; of a spot or point light: the emitter's
+    /// reach in texels (0: hard shadows), w: a spot or point light's emitter depth extent (0: otherwise).
     pub fit: Vec4,
     /// x: (triangle, texel) pairs the compute count appended to the pair list, y: entries needed, z: entry
     /// capacity, w: triangles binned (kept by the culling).

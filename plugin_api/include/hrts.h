@@ -9,7 +9,7 @@
 
 // Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 // version differs.
-#define HRTS_API_VERSION ((5 << 22) | (5 << 12))
+#define HRTS_API_VERSION ((5 << 22) | (6 << 12))
 
 // The most lights one context shades (`hrts_configure_lights`); a point light counts once.
 #define HRTS_MAX_LIGHTS 64
@@ -147,9 +147,11 @@ enum HrtsShadowMode
   HRTS_SHADOW_MODE_SOFT = 2,
   // The talk's hybrid: lerp(ray-traced, PCSS, saturate(BD / WSS * PHS)).
   HRTS_SHADOW_MODE_HYBRID = 3,
-  // Exact soft shadows of a sized directional light (`pcss_angular_radius`): the visible fraction of
-  // `area_samples` light samples per pixel, each tested exactly against the triangles the primitive map
-  // lists, widened by their penumbra. Noise-free and deterministic; compute binning only.
+  // Exact soft shadows of a sized light: the visible fraction of `area_samples` light samples per pixel,
+  // each tested exactly against the triangles the primitive map lists, widened by their penumbra. A
+  // directional light's samples are directions within `pcss_angular_radius`; a spot or point light's
+  // are points of its spherical emitter of radius `pcss_spot_radius` (on the disc through its centre
+  // facing the pixel). Noise-free and deterministic; compute binning only; a point light is one cube map.
   HRTS_SHADOW_MODE_AREA = 4,
 };
 #ifndef __cplusplus
@@ -171,8 +173,8 @@ enum HrtsLightType
   // Spot light at `position` pointing along `direction`: the engine's perspective `view_proj`, or, when
   // `view_proj` is all zeros, frusta the plugin fits to `outer_cone` and `range`.
   HRTS_LIGHT_TYPE_SPOT = 1,
-  // Point light at `position`, shining in every direction within `range`. With hard shadows (or none)
-  // and compute binning, the plugin builds the six cube faces around it as one primitive map (each
+  // Point light at `position`, shining in every direction within `range`. With hard or area shadows
+  // (or none) and compute binning, the plugin builds the six cube faces around it as one primitive map (each
   // pixel's ray looks up the face its direction from the light falls in; faces share the map's
   // texels in proportion to their rays) and traces it once; otherwise it shadows it through the six
   // faces as frusta and writes their minimum to the light's output layer.
@@ -527,7 +529,8 @@ typedef struct HrtsConfig {
   uint32_t shadow_map_size;
   // PCSS: angular radius of a directional emitter in radians (default 0.02).
   float pcss_angular_radius;
-  // PCSS: radius of a spot emitter in world units (default 0.05).
+  // Radius of a spot or point light's spherical emitter in world units (default 0.05): PCSS, the
+  // hybrid and area shadows.
   float pcss_spot_radius;
   // PCSS blocker-search taps (default 16).
   uint32_t pcss_blocker_search_taps;

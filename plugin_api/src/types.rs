@@ -6,7 +6,7 @@ use std::ffi::c_char;
 
 /// Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 /// version differs.
-pub const HRTS_API_VERSION: u32 = 5 << 22 | 5 << 12;
+pub const HRTS_API_VERSION: u32 = 5 << 22 | 6 << 12;
 
 /// A flag in the C structs: 0 is false, any other value true. (A Rust `bool` would make any byte but 0
 /// and 1 undefined behaviour when the engine writes it.)
@@ -247,9 +247,11 @@ pub enum HrtsShadowMode {
     Soft = 2,
     /// The talk's hybrid: lerp(ray-traced, PCSS, saturate(BD / WSS * PHS)).
     Hybrid = 3,
-    /// Exact soft shadows of a sized directional light (`pcss_angular_radius`): the visible fraction of
-    /// `area_samples` light samples per pixel, each tested exactly against the triangles the primitive map
-    /// lists, widened by their penumbra. Noise-free and deterministic; compute binning only.
+    /// Exact soft shadows of a sized light: the visible fraction of `area_samples` light samples per pixel,
+    /// each tested exactly against the triangles the primitive map lists, widened by their penumbra. A
+    /// directional light's samples are directions within `pcss_angular_radius`; a spot or point light's
+    /// are points of its spherical emitter of radius `pcss_spot_radius` (on the disc through its centre
+    /// facing the pixel). Noise-free and deterministic; compute binning only; a point light is one cube map.
     Area = 4,
 }
 
@@ -262,8 +264,8 @@ pub enum HrtsLightType {
     /// Spot light at `position` pointing along `direction`: the engine's perspective `view_proj`, or, when
     /// `view_proj` is all zeros, frusta the plugin fits to `outer_cone` and `range`.
     Spot = 1,
-    /// Point light at `position`, shining in every direction within `range`. With hard shadows (or none)
-    /// and compute binning, the plugin builds the six cube faces around it as one primitive map (each
+    /// Point light at `position`, shining in every direction within `range`. With hard or area shadows
+    /// (or none) and compute binning, the plugin builds the six cube faces around it as one primitive map (each
     /// pixel's ray looks up the face its direction from the light falls in; faces share the map's
     /// texels in proportion to their rays) and traces it once; otherwise it shadows it through the six
     /// faces as frusta and writes their minimum to the light's output layer.
@@ -435,7 +437,8 @@ pub struct HrtsConfig {
     pub shadow_map_size: u32,
     /// PCSS: angular radius of a directional emitter in radians (default 0.02).
     pub pcss_angular_radius: f32,
-    /// PCSS: radius of a spot emitter in world units (default 0.05).
+    /// Radius of a spot or point light's spherical emitter in world units (default 0.05): PCSS, the
+    /// hybrid and area shadows.
     pub pcss_spot_radius: f32,
     /// PCSS blocker-search taps (default 16).
     pub pcss_blocker_search_taps: u32,

@@ -2,7 +2,7 @@
 //! directions reach the light, each decided by [`reference_visibility`] as a hard shadow ray of its own, and
 //! whether every one of them is decided beyond the tolerance (a stable pixel).
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use crate::{reference_visibility, Light, PixelClass, RefScene, VisibilityParams};
 
@@ -33,20 +33,53 @@ pub fn area_reference(
     params: &VisibilityParams,
     towards_light: &[DVec3],
 ) -> AreaReference {
+    count_samples(
+        scene,
+        params,
+        towards_light
+            .iter()
+            .map(|&w| Light::Directional { direction: -w }),
+    )
+}
+
+/// The visible count of each pixel of `params`' view for a spherical emitter of `radius` at `centre` (a sized
+/// spot or point light), sampled at `offsets` on the unit disc facing each receiver ([`Light::DiscSample`];
+/// `params.light` is replaced).
+pub fn local_area_reference(
+    scene: &RefScene,
+    params: &VisibilityParams,
+    centre: DVec3,
+    radius: f64,
+    offsets: &[DVec2],
+) -> AreaReference {
+    count_samples(
+        scene,
+        params,
+        offsets.iter().map(|&offset| Light::DiscSample {
+            centre,
+            radius,
+            offset,
+        }),
+    )
+}
+
+/// Counts, per pixel, the `lights` (one per sample) that reach it.
+fn count_samples(
+    scene: &RefScene,
+    params: &VisibilityParams,
+    lights: impl ExactSizeIterator<Item = Light>,
+) -> AreaReference {
     let pixels = params.width as usize * params.height as usize;
     let mut out = AreaReference {
         width: params.width,
         height: params.height,
-        samples: towards_light.len() as u32,
+        samples: lights.len() as u32,
         visible: vec![0; pixels],
         stable: vec![true; pixels],
         background: vec![false; pixels],
     };
-    for &w in towards_light {
-        let per_sample = VisibilityParams {
-            light: Light::Directional { direction: -w },
-            ..*params
-        };
+    for light in lights {
+        let per_sample = VisibilityParams { light, ..*params };
         let r = reference_visibility(scene, &per_sample);
         for (i, class) in r.class.iter().enumerate() {
             match class {

@@ -1,6 +1,6 @@
 //! Exact per-pixel light visibility with ambiguity classification.
 
-use glam::{DMat4, DVec3, DVec4};
+use glam::{DMat4, DVec2, DVec3, DVec4};
 use rayon::prelude::*;
 
 use crate::geometry::{intersect_watertight, line_segment_approach};
@@ -26,7 +26,36 @@ pub enum Light {
         /// World-space position of the light.
         position: DVec3,
     },
+    /// One sample of a spherical emitter (a sized spot or point light) as area shadows place it for each
+    /// receiver `x`: the point `centre + radius (offset.x t1 + offset.y t2)` of the disc through the centre
+    /// facing `x`, with `(t1, t2)` = [`disc_basis`] of the unit direction from `x` to the centre. A pixel
+    /// whose direction lies within [`DISC_BASIS_POLE`] of the basis' pole is Ambiguous.
+    DiscSample {
+        /// The emitter's centre.
+        centre: DVec3,
+        /// The emitter's radius.
+        radius: f64,
+        /// The sample's offset on the unit disc.
+        offset: DVec2,
+    },
 }
+
+/// Two unit axes across the unit direction `n`: the rotation taking +Y to `n` applied to +X and +Z. It turns
+/// smoothly with `n` except at `n = -Y`, where it is undefined (there it is +X and -Z).
+pub fn disc_basis(n: DVec3) -> (DVec3, DVec3) {
+    let a = 1.0 / (1.0 + n.y);
+    if !a.is_finite() {
+        return (DVec3::X, DVec3::NEG_Z);
+    }
+    (
+        DVec3::new(1.0 - n.x * n.x * a, -n.x, -n.x * n.z * a),
+        DVec3::new(-n.z * n.x * a, -n.z, 1.0 - n.z * n.z * a),
+    )
+}
+
+/// Below this value of `1 + n.y`, [`disc_basis`] is too ill-conditioned for a GPU's f32 and this f64 to
+/// agree on the samples' places: such pixels of a [`Light::DiscSample`] are Ambiguous.
+pub const DISC_BASIS_POLE: f64 = 0.01;
 
 /// Reference classification of one pixel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -279,6 +308,19 @@ fn shade_pixel(
         Light::Point { position: light } => {
             let offset = light - position;
             (offset.normalize_or_zero(), offset.length())
+        }
+        Light::DiscSample {
+            centre,
+            radius,
+            offset,
+        } => {
+            let n = (centre - position).normalize_or_zero();
+            if 1.0 + n.y < DISC_BASIS_POLE || n == DVec3::ZERO {
+                return pixel;
+            }
+            let (t1, t2) = disc_basis(n);
+            let to_sample = centre + radius * (offset.x * t1 + offset.y * t2) - position;
+            (to_sample.normalize_or_zero(), to_sample.length())
         }
     };
     let cosine = normal.dot(to_light);

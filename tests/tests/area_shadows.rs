@@ -242,18 +242,31 @@ fn invalid_light_sizes_and_sample_counts_are_rejected() {
         .expect("software binning accepted")
         .to_string();
     assert!(err.contains("compute binning"), "{err}");
-    // Area shadows are directional: a spot light's frame is refused, naming the light.
-    let geometry = view.upload(&device).expect("upload");
-    let config = area_config(0.02, 32, FaceMode::Both);
-    let mut r =
-        ShadowRenderer::new(&device, geometry, view.width, view.height, config).expect("renderer");
-    let mut inputs = view.frame_inputs();
+    // A spot light needs an emitter of some size, and a frustum it can widen footprints in.
     let position = Vec3::new(0.0, 4.0, 0.0);
-    inputs.light = passes::spot_light_frusta(position, Vec3::NEG_Y, 0.5, Some(10.0))[0];
-    let err = r
-        .render(&device, &inputs)
-        .expect_err("spot light accepted")
-        .to_string();
-    assert!(err.contains("directional") && err.contains("spot"), "{err}");
+    let narrow = passes::spot_light_frusta(position, Vec3::NEG_Y, 0.5, Some(10.0))[0];
+    let wide = passes::Light::Spot {
+        position,
+        direction: Vec3::NEG_Y,
+        view_proj: glam::Mat4::perspective_infinite_rh(176f32.to_radians(), 1.0, 0.01)
+            * glam::Mat4::look_to_rh(position, Vec3::NEG_Y, Vec3::Z),
+    };
+    for (spot_radius, light, what) in [
+        (0.0, narrow, "emitter radius"),
+        (0.05, wide, "narrower than 174°"),
+    ] {
+        let geometry = view.upload(&device).expect("upload");
+        let mut config = area_config(0.02, 32, FaceMode::Both);
+        config.pcss.spot_radius = spot_radius;
+        let mut r = ShadowRenderer::new(&device, geometry, view.width, view.height, config)
+            .expect("renderer");
+        let mut inputs = view.frame_inputs();
+        inputs.light = light;
+        let err = r
+            .render(&device, &inputs)
+            .expect_err("spot light accepted")
+            .to_string();
+        assert!(err.contains(what), "{err}");
+    }
     assert_no_validation_errors(&device);
 }

@@ -1,7 +1,9 @@
 //! A glTF scene's lights through the plugin, as the scene's plan says (`host_demo::scene_plan`), on
 //! lavapipe: every shadowed light against the exact reference (a point light given to the plugin as a
 //! point light: hard, its six cube faces built as one map; sized, the minimum over the faces it records), a scene whose lights need nothing records no
-//! plugin pass, and changing one light reruns only that light's passes.
+//! plugin pass, and changing one light reruns only that light's passes. Sized spot and point lights with
+//! area shadows: every sample of every stable pixel as the exact reference of the same emitter samples
+//! decides it (a lamp inside a closed room, spot lights of one and five frusta, emitters next to geometry).
 
 mod common;
 
@@ -9,17 +11,20 @@ use common::{
     assert_no_validation_errors, compare_with_reference, device, scene_visibility_params,
 };
 use glam::Vec3;
-use host_demo::plugin::{c_point_light, LightFrameReport, LightsFrame, PluginRenderer};
+use host_demo::accuracy::{compare_area_counts, AreaComparison};
+use host_demo::plugin::{
+    c_fitted_spot_light, c_point_light, LightFrameReport, LightsFrame, PluginRenderer,
+};
 use host_demo::scene_plan::{
     plan_scene, scene_camera, LightDecision, NoPassReason, PlanSettings, ScenePlan,
 };
 use host_demo::scene_render::SceneRenderer;
 use host_demo::CameraMatrices;
 use passes::{
-    PassId, PassStatus, PrimitiveMapConfig, ResourceId, ShadowConfig, ShadowMapConfig, ShadowMode,
-    SkipReason,
+    AreaConfig, PassId, PassStatus, PrimitiveMapConfig, ResourceId, ShadowConfig, ShadowMapConfig,
+    ShadowMode, SkipReason,
 };
-use reference::{reference_visibility, RefScene};
+use reference::{local_area_reference, reference_visibility, RefScene};
 use rhi::Device;
 use scene::{Camera, LightKind, LightSize, SceneFile, SceneLight};
 use std::path::PathBuf;
@@ -638,7 +643,7 @@ fn changing_one_light_reruns_only_its_passes() {
     let resized = render(&mut renderer, &device, &plan);
     assert_eq!(resized.lights[spot_k].light_builds, 2);
     assert_eq!(
-        status(&resized.lights[spot_k], PassId::ShadowMap),
+        status(&resized.lights[spot_k], PassId::PrimitiveMap),
         PassStatus::Ran
     );
     assert_only_changed_reran(&plan, &resized, &second, &[spot_k], "spot resized");
@@ -662,7 +667,10 @@ fn changing_one_light_reruns_only_its_passes() {
     let moved = render(&mut renderer, &device, &plan);
     for &k in &lamp {
         assert_eq!(moved.lights[k].light_builds, 1, "the lamp is not rebuilt");
-        assert_eq!(status(&moved.lights[k], PassId::ShadowMap), PassStatus::Ran);
+        assert_eq!(
+            status(&moved.lights[k], PassId::PrimitiveMap),
+            PassStatus::Ran
+        );
     }
     assert_only_changed_reran(&plan, &moved, &resized, &lamp, "lamp moved");
     assert_eq!(moved.lights[spot_k].light_builds, 2);
@@ -678,4 +686,186 @@ fn changing_one_light_reruns_only_its_passes() {
         .count();
     assert!(lamp_changed > 0, "the lamp's shadows did not follow it");
     assert_no_validation_errors(&device);
+}
+
+/// Renders `light` (given natively, as the C ABI takes it) over `file` in area mode, with an emitter of
+/// `radius` around `centre` and `samples` samples, and compares its layer with the exact reference of the
+/// same samples (a spot light's `cone`, axis and half-angle: on the pixels well inside it): 0 mismatched
+/// counts on stable pixels, at least `min_penumbra` stable penumbra pixels judged, at most
+/// `max_unstable_percent` of the pixels unstable. Returns the comparison and the light's map statistics.
+fn check_local_area(
+    device: &Device,
+    name: &str,
+    file: &SceneFile,
+    light: hrts_plugin::HrtsLight,
+    (centre, radius, samples): (Vec3, f32, u32),
+    cone: Option<(Vec3, f32)>,
+    (min_penumbra, max_unstable_percent): (usize, usize),
+) -> (AreaComparison, passes::MapStats) {
+    let camera = camera(file);
+    let mut plugin = PluginRenderer::for_scene(
+        device,
+        &file.scene,
+        WIDTH,
+        HEIGHT,
+        false,
+        host_demo::gbuffer::GBufferLayout::ANALYSIS,
+    )
+    .expect("plugin");
+    let mut config = ShadowConfig {
+        mode: ShadowMode::Area,
+        antialiasing: false,
+        area: AreaConfig { samples },
+        ..settings(false).base
+    };
+    config.pcss.spot_radius = radius;
+    plugin
+        .configure_lights(device, &[config])
+        .expect("configure");
+    let matrices = CameraMatrices::of_camera(&camera, WIDTH, HEIGHT);
+    // The second frame: the first one's lists grow to what it needed.
+    let mut frame = None;
+    for _ in 0..2 {
+        frame = Some(
+            plugin
+                .render_c_lights(device, &matrices, vec![light])
+                .expect("frame"),
+        );
+    }
+    let frame = frame.expect("two frames");
+    let report = &frame.lights[0].report;
+    let (_, layers) = plugin.read_frame(device).expect("read back");
+    let rs = RefScene::new(&file.scene);
+    let params = scene_visibility_params(
+        &file.scene,
+        &camera,
+        WIDTH,
+        HEIGHT,
+        reference::Light::Point {
+            position: centre.as_dvec3(),
+        },
+    );
+    let offsets: Vec<glam::DVec2> = passes::area::local_area_offsets(samples)
+        .iter()
+        .map(|o| o.as_dvec2())
+        .collect();
+    let r = local_area_reference(&rs, &params, centre.as_dvec3(), f64::from(radius), &offsets);
+    // A spot light's pixels well inside its cone (its frustum ends just beyond the cone; the engine's cone
+    // falloff darkens the rest).
+    let considered: Option<Vec<bool>> = cone.map(|(axis, half_angle)| {
+        let limit = (half_angle - 2f32.to_radians()).cos() as f64;
+        r_positions(&rs, &params)
+            .iter()
+            .map(|p| {
+                !p.is_finite()
+                    || (*p - centre.as_dvec3())
+                        .normalize()
+                        .dot(axis.as_dvec3().normalize())
+                        > limit
+            })
+            .collect()
+    });
+    let c = compare_area_counts(&r, &layers[0], considered.as_deref());
+    println!(
+        "{name}: R {radius}, {samples} samples: {} px, {} unstable, {} penumbra, {} umbra, {} mismatches; {}; map {} entries, mean list {:.1}, longest {}, {} texels past capacity",
+        c.pixels, c.unstable, c.penumbra, c.umbra, c.mismatches, frame.lights[0].decision,
+        report.stats.entries, report.stats.mean_list(), report.stats.longest_list,
+        report.stats.texels_past_capacity
+    );
+    assert_eq!(c.non_finite, 0, "{name}: values that are no count");
+    assert_eq!(
+        c.mismatches, 0,
+        "{name}: stable pixels whose visible count differs (x, y, reference, GPU): {:?}",
+        c.examples
+    );
+    assert!(
+        c.penumbra >= min_penumbra,
+        "{name}: only {} stable penumbra pixels judged",
+        c.penumbra
+    );
+    assert!(
+        c.unstable * 100 <= c.pixels * max_unstable_percent,
+        "{name}: {} of {} pixels unstable",
+        c.unstable,
+        c.pixels
+    );
+    assert_no_validation_errors(device);
+    (c, report.stats)
+}
+
+/// A sized point lamp inside the closed room, as one cube map: every sample of every stable pixel as the
+/// reference decides it, for emitters of 0.3 and 0.6 m and 16 to 64 samples.
+#[test]
+fn a_sized_point_light_inside_a_closed_room_matches_the_reference_sample_for_sample() {
+    let device = device();
+    let lamp = Vec3::new(0.15, 2.5, 0.1);
+    let file = closed_room(lamp);
+    for (radius, samples, min_penumbra) in [(0.3, 16, 200), (0.6, 32, 200), (0.3, 64, 50)] {
+        let (_, stats) = check_local_area(
+            &device,
+            "point lamp in a closed room",
+            &file,
+            c_point_light(lamp, 0.0),
+            (lamp, radius, samples),
+            None,
+            (min_penumbra, 25),
+        );
+        assert_eq!(stats.texels_past_capacity, 0);
+    }
+}
+
+/// Sized spot lights in the closed room: a cone of 50° (one frustum) and one of 75° (the five cube faces
+/// around its axis, each exact for its own receivers, and their minimum).
+#[test]
+fn sized_spot_lights_match_the_reference_sample_for_sample() {
+    let device = device();
+    let lamp = Vec3::new(-0.4, 2.6, 0.3);
+    let file = closed_room(lamp);
+    let down = Vec3::new(0.2, -1.0, -0.1);
+    for cone in [50f32, 75.0] {
+        check_local_area(
+            &device,
+            &format!("spot of {cone}°"),
+            &file,
+            c_fitted_spot_light(lamp, down, cone.to_radians(), 0.0),
+            (lamp, 0.25, 16),
+            Some((down, cone.to_radians())),
+            (100, 25),
+        );
+    }
+}
+
+/// Emitters on and against geometry: a lamp just over a table (its triangles lie within the light's near
+/// radius and are listed in every texel), and one 5 cm from a wall's face (its disc reaching into the
+/// wall).
+#[test]
+fn emitters_touching_geometry_match_the_reference_sample_for_sample() {
+    let device = device();
+    let over_table = Vec3::new(-0.4, 0.9, -0.1);
+    let file = closed_room(over_table);
+    check_local_area(
+        &device,
+        "lamp just over the table",
+        &file,
+        c_point_light(over_table, 0.0),
+        (over_table, 0.1, 32),
+        None,
+        (40, 25),
+    );
+    let on_wall = Vec3::new(-2.95, 1.6, 0.4);
+    let file = closed_room(on_wall);
+    check_local_area(
+        &device,
+        "lamp on a wall",
+        &file,
+        c_point_light(on_wall, 0.0),
+        (on_wall, 0.2, 16),
+        None,
+        (200, 40),
+    );
+}
+
+/// The receiver points of `params`' view (NaN where the camera ray hits nothing).
+fn r_positions(rs: &RefScene, params: &reference::VisibilityParams) -> Vec<glam::DVec3> {
+    reference_visibility(rs, params).position
 }

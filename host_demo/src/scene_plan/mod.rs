@@ -9,8 +9,9 @@
 //!   visibility is 1;
 //! - a **zero-size** light gets exact ray-traced hard shadows: mode hard, so no shadow map and no PCSS
 //!   are allocated;
-//! - a **sized** light gets the hybrid: its angular radius (directional) becomes
-//!   `pcss_angular_radius`, its radius (spot, point) `pcss_spot_radius`.
+//! - a **sized** light gets exact soft shadows (mode area): its angular radius (directional) becomes
+//!   `pcss_angular_radius`, its radius (spot, point) `pcss_spot_radius`; the hybrid and PCSS stay
+//!   available through the configuration.
 //!
 //! A shadowed light is one light of the plugin:
 //! - a directional light, with one orthographic frustum enclosing the scene
@@ -141,8 +142,10 @@ impl LightPlan {
                 shadowed.config.area.samples
             ),
             LightSize::Radius(r) => format!(
-                "hybrid (sized light: PCSS with pcss_spot_radius {r} m, blended with the exact ray trace{})",
-                if shadowed.frusta.len() > 1 { ", per cube face" } else { "" }
+                "area (sized {} light: exact soft shadows, the visible fraction of {} samples of its emitter of radius {r} m, each tested against the exact triangles; no shadow map{})",
+                if self.light.kind.direction().is_some() { "spot" } else { "point" },
+                shadowed.config.area.samples,
+                if shadowed.frusta.len() > 1 { ", per frustum" } else { "" }
             ),
         }
     }
@@ -488,7 +491,8 @@ fn shadowed(
             config.pcss.angular_radius = a;
         }
         LightSize::Radius(r) => {
-            config.mode = ShadowMode::Hybrid;
+            // Exact soft shadows of the spherical emitter, as for a sized sun.
+            config.mode = ShadowMode::Area;
             config.pcss.spot_radius = r;
         }
     }
@@ -614,7 +618,7 @@ mod tests {
     }
 
     #[test]
-    fn a_sized_sun_gets_area_shadows_and_a_sized_spot_the_hybrid() {
+    fn sized_suns_and_spot_lights_get_area_shadows() {
         let p = only(ground_and_box(vec![sun(LightSize::AngularRadius(0.03))]));
         let s = p.shadowed().expect("shadowed");
         assert_eq!(s.config.mode, ShadowMode::Area);
@@ -628,8 +632,9 @@ mod tests {
             Some(10.0),
         )]));
         let s = p.shadowed().expect("shadowed");
-        assert_eq!(s.config.mode, ShadowMode::Hybrid);
+        assert_eq!(s.config.mode, ShadowMode::Area);
         assert_eq!(s.config.pcss.spot_radius, 0.05);
+        assert!(p.describe_decision().starts_with("area (sized spot light"));
         assert_eq!(s.config.map.faces, FaceMode::Both);
         // A fitted spot light: no matrix; the plugin fits one frustum to its cone and range.
         assert_eq!(s.frusta, ["whole"]);
@@ -722,10 +727,11 @@ mod tests {
         let s = p.shadowed().expect("shadowed");
         assert_eq!(s.light.light_type, HrtsLightType::Point as u32);
         assert_eq!((s.light.position, s.light.range), ([2.0, 1.5, 2.0], 20.0));
-        assert_eq!(s.frusta, ["+X", "-X", "+Y", "-Y", "+Z", "-Z"]);
-        assert_eq!(s.config.mode, ShadowMode::Hybrid);
+        // Area shadows of a point light: its six faces as one cube map.
+        assert_eq!(s.frusta, ["cube"]);
+        assert_eq!(s.config.mode, ShadowMode::Area);
         assert_eq!(s.config.pcss.spot_radius, 0.1);
-        assert!(p.describe_decision().contains("per cube face"));
+        assert!(p.describe_decision().starts_with("area (sized point light"));
         // A wide spot light: the front face and the four across its axis, no back face.
         let wide = spot(Vec3::new(0.0, 3.0, 0.0), Vec3::NEG_Y, 1.3, None);
         let p = only(ground_and_box(vec![wide]));
@@ -796,9 +802,9 @@ mod tests {
             [
                 ("sun", Some(ShadowMode::Area), 1),
                 ("rim", Some(ShadowMode::Hard), 1),
-                ("spot", Some(ShadowMode::Hybrid), 1),
+                ("spot", Some(ShadowMode::Area), 1),
                 ("fill", None, 0),
-                ("cart_lamp", Some(ShadowMode::Hybrid), 6),
+                ("cart_lamp", Some(ShadowMode::Area), 1),
             ]
         );
         assert!(p.dynamic_geometry);

@@ -196,13 +196,15 @@ impl MapScratchPool {
         )
     }
 
-    /// A pair list of at least `pairs` pairs: the pool's, or a new one as large.
+    /// A pair list of at least `pairs` pairs, or as many as the device's largest storage buffer holds: the
+    /// pool's, or a new one as large. A frame whose pairs do not fit it walks the tiles again to fill.
     pub(super) fn pair_list(
         &self,
         device: &Device,
         pairs: u32,
     ) -> Result<std::sync::Arc<Buffer>, PassError> {
-        let bytes = u64::from(pairs) * PAIR_BYTES;
+        let largest = device.capabilities().max_storage_buffer_range / PAIR_BYTES * PAIR_BYTES;
+        let bytes = (u64::from(pairs) * PAIR_BYTES).min(largest);
         shared_in(
             &self.pair_list,
             |l| l.size() >= bytes,

@@ -98,16 +98,17 @@ impl From<PrimitiveMapConfig> for ShadowConfig {
 
 impl ShadowConfig {
     /// Whether a point light under this configuration is shadowed as one cube map
-    /// ([`PrimitiveMapConfig::cube`]): hard shadows (or none) with compute binning. Soft and hybrid
+    /// ([`PrimitiveMapConfig::cube`]): hard or area shadows (or none) with compute binning. Soft and hybrid
     /// shadows need a shadow map per frustum: such a point light is shadowed through its six faces as
     /// spot lights, and the minimum over them.
     pub fn shadows_point_as_cube(&self) -> bool {
-        matches!(self.mode, ShadowMode::Hard | ShadowMode::None)
-            && matches!(
-                self.map.binning,
-                crate::BinningRequest::Auto | crate::BinningRequest::Compute
-            )
-            && self.map.faces == crate::FaceMode::Both
+        matches!(
+            self.mode,
+            ShadowMode::Hard | ShadowMode::None | ShadowMode::Area
+        ) && matches!(
+            self.map.binning,
+            crate::BinningRequest::Auto | crate::BinningRequest::Compute
+        ) && self.map.faces == crate::FaceMode::Both
     }
 
     /// The frame-plan request of this configuration.

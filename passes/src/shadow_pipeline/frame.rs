@@ -3,7 +3,7 @@
 use super::{
     camera_in_frame, camera_relative, FrameConstants, FrameInputs, FrameState, ShadowPipeline,
 };
-use crate::area::area_samples;
+use crate::area::{area_samples, local_area_reach, local_area_samples};
 use crate::frame_plan::{PassId, PassStatus, ResourceId, ResourceSet, ShadowMode, SkipReason};
 use crate::gpu_types::{MapPush, PcssConstants, RayTraceConstants};
 use crate::light::{Light, LightFrame};
@@ -55,34 +55,45 @@ impl ShadowPipeline {
             surface::surface_vector(inputs.proj, self.depth_format, self.normal_precision);
         let pc = self.config.pcss;
         let area = self.config.mode == ShadowMode::Area;
-        if area && light.position.is_some() {
-            return Err(PassError::InvalidConfig(format!(
-                "area shadows are computed for directional lights; this frame gave a {} light (use mode hybrid or soft for it)",
-                inputs.light.kind_name()
-            )));
-        }
-        let penumbra = if area { pc.angular_radius.tan() } else { 0.0 };
+        let samples = self.config.area.samples;
+        // Area shadows: a directional light widens footprints by its angular radius; a spot or point light
+        // by its emitter's radius, within the reach of every frustum (the same shape for a cube's faces).
+        let (penumbra, emitter_radius, reach) = match (area, light.position) {
+            (false, _) => (0.0, 0.0, None),
+            (true, None) => (pc.angular_radius.tan(), 0.0, None),
+            (true, Some(position)) => {
+                let reach = local_area_reach(light.frusta[0], position, pc.spot_radius)?;
+                (0.0, pc.spot_radius, Some(reach))
+            }
+        };
         Ok(FrameConstants {
             light,
             area: area.then(|| {
-                Box::new(area_samples(
-                    dir,
-                    pc.angular_radius,
-                    self.config.area.samples,
-                ))
+                Box::new(if light.position.is_some() {
+                    local_area_samples(samples)
+                } else {
+                    area_samples(dir, pc.angular_radius, samples)
+                })
             }),
             map: MapPush {
-                to_light: (-dir).extend(if light.position.is_some() { 1.0 } else { 0.0 }),
+                to_light: light.position.map_or((-dir).extend(0.0), |p| p.extend(1.0)),
                 size: cfg.size,
                 front_only,
                 penumbra,
+                emitter_radius,
+                near_radius: reach.map_or(0.0, |r| r.near_radius),
+                depth_floor: reach.map_or(0.0, |r| r.depth_floor),
                 ..MapPush::zeroed()
             },
             ray: RayTraceConstants {
                 inv_view_proj_rel,
                 light_view_proj: light.view_proj,
                 camera_pos: camera_frame.extend(1.0),
-                light_dir: dir.extend(penumbra),
+                light_dir: dir.extend(if emitter_radius > 0.0 {
+                    emitter_radius
+                } else {
+                    penumbra
+                }),
                 dims: UVec4::new(self.width, self.height, cfg.size, 0),
                 offset: Vec4::new(
                     radians_per_pixel,
@@ -94,7 +105,7 @@ impl ShadowPipeline {
                     front_only,
                     self.geometry().triangle_count(),
                     0,
-                    if area { self.config.area.samples } else { 0 },
+                    if area { samples } else { 0 },
                 ),
                 light_pos: light.position.map_or(Vec4::ZERO, |p| p.extend(1.0)),
                 view_to_world,

@@ -357,3 +357,23 @@ fn uncertain_nearer_events_hide_the_blocker_distance() {
         PixelClass::Lit
     );
 }
+
+/// The disc's axes are orthonormal and across the direction, everywhere but the pole.
+#[test]
+fn disc_basis_is_orthonormal_across_the_direction() {
+    use crate::disc_basis;
+    for n in [
+        DVec3::Y,
+        DVec3::X,
+        DVec3::new(0.3, -0.9, 0.2),
+        DVec3::new(-0.2, -0.98, 0.05),
+    ] {
+        let n = n.normalize();
+        let (t1, t2) = disc_basis(n);
+        for (a, b) in [(t1, t2), (t1, n), (t2, n)] {
+            assert!(a.dot(b).abs() < 1e-12, "{n}");
+        }
+        assert!((t1.length() - 1.0).abs() < 1e-12 && (t2.length() - 1.0).abs() < 1e-12);
+    }
+    assert_eq!(disc_basis(DVec3::NEG_Y), (DVec3::X, DVec3::NEG_Z));
+}
