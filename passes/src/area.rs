@@ -133,20 +133,19 @@ pub fn area_samples(direction: Vec3, angular_radius: f32, samples: u32) -> AreaS
 /// through the light's centre `P`, facing it: `P + R (u t1 + v t2)` with `(t1, t2)` the rotation taking +Y
 /// to the unit direction from `x` to `P` applied to +X and +Z (`reference::disc_basis`).
 pub fn local_area_offsets(samples: u32) -> Vec<Vec2> {
-    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-    (0..samples)
-        .map(|i| {
-            let r = ((f64::from(i) + 0.5) / f64::from(samples)).sqrt();
-            let phi = golden * f64::from(i);
-            DVec2::new(r * phi.cos(), r * phi.sin()).as_vec2()
-        })
+    local_pattern(samples)
+        .map(|(r, phi)| DVec2::new(r * phi.cos(), r * phi.sin()).as_vec2())
         .collect()
 }
 
 /// The area trace's per-frame sample table of a spot or point light: the unit-disc offsets
-/// ([`local_area_offsets`]) in the directions' slots (xy); the centre and axes are unused.
+/// ([`local_area_offsets`]) in the directions' slots (xy), and the extent and resolution of the local edge
+/// table's offsets ([`local_area_edge_table`]); the centre and axes are unused.
 pub fn local_area_samples(samples: u32) -> AreaSamples {
+    let extent = local_edge_extent(samples);
     let mut table = AreaSamples::zeroed();
+    table.axis_u.w = extent as f32;
+    table.axis_v.w = (f64::from(EDGE_OFFSETS) / (2.0 * extent)) as f32;
     for (slot, o) in table.dirs.iter_mut().zip(local_area_offsets(samples)) {
         *slot = Vec4::new(o.x, o.y, 0.0, 0.0);
     }
@@ -290,14 +289,52 @@ fn diamond_to_angle(t: f64) -> f64 {
     b.atan2(a).rem_euclid(std::f64::consts::TAU) + std::f64::consts::TAU * turns
 }
 
-/// Builds the edge table of a light of `angular_radius` with `samples` samples.
+/// Builds the edge table of a directional light of `angular_radius` with `samples` samples.
 pub fn area_edge_table(angular_radius: f32, samples: u32) -> AreaEdgeTable {
     let points: Vec<(f64, f64)> = pattern(angular_radius, samples)
         .map(|(cos_t, sin_t, phi)| (sin_t / cos_t, phi))
         .collect();
     let radius = points.iter().map(|p| p.0).fold(0.0, f64::max);
     let margin = decision_margin(angular_radius, radius);
-    let extent = edge_extent(angular_radius, samples);
+    edge_table(&points, margin, edge_extent(angular_radius, samples))
+}
+
+/// The points of a spot or point light's samples on the unit disc ([`local_area_offsets`]): radius and
+/// angle, in f64.
+fn local_pattern(samples: u32) -> impl Iterator<Item = (f64, f64)> {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..samples).map(move |i| {
+        (
+            ((f64::from(i) + 0.5) / f64::from(samples)).sqrt(),
+            golden * f64::from(i),
+        )
+    })
+}
+
+/// The margin beyond which the local edge table calls a sample decided, in units of the unit disc: the
+/// per-sample test `f0 + u fu + v fv` errs by a few ulps of `|f0| + |fu| + |fv|`, below 1e-6 of the line's
+/// normal for the lines the table serves (offsets within a few disc radii), and the f32 offsets lie within
+/// 1e-7 of the f64 points.
+const LOCAL_DECISION_MARGIN: f64 = 2e-5;
+
+/// The half-extent of the local edge table's offsets: beyond the unit disc by the decision margin.
+fn local_edge_extent(samples: u32) -> f64 {
+    let radius = local_pattern(samples).map(|p| p.0).fold(0.0, f64::max);
+    radius * (1.0 + 1e-3) + 2.0 * LOCAL_DECISION_MARGIN + 1e-9
+}
+
+/// Builds the edge table of a spot or point light's `samples` samples on the unit disc: a condition
+/// `f0 + u fu + v fv >= 0` of the area trace is the line of direction `(fu, fv)` and offset
+/// `-f0 / |(fu, fv)|` in the disc's plane, as a directional light's edge is in its gnomonic plane.
+pub fn local_area_edge_table(samples: u32) -> AreaEdgeTable {
+    let points: Vec<(f64, f64)> = local_pattern(samples).collect();
+    edge_table(&points, LOCAL_DECISION_MARGIN, local_edge_extent(samples))
+}
+
+/// The edge table of the sample `points` (radius, angle) with the decision `margin`, over offsets within
+/// `extent`.
+fn edge_table(points: &[(f64, f64)], margin: f64, extent: f64) -> AreaEdgeTable {
+    let samples = points.len() as u32;
     // The shader's diamond angle and offset err by far less than these widenings of each cell.
     let widen_t = 1e-4;
     let widen_d = 1e-4 * extent;
@@ -413,6 +450,83 @@ mod tests {
 
     /// On random lines across the samples, the table's decided samples agree with the per-sample test on
     /// the f32 directions, and most samples are decided.
+    /// The cell words of the line `(a, b, c)` as area_trace.glsl finds them: inside and uncertain.
+    fn cell_words(
+        words: &[UVec4],
+        t: &AreaSamples,
+        n: u32,
+        (a, b, c): (f32, f32, f32),
+    ) -> (UVec4, UVec4) {
+        let diamond = if b >= 0.0 {
+            if a >= 0.0 {
+                b / (a + b)
+            } else {
+                1.0 - a / (-a + b)
+            }
+        } else if a < 0.0 {
+            2.0 - b / (-a - b)
+        } else {
+            3.0 + a / (a - b)
+        };
+        let k = ((diamond * (EDGE_ANGLES as f32 / 4.0)) as u32).min(EDGE_ANGLES - 1);
+        let d = -c / (a * a + b * b).sqrt();
+        let o = ((d + t.axis_u.w) * t.axis_v.w)
+            .floor()
+            .clamp(0.0, EDGE_OFFSETS as f32 - 1.0) as u32;
+        let cell = (k * EDGE_OFFSETS + o) as usize;
+        if n <= 64 {
+            let w = words[cell];
+            (UVec4::new(w.x, w.y, 0, 0), UVec4::new(w.z, w.w, 0, 0))
+        } else {
+            (words[2 * cell], words[2 * cell + 1])
+        }
+    }
+
+    /// On random lines across the unit disc, the local table's decided samples agree with the area
+    /// trace's per-sample test `f0 + u fu + v fv >= 0` on the f32 offsets, and most samples are decided.
+    #[test]
+    fn the_local_edge_table_decides_as_the_per_sample_test() {
+        for n in [16u32, 64, 128] {
+            let t = local_area_samples(n);
+            let words = local_area_edge_table(n).gpu_words();
+            let mut state = 11u64;
+            let mut rng = move || {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 40) as f32 / (1u64 << 24) as f32
+            };
+            let (mut decided, mut total) = (0usize, 0usize);
+            for _ in 0..4000 {
+                let angle = rng() * std::f32::consts::TAU;
+                let offset = (rng() * 2.0 - 1.0) * t.axis_u.w * 1.2;
+                let scale = 0.01 + rng() * 100.0;
+                let (fu, fv, f0) = (angle.cos() * scale, angle.sin() * scale, -offset * scale);
+                let (cell_inside, cell_uncertain) = cell_words(&words, &t, n, (fu, fv, f0));
+                for i in 0..n as usize {
+                    let s = t.dirs[i];
+                    let keeps = f0 + s.x * fu + s.y * fv >= 0.0;
+                    let bit = 1 << (i % 32);
+                    let inside = cell_inside[i / 32] & bit != 0;
+                    let uncertain = cell_uncertain[i / 32] & bit != 0;
+                    assert!(!(inside && uncertain));
+                    total += 1;
+                    if !uncertain {
+                        decided += 1;
+                        assert_eq!(
+                            inside, keeps,
+                            "{n} samples, sample {i}, line ({fu}, {fv}, {f0})"
+                        );
+                    }
+                }
+            }
+            assert!(
+                decided * 10 > total * 8,
+                "{n}: {decided} of {total} decided"
+            );
+        }
+    }
+
     #[test]
     fn the_edge_table_decides_as_the_per_sample_test() {
         for (r, n) in [(0.02f32, 64u32), (0.3, 128), (0.005, 16)] {
@@ -438,31 +552,7 @@ mod tests {
                 let across = u * angle.cos() + v * angle.sin();
                 let normal = (across - c * offset) * (0.5 + rng() * 4.0);
                 let (a, b, cc) = (normal.dot(u), normal.dot(v), normal.dot(c));
-                // As area_trace.comp computes the cell.
-                let diamond = if b >= 0.0 {
-                    if a >= 0.0 {
-                        b / (a + b)
-                    } else {
-                        1.0 - a / (-a + b)
-                    }
-                } else if a < 0.0 {
-                    2.0 - b / (-a - b)
-                } else {
-                    3.0 + a / (a - b)
-                };
-                let k = ((diamond * (EDGE_ANGLES as f32 / 4.0)) as u32).min(EDGE_ANGLES - 1);
-                let d = -cc / (a * a + b * b).sqrt();
-                let o = ((d + t.axis_u.w) * t.axis_v.w)
-                    .floor()
-                    .clamp(0.0, EDGE_OFFSETS as f32 - 1.0) as u32;
-                let cell = (k * EDGE_OFFSETS + o) as usize;
-
-                let (cell_inside, cell_uncertain) = if n <= 64 {
-                    let w = words[cell];
-                    (UVec4::new(w.x, w.y, 0, 0), UVec4::new(w.z, w.w, 0, 0))
-                } else {
-                    (words[2 * cell], words[2 * cell + 1])
-                };
+                let (cell_inside, cell_uncertain) = cell_words(&words, &t, n, (a, b, cc));
                 for i in 0..n as usize {
                     let keeps = normal.dot(t.dirs[i].truncate()) >= 0.0;
                     let bit = 1 << (i % 32);

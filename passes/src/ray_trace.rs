@@ -1,10 +1,11 @@
 //! Per-pixel shadow rays through the deep primitive map: visibility (1 = lit) and blocker distance; or, for
-//! area shadows, the visible fraction of the light's samples (`area_trace.comp`).
+//! area shadows, the visible fraction of the light's samples (`area_trace.glsl`, in a variant for
+//! directional lights and one for spot and point lights).
 //!
 //! Reads: depth, normal, the primitive map (state, per-pixel texels, list offsets and entries), prim buffer,
 //! constants (and the light samples, area shadows). Writes: visibility, blocker distance (hard rays only).
 
-use crate::area::area_edge_table;
+use crate::area::{area_edge_table, local_area_edge_table};
 use crate::gpu_types::{constant_buffer, AreaSamples, RayTraceConstants};
 use crate::primitive_map::PrimitiveMap;
 use crate::{shader, PassError};
@@ -56,10 +57,13 @@ pub enum RayTraceKind {
 
 /// The ray-trace pass and its outputs.
 pub struct RayTracePass {
+    /// The trace's pipeline and bind group (an area trace's for directional lights).
     pipeline: ComputePipeline,
     group: BindGroup,
+    /// An area trace's pipeline and bind group for spot and point lights.
+    local: Option<(ComputePipeline, BindGroup)>,
     constants: Buffer,
-    /// The area trace's light samples, and its edge table (area shadows only).
+    /// The area trace's light samples, and its edge tables (area shadows only).
     samples: Option<(Buffer, Buffer)>,
     /// `R32_SFLOAT` visibility, 1 = lit.
     pub visibility: Image,
@@ -118,9 +122,17 @@ impl RayTracePass {
                 samples,
             } => Some((
                 constant_buffer::<AreaSamples>(device, "area light samples")?,
+                // A directional light's table, then a spot or point light's (each variant of
+                // area_trace.glsl reads its own).
                 device.create_buffer_init(
-                    "area edge table",
-                    bytemuck::cast_slice(&area_edge_table(angular_radius, samples).gpu_words()),
+                    "area edge tables",
+                    bytemuck::cast_slice(
+                        &[
+                            area_edge_table(angular_radius, samples).gpu_words(),
+                            local_area_edge_table(samples).gpu_words(),
+                        ]
+                        .concat(),
+                    ),
                     BufferUsage::STORAGE,
                 )?,
             )),
@@ -164,14 +176,28 @@ impl RayTracePass {
             }
         }
         let (name, shader_name) = match kind {
-            RayTraceKind::Area { .. } => ("area trace", "area_trace.comp"),
+            RayTraceKind::Area { .. } => ("area trace (directional lights)", "area_trace.comp"),
             RayTraceKind::Hard { .. } => ("ray trace", "ray_trace.comp"),
         };
         let pipeline = device.create_compute_pipeline(name, &shader(shader_name)?, &kinds, 0)?;
         let group = device.create_bind_group(pipeline.layout(), &resources)?;
+        let local = match kind {
+            RayTraceKind::Area { .. } => {
+                let pipeline = device.create_compute_pipeline(
+                    "area trace (spot and point lights)",
+                    &shader("area_trace_local.comp")?,
+                    &kinds,
+                    0,
+                )?;
+                let group = device.create_bind_group(pipeline.layout(), &resources)?;
+                Some((pipeline, group))
+            }
+            RayTraceKind::Hard { .. } => None,
+        };
         Ok(Self {
             pipeline,
             group,
+            local,
             constants,
             samples,
             visibility,
@@ -181,19 +207,21 @@ impl RayTracePass {
     }
 
     /// Points the ray trace at the primitive map's entries after [`PrimitiveMap::grow`] reallocated them.
-    /// Returns the bind group it used before: frames in flight may still use it.
+    /// Returns the bind groups it used before: frames in flight may still use them.
     pub fn rebind_entries(
         &mut self,
         device: &Device,
         map: &PrimitiveMap,
-    ) -> Result<BindGroup, PassError> {
-        let group = device.rebound(
-            self.pipeline.layout(),
-            &self.group,
-            ENTRIES_BINDING,
-            &map.entries,
-        )?;
-        Ok(std::mem::replace(&mut self.group, group))
+    ) -> Result<Vec<BindGroup>, PassError> {
+        let rebound = |pipeline: &ComputePipeline, group: &mut BindGroup| {
+            let new = device.rebound(pipeline.layout(), group, ENTRIES_BINDING, &map.entries)?;
+            Ok::<_, PassError>(std::mem::replace(group, new))
+        };
+        let mut old = vec![rebound(&self.pipeline, &mut self.group)?];
+        if let Some((pipeline, group)) = &mut self.local {
+            old.push(rebound(pipeline, group)?);
+        }
+        Ok(old)
     }
 
     /// Records the constants' update (into the command buffer) and the pass; an area trace also updates
@@ -232,7 +260,12 @@ impl RayTracePass {
             constants.dims.y.div_ceil(8),
             1,
         ];
-        enc.dispatch(&self.pipeline, &self.group, &[], groups)?;
+        // An area trace of a spot or point light (the constants' light position) takes its own variant.
+        let (pipeline, group) = match &self.local {
+            Some((pipeline, group)) if constants.light_pos.w != 0.0 => (pipeline, group),
+            _ => (&self.pipeline, &self.group),
+        };
+        enc.dispatch(pipeline, group, &[], groups)?;
         enc.end_pass();
         Ok(())
     }

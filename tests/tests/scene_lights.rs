@@ -869,3 +869,26 @@ fn emitters_touching_geometry_match_the_reference_sample_for_sample() {
 fn r_positions(rs: &RefScene, params: &reference::VisibilityParams) -> Vec<glam::DVec3> {
     reference_visibility(rs, params).position
 }
+
+/// The sized lamp in the closed room, everything moved 1e4 from the origin (the passes work relative to the
+/// geometry's centre): the same exact counts on stable pixels.
+#[test]
+fn a_sized_point_light_1e4_from_the_origin_matches_the_reference() {
+    let device = device();
+    let offset = Vec3::new(1e4, 0.0, -1e4);
+    let lamp = Vec3::new(0.15, 2.5, 0.1) + offset;
+    let mut file = closed_room(Vec3::new(0.15, 2.5, 0.1));
+    file.scene = file.scene.translated(offset);
+    let camera = file.camera.as_mut().expect("a camera");
+    camera.position += offset;
+    camera.target += offset;
+    check_local_area(
+        &device,
+        "point lamp 1e4 from the origin",
+        &file,
+        c_point_light(lamp, 0.0),
+        (lamp, 0.3, 16),
+        None,
+        (200, 25),
+    );
+}

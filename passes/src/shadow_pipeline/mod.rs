@@ -81,7 +81,7 @@ enum RetiredMap {
     Entries {
         _entries: Buffer,
         _bindings: Box<ScratchBindings>,
-        _ray_group: Option<BindGroup>,
+        _ray_groups: Vec<BindGroup>,
     },
     Pairs {
         _bindings: Box<ScratchBindings>,

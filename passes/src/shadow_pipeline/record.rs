@@ -311,14 +311,14 @@ impl ShadowPipeline {
         if let Some((entries, bindings)) =
             map.fit_entries(device, pool, self.shared.prims(), self.needed_entries)?
         {
-            let ray_group = match self.ray.as_mut() {
-                Some(ray) => Some(ray.rebind_entries(device, map)?),
-                None => None,
+            let ray_groups = match self.ray.as_mut() {
+                Some(ray) => ray.rebind_entries(device, map)?,
+                None => Vec::new(),
             };
             retired.push(RetiredMap::Entries {
                 _entries: entries,
                 _bindings: Box::new(bindings),
-                _ray_group: ray_group,
+                _ray_groups: ray_groups,
             });
         }
         if let Some(bound) = map.grow_pairs(device, pool, self.shared.prims(), self.needed_pairs)? {

@@ -1,0 +1,319 @@
+// The area trace (area_trace.comp: directional lights; area_trace_local.comp: spot and point lights).
+// Exact soft shadows of a sized light: per pixel, which of the light's N samples (a directional light's
+// sample directions, the same for every pixel; a spot or point light's points on its emitter's disc facing
+// the pixel; area_samples.glsl) it reaches, tested against every triangle of the pixel's texel list in a
+// primitive map whose footprints are widened by their penumbra (map_store.glsl).
+// The visibility is the visible fraction, k / N: no noise, no filter, the same output for the same input.
+//
+// The ray test is the triple-product form of the watertight test, for all N directions from the pixel's
+// one ray origin o at once. With a, b, c the triangle's vertices relative to o and D = det(a, b, c), a
+// direction w reaches the triangle (at a positive distance) iff w = alpha a + beta b + gamma c with alpha,
+// beta, gamma >= 0, i.e. iff the three edge functions (b x c).w = alpha D, (c x a).w = beta D and
+// (a x b).w = gamma D all have the sign of D (Cramer's rule). Each edge's normal is computed from its two
+// vertices in an order fixed by their world positions, so a shared edge gets exactly opposite normals in
+// its two triangles, and a direction exactly through the edge counts as blocked by both (>= 0): no leak
+// through a closed mesh. D = 0 (o in the triangle's plane, or a degenerate triangle) blocks nothing.
+// Each edge function is linear in w, and every sample lies within `spread` of the centre direction C, so
+// E(w) lies within |n| spread of E(C): a triangle is rejected for every sample, or taken as blocking every
+// sample, with one evaluation, exactly as the per-sample evaluation would decide (the margin covers the
+// rounding of both). For a triangle across the penumbra's edge, the exact edge table of Schwarz and
+// Stamminger's bitmask soft shadows (passes::area::AreaEdgeTable) gives each edge's kept samples, certain
+// beyond every rounding; only the samples still open that a table cell is uncertain about are tested one by
+// one. Every sample is decided as the per-sample test alone decides it.
+// A sample towards which the receiver's normal does not face is blocked, as the reference has it.
+#include "triangle.glsl"
+#include "ray_trace_constants.glsl"
+#include "map_state.glsl"
+#include "area_samples.glsl"
+
+// The exhaustive trace's quick test of triangle i (one of 16 unrolled copies): the undecided ones wait in
+// `pending`, so that the shader holds resolve() twice rather than 17 times (llvmpipe compiles it in seconds).
+#define QUICK1(i) if ((i) < total) { uint q = quick(i); if (q == BLOCKS_ALL) { blocked = all_samples; } \
+                                     else if (q == UNDECIDED) { pending[pending_count++] = (i); } }
+#define QUICK4(i) QUICK1(i) QUICK1((i) + 1u) QUICK1((i) + 2u) QUICK1((i) + 3u)
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(set = 0, binding = 0) uniform Constants { RayTraceConstants k; };
+layout(set = 0, binding = 1) uniform sampler2D depth_tex;
+layout(set = 0, binding = 2) uniform sampler2D normal_tex;
+layout(set = 0, binding = 3) readonly buffer State { MapState ms; };
+layout(set = 0, binding = 4) readonly buffer PixelTexels { uint pixel_texel[]; };
+layout(set = 0, binding = 5) readonly buffer Offsets { uint offsets[]; };
+layout(set = 0, binding = 6) readonly buffer Entries { uint entries[]; };
+layout(set = 0, binding = 7) readonly buffer Prims { Triangle tris[]; };
+layout(set = 0, binding = 8, r32f) uniform writeonly image2D visibility;
+layout(set = 0, binding = 9) uniform Samples { AreaSamples samples; };
+layout(set = 0, binding = 10) readonly buffer EdgeTable { uvec4 edge_table[]; };
+#include "shadow_ray.glsl"
+
+// The workgroup's copy of the sample directions: the trace reads them at indices that differ from pixel to
+// pixel, which a uniform buffer serves one index at a time.
+shared vec3 sample_dirs[128];
+
+vec3 origin;
+// A spot or point light (the emitter's disc), else a directional light (a cone): the includer's
+// LOCAL_LIGHT, so that each variant holds the code of its own lights only.
+const bool local = LOCAL_LIGHT != 0;
+// The light's edge table's first cell: a directional light's, then a local light's.
+const uint table_base = local ? EDGE_ANGLES * EDGE_OFFSETS : 0u;
+uint sample_count;
+uvec4 all_samples;  // bit i of word i / 32: sample i exists
+uvec4 blocked;      // bit i: sample i is blocked
+
+// Relative margin of the one-evaluation decisions: far above the f32 rounding of the edge functions.
+const float DECIDE_MARGIN = 1e-5;
+
+// rp x rq for the edge from world vertex p to q (rp, rq: relative to the ray origin), computed in an order
+// fixed by p and q, so that the edge from q to p gives exactly the opposite vector.
+vec3 edge_normal(vec3 p, vec3 q, vec3 rp, vec3 rq) {
+    bool swap = p.x > q.x || (p.x == q.x && (p.y > q.y || (p.y == q.y && p.z > q.z)));
+    vec3 u = swap ? rq : rp;
+    vec3 v = swap ? rp : rq;
+    precise vec3 n = vec3(u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x);
+    return swap ? -n : n;
+}
+
+// The edge table's samples for the line a x + b y + c >= 0 (`line`) in the samples' plane (a directional
+// light's gnomonic plane, a local light's unit disc): `inside`, those every line of its cell keeps; `maybe`,
+// those it keeps or is uncertain about (passes::area::AreaEdgeTable; the light's table starts at
+// `table_base`). A line without a direction (a = b = 0 within rounding: for a directional light, an edge
+// plane that holds C's axis) leaves every sample uncertain.
+void line_masks(vec3 line, out uvec4 inside, out uvec4 maybe) {
+    float a = line.x, b = line.y, c = line.z;
+    float l = sqrt(a * a + b * b);
+    if (!(l > 0.0)) {
+        inside = uvec4(0u);
+        maybe = all_samples;
+        return;
+    }
+    // The diamond angle of (a, b), in [0, 4): monotonic in the angle, without atan's loose precision.
+    float t = b >= 0.0 ? (a >= 0.0 ? b / (a + b) : 1.0 - a / (-a + b))
+                       : (a < 0.0 ? 2.0 - b / (-a - b) : 3.0 + a / (a - b));
+    uint angle = min(uint(t * (float(EDGE_ANGLES) / 4.0)), EDGE_ANGLES - 1u);
+    float d = -c / l;
+    uint offset = uint(clamp(floor((d + samples.axis_u.w) * samples.axis_v.w), 0.0, float(EDGE_OFFSETS - 1u)));
+    uint cell = table_base + angle * EDGE_OFFSETS + offset;
+    if (sample_count <= 64u) {
+        uvec4 words = edge_table[cell];     // up to 64 samples: inside's and uncertain's two words
+        inside = uvec4(words.xy, 0u, 0u);
+        maybe = inside | uvec4(words.zw, 0u, 0u);
+    } else {
+        inside = edge_table[2u * cell];
+        maybe = inside | edge_table[2u * cell + 1u];
+    }
+}
+
+// The edge table's samples for a directional light's edge plane of normal n (oriented inwards): the line of
+// the plane in the light's gnomonic frame.
+void edge_masks(vec3 n, out uvec4 inside, out uvec4 maybe) {
+    line_masks(vec3(dot(n, samples.axis_u.xyz), dot(n, samples.axis_v.xyz), dot(n, samples.center.xyz)),
+               inside, maybe);
+}
+
+// A spot or point light: the samples are the points s = P + u U + v V of the emitter's disc through its
+// centre P facing the ray origin (U, V: the disc's axes scaled by its radius; (u, v): the unit-disc offsets
+// in sample_dirs[i].xy). With w = s - o = C + u U + v V (C = P - o), the segment from o to s crosses the
+// triangle iff w reaches it (the three edge functions, as for a direction) and s lies beyond its plane:
+// the crossing's parameter is 1 / (alpha + beta + gamma), below 1 iff N.(s - p0) has the sign of D (N the
+// triangle's normal, D = N.(p0 - o)). Each of the four is affine in (u, v), so each is evaluated as
+// f0 + u fu + v fv, a shared edge's exactly negated; over the unit disc it lies within |(fu, fv)| of f0,
+// which rejects the triangle or takes it as blocking every sample with one evaluation, exactly as the
+// per-sample evaluation decides (the margin covers the rounding of both).
+vec3 disc_c, disc_u, disc_v;
+
+vec3 affine(vec3 n) {
+    return vec3(dot(n, disc_c), dot(n, disc_u), dot(n, disc_v));
+}
+
+// Whether f0 + u fu + v fv is negative (`sign` -1) or positive (+1) over the whole unit disc, beyond the
+// rounding of evaluating it at any sample.
+bool disc_sign(vec3 f, float sign) {
+    float spread = length(f.yz) * (1.0 + DECIDE_MARGIN) + DECIDE_MARGIN * (abs(f.x) + abs(f.y) + abs(f.z));
+    return sign * f.x > spread;
+}
+
+// What a triangle's one evaluation over all samples decided.
+const uint MISSES_ALL = 0u;
+const uint BLOCKS_ALL = 1u;
+const uint UNDECIDED = 2u;
+
+// The lines of the triangle quick() looked at last: a directional light's three inward edge normals (a, b,
+// c); a local light's four affine conditions (a, b, c, and p, beyond the plane) as (f0, fu, fv).
+vec3 line_a, line_b, line_c, line_p;
+
+// The triangle's lines, and whether it misses every sample, blocks every sample or needs resolve().
+uint quick(uint index) {
+    if (index >= uint(tris.length())) {
+        return MISSES_ALL;
+    }
+    vec3 p0 = tris[index].v[0].xyz, p1 = tris[index].v[1].xyz, p2 = tris[index].v[2].xyz;
+    precise vec3 a = p0 - origin;
+    precise vec3 b = p1 - origin;
+    precise vec3 c = p2 - origin;
+    vec3 na = edge_normal(p1, p2, b, c);
+    vec3 nb = edge_normal(p2, p0, c, a);
+    vec3 nc = edge_normal(p0, p1, a, b);
+    precise float det = dot(a, na);
+    if (det == 0.0) {
+        return MISSES_ALL;
+    }
+    float orient = det < 0.0 ? -1.0 : 1.0;
+    if (local) {
+        precise vec3 normal = orient * cross(p1 - p0, p2 - p0);
+        line_a = orient * affine(na);
+        line_b = orient * affine(nb);
+        line_c = orient * affine(nc);
+        line_p = vec3(dot(normal, k.light_pos.xyz - p0), dot(normal, disc_u), dot(normal, disc_v));
+        if (disc_sign(line_a, -1.0) || disc_sign(line_b, -1.0) || disc_sign(line_c, -1.0)
+            || disc_sign(line_p, -1.0)) {
+            return MISSES_ALL;
+        }
+        if (disc_sign(line_a, 1.0) && disc_sign(line_b, 1.0) && disc_sign(line_c, 1.0)
+            && disc_sign(line_p, 1.0)) {
+            return BLOCKS_ALL;
+        }
+        return UNDECIDED;
+    }
+    line_a = orient * na;
+    line_b = orient * nb;
+    line_c = orient * nc;
+    vec3 centre = samples.center.xyz;
+    vec3 at_centre = vec3(dot(line_a, centre), dot(line_b, centre), dot(line_c, centre));
+    vec3 span = vec3(length(line_a), length(line_b), length(line_c)) * (samples.center.w + DECIDE_MARGIN);
+    if (any(lessThan(at_centre + span, vec3(0.0)))) {
+        return MISSES_ALL;
+    }
+    if (all(greaterThan(at_centre - span, vec3(0.0)))) {
+        return BLOCKS_ALL;
+    }
+    return UNDECIDED;
+}
+
+// Decides the samples still open against the triangle quick() left undecided: the edge table decides most
+// samples of its lines at once (a local light's four lines in the unit disc), and the samples still open
+// that it is uncertain about are tested one by one.
+void resolve() {
+    uvec4 in_a, in_b, in_c, in_p, maybe_a, maybe_b, maybe_c, maybe_p;
+    if (local) {
+        line_masks(line_a.yzx, in_a, maybe_a);
+        line_masks(line_b.yzx, in_b, maybe_b);
+        line_masks(line_c.yzx, in_c, maybe_c);
+        line_masks(line_p.yzx, in_p, maybe_p);
+    } else {
+        edge_masks(line_a, in_a, maybe_a);
+        edge_masks(line_b, in_b, maybe_b);
+        edge_masks(line_c, in_c, maybe_c);
+        in_p = all_samples;
+        maybe_p = all_samples;
+    }
+    uvec4 hidden = in_a & in_b & in_c & in_p & all_samples;
+    uvec4 open = maybe_a & maybe_b & maybe_c & maybe_p & all_samples & ~hidden & ~blocked;
+    blocked |= hidden;
+    for (uint word = 0u; word < 4u; ++word) {
+        uint bits = open[word];
+        while (bits != 0u) {
+            uint bit = findLSB(bits);
+            bits &= bits - 1u;
+            vec3 w = sample_dirs[word * 32u + bit];
+            bool hit = local
+                ? line_a.x + w.x * line_a.y + w.y * line_a.z >= 0.0
+                  && line_b.x + w.x * line_b.y + w.y * line_b.z >= 0.0
+                  && line_c.x + w.x * line_c.y + w.y * line_c.z >= 0.0
+                  && line_p.x + w.x * line_p.y + w.y * line_p.z > 0.0
+                : dot(line_a, w) >= 0.0 && dot(line_b, w) >= 0.0 && dot(line_c, w) >= 0.0;
+            if (hit) {
+                blocked[word] |= 1u << bit;
+            }
+        }
+    }
+}
+
+void consider(uint index) {
+    uint q = quick(index);
+    if (q == BLOCKS_ALL) {
+        blocked = all_samples;
+    } else if (q == UNDECIDED) {
+        resolve();
+    }
+}
+
+// The exhaustive trace's undecided triangles of one block of 16, resolved after the block.
+uint pending[16];
+uint pending_count;
+
+bool all_blocked() {
+    return blocked == all_samples;
+}
+
+void main() {
+    sample_count = k.misc.w;
+    uint lid = gl_LocalInvocationIndex;
+    for (uint i = lid; i < sample_count; i += 64u) {
+        sample_dirs[i] = samples.dirs[i].xyz;
+    }
+    barrier();
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (px.x >= int(k.dims.x) || px.y >= int(k.dims.y)) {
+        return;
+    }
+    vec3 dir;
+    float t_max;
+    int ray = shadow_ray(px, origin, dir, t_max);
+    if (ray != SHADOW_RAY_TRACE) {
+        imageStore(visibility, px, vec4(ray == SHADOW_RAY_LIT ? 1.0 : 0.0));
+        return;
+    }
+    uint texel = pixel_texel[uint(px.y) * k.dims.x + uint(px.x)];
+    if (texel == TEXEL_OUTSIDE) {
+        imageStore(visibility, px, vec4(1.0));
+        return;
+    }
+    all_samples = uvec4(0u);
+    blocked = uvec4(0u);
+    vec3 n = shadow_ray_normal;
+    // A spot or point light's samples lie on the emitter's disc facing the receiver: its axes are the
+    // rotation taking +Y to the direction from the receiver (not the offset ray origin) towards the light,
+    // applied to +X and +Z (reference::disc_basis). Each sample's facing is judged from the receiver too.
+    vec3 to_centre = k.light_pos.xyz - shadow_ray_receiver;
+    if (local) {
+        disc_c = k.light_pos.xyz - origin;
+        vec3 d = normalize(to_centre);
+        float inv = 1.0 / (1.0 + d.y);
+        vec3 t1 = vec3(1.0, 0.0, 0.0), t2 = vec3(0.0, 0.0, -1.0);
+        if (!isinf(inv) && !isnan(inv)) {
+            t1 = vec3(1.0 - d.x * d.x * inv, -d.x, -d.x * d.z * inv);
+            t2 = vec3(-d.z * d.x * inv, -d.z, 1.0 - d.z * d.z * inv);
+        }
+        disc_u = k.light_dir.w * t1;
+        disc_v = k.light_dir.w * t2;
+    }
+    for (uint i = 0u; i < sample_count; ++i) {
+        all_samples[i >> 5u] |= 1u << (i & 31u);
+        vec3 w = local ? to_centre + sample_dirs[i].x * disc_u + sample_dirs[i].y * disc_v : sample_dirs[i];
+        if (dot(n, w) <= 0.0) {
+            blocked[i >> 5u] |= 1u << (i & 31u);
+        }
+    }
+    uint begin = texel == TEXEL_NO_RAY ? 0u : offsets[texel];
+    uint end = texel == TEXEL_NO_RAY ? 0u : offsets[texel + 1u];
+    bool binned = ms.grid.z <= ms.grid.w;
+    if (texel != TEXEL_NO_RAY && binned && (end <= ms.totals.z || begin == end)) {
+        for (uint i = begin; i < end && !all_blocked(); ++i) {
+            consider(entries[i]);
+        }
+    } else {
+        // Past the entry capacity: every triangle, exact (unrolled: see ray_trace.comp on llvmpipe's loop
+        // cap).
+        uint total = min(k.misc.y, uint(tris.length()));
+        for (uint base = 0u; base < total && !all_blocked(); base += 16u) {
+            pending_count = 0u;
+            QUICK4(base) QUICK4(base + 4u) QUICK4(base + 8u) QUICK4(base + 12u)
+            for (uint j = 0u; j < pending_count && !all_blocked(); ++j) {
+                consider(pending[j]);
+            }
+        }
+    }
+    uvec4 seen = blocked & all_samples;
+    uint hidden = bitCount(seen.x) + bitCount(seen.y) + bitCount(seen.z) + bitCount(seen.w);
+    imageStore(visibility, px, vec4(float(sample_count - hidden) / float(sample_count)));
+}
