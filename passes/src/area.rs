@@ -448,8 +448,6 @@ mod tests {
         assert!(t.dirs[15].truncate().length() > 0.99);
     }
 
-    /// On random lines across the samples, the table's decided samples agree with the per-sample test on
-    /// the f32 directions, and most samples are decided.
     /// The cell words of the line `(a, b, c)` as area_trace.glsl finds them: inside and uncertain.
     fn cell_words(
         words: &[UVec4],
@@ -482,6 +480,69 @@ mod tests {
         }
     }
 
+    /// On 4000 random lines, each made by `line` from an angle, an offset within 1.2 times the table's
+    /// extent and a scale (its table line `(a, b, c)` and the per-sample test of each sample), the table's
+    /// decided samples agree with the per-sample test, and over 80% of the samples are decided.
+    fn check_decisions(
+        words: &[UVec4],
+        t: &AreaSamples,
+        n: u32,
+        mut line: impl FnMut(f32, f32, f32) -> ((f32, f32, f32), Vec<bool>),
+    ) {
+        let mut state = 7u64;
+        let mut rng = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (mut decided, mut total) = (0usize, 0usize);
+        for _ in 0..4000 {
+            let angle = rng() * std::f32::consts::TAU;
+            let offset = (rng() * 2.0 - 1.0) * t.axis_u.w * 1.2;
+            let (abc, keeps) = line(angle, offset, rng());
+            let (cell_inside, cell_uncertain) = cell_words(words, t, n, abc);
+            for (i, &keeps) in keeps.iter().enumerate() {
+                let bit = 1 << (i % 32);
+                let inside = cell_inside[i / 32] & bit != 0;
+                let uncertain = cell_uncertain[i / 32] & bit != 0;
+                assert!(!(inside && uncertain));
+                total += 1;
+                if !uncertain {
+                    decided += 1;
+                    assert_eq!(inside, keeps, "{n} samples, sample {i}, line {abc:?}");
+                }
+            }
+        }
+        assert!(
+            decided * 10 > total * 8,
+            "{n} samples: {decided} of {total} decided"
+        );
+    }
+
+    /// On random lines across the samples, the table's decided samples agree with the per-sample test on
+    /// the f32 directions, and most samples are decided.
+    #[test]
+    fn the_edge_table_decides_as_the_per_sample_test() {
+        for (r, n) in [(0.02f32, 64u32), (0.3, 128), (0.005, 16)] {
+            let t = area_samples(Vec3::new(0.3, -1.0, 0.2), r, n);
+            let words = area_edge_table(r, n).gpu_words();
+            let (c, u, v) = (
+                t.center.truncate(),
+                t.axis_u.truncate(),
+                t.axis_v.truncate(),
+            );
+            check_decisions(&words, &t, n, |angle, offset, scale| {
+                let across = u * angle.cos() + v * angle.sin();
+                let normal = (across - c * offset) * (0.5 + scale * 4.0);
+                let keeps = (0..n as usize)
+                    .map(|i| normal.dot(t.dirs[i].truncate()) >= 0.0)
+                    .collect();
+                ((normal.dot(u), normal.dot(v), normal.dot(c)), keeps)
+            });
+        }
+    }
+
     /// On random lines across the unit disc, the local table's decided samples agree with the area
     /// trace's per-sample test `f0 + u fu + v fv >= 0` on the f32 offsets, and most samples are decided.
     #[test]
@@ -489,87 +550,14 @@ mod tests {
         for n in [16u32, 64, 128] {
             let t = local_area_samples(n);
             let words = local_area_edge_table(n).gpu_words();
-            let mut state = 11u64;
-            let mut rng = move || {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                (state >> 40) as f32 / (1u64 << 24) as f32
-            };
-            let (mut decided, mut total) = (0usize, 0usize);
-            for _ in 0..4000 {
-                let angle = rng() * std::f32::consts::TAU;
-                let offset = (rng() * 2.0 - 1.0) * t.axis_u.w * 1.2;
-                let scale = 0.01 + rng() * 100.0;
+            check_decisions(&words, &t, n, |angle, offset, scale| {
+                let scale = 0.01 + scale * 100.0;
                 let (fu, fv, f0) = (angle.cos() * scale, angle.sin() * scale, -offset * scale);
-                let (cell_inside, cell_uncertain) = cell_words(&words, &t, n, (fu, fv, f0));
-                for i in 0..n as usize {
-                    let s = t.dirs[i];
-                    let keeps = f0 + s.x * fu + s.y * fv >= 0.0;
-                    let bit = 1 << (i % 32);
-                    let inside = cell_inside[i / 32] & bit != 0;
-                    let uncertain = cell_uncertain[i / 32] & bit != 0;
-                    assert!(!(inside && uncertain));
-                    total += 1;
-                    if !uncertain {
-                        decided += 1;
-                        assert_eq!(
-                            inside, keeps,
-                            "{n} samples, sample {i}, line ({fu}, {fv}, {f0})"
-                        );
-                    }
-                }
-            }
-            assert!(
-                decided * 10 > total * 8,
-                "{n}: {decided} of {total} decided"
-            );
-        }
-    }
-
-    #[test]
-    fn the_edge_table_decides_as_the_per_sample_test() {
-        for (r, n) in [(0.02f32, 64u32), (0.3, 128), (0.005, 16)] {
-            let t = area_samples(Vec3::new(0.3, -1.0, 0.2), r, n);
-            let table = area_edge_table(r, n);
-            let words = table.gpu_words();
-            let (c, u, v) = (
-                t.center.truncate(),
-                t.axis_u.truncate(),
-                t.axis_v.truncate(),
-            );
-            let mut state = 7u64;
-            let mut rng = move || {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                (state >> 40) as f32 / (1u64 << 24) as f32
-            };
-            let (mut decided, mut total) = (0usize, 0usize);
-            for _ in 0..4000 {
-                let angle = rng() * std::f32::consts::TAU;
-                let offset = (rng() * 2.0 - 1.0) * t.axis_u.w * 1.2;
-                let across = u * angle.cos() + v * angle.sin();
-                let normal = (across - c * offset) * (0.5 + rng() * 4.0);
-                let (a, b, cc) = (normal.dot(u), normal.dot(v), normal.dot(c));
-                let (cell_inside, cell_uncertain) = cell_words(&words, &t, n, (a, b, cc));
-                for i in 0..n as usize {
-                    let keeps = normal.dot(t.dirs[i].truncate()) >= 0.0;
-                    let bit = 1 << (i % 32);
-                    let inside = cell_inside[i / 32] & bit != 0;
-                    let uncertain = cell_uncertain[i / 32] & bit != 0;
-                    assert!(!(inside && uncertain));
-                    total += 1;
-                    if !uncertain {
-                        decided += 1;
-                        assert_eq!(inside, keeps, "r {r}, sample {i}, line ({a}, {b}, {cc})");
-                    }
-                }
-            }
-            assert!(
-                decided * 10 > total * 8,
-                "r {r}: {decided} of {total} decided"
-            );
+                let keeps = (0..n as usize)
+                    .map(|i| f0 + t.dirs[i].x * fu + t.dirs[i].y * fv >= 0.0)
+                    .collect();
+                ((fu, fv, f0), keeps)
+            });
         }
     }
 

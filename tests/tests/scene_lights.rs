@@ -8,7 +8,8 @@
 mod common;
 
 use common::{
-    assert_no_validation_errors, compare_with_reference, device, scene_visibility_params,
+    assert_exact_area, assert_no_validation_errors, compare_with_reference, device,
+    scene_visibility_params,
 };
 use glam::Vec3;
 use host_demo::accuracy::{compare_area_counts, AreaComparison};
@@ -351,15 +352,7 @@ fn native_point_frames(
 ) -> Vec<(passes::MapStats, common::VisibilityComparison)> {
     let file = closed_room(lamp);
     let camera = camera(&file);
-    let mut plugin = PluginRenderer::for_scene(
-        device,
-        &file.scene,
-        WIDTH,
-        HEIGHT,
-        false,
-        host_demo::gbuffer::GBufferLayout::ANALYSIS,
-    )
-    .expect("plugin");
+    let mut plugin = plugin_for(device, &file);
     plugin
         .configure_lights(device, &[config])
         .expect("configure");
@@ -703,15 +696,7 @@ fn check_local_area(
     (min_penumbra, max_unstable_percent): (usize, usize),
 ) -> (AreaComparison, passes::MapStats) {
     let camera = camera(file);
-    let mut plugin = PluginRenderer::for_scene(
-        device,
-        &file.scene,
-        WIDTH,
-        HEIGHT,
-        false,
-        host_demo::gbuffer::GBufferLayout::ANALYSIS,
-    )
-    .expect("plugin");
+    let mut plugin = plugin_for(device, file);
     let mut config = ShadowConfig {
         mode: ShadowMode::Area,
         antialiasing: false,
@@ -772,23 +757,7 @@ fn check_local_area(
         report.stats.entries, report.stats.mean_list(), report.stats.longest_list,
         report.stats.texels_past_capacity
     );
-    assert_eq!(c.non_finite, 0, "{name}: values that are no count");
-    assert_eq!(
-        c.mismatches, 0,
-        "{name}: stable pixels whose visible count differs (x, y, reference, GPU): {:?}",
-        c.examples
-    );
-    assert!(
-        c.penumbra >= min_penumbra,
-        "{name}: only {} stable penumbra pixels judged",
-        c.penumbra
-    );
-    assert!(
-        c.unstable * 100 <= c.pixels * max_unstable_percent,
-        "{name}: {} of {} pixels unstable",
-        c.unstable,
-        c.pixels
-    );
+    assert_exact_area(name, &c, min_penumbra, max_unstable_percent);
     assert_no_validation_errors(device);
     (c, report.stats)
 }
@@ -891,4 +860,17 @@ fn a_sized_point_light_1e4_from_the_origin_matches_the_reference() {
         None,
         (200, 25),
     );
+}
+
+/// The plugin over `file`'s static geometry at the test size, with the analysis G-buffer.
+fn plugin_for(device: &Device, file: &SceneFile) -> PluginRenderer {
+    PluginRenderer::for_scene(
+        device,
+        &file.scene,
+        WIDTH,
+        HEIGHT,
+        false,
+        host_demo::gbuffer::GBufferLayout::ANALYSIS,
+    )
+    .expect("plugin")
 }

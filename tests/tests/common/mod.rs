@@ -104,6 +104,35 @@ pub fn plate_and_box_view(width: u32, height: u32) -> View {
     view
 }
 
+/// Asserts an area-shadow comparison with the exact reference of the same samples (`name` in messages):
+/// every value a whole count, 0 mismatched counts on stable pixels, at least `min_penumbra` stable
+/// penumbra pixels judged (a test that cannot fail is no test), at most `max_unstable_percent` of the
+/// pixels unstable.
+pub fn assert_exact_area(
+    name: &str,
+    c: &AreaComparison,
+    min_penumbra: usize,
+    max_unstable_percent: usize,
+) {
+    assert_eq!(c.non_finite, 0, "{name}: values that are no count");
+    assert_eq!(
+        c.mismatches, 0,
+        "{name}: stable pixels whose visible count differs (x, y, reference, GPU): {:?}",
+        c.examples
+    );
+    assert!(
+        c.penumbra >= min_penumbra,
+        "{name}: only {} stable penumbra pixels judged",
+        c.penumbra
+    );
+    assert!(
+        c.unstable * 100 <= c.pixels * max_unstable_percent,
+        "{name}: {} of {} pixels unstable",
+        c.unstable,
+        c.pixels
+    );
+}
+
 /// Asserts a visibility comparison with the exact reference: no NaN/Inf, 0 mismatches outside near-edge
 /// pixels, a view with shadows in it (more than 2% of its pixels), and at most `max_near_edge_fraction`
 /// of the pixels near an edge.
