@@ -358,15 +358,7 @@ fn native_point_frames(
         .expect("configure");
     let matrices = CameraMatrices::of_camera(&camera, WIDTH, HEIGHT);
     let rs = RefScene::new(&file.scene);
-    let params = scene_visibility_params(
-        &file.scene,
-        &camera,
-        WIDTH,
-        HEIGHT,
-        reference::Light::Point {
-            position: lamp.as_dvec3(),
-        },
-    );
+    let params = point_light_params(&file, &camera, lamp);
     let r = reference_visibility(&rs, &params);
     (0..frames)
         .map(|_| {
@@ -721,15 +713,7 @@ fn check_local_area(
     let report = &frame.lights[0].report;
     let (_, layers) = plugin.read_frame(device).expect("read back");
     let rs = RefScene::new(&file.scene);
-    let params = scene_visibility_params(
-        &file.scene,
-        &camera,
-        WIDTH,
-        HEIGHT,
-        reference::Light::Point {
-            position: centre.as_dvec3(),
-        },
-    );
+    let params = point_light_params(file, &camera, centre);
     let offsets: Vec<glam::DVec2> = passes::area::local_area_offsets(samples)
         .iter()
         .map(|o| o.as_dvec2())
@@ -873,4 +857,21 @@ fn plugin_for(device: &Device, file: &SceneFile) -> PluginRenderer {
         host_demo::gbuffer::GBufferLayout::ANALYSIS,
     )
     .expect("plugin")
+}
+
+/// The exact reference's view of `file` from `camera` at the test size, lit by a point light at `position`.
+fn point_light_params(
+    file: &SceneFile,
+    camera: &Camera,
+    position: Vec3,
+) -> reference::VisibilityParams {
+    scene_visibility_params(
+        &file.scene,
+        camera,
+        WIDTH,
+        HEIGHT,
+        reference::Light::Point {
+            position: position.as_dvec3(),
+        },
+    )
 }
