@@ -2630,8 +2630,9 @@ static void several_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g)
 /* A point light and a wide spot light given without matrices: the plugin builds the point light's six cube
  * faces as one map (hard shadows), fits the spot light's five faces around its axis and writes the minimum
  * over them, and reports them as one light each; both match the exact shadow. A light that turns from
- * point to spot is rebuilt and stays exact. Bad local lights are refused with a message, and a wide spot
- * light's per-face resources cannot be read back. */
+ * point to spot is rebuilt and stays exact. The point light with area shadows: a tiny emitter gives the
+ * exact hard shadow, a sized one whole sample counts. Bad local lights are refused with a message, and a
+ * wide spot light's per-face resources cannot be read back. */
 static void native_local_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
     enum { N = 2 };
     Emitter lights[N] = {point(v3(0.9, 2.3, 0.7)), fitted_spot(v3(-1.5, 3.2, 1.8), v3(0, 0, 0), 1.35)};
@@ -2708,6 +2709,39 @@ static void native_local_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometr
            r1.light_builds, sh, mismatches);
     CHECK(r0.frusta == 1 && r0.light_builds == 2 && r1.light_builds == 1 && mismatches == 0 && sh > 100,
           "a light that changes type is rebuilt alone and stays exact");
+    /* area shadows of the point light (its six faces as one cube map, the visible fraction of 64 points of
+     * its spherical emitter): an emitter of radius 1e-4 casts penumbrae far below a pixel, so its counts are
+     * the exact hard shadow outside near-edge pixels; one of 0.15 gives whole counts k / 64 in penumbrae */
+    lights[0] = point(v3(0.9, 2.3, 0.7));
+    set_lights(lights, N);
+    HrtsConfig area_cfgs[N] = {config(HRTS_SHADOW_MODE_AREA), config(HRTS_SHADOW_MODE_HARD)};
+    area_cfgs[0].pcss_spot_radius = 1e-4f;
+    CHECK(hrts_configure_lights(ctx, N, area_cfgs) == HRTS_RESULT_OK, "area point light: %s", hrts_last_error(ctx));
+    CHECK(run_frame(ctx, vis) == HRTS_RESULT_OK, "area point light: %s", hrts_last_error(ctx));
+    HrtsFrameReport ra;
+    CHECK(report(ctx, next_frame - 1, 0, &ra) == HRTS_RESULT_OK, "area report: %s", hrts_last_error(ctx));
+    mismatches = count_mismatches(vis, tol, &lights[0], &ne, &sh, &li);
+    printf("area point light, emitter 1e-4: %s; %u entries; %d shadowed, %d mismatches with the exact hard shadow "
+           "outside %d near-edge px\n",
+           ra.decision_reason, ra.entries, sh, mismatches, ne);
+    CHECK(strstr(ra.decision_reason, "cube") && ra.frusta == 1 && mismatches == 0 && sh > 100,
+          "a tiny area point light is the exact hard shadow: %d mismatches, %d shadowed", mismatches, sh);
+    area_cfgs[0].pcss_spot_radius = 0.15f;
+    CHECK(hrts_configure_lights(ctx, N, area_cfgs) == HRTS_RESULT_OK, "area point light: %s", hrts_last_error(ctx));
+    CHECK(run_frame(ctx, vis) == HRTS_RESULT_OK, "area point light: %s", hrts_last_error(ctx));
+    int lamp_penumbra = 0, lamp_not_counts = 0;
+    for (int p = 0; p < W * H; p++) {
+        float k = vis[p] * 64.0f;
+        if (!(vis[p] >= 0.0f && vis[p] <= 1.0f) || k != floorf(k)) lamp_not_counts++;
+        if (vis[p] > 0.0f && vis[p] < 1.0f) lamp_penumbra++;
+    }
+    printf("area point light, emitter 0.15: %d penumbra pixels, %d values that are no count\n", lamp_penumbra,
+           lamp_not_counts);
+    CHECK(lamp_not_counts == 0 && lamp_penumbra > 100, "area point light: %d penumbra px, %d not k/64", lamp_penumbra,
+          lamp_not_counts);
+    CHECK(configure_all(ctx, N, HRTS_SHADOW_MODE_HARD) == HRTS_RESULT_OK, "configure back: %s", hrts_last_error(ctx));
+    lights[0] = fitted_spot(v3(0.9, 2.3, 0.7), v3(-0.5, 0, -0.6), 0.9);
+    set_lights(lights, N);
     /* bad local lights: a negative range, a fitted spot light without a cone */
     c_lights[0].range = -1.0f;
     CHECK(run_frame(ctx, NULL) == HRTS_RESULT_ERROR_INVALID_ARGUMENT && strstr(hrts_last_error(ctx), "range"),
