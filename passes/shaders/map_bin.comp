@@ -78,6 +78,20 @@ void main() {
             uvec2 t0 = bmin + uvec2(k % bt.info.w, k / bt.info.w) * BIN_TILE;
             uvec2 t1 = min(t0 + (BIN_TILE - 1u), bmax);
             // The tile's texel centres span [t0, t1] + 0.5.
+            if (pc.emitter_radius > 0.0) {
+                // A spot or point light: the emitter's reach over this tile's receivers rather than the
+                // grid's (map_fit.comp): R |row - T row_w| is convex in the texel coordinate T, so its
+                // largest value over the tile's texels, with a texel of slack for the receivers' projection
+                // error, is at the ends of that range.
+                mat4 m = faces[face].to_texels;
+                vec3 rx = vec3(m[0][0], m[1][0], m[2][0]);
+                vec3 ry = vec3(m[0][1], m[1][1], m[2][1]);
+                vec3 rw = vec3(m[0][3], m[1][3], m[2][3]);
+                vec2 lo = vec2(t0) - 1.0, hi = vec2(t1) + 2.0;
+                float reach = max(max(length(rx - lo.x * rw), length(rx - hi.x * rw)),
+                                  max(length(ry - lo.y * rw), length(ry - hi.y * rw)));
+                widen.x = min(widen.x, pc.emitter_radius * reach * (1.0 + 1.0 / 1024.0));
+            }
             float widest = widen.x == 0.0 ? 0.0 : penumbra_texels(bt, deepest, widen);
             if (bin_tile_overlaps(bt, (vec2(t0) + vec2(t1)) * 0.5 + 0.5, (vec2(t1) - vec2(t0)) * 0.5,
                                   widest)) {
