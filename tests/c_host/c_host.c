@@ -821,6 +821,19 @@ static int differing(const float *a, const float *b, int n) {
     return d;
 }
 
+/* Area shadows of `samples` samples: the pixels of `vis` strictly between 0 and 1 (`penumbra`), and those that
+ * are no whole count k / samples in [0, 1], which it returns. */
+static int area_not_counts(const float *vis, float samples, int *penumbra) {
+    int not_counts = 0;
+    *penumbra = 0;
+    for (int i = 0; i < W * H; i++) {
+        float k = vis[i] * samples;
+        if (!(vis[i] >= 0.0f && vis[i] <= 1.0f) || k != floorf(k)) not_counts++;
+        if (vis[i] > 0.0f && vis[i] < 1.0f) (*penumbra)++;
+    }
+    return not_counts;
+}
+
 /* Pixels whose visibility differs from the exact shadow of light `e` (near-edge pixels counted apart). */
 static int count_mismatches(const float *vis, double tol, const Emitter *e, int *near_edge, int *shadowed, int *lit) {
     int mismatches = 0;
@@ -2729,12 +2742,8 @@ static void native_local_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometr
     area_cfgs[0].pcss_spot_radius = 0.15f;
     CHECK(hrts_configure_lights(ctx, N, area_cfgs) == HRTS_RESULT_OK, "area point light: %s", hrts_last_error(ctx));
     CHECK(run_frame(ctx, vis) == HRTS_RESULT_OK, "area point light: %s", hrts_last_error(ctx));
-    int lamp_penumbra = 0, lamp_not_counts = 0;
-    for (int p = 0; p < W * H; p++) {
-        float k = vis[p] * 64.0f;
-        if (!(vis[p] >= 0.0f && vis[p] <= 1.0f) || k != floorf(k)) lamp_not_counts++;
-        if (vis[p] > 0.0f && vis[p] < 1.0f) lamp_penumbra++;
-    }
+    int lamp_penumbra;
+    int lamp_not_counts = area_not_counts(vis, 64.0f, &lamp_penumbra);
     printf("area point light, emitter 0.15: %d penumbra pixels, %d values that are no count\n", lamp_penumbra,
            lamp_not_counts);
     CHECK(lamp_not_counts == 0 && lamp_penumbra > 100, "area point light: %d penumbra px, %d not k/64", lamp_penumbra,
@@ -3034,12 +3043,8 @@ int main(void) {
     area.pcss_angular_radius = 0.05f;
     CHECK(hrts_configure(ctx, &area) == HRTS_RESULT_OK, "configure area: %s", hrts_last_error(ctx));
     CHECK(run_frame(ctx, area_vis) == HRTS_RESULT_OK, "record area: %s", hrts_last_error(ctx));
-    int penumbra = 0, not_counts = 0;
-    for (int i = 0; i < W * H; i++) {
-        float k = area_vis[i] * 64.0f;
-        if (!(area_vis[i] >= 0.0f && area_vis[i] <= 1.0f) || k != floorf(k)) not_counts++;
-        if (area_vis[i] > 0.0f && area_vis[i] < 1.0f) penumbra++;
-    }
+    int penumbra;
+    int not_counts = area_not_counts(area_vis, 64.0f, &penumbra);
     printf("area, 0.05 rad, 64 samples: %d penumbra pixels, %d values that are no count\n", penumbra, not_counts);
     CHECK(not_counts == 0 && penumbra > 100, "area: %d penumbra px, %d not k/64", penumbra, not_counts);
     HrtsConfig bad = area;
