@@ -60,7 +60,8 @@ pub struct RayTracePass {
     /// The trace's pipeline and bind group (an area trace's for directional lights).
     pipeline: ComputePipeline,
     group: BindGroup,
-    /// An area trace's pipeline and bind group for spot and point lights.
+    /// An area trace's pipeline and bind group for spot lights, beside the directional one (a point light's
+    /// cube map has the local variant as its one pipeline).
     local: Option<(ComputePipeline, BindGroup)>,
     constants: Buffer,
     /// The area trace's light samples, and its edge tables (area shadows only).
@@ -175,14 +176,19 @@ impl RayTracePass {
                 return Err(PassError::InvalidConfig("no blocker image".into()));
             }
         }
+        // A point light's cube map only ever traces a local light: the local variant is its one pipeline.
+        let cube = inputs.map.config().cube;
         let (name, shader_name) = match kind {
+            RayTraceKind::Area { .. } if cube => {
+                ("area trace (point light)", "area_trace_local.comp")
+            }
             RayTraceKind::Area { .. } => ("area trace (directional lights)", "area_trace.comp"),
             RayTraceKind::Hard { .. } => ("ray trace", "ray_trace.comp"),
         };
         let pipeline = device.create_compute_pipeline(name, &shader(shader_name)?, &kinds, 0)?;
         let group = device.create_bind_group(pipeline.layout(), &resources)?;
         let local = match kind {
-            RayTraceKind::Area { .. } => {
+            RayTraceKind::Area { .. } if !cube => {
                 let pipeline = device.create_compute_pipeline(
                     "area trace (spot and point lights)",
                     &shader("area_trace_local.comp")?,
@@ -192,7 +198,7 @@ impl RayTracePass {
                 let group = device.create_bind_group(pipeline.layout(), &resources)?;
                 Some((pipeline, group))
             }
-            RayTraceKind::Hard { .. } => None,
+            _ => None,
         };
         Ok(Self {
             pipeline,
