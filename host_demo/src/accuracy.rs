@@ -74,14 +74,11 @@ pub fn compare_map(
     for y in 0..n {
         for x in 0..n {
             let t = (y * n + x) as usize;
-            let (begin, end) = (
-                images.list_offsets[t] as usize,
-                images.list_offsets[t + 1] as usize,
-            );
-            if end > capacity {
+            let Some(range) = images.list_offsets.range(t).filter(|r| r.end <= capacity) else {
                 c.past_capacity += 1;
                 continue;
-            }
+            };
+            let (begin, end) = (range.start, range.end);
             let stored = &images.list_entries[begin..end];
             let mut sorted = stored.to_vec();
             sorted.sort_unstable();

@@ -642,7 +642,10 @@ impl PluginRenderer {
             match *output {
                 Destination::Image(image) => frame.insert(image, bytes, origin),
                 Destination::ListOffsets => {
-                    frame.list_offsets = bytemuck::pod_collect_to_vec(bytes)
+                    let packed: Vec<u32> = bytemuck::pod_collect_to_vec(bytes);
+                    frame.list_offsets =
+                        passes::unpack_list_offsets(&packed, passes::packed_texels(packed.len()))
+                            .map_err(anyhow::Error::msg)?;
                 }
                 Destination::ListEntries => {
                     frame.list_entries = bytemuck::pod_collect_to_vec(bytes)

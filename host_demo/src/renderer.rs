@@ -26,8 +26,8 @@ pub struct FrameImages {
     pub blocker_distance: Vec<f32>,
     /// Occupancy view, N×N RGBA8.
     pub occupancy: Vec<[u8; 4]>,
-    /// Primitive map list offsets, N² + 1: texel t's list is `list_entries[offsets[t] .. offsets[t + 1]]`.
-    pub list_offsets: Vec<u32>,
+    /// Primitive map list offsets, unpacked: texel t's list is `list_entries[list_offsets.range(t)]`.
+    pub list_offsets: passes::ListOffsets,
     /// Primitive map list entries (triangle indices); empty unless requested.
     pub list_entries: Vec<u32>,
     /// Classic single-tap shadow-map visibility.
@@ -154,10 +154,12 @@ impl ShadowRenderer {
         }
         let buffers: Vec<&Buffer> = lists.iter().filter_map(|&r| p.buffer(r)).collect();
         let mut words = read_buffers(device, &buffers)?.into_iter();
-        frame.list_offsets = words
-            .next()
-            .map(|b| bytemuck::pod_collect_to_vec(&b))
-            .unwrap_or_default();
+        if let (Some(packed), Some(map)) = (words.next(), p.primitive_map()) {
+            let packed: Vec<u32> = bytemuck::pod_collect_to_vec(&packed);
+            frame.list_offsets =
+                passes::unpack_list_offsets(&packed, map.config().texels() as usize)
+                    .map_err(PassError::InvalidConfig)?;
+        }
         frame.list_entries = words
             .next()
             .map(|b| bytemuck::pod_collect_to_vec(&b))

@@ -39,6 +39,7 @@ layout(set = 0, binding = 2) uniform sampler2D normal_tex;
 layout(set = 0, binding = 3) readonly buffer State { MapState ms; };
 layout(set = 0, binding = 4) readonly buffer PixelTexels { uint pixel_texel[]; };
 layout(set = 0, binding = 5) readonly buffer Offsets { uint offsets[]; };
+#include "map_offsets.glsl"
 layout(set = 0, binding = 6) readonly buffer Entries { uint entries[]; };
 layout(set = 0, binding = 7) readonly buffer Prims { Triangle tris[]; };
 layout(set = 0, binding = 8, r32f) uniform writeonly image2D visibility;
@@ -294,16 +295,16 @@ void main() {
             blocked[i >> 5u] |= 1u << (i & 31u);
         }
     }
-    uint begin = texel == TEXEL_NO_RAY ? 0u : offsets[texel];
-    uint end = texel == TEXEL_NO_RAY ? 0u : offsets[texel + 1u];
+    uint begin = 0u, end = 0u;
+    bool listed = texel != TEXEL_NO_RAY && list_range(texel, begin, end);
     bool binned = ms.grid.z <= ms.grid.w;
-    if (texel != TEXEL_NO_RAY && binned && (end <= ms.totals.z || begin == end)) {
+    if (listed && binned && (end <= ms.totals.z || begin == end)) {
         for (uint i = begin; i < end && !all_blocked(); ++i) {
             consider(entries[i]);
         }
     } else {
-        // Past the entry capacity: every triangle, exact (unrolled: see ray_trace.comp on llvmpipe's loop
-        // cap).
+        // Past the entry capacity, or in a group whose list offsets overflowed: every triangle, exact
+        // (unrolled: see ray_trace.comp on llvmpipe's loop cap).
         uint total = min(k.misc.y, uint(tris.length()));
         for (uint base = 0u; base < total && !all_blocked(); base += 16u) {
             pending_count = 0u;

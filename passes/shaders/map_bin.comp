@@ -21,11 +21,10 @@ layout(set = 0, binding = 0) readonly buffer BinTris { BinTri bin_tris[]; };
 layout(set = 0, binding = 1) readonly buffer TileOffsets { uint tile_offsets[]; };
 layout(set = 0, binding = 2) readonly buffer Receivers { uint receiver[]; };
 layout(set = 0, binding = 3) buffer Counts { uint counts[]; };
-layout(set = 0, binding = 4) readonly buffer Offsets { uint offsets[]; };
-layout(set = 0, binding = 5) writeonly buffer Entries { uint entries[]; };
-layout(set = 0, binding = 6) buffer State { MapState faces[]; };
-layout(set = 0, binding = 7) readonly buffer PairOwners { uint pair_owner[]; };
-layout(set = 0, binding = 8) buffer PairList { uvec2 pair_list[]; };
+layout(set = 0, binding = 4) writeonly buffer Entries { uint entries[]; };
+layout(set = 0, binding = 5) buffer State { MapState faces[]; };
+layout(set = 0, binding = 6) readonly buffer PairOwners { uint pair_owner[]; };
+layout(set = 0, binding = 7) buffer PairList { uvec2 pair_list[]; };
 layout(push_constant) uniform Push { MapPush pc; };
 #include "map_store.glsl"
 

@@ -1,5 +1,5 @@
 // The texel test and the store of the compute and raster binning paths (after map_bin.glsl). Needs the
-// includer's `receiver`, `counts`, `offsets`, `entries` and `pc`.
+// includer's `receiver`, `counts`, `entries` and `pc`.
 
 // Whether `texel`, centred at `centre`, gets triangle `t`: it overlaps the triangle, and (with `cull`) a
 // ray origin lies in it and the triangle is not wholly farther from the light than all of them. The
@@ -33,14 +33,14 @@ bool bin_accepts(BinTri t, uint texel, vec2 centre, bool cull, vec2 widen, float
 }
 
 // Counts (mode 0) or stores (mode 1) triangle `tri` in the list of `texel`.
-// Fill: the slot is offsets[texel] + (counts[texel] -= 1), so the counts return to 0 for the next frame.
+// Fill: the counts hold the scanned offsets of the lists by then, and serve as each list's cursor.
 // Nothing is written at or past the entry capacity: such texels are traced exhaustively, and reported.
 void bin_store(uint tri, uint texel) {
     if (pc.mode == 0u) {
         atomicAdd(counts[texel], 1u);
         return;
     }
-    uint slot = offsets[texel] + atomicAdd(counts[texel], 0xFFFFFFFFu) - 1u;
+    uint slot = atomicAdd(counts[texel], 1u);
     if (slot < pc.capacity) {
         entries[slot] = tri;
     }

@@ -33,6 +33,7 @@ layout(set = 0, binding = 2) uniform sampler2D normal_tex;
 layout(set = 0, binding = 3) readonly buffer State { MapState ms; };
 layout(set = 0, binding = 4) readonly buffer PixelTexels { uint pixel_texel[]; };
 layout(set = 0, binding = 5) readonly buffer Offsets { uint offsets[]; };
+#include "map_offsets.glsl"
 layout(set = 0, binding = 6) readonly buffer Entries { uint entries[]; };
 layout(set = 0, binding = 7) readonly buffer Prims { Triangle tris[]; };
 layout(set = 0, binding = 8, r32f) uniform writeonly image2D visibility;
@@ -148,18 +149,19 @@ void main() {
         return;
     }
     float nearest = t_max;
-    uint begin = texel == TEXEL_NO_RAY ? 0u : offsets[texel];
-    uint end = texel == TEXEL_NO_RAY ? 0u : offsets[texel + 1u];
+    uint begin = 0u, end = 0u;
+    bool listed = texel != TEXEL_NO_RAY && list_range(texel, begin, end);
     // An empty list is complete wherever it lies; a list is complete when it ends within the capacity.
     // A point light's frame that kept more (triangle, face) pairs than its bin items hold has no complete
     // list.
     bool binned = ms.grid.z <= ms.grid.w;
-    if (texel != TEXEL_NO_RAY && binned && (end <= ms.totals.z || begin == end)) {
+    if (listed && binned && (end <= ms.totals.z || begin == end)) {
         for (uint i = begin; i < end; ++i) {
             consider(entries[i], nearest);
         }
     } else {
-        // Past the entry or pair capacity (or, never seen, a pixel the receiver pass gave no ray):
+        // Past the entry or pair capacity, in a group whose list offsets overflowed (or, never seen, a pixel
+        // the receiver pass gave no ray):
         // exhaustive and exact. Unrolled 16x by hand: llvmpipe (lavapipe) silently ends a shader's loops after 65535
         // iterations in total, which would drop every triangle past that index; unrolled, its cap is 1M.
         uint total = min(k.misc.y, uint(tris.length()));

@@ -84,7 +84,7 @@ ids!(
         /// The primitive map: receivers placed and fitted, triangles culled, counted, scanned and binned into
         /// exact per-texel lists.
         PrimitiveMap = "primitive map",
-        /// Occupancy view and statistics of the primitive map (entries, list lengths, capacity).
+        /// The primitive map statistics (entries, list lengths, capacity) read back, and its occupancy view.
         Occupancy = "occupancy",
         /// Shadow rays through the primitive map: hard visibility and blocker distance.
         RayTrace = "ray trace",

@@ -41,8 +41,9 @@ pub use prim_buffer::{
     VertexLayout,
 };
 pub use primitive_map::{
-    choose_binning_path, BinningPath, BinningRequest, FaceMode, PrimitiveMapConfig,
-    DEFAULT_ENTRY_BUDGET, GUARD_VALUE, GUARD_WORDS, MIN_ENTRY_BUDGET, MIN_FITTED_ENTRIES,
+    choose_binning_path, packed_offset_words, packed_texels, unpack_list_offsets, BinningPath,
+    BinningRequest, FaceMode, ListOffsets, PrimitiveMapConfig, DEFAULT_ENTRY_BUDGET, GUARD_VALUE,
+    GUARD_WORDS, MIN_ENTRY_BUDGET, MIN_FITTED_ENTRIES,
 };
 pub use shadow_map::ShadowMapConfig;
 pub use shadow_pipeline::{

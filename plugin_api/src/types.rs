@@ -196,8 +196,12 @@ pub enum HrtsLightDecision {
 pub enum HrtsResource {
     /// Light-space depth, `D32_SFLOAT`, shadow_map_size².
     ShadowMap = 0,
-    /// Primitive map list offsets, a buffer of N² + 1 `uint32_t` (`R32_UINT`, width N² + 1): texel
-    /// t = y·N + x holds entries [offsets[t], offsets[t + 1]).
+    /// Primitive map list offsets, packed: a buffer of `uint32_t` (`R32_UINT`) holding the texels (t = y·N + x)
+    /// in groups of 16, 9 words per group and one group more than the N² texels need. Word 0 of group g
+    /// is the offset of texel 16g's list (bit 31 set: the group's lists are not kept, their texels are
+    /// traced against every triangle); word 1 + i/2 holds texel 16g + i's offset from it in its low 16 bits
+    /// for even i, its high 16 bits for odd i. Texel t holds entries [offset(t), offset(t + 1)); the last
+    /// group's word 0 is the entries of all lists.
     PrimListOffsets = 1,
     /// Primitive map list entries, a buffer of `uint32_t` triangle indices (`R32_UINT`, width = capacity).
     PrimListEntries = 2,

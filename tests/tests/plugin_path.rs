@@ -47,7 +47,11 @@ fn differences(a: &FrameImages, b: &FrameImages) -> Vec<(&'static str, usize)> {
         ),
         (
             "list offsets",
-            count(bits(&a.list_offsets), bits(&b.list_offsets), 4),
+            count(
+                bits(&a.list_offsets.offsets),
+                bits(&b.list_offsets.offsets),
+                4,
+            ),
         ),
         ("lists", list_differences(a, b)),
         (
@@ -80,14 +84,14 @@ fn list_differences(a: &FrameImages, b: &FrameImages) -> usize {
         return usize::MAX;
     }
     let capacity = a.list_entries.len();
-    let list = |images: &FrameImages, t: usize| {
-        let mut l = images.list_entries[a.list_offsets[t] as usize..a.list_offsets[t + 1] as usize]
-            .to_vec();
+    let list = |images: &FrameImages, range: std::ops::Range<usize>| {
+        let mut l = images.list_entries[range].to_vec();
         l.sort_unstable();
         l
     };
-    (0..a.list_offsets.len().saturating_sub(1))
-        .filter(|&t| a.list_offsets[t + 1] as usize <= capacity && list(a, t) != list(b, t))
+    (0..a.list_offsets.overflowed.len())
+        .filter_map(|t| a.list_offsets.range(t).filter(|r| r.end <= capacity))
+        .filter(|r| list(a, r.clone()) != list(b, r.clone()))
         .count()
 }
 

@@ -8,10 +8,11 @@
 //!    outside every receiver texel, or farther from the light than every ray origin) or projected, with a
 //!    rigorous bound on its projection error, and split into 4×4-texel tiles of its bounding box;
 //! 3. count, scan, fill: the (triangle, texel) pairs that pass the exact conservative overlap test are
-//!    counted per texel, the counts are prefix-summed into list offsets, and the lists are filled. Memory
-//!    is proportional to the entries; nothing is ever dropped. Texels whose list would pass the entry
-//!    capacity are traced exhaustively (exact, slower), reported, and the capacity grows for the next frame
-//!    within the memory budget.
+//!    counted per texel, the counts are prefix-summed in place, packed into the map's list offsets
+//!    ([`packed_offset_words`]: 2.25 bytes per texel) and then serve as the fill's cursors. Memory is
+//!    proportional to the entries; nothing is ever dropped. Texels whose list would pass the entry
+//!    capacity (or whose group of 16 texels holds 65536 entries or more) are traced exhaustively (exact,
+//!    slower), reported, and the capacity grows for the next frame within the memory budget.
 //!
 //! The count and fill run in a compute shader (load-balanced over tiles) or, for the tier-fallback paths,
 //! through the rasterizer: hardware conservative raster at the device's tier, the geometry-shader software
@@ -30,11 +31,16 @@ use rhi::{
 };
 
 mod config;
+mod offsets;
 mod scratch;
 
 pub use config::{
     choose_binning_path, BinningPath, BinningRequest, FaceMode, PrimitiveMapConfig,
     DEFAULT_ENTRY_BUDGET, GUARD_VALUE, GUARD_WORDS, MIN_ENTRY_BUDGET,
+};
+pub use offsets::{
+    packed_offset_words, packed_texels, unpack_list_offsets, ListOffsets, OFFSET_GROUP, OFFSET_GROUP_OVERFLOW,
+    OFFSET_GROUP_WORDS,
 };
 use scratch::{storage_buffer, BindTargets, SharedTexels, PAIR_BYTES};
 pub use scratch::{MapScratch, MapScratchPool, ScratchBindings};
@@ -58,8 +64,7 @@ pub struct PrimitiveMapInputs<'a> {
     pub depth: &'a Image,
     /// Camera-facing geometric normal, w = 0 on background (`ShaderResource` state).
     pub normal: &'a Image,
-    /// Whether the occupancy pass draws the N×N occupancy view, besides the statistics it always
-    /// gathers.
+    /// Whether the occupancy pass draws the N×N occupancy view, besides reading back the statistics.
     pub occupancy_view: bool,
     /// Where the map takes its build scratch from (one pool per geometry).
     pub scratch: &'a MapScratchPool,
@@ -78,6 +83,7 @@ pub(super) struct MapPipelines {
     pub(super) setup: ComputePipeline,
     pub(super) scan: ScanPipeline,
     pub(super) binner: Binner,
+    pub(super) pack: ComputePipeline,
     pub(super) occupancy: ComputePipeline,
 }
 
@@ -110,7 +116,7 @@ pub struct PrimitiveMap {
     id: u64,
     /// The push constants of the last build recorded (its pixel texels are rewritten from them).
     last_push: Option<MapPush>,
-    /// One `u32` per texel, plus one: texel t's list is `entries[offsets[t] .. offsets[t + 1]]`.
+    /// The lists' offsets, packed ([`packed_offset_words`]: a `u32` per 16 texels, a `u16` per texel).
     pub offsets: Buffer,
     /// The lists' triangle indices (capacity `u32`, plus the guard words in guard mode).
     pub entries: Buffer,
@@ -148,7 +154,11 @@ impl PrimitiveMap {
         let pixel_texels = inputs
             .scratch
             .pixel_texels(device, u64::from(width) * u64::from(height))?;
-        let offsets = storage("primitive map list offsets", (texels + 1) * 4, copy)?;
+        let offsets = storage(
+            "primitive map list offsets",
+            packed_offset_words(texels) * 4,
+            copy,
+        )?;
         let capacity = config.starting_entries(caps, inputs.triangles);
         let entries = Self::create_entries(device, &config, capacity)?;
         let view_size = if inputs.occupancy_view { n } else { 1 };
@@ -257,11 +267,17 @@ impl PrimitiveMap {
                 BinningPath::Compute => Binner::Compute(device.create_compute_pipeline(
                     "map bin",
                     &shader("map_bin.comp")?,
-                    &buffers(9),
+                    &buffers(8),
                     push,
                 )?),
                 raster => Binner::Raster(Self::raster_pipeline(device, raster)?),
             },
+            pack: device.create_compute_pipeline(
+                "map pack",
+                &shader("map_pack.comp")?,
+                &buffers(3),
+                std::mem::size_of::<u32>() as u32,
+            )?,
             occupancy: device.create_compute_pipeline(
                 "occupancy",
                 &shader("occupancy.comp")?,
@@ -271,7 +287,7 @@ impl PrimitiveMap {
                     BindingKind::StorageImage,
                     BindingKind::StorageBuffer,
                 ],
-                std::mem::size_of::<[u32; 3]>() as u32,
+                std::mem::size_of::<[u32; 2]>() as u32,
             )?,
         })
     }
@@ -306,7 +322,7 @@ impl PrimitiveMap {
             vertex: &shader("prim_map.vert")?,
             geometry: geometry.as_deref(),
             fragment: &shader("prim_map_raster.frag")?,
-            bindings: &[BindingKind::StorageBuffer; 5],
+            bindings: &[BindingKind::StorageBuffer; 4],
             push_constant_size: std::mem::size_of::<MapPush>() as u32,
             color_formats: &[],
             depth: None,
@@ -345,11 +361,6 @@ impl PrimitiveMap {
     /// The occupancy view, when the map draws one.
     pub fn occupancy_view(&self) -> Option<&Image> {
         self.occupancy_view.then_some(&self.occupancy)
-    }
-
-    /// The occupancy pass's image (1×1 and never written without the view), for its barriers.
-    pub fn occupancy_target(&self) -> &Image {
-        &self.occupancy
     }
 
     /// Sizes the entry capacity by what the lists occupy: grows it to hold `needed` entries (with a quarter
@@ -531,6 +542,14 @@ impl PrimitiveMap {
 
         enc.begin_pass("primitive map: scan");
         self.bound.offset_scan.record(enc, &self.pipes.scan)?;
+        let groups = self.config.texels().div_ceil(OFFSET_GROUP as u64) + 1;
+        enc.dispatch(
+            &self.pipes.pack,
+            &self.bound.pack_group,
+            bytemuck::bytes_of(&(self.config.texels() as u32)),
+            [groups.div_ceil(64) as u32, 1, 1],
+        )?;
+        enc.barriers(&[Barrier::Uav]);
         enc.end_pass();
 
         enc.begin_pass(&format!("primitive map: fill ({label})"));
@@ -608,30 +627,30 @@ impl PrimitiveMap {
         Ok(())
     }
 
-    /// Writes the map statistics into the state, and the occupancy view when the map draws one, and copies
-    /// the state into `state_readback` (host-readable once the frame completed; as large as the state).
+    /// Draws the occupancy view when the map has one, and copies the state with the statistics the build
+    /// tallied into `state_readback` (host-readable once the frame completed; as large as the state).
     pub fn record_occupancy(
         &self,
         enc: &mut Encoder<'_>,
         state_readback: &Buffer,
     ) -> Result<(), PassError> {
         enc.begin_pass("occupancy");
-        enc.barriers(&[Barrier::Image {
-            image: &self.occupancy,
-            before: S::Undefined,
-            after: S::UnorderedAccess,
-        }]);
-        let n = self.config.size;
-        let texels = self.config.texels();
-        let push = [n, u32::from(self.occupancy_view), texels as u32];
-        // Each invocation tallies a 2x2 quad of texels, in rows of N.
-        let rows = texels.div_ceil(u64::from(n)) as u32;
-        enc.dispatch(
-            &self.pipes.occupancy,
-            &self.occupancy_group,
-            bytemuck::cast_slice(&push),
-            [n.div_ceil(16), rows.div_ceil(16), 1],
-        )?;
+        if self.occupancy_view {
+            enc.barriers(&[Barrier::Image {
+                image: &self.occupancy,
+                before: S::Undefined,
+                after: S::UnorderedAccess,
+            }]);
+            let n = self.config.size;
+            let push = [n, self.config.texels() as u32];
+            // Each invocation draws a 2x2 quad of the first N rows of texels.
+            enc.dispatch(
+                &self.pipes.occupancy,
+                &self.occupancy_group,
+                bytemuck::cast_slice(&push),
+                [n.div_ceil(16), n.div_ceil(16), 1],
+            )?;
+        }
         enc.barriers(&[Barrier::Global {
             before: S::UnorderedAccess,
             after: S::CopySource,

@@ -237,7 +237,10 @@ pub struct ScratchBindings {
     pub(super) setup_group: BindGroup,
     pub(super) bin_group: BindGroup,
     pub(super) tile_scan: PrefixScan,
+    /// The counts scanned in place into the lists' offsets (the fill's cursors).
     pub(super) offset_scan: PrefixScan,
+    /// Packs the scanned offsets into the map's list offsets and tallies its statistics.
+    pub(super) pack_group: BindGroup,
 }
 
 /// The buffers the scratch bindings pair with the scratch.
@@ -285,7 +288,6 @@ impl ScratchBindings {
                         b(&s.tile_offsets),
                         b(t.receivers),
                         b(&s.counts),
-                        b(t.offsets),
                         b(t.entries),
                         b(t.state),
                         b(&s.pair_owners),
@@ -301,7 +303,6 @@ impl ScratchBindings {
                     b(&s.bin_tris),
                     b(t.receivers),
                     b(&s.counts),
-                    b(t.offsets),
                     b(t.entries),
                 ],
             )?,
@@ -317,8 +318,16 @@ impl ScratchBindings {
             device,
             &pipes.scan,
             &s.counts,
-            t.offsets,
+            &s.counts,
             (texels + 1) as u32,
+        )?;
+        let pack_group = device.create_bind_group(
+            pipes.pack.layout(),
+            &[
+                Resource::Buffer(&s.counts),
+                Resource::Buffer(t.offsets),
+                Resource::Buffer(t.state),
+            ],
         )?;
         Ok(Self {
             scratch,
@@ -327,6 +336,7 @@ impl ScratchBindings {
             bin_group,
             tile_scan,
             offset_scan,
+            pack_group,
         })
     }
 }

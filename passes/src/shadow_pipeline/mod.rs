@@ -178,8 +178,8 @@ impl ShadowPipeline {
         }
     }
 
-    /// The buffer holding `resource`, if the plan allocated it: the primitive map's list offsets
-    /// (N² + 1 `u32`: texel t's list is `entries[offsets[t] .. offsets[t + 1]]`) and list entries.
+    /// The buffer holding `resource`, if the plan allocated it: the primitive map's list offsets (packed:
+    /// [`crate::unpack_list_offsets`] reads them) and list entries.
     pub fn buffer(&self, resource: ResourceId) -> Option<&Buffer> {
         match resource {
             ResourceId::PrimListOffsets => self.map.as_ref().map(|m| &m.offsets),
