@@ -75,6 +75,9 @@ pub struct BenchArgs {
     /// --angular-radius. 0: zero-size lights (hard shadows).
     #[arg(long, default_value_t = 0.0, requires = "lights")]
     pub emitter_size: f32,
+    /// With --lights: the primitive map's N (texels per side; a point light's cube faces share N²).
+    #[arg(long, default_value_t = passes::PrimitiveMapConfig::DEFAULT_SIZE, requires = "lights", value_parser = clap::value_parser!(u32).range(1..=i64::from(u16::MAX)))]
+    pub map_size: u32,
 }
 
 /// One benchmark model: a file of `../shared/models`, how it is shown, and the talk's GTX 980 times (ms)

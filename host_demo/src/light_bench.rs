@@ -14,7 +14,7 @@ use crate::scene_render::SceneRenderer;
 use crate::CameraMatrices;
 use anyhow::{Context, Result};
 use glam::Vec3;
-use passes::{AreaConfig, ResourceId, ShadowConfig, ShadowMode};
+use passes::{AreaConfig, PrimitiveMapConfig, ResourceId, ShadowConfig, ShadowMode};
 use rhi::Device;
 use scene::{Aabb, Camera, LightKind, LightSize, SceneFile, SceneLight};
 use std::fmt::Write as _;
@@ -201,6 +201,10 @@ fn measure_light(
             area: AreaConfig {
                 samples: args.area_samples,
             },
+            map: PrimitiveMapConfig {
+                size: args.map_size,
+                ..PrimitiveMapConfig::default()
+            },
             ..ShadowConfig::default()
         },
         width: args.width,
@@ -288,6 +292,10 @@ fn measure_native_points(
     let mut config = ShadowConfig {
         mode: ShadowMode::Hard,
         antialiasing: false,
+        map: PrimitiveMapConfig {
+            size: args.map_size,
+            ..PrimitiveMapConfig::default()
+        },
         ..ShadowConfig::default()
     };
     if let Some(radius) = emitter_radius {
@@ -338,7 +346,7 @@ fn measure_native_points(
 pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Result<String> {
     let caps = device.capabilities();
     let mut out = format!(
-        "Device: {} ({}); {}×{}, {}, no FXAA; one light at a time, planned as \
+        "Device: {} ({}); {}×{}, {}, primitive map N = {}, no FXAA; one light at a time, planned as \
          `render --scene` plans it; GPU ms = median over {} frames after the first of the light's passes \
          summed over its frusta (the shared prim buffer excluded); memory = the light's own resources (each light \
          writes its layer of an R32F storage output directly; the build scratch shared by all lights is listed \
@@ -357,6 +365,7 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
         } else {
             "hard shadows (zero-size lights)".to_owned()
         },
+        args.map_size,
         args.frames.max(2) - 1
     );
     let chosen: Vec<&LightScene> = SCENES

@@ -1,8 +1,9 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// One invocation. mode 0: resets the map state of every frustum for a new frame. mode 1: fits each frustum's grid to its receivers' light-space bounds (padded by 1/256
-// of their extent): `to_texels` maps frame coordinates to homogeneous texel space, the frustum's
-// view-projection followed by the 2D affine fit; `grid` places the grid in the map's texels.
+// One invocation: fits each frustum's grid to its receivers' light-space bounds (padded by 1/256 of their
+// extent): `to_texels` maps frame coordinates to homogeneous texel space, the frustum's view-projection
+// followed by the 2D affine fit; `grid` places the grid in the map's texels. (The host resets the state
+// of every frustum for each frame: passes::gpu_types::MapState::reset.)
 #include "ray_trace_constants.glsl"
 #include "map_state.glsl"
 #include "map_push.glsl"
@@ -15,18 +16,6 @@ layout(push_constant) uniform Push { MapPush pc; };
 const uint MIN_GRID = 16u;
 
 void main() {
-    if (pc.mode == 0u) {
-        for (uint f = 0u; f < pc.faces; ++f) {
-            faces[f].to_texels = mat4(1.0);
-            faces[f].bounds = uvec4(0xFFFFFFFFu, 0xFFFFFFFFu, 0u, 0u);
-            faces[f].receivers = uvec4(0u);
-            faces[f].fit = vec4(0.0);
-            faces[f].totals = uvec4(0u, 0u, f == 0u ? pc.capacity : 0u, 0u);
-            faces[f].stats = uvec4(0u);
-            faces[f].grid = uvec4(0u, 0u, 0u, f == 0u ? pc.pairs : 0u);
-        }
-        return;
-    }
     uint rays = 0u;
     for (uint f = 0u; f < pc.faces; ++f) {
         rays += faces[f].receivers.w;

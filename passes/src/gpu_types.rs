@@ -154,6 +154,24 @@ pub struct MapState {
     pub grid: UVec4,
 }
 
+impl MapState {
+    /// The state of frustum `frustum` at the start of a frame's build: nothing fitted, bounds empty, no
+    /// receivers, totals and statistics zero; the first frustum's holds the entry capacity and the
+    /// (triangle, face) pairs the bin items hold.
+    pub fn reset(frustum: usize, capacity: u32, pairs: u32) -> Self {
+        let first = |v: u32| if frustum == 0 { v } else { 0 };
+        Self {
+            to_texels: Mat4::IDENTITY,
+            bounds: UVec4::new(u32::MAX, u32::MAX, 0, 0),
+            receivers: UVec4::ZERO,
+            fit: Vec4::ZERO,
+            totals: UVec4::new(0, 0, first(capacity), 0),
+            stats: UVec4::ZERO,
+            grid: UVec4::new(0, 0, 0, first(pairs)),
+        }
+    }
+}
+
 /// What the primitive map held in a frame (decoded from [`MapState`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct MapStats {

@@ -177,7 +177,7 @@ const MIN_GRID: u32 = 16;
 impl Default for PrimitiveMapConfig {
     fn default() -> Self {
         Self {
-            size: 1024,
+            size: Self::DEFAULT_SIZE,
             faces: FaceMode::Both,
             binning: BinningRequest::Auto,
             entry_budget: DEFAULT_ENTRY_BUDGET,
@@ -191,6 +191,9 @@ impl Default for PrimitiveMapConfig {
 }
 
 impl PrimitiveMapConfig {
+    /// The default N: texels per side.
+    pub const DEFAULT_SIZE: u32 = 1024;
+
     /// Checks the configuration against the device limits.
     pub fn validate(&self, caps: &Capabilities) -> Result<(), PassError> {
         let max = caps.max_image_dimension_2d.min(u32::from(u16::MAX));

@@ -485,11 +485,16 @@ impl PrimitiveMap {
         };
         let with_mode = |mode| MapPush { mode, ..push };
 
+        let reset: Vec<MapState> = (0..self.config.frusta() as usize)
+            .map(|f| MapState::reset(f, push.capacity, push.pairs))
+            .collect();
+
         enc.begin_pass("primitive map: fit");
         enc.barriers(&[Barrier::Global {
             before: S::UnorderedAccess,
             after: S::CopyDest,
         }]);
+        enc.update_buffer(&self.state, 0, bytemuck::cast_slice(&reset))?;
         enc.fill_buffer(&self.receivers, 0);
         enc.fill_buffer(&self.bound.scratch.counts, 0);
         if self.config.guard {
@@ -499,19 +504,14 @@ impl PrimitiveMap {
             before: S::CopyDest,
             after: S::UnorderedAccess,
         }]);
-        let fit = |enc: &mut Encoder<'_>, mode| {
-            enc.dispatch(
-                &self.pipes.fit,
-                &self.fit_group,
-                bytemuck::bytes_of(&with_mode(mode)),
-                [1, 1, 1],
-            )
-        };
-        fit(enc, 0)?;
-        enc.barriers(&[Barrier::Uav]);
         self.dispatch_receivers(enc, &push, 0)?;
         enc.barriers(&[Barrier::Uav]);
-        fit(enc, 1)?;
+        enc.dispatch(
+            &self.pipes.fit,
+            &self.fit_group,
+            bytemuck::bytes_of(&push),
+            [1, 1, 1],
+        )?;
         enc.barriers(&[Barrier::Uav]);
         enc.end_pass();
 
