@@ -436,7 +436,7 @@ fn closed_interior(model: &Scene, args: &RenderArgs) -> Result<Option<Interior>>
     let light_text = match (args.light_dir, light.kind.position()) {
         (None, Some(position)) => {
             match args.soft.mode {
-                ShadowMode::Soft | ShadowMode::Area => bail!(
+                ShadowMode::Soft | ShadowMode::Area | ShadowMode::Auto => bail!(
                     "--mode {}: the point light inside a closed scene is shadowed hard or hybrid; pass \
                      --light-dir for a sun with soft shadows",
                     args.soft.mode.name()

@@ -157,7 +157,8 @@ fn demo_outputs(mode: ShadowMode, occupancy_view: bool) -> ResourceSet {
     let outputs = match mode {
         ShadowMode::None => ResourceSet::EMPTY,
         ShadowMode::Hard => ResourceSet::of(&[R::RtVisibility, R::BlockerDistance]),
-        ShadowMode::Area => ResourceSet::of(&[R::RtVisibility]),
+        // Auto, until resolved per light, has what hard and area shadows share.
+        ShadowMode::Area | ShadowMode::Auto => ResourceSet::of(&[R::RtVisibility]),
         ShadowMode::Soft => ResourceSet::of(&[R::ShadowMapVisibility, R::Pcss]),
         ShadowMode::Hybrid => ResourceSet::of(&[
             R::RtVisibility,
@@ -495,6 +496,7 @@ pub fn render_to_folder(
             "{fxaa}, {soft}, WSS {:.3}, PHS {}",
             config.hybrid.world_space_scale, config.hybrid.hard_shadow_percentage
         ),
+        ShadowMode::Auto => "hard or area, by the light's size".to_owned(),
     };
     println!("shadows: {} ({settings})", s.mode.name());
     print_plan(&report);

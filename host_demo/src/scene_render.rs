@@ -241,7 +241,7 @@ pub fn describe_frame(
             s,
             "  {} (plugin light {k}): {}, {} of {} frust{} recorded, holds {}; passes built {} time{}",
             light.light.name,
-            shadowed.config.mode.name(),
+            shadowed.resolved_config().mode.name(),
             report.frusta,
             shadowed.frusta.len(),
             if shadowed.frusta.len() == 1 { "um" } else { "a" },
@@ -488,7 +488,7 @@ pub fn render_scene_to_folder(
                 .zip(&plugin_lights)
                 .map(|(report, pl)| LightReportJson {
                     scene_light: plan.lights[pl.scene_light].light.name.clone(),
-                    mode: pl.shadowed.config.mode.name(),
+                    mode: pl.shadowed.resolved_config().mode.name(),
                     light_builds: report.light_builds,
                     frusta_recorded: report.frusta,
                     frusta_culled: report.frusta_culled,

@@ -53,20 +53,31 @@ impl Default for AreaConfig {
 impl AreaConfig {
     /// Checks the sample count, and the light's angular radius: finite, above 0 and below pi/2.
     pub fn validate(&self, angular_radius: f32) -> Result<(), PassError> {
+        self.validate_samples()?;
+        check_angular_radius(angular_radius)
+    }
+
+    /// Checks the sample count alone (a spot or point light's emitter has a radius, not an angular one).
+    pub fn validate_samples(&self) -> Result<(), PassError> {
         if !(1..=MAX_AREA_SAMPLES).contains(&self.samples) {
             return Err(PassError::InvalidConfig(format!(
                 "area shadows: {} light samples per pixel; give 1..={MAX_AREA_SAMPLES}",
                 self.samples
             )));
         }
-        if !(angular_radius > 0.0 && angular_radius < std::f32::consts::FRAC_PI_2) {
-            return Err(PassError::InvalidConfig(format!(
-                "area shadows need a light of angular radius in (0, pi/2) radians, not {angular_radius}: \
-                 a light of no size has hard shadows (mode hard)"
-            )));
-        }
         Ok(())
     }
+}
+
+/// Checks a directional light's angular radius for area shadows: finite, above 0 and below pi/2.
+pub(crate) fn check_angular_radius(angular_radius: f32) -> Result<(), PassError> {
+    if !(angular_radius > 0.0 && angular_radius < std::f32::consts::FRAC_PI_2) {
+        return Err(PassError::InvalidConfig(format!(
+            "area shadows need a light of angular radius in (0, pi/2) radians, not {angular_radius}: \
+             a light of no size has hard shadows (mode hard)"
+        )));
+    }
+    Ok(())
 }
 
 /// The frame of a directional light travelling along `direction`: the unit direction towards it `C` and

@@ -23,10 +23,15 @@ pub enum ShadowMode {
     /// each tested exactly against the triangles of the pixel's list in a primitive map whose footprints
     /// are widened by the penumbra they cast (no shadow map, no filter, no denoiser).
     Area,
+    /// Chosen per light by its size ([`ShadowConfig::resolved`](crate::ShadowConfig::resolved)):
+    /// [`ShadowMode::Hard`] for a light of zero size, [`ShadowMode::Area`] for a sized one. Pipelines are
+    /// built for the mode it resolves to; unresolved, it plans only what both share (the ray-traced
+    /// visibility, without antialiasing).
+    Auto,
 }
 
 impl ShadowMode {
-    /// "none", "hard", "soft", "hybrid" or "area".
+    /// "none", "hard", "soft", "hybrid", "area" or "auto".
     pub fn name(self) -> &'static str {
         match self {
             Self::None => "none",
@@ -34,12 +39,24 @@ impl ShadowMode {
             Self::Soft => "soft",
             Self::Hybrid => "hybrid",
             Self::Area => "area",
+            Self::Auto => "auto",
         }
     }
 
-    /// Whether the mode traces shadow rays through the primitive map (hard, hybrid and area).
+    /// Whether the mode traces shadow rays through the primitive map (hard, hybrid and area, and so auto).
     pub fn traces_rays(self) -> bool {
-        matches!(self, Self::Hard | Self::Hybrid | Self::Area)
+        matches!(self, Self::Hard | Self::Hybrid | Self::Area | Self::Auto)
+    }
+
+    /// The mode [`ShadowMode::Auto`] chooses for a light of `size` (its angular radius, or its emitter's
+    /// radius): exact ray-traced hard shadows for a light of zero size, exact soft (area) shadows for a
+    /// sized one.
+    pub fn for_light_size(size: f32) -> Self {
+        if size > 0.0 {
+            Self::Area
+        } else {
+            Self::Hard
+        }
     }
 }
 
@@ -228,7 +245,7 @@ impl PlanRequest {
         match self.mode {
             ShadowMode::None => ResourceId::Lit,
             ShadowMode::Hard if self.antialiasing => ResourceId::RtAntialiased,
-            ShadowMode::Hard | ShadowMode::Area => ResourceId::RtVisibility,
+            ShadowMode::Hard | ShadowMode::Area | ShadowMode::Auto => ResourceId::RtVisibility,
             ShadowMode::Soft => ResourceId::Pcss,
             ShadowMode::Hybrid => ResourceId::Hybrid,
         }
@@ -510,6 +527,21 @@ mod tests {
             assert!(!p.resources().contains(R::BlockerDistance));
             assert!(!p.resources().contains(R::ShadowMap));
         }
+    }
+
+    /// Auto chooses hard or area per light by its size; unresolved, it plans what both share: the ray
+    /// trace through the map, without antialiasing.
+    #[test]
+    fn auto_chooses_by_size_and_unresolved_plans_what_hard_and_area_share() {
+        assert_eq!(ShadowMode::for_light_size(0.0), ShadowMode::Hard);
+        assert_eq!(ShadowMode::for_light_size(1e-6), ShadowMode::Area);
+        for aa in [false, true] {
+            let p = plan(ShadowMode::Auto, aa);
+            assert_eq!(p.passes(), plan(ShadowMode::Area, aa).passes());
+            assert_eq!(p.passes(), plan(ShadowMode::Hard, false).passes());
+            assert_eq!(p.final_output(), R::RtVisibility);
+        }
+        assert!(ShadowMode::Auto.traces_rays());
     }
 
     #[test]

@@ -33,7 +33,10 @@ pub use frame_plan::{
 };
 pub use gpu_types::MapStats;
 pub use hybrid::HybridConfig;
-pub use light::{frustum_names, point_light_faces, spot_light_frusta, Light, CUBE_MAP_NAME};
+pub use light::{
+    directional_light_frustum, frustum_names, point_light_faces, spot_light_frusta, Light,
+    CUBE_MAP_NAME,
+};
 pub use min_combine::MinCombine;
 pub use pcss::PcssConfig;
 pub use prim_buffer::{

@@ -1,6 +1,6 @@
 //! The light of a frame — directional (orthographic light frustum), spot (perspective light frustum) or
-//! point (the six cube faces, built as one map) — and the light-space constants every light-space pass
-//! derives from it, in frame coordinates.
+//! point (the six cube faces, built as one map) —, the frusta fitted to a light given without a matrix, and
+//! the light-space constants every light-space pass derives from it, in frame coordinates.
 
 use crate::gpu_types::GpuLight;
 use crate::PassError;
@@ -180,6 +180,78 @@ pub fn spot_light_frusta(
     .into_iter()
     .map(|(forward, up)| perspective(position, forward, up, CUBE_FACE_TAN_HALF, near))
     .collect()
+}
+
+/// Smallest radius (world units) of the bounding sphere a directional light's frustum is fitted around, so
+/// that bounds of a single point still have an extent.
+const MIN_FIT_RADIUS: f32 = 1e-4;
+
+/// A directional light travelling along `direction`, with the orthographic frustum the plugin fits to the
+/// scene's `bounds` (world-space min and max corners): their light-space x/y range maps exactly onto clip
+/// `[-1, 1]²`, and their depth range, widened by 1% on both sides plus a tiny margin, onto depth `[0, 1]`
+/// (near to far, standard depth). The light's view looks at the centre of the bounds' bounding sphere from
+/// twice its radius away, +Y up unless the direction is within about 1° of ±Y (then +Z). Degenerate extents
+/// (flat bounds seen edge-on, a single point) are widened to the tiny margin: 1e-4 of the sphere's radius
+/// plus 1e-5 of the centre's largest coordinate. The same construction, in the same f32 arithmetic, as
+/// `scene::DirectionalLight::view_proj`: a host fitting the same bounds gets the same matrix. `direction` is
+/// kept as given in the light (the passes normalise it in f64).
+///
+/// # Errors
+///
+/// A zero or non-finite `direction`; `bounds` that are not finite, whose min exceeds their max, or too large
+/// to measure in f32.
+pub fn directional_light_frustum(direction: Vec3, bounds: [Vec3; 2]) -> Result<Light, PassError> {
+    let unit = direction.try_normalize().ok_or_else(|| {
+        invalid(&format!(
+            "a directional light's direction must be finite and non-zero to fit its frustum, got {direction}"
+        ))
+    })?;
+    let [lo, hi] = bounds;
+    if !(lo.is_finite() && hi.is_finite()) || lo.cmpgt(hi).any() {
+        return Err(invalid(&format!(
+            "the bounds a directional light's frustum is fitted to must be finite with min not above max, got {lo} to {hi}"
+        )));
+    }
+    let center = (lo + hi) * 0.5;
+    let radius = (hi - lo).length() * 0.5;
+    if !(center.is_finite() && radius.is_finite()) {
+        return Err(invalid(&format!(
+            "the bounds {lo} to {hi} are too large to fit a directional light's frustum to"
+        )));
+    }
+    let radius = radius.max(MIN_FIT_RADIUS);
+    let view = Mat4::look_at_rh(center - unit * radius * 2.0, center, up_hint(unit));
+    let epsilon = radius * 1e-4 + center.abs().max_element() * 1e-5;
+    let (mut min, mut max) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    for i in 0..8 {
+        let corner = Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        );
+        let p = view.transform_point3(corner);
+        min = min.min(p);
+        max = max.max(p);
+    }
+    let (left, right) = at_least(min.x, max.x, epsilon);
+    let (bottom, top) = at_least(min.y, max.y, epsilon);
+    let (near, far) = (-max.z, -min.z);
+    let margin = (far - near) * 0.01 + epsilon;
+    Ok(Light::Directional {
+        direction,
+        view_proj: Mat4::orthographic_rh(left, right, bottom, top, near - margin, far + margin)
+            * view,
+    })
+}
+
+/// The interval `[lo, hi]`, widened symmetrically to `min_extent` if it is narrower.
+fn at_least(lo: f32, hi: f32, min_extent: f32) -> (f32, f32) {
+    if hi - lo >= min_extent {
+        (lo, hi)
+    } else {
+        let mid = (lo + hi) * 0.5;
+        (mid - min_extent * 0.5, mid + min_extent * 0.5)
+    }
 }
 
 /// Relative tolerance of the checks that a matrix matches the light it is given for.
@@ -512,6 +584,124 @@ mod tests {
             if d.angle_between(axis) < 1.4 {
                 assert!(wide.iter().any(|f| inside(f, position + d * 3.0)), "{d}");
             }
+        }
+    }
+
+    /// Directions of every kind: slanted, straight down and up (+Z up), within 1° of vertical, horizontal,
+    /// grazing.
+    fn sun_directions() -> [Vec3; 7] {
+        [
+            Vec3::new(0.68, -1.0, 0.05),
+            Vec3::NEG_Y,
+            Vec3::Y,
+            Vec3::new(0.001, -1.0, 0.0),
+            Vec3::X,
+            Vec3::new(0.3, -0.2, 0.9),
+            Vec3::new(-1.0, -0.05, 0.2),
+        ]
+    }
+
+    /// Every corner of `bounds` in clip x, y within [-1, 1] and depth within [0, 1], up to `tolerance`
+    /// (evaluated in f64); returns the largest |x| and |y|.
+    fn assert_corners_inside(light: &Light, [lo, hi]: [Vec3; 2], tolerance: f64) -> (f64, f64) {
+        let m = light.view_proj();
+        assert!(m.is_finite(), "{light:?}");
+        let (mut x, mut y) = (0.0f64, 0.0f64);
+        for i in 0..8 {
+            let corner = Vec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            );
+            let clip = m.as_dmat4() * corner.as_dvec3().extend(1.0);
+            assert!((clip.w - 1.0).abs() < 1e-6, "orthographic: w {}", clip.w);
+            assert!(
+                clip.x.abs() <= 1.0 + tolerance
+                    && clip.y.abs() <= 1.0 + tolerance
+                    && (-tolerance..=1.0 + tolerance).contains(&clip.z),
+                "{:?}: corner {corner} maps to {clip}",
+                light.direction()
+            );
+            (x, y) = (x.max(clip.x.abs()), y.max(clip.y.abs()));
+        }
+        (x, y)
+    }
+
+    /// The fitted frustum encloses the bounds tightly (x and y reach ±1) in every direction, and is a valid
+    /// directional light of the pipeline (orthographic along its direction), far from the origin too. (A
+    /// world-space f32 matrix, computed in f32 as hosts do, resolves clip space only to about 1e-6 times
+    /// the bounds' distance from the origin over their extent: the tolerance away from it.)
+    #[test]
+    fn a_fitted_directional_frustum_encloses_its_bounds_tightly() {
+        let boxes = [
+            (
+                [Vec3::new(-4.0, -0.1, -4.0), Vec3::new(4.0, 2.0, 4.0)],
+                1e-5,
+            ),
+            (
+                [Vec3::new(97.0, 0.0, -200.0), Vec3::new(105.0, 7.0, -199.0)],
+                1e-4,
+            ),
+            (
+                [
+                    Vec3::new(1e4 - 3.0, 0.0, -2e4),
+                    Vec3::new(1e4 + 5.0, 7.0, -2e4 + 1.0),
+                ],
+                4e-3,
+            ),
+        ];
+        for (bounds, tolerance) in boxes {
+            for direction in sun_directions() {
+                let light = directional_light_frustum(direction, bounds).expect("fitted");
+                assert_eq!(light.direction(), direction, "kept as given");
+                let (x, y) = assert_corners_inside(&light, bounds, tolerance);
+                assert!(
+                    (x - 1.0).abs() < tolerance && (y - 1.0).abs() < tolerance,
+                    "{direction}: {x} {y}"
+                );
+                LightFrame::new(&light, (bounds[0] + bounds[1]).as_dvec3() * 0.5)
+                    .expect("a valid directional light");
+            }
+        }
+    }
+
+    /// Flat bounds (a ground plane seen edge-on by a horizontal light) and a single point get finite,
+    /// invertible frusta enclosing them.
+    #[test]
+    fn degenerate_bounds_get_finite_frusta() {
+        let flat = [Vec3::new(0.0, 1.0, -8.0), Vec3::new(10.0, 1.0, 2.0)];
+        let point = [Vec3::splat(2.0); 2];
+        for bounds in [flat, point] {
+            for direction in sun_directions() {
+                let light = directional_light_frustum(direction, bounds).expect("fitted");
+                assert_corners_inside(&light, bounds, 1e-5);
+                LightFrame::new(&light, DVec3::ZERO).expect("a valid directional light");
+            }
+        }
+    }
+
+    #[test]
+    fn a_directional_frustum_needs_a_direction_and_bounds() {
+        let bounds = [Vec3::splat(-1.0), Vec3::ONE];
+        for direction in [
+            Vec3::ZERO,
+            Vec3::new(f32::NAN, -1.0, 0.0),
+            Vec3::new(0.0, f32::INFINITY, 0.0),
+        ] {
+            let e = directional_light_frustum(direction, bounds)
+                .expect_err("refused")
+                .to_string();
+            assert!(e.contains("direction must be finite and non-zero"), "{e}");
+        }
+        for bad in [
+            [Vec3::ONE, Vec3::ZERO],
+            [Vec3::new(f32::NAN, 0.0, 0.0), Vec3::ONE],
+            [Vec3::splat(-f32::MAX), Vec3::splat(f32::MAX)],
+        ] {
+            let e = directional_light_frustum(Vec3::NEG_Y, bad)
+                .expect_err("refused")
+                .to_string();
+            assert!(e.contains("bounds"), "{e}");
         }
     }
 

@@ -9,7 +9,7 @@
 
 // Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 // version differs.
-#define HRTS_API_VERSION ((5 << 22) | (6 << 12))
+#define HRTS_API_VERSION ((5 << 22) | (7 << 12))
 
 // The most lights one context shades (`hrts_configure_lights`); a point light counts once.
 #define HRTS_MAX_LIGHTS 64
@@ -153,6 +153,12 @@ enum HrtsShadowMode
   // are points of its spherical emitter of radius `pcss_spot_radius` (on the disc through its centre
   // facing the pixel). Noise-free and deterministic; compute binning only; a point light is one cube map.
   HRTS_SHADOW_MODE_AREA = 4,
+  // The plugin chooses per light by its size: `HRTS_SHADOW_MODE_HARD` for a light of zero size
+  // (`pcss_angular_radius` 0 for a directional light, `pcss_spot_radius` 0 for a spot or point light),
+  // `HRTS_SHADOW_MODE_AREA` for a sized one. The frame report's `decision_reason` says which ("auto:
+  // hard (zero-size light)" or "auto: area (sized light)"). A light whose choice changes (its type, or
+  // its configured size) has its passes rebuilt.
+  HRTS_SHADOW_MODE_AUTO = 5,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -168,7 +174,8 @@ enum HrtsLightType
   : uint32_t
 #endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
  {
-  // Parallel light along `direction`, orthographic `view_proj`.
+  // Parallel light along `direction`: the engine's orthographic `view_proj`, or, when `view_proj` is all
+  // zeros, the frustum the plugin fits to the scene's bounds every frame.
   HRTS_LIGHT_TYPE_DIRECTIONAL = 0,
   // Spot light at `position` pointing along `direction`: the engine's perspective `view_proj`, or, when
   // `view_proj` is all zeros, frusta the plugin fits to `outer_cone` and `range`.
@@ -531,10 +538,11 @@ typedef struct HrtsConfig {
   uint32_t binning_path;
   // Shadow map size (default 3072, as in the talk).
   uint32_t shadow_map_size;
-  // PCSS: angular radius of a directional emitter in radians (default 0.02).
+  // PCSS: angular radius of a directional emitter in radians (default 0.02). Positive; 0 (a light of no
+  // size) only with `HRTS_SHADOW_MODE_AUTO`.
   float pcss_angular_radius;
   // Radius of a spot or point light's spherical emitter in world units (default 0.05): PCSS, the
-  // hybrid and area shadows.
+  // hybrid and area shadows. Positive; 0 (a light of no size) only with `HRTS_SHADOW_MODE_AUTO`.
   float pcss_spot_radius;
   // PCSS blocker-search taps (default 16).
   uint32_t pcss_blocker_search_taps;
@@ -720,9 +728,16 @@ typedef struct HrtsLight {
   // for point lights).
   float direction[3];
   // The light's view-projection enclosing shadow casters and receivers (column-major): orthographic
-  // for a directional light (required), perspective with its eye at `position` for a spot light, or
-  // all zeros for the plugin to fit a spot light's frusta itself (ignored for point lights). A fitted
-  // frustum has its near plane at `range / 1024` (0.01 without a range) and its far plane at infinity.
+  // for a directional light, perspective with its eye at `position` for a spot light, or all zeros for
+  // the plugin to fit the light's frusta itself (ignored for point lights).
+  //
+  // A fitted directional frustum is orthographic along `direction`, fitted every frame to the scene's
+  // bounds (`HrtsFrame::bounds` when `has_bounds` is set, else those of CPU geometry or of Vulkan
+  // geometry that does not change): their extent across the light maps exactly onto the frustum, their
+  // depth range widened by 1% on both sides plus a tiny margin. A frame that knows no bounds (Vulkan
+  // geometry that moves or is deformed, without `has_bounds`) is refused with a message. A fitted spot
+  // light frustum has its near plane at `range / 1024` (0.01 without a range) and its far plane at
+  // infinity.
   float view_proj[16];
   // Spot and point lights: distance beyond which the light has no effect, or 0 for unlimited. It sets
   // the near plane of the frusta the plugin fits. A frustum holding no receiver in view within the
@@ -787,7 +802,8 @@ typedef struct HrtsFrame {
   // World-space bounds (min xyz, max xyz) of every triangle of the geometry this frame, read when
   // `has_bounds` is set. They let the plugin cull light frusta by the scene's extent when the geometry
   // moves; without them it culls moving Vulkan geometry by the view and the lights' ranges alone
-  // (CPU geometry and static Vulkan geometry use the bounds they were given).
+  // (CPU geometry and static Vulkan geometry use the bounds they were given). A directional light given
+  // without a `view_proj` is fitted to them.
   float bounds[6];
   // Whether `bounds` holds this frame's bounds.
   HrtsBool has_bounds;
@@ -902,7 +918,8 @@ typedef struct HrtsFrameReport {
   uint32_t frusta_culled;
   // `HrtsLightDecision` of the light this frame.
   uint32_t decision;
-  // Why, in words (NUL-terminated, truncated to fit): the frusta recorded and those culled, by name.
+  // Why, in words (NUL-terminated, truncated to fit): the frusta recorded and those culled, by name;
+  // under `HRTS_SHADOW_MODE_AUTO`, the mode chosen and why ("auto: hard (zero-size light)").
   char decision_reason[128];
   // GPU milliseconds of all of this light's passes in the frame (every frustum, the minimum over
   // them, and the light's share of nothing else).

@@ -35,20 +35,33 @@ pub(crate) struct TargetSource {
     pub(crate) output_usage: ImageUsage,
 }
 
-/// How a light is shadowed in a frame: through how many frusta, and whether its one frustum is a point
-/// light's cube map.
+/// How a light is shadowed in a frame: through how many frusta, whether its one frustum is a point
+/// light's cube map, and whether it is a directional light (mode auto chooses by the size of its kind).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct LightShape {
     pub(crate) frusta: usize,
     pub(crate) cube: bool,
+    pub(crate) directional: bool,
 }
 
 impl Default for LightShape {
+    /// Before any frame: one frustum of a directional light.
     fn default() -> Self {
         Self {
             frusta: 1,
             cube: false,
+            directional: true,
         }
+    }
+}
+
+impl LightShape {
+    /// The configuration the light's passes are built with: `configured` with mode auto resolved for the
+    /// light's kind, and a cube primitive map for a point light shadowed as one.
+    pub(crate) fn config(&self, configured: &ShadowConfig) -> ShadowConfig {
+        let mut config = configured.resolved(self.directional);
+        config.map.cube = self.cube;
+        config
     }
 }
 
@@ -192,11 +205,22 @@ pub(crate) struct LightSchedule {
     pub(crate) kind: HrtsLightType,
     pub(crate) recorded: Vec<bool>,
     pub(crate) names: Vec<&'static str>,
+    /// The mode auto chose for the light and why ([`ShadowConfig::auto_reason`]); `None` for a mode given.
+    pub(crate) auto: Option<&'static str>,
 }
 
 impl LightSchedule {
-    /// The light's decision and its reason in words.
+    /// The light's decision and its reason in words, with the mode auto chose for it.
     pub(crate) fn decision(&self) -> (HrtsLightDecision, String) {
+        let (decision, reason) = self.frusta_decision();
+        match self.auto {
+            Some(auto) => (decision, format!("{reason}; {auto}")),
+            None => (decision, reason),
+        }
+    }
+
+    /// The light's decision by the frusta recorded, and its reason in words.
+    fn frusta_decision(&self) -> (HrtsLightDecision, String) {
         let kind = match self.kind {
             HrtsLightType::Directional => "directional light",
             HrtsLightType::Spot => "spot light",
@@ -383,30 +407,39 @@ impl Context {
         Ok(())
     }
 
-    /// Which frusta of each light may hold a receiver in view within the light's range this frame, within
-    /// `frame_bounds` when the engine gave them, else the geometry's own bounds when they hold (not when
-    /// the frame `deforms` a mesh).
-    pub(crate) fn schedule(
+    /// The scene's bounds this frame: `frame_bounds` when the engine gave them, else the geometry's own
+    /// bounds when they hold (not when the frame `deforms` a mesh, nor for Vulkan geometry that moves).
+    pub(crate) fn scene_bounds(
         &self,
-        lights: &[FrameLight],
         frame_bounds: Option<[glam::DVec3; 2]>,
         deforms: bool,
-    ) -> Vec<LightSchedule> {
+    ) -> Option<[glam::DVec3; 2]> {
         let dynamic = self.lights.iter().any(|c| !c.static_geometry);
-        let bounds = frame_bounds.or_else(|| {
+        frame_bounds.or_else(|| {
             self.geometry
                 .as_ref()
                 .filter(|_| !deforms)
                 .and_then(|g| g.cull_bounds(dynamic))
-        });
+        })
+    }
+
+    /// Which frusta of each light may hold a receiver in view within the light's range this frame, within
+    /// the scene's `bounds` when they are known ([`Context::scene_bounds`]), and the mode auto chose for it.
+    pub(crate) fn schedule(
+        &self,
+        lights: &[FrameLight],
+        bounds: Option<[glam::DVec3; 2]>,
+    ) -> Vec<LightSchedule> {
         let camera = lights
             .first()
             .and_then(|l| l.frusta.first())
             .map(|f| ViewVolume::new(f.proj.as_dmat4() * f.view.as_dmat4(), bounds));
         lights
             .iter()
-            .map(|light| LightSchedule {
+            .zip(&self.lights)
+            .map(|(light, config)| LightSchedule {
                 kind: light.kind,
+                auto: config.auto_reason(light.kind == HrtsLightType::Directional),
                 recorded: light
                     .frusta
                     .iter()
@@ -431,13 +464,21 @@ impl Context {
         self.schedules.push_back(FrameSchedule { index, lights });
     }
 
-    /// Takes each light's number of frusta this frame: a light whose number changed (a spot light turned
-    /// point light, say) has its passes rebuilt.
+    /// Takes how each light is shadowed this frame: a light whose number of frusta changed (a spot light
+    /// turned point light, say), or whose resolved configuration did (mode auto choosing otherwise for a
+    /// light that changed kind), has its passes rebuilt.
     pub(crate) fn set_frusta(&mut self, frusta: &[LightShape]) {
         let mut replaced = Vec::new();
-        for (i, (&new, old)) in frusta.iter().zip(&mut self.frusta).enumerate() {
-            if new != *old {
-                *old = new;
+        for (i, ((&new, old), configured)) in frusta
+            .iter()
+            .zip(&mut self.frusta)
+            .zip(&self.lights)
+            .enumerate()
+        {
+            let rebuild =
+                new.frusta != old.frusta || new.config(configured) != old.config(configured);
+            *old = new;
+            if rebuild {
                 if let Some(passes) = self.built.as_mut().and_then(|b| b.lights[i].take()) {
                     replaced.push(passes);
                 }
@@ -698,6 +739,7 @@ impl Context {
             .enumerate()
         {
             if slot.is_none() {
+                let config = shape.config(config);
                 // The light's layer, written directly unless the configuration reads the final output
                 // back (from the pipeline's own image).
                 let read_back = config
@@ -711,8 +753,6 @@ impl Context {
                         surface: built.surface,
                         direct_output: layer.filter(|_| shape.frusta == 1),
                     };
-                    let mut config = *config;
-                    config.map.cube = shape.cube;
                     let frusta = (0..shape.frusta)
                         .map(|_| {
                             ShadowPipeline::with_shared_geometry(
@@ -1036,5 +1076,48 @@ impl Context {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use passes::ShadowMode;
+
+    /// Under mode auto a light's passes are built for the mode its kind's size gives, and its report says
+    /// which and why.
+    #[test]
+    fn auto_lights_are_built_and_reported_by_their_size() {
+        let mut auto = ShadowConfig {
+            mode: ShadowMode::Auto,
+            ..ShadowConfig::default()
+        };
+        auto.pcss.angular_radius = 0.0;
+        let sun = LightShape::default();
+        let lamp = LightShape {
+            cube: true,
+            directional: false,
+            ..sun
+        };
+        assert_eq!(sun.config(&auto).mode, ShadowMode::Hard);
+        let lamp_config = lamp.config(&auto);
+        assert_eq!(lamp_config.mode, ShadowMode::Area);
+        assert!(lamp_config.map.cube);
+        let schedule = |kind, config: &ShadowConfig| LightSchedule {
+            kind,
+            recorded: vec![true],
+            names: vec!["whole"],
+            auto: config.auto_reason(kind == HrtsLightType::Directional),
+        };
+        let (decision, reason) = schedule(HrtsLightType::Directional, &auto).decision();
+        assert_eq!(decision, HrtsLightDecision::Shadowed);
+        assert_eq!(
+            reason,
+            "directional light: its frustum holds receivers in view; auto: hard (zero-size light)"
+        );
+        let (_, reason) = schedule(HrtsLightType::Spot, &auto).decision();
+        assert!(reason.ends_with("; auto: area (sized light)"), "{reason}");
+        let (_, reason) = schedule(HrtsLightType::Spot, &ShadowConfig::default()).decision();
+        assert_eq!(reason, "spot light: its frustum holds receivers in view");
     }
 }

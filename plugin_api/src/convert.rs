@@ -106,8 +106,12 @@ pub(crate) fn resource_index(id: ResourceId) -> ApiResult<u32> {
 }
 
 /// The camera and each light of a frame (every field checked): per light, one `FrameInputs` per frustum
-/// it is shadowed through.
-pub(crate) fn frame_inputs(f: &HrtsFrame) -> ApiResult<Vec<FrameLight>> {
+/// it is shadowed through. `scene_bounds` are the bounds a directional light without a `view_proj` is
+/// fitted to (`None`: unknown this frame).
+pub(crate) fn frame_inputs(
+    f: &HrtsFrame,
+    scene_bounds: Option<[glam::DVec3; 2]>,
+) -> ApiResult<Vec<FrameLight>> {
     finite(&f.view, "view")?;
     finite(&f.proj, "proj")?;
     finite(&f.camera_position, "camera_position")?;
@@ -129,7 +133,7 @@ pub(crate) fn frame_inputs(f: &HrtsFrame) -> ApiResult<Vec<FrameLight>> {
         .iter()
         .enumerate()
         .map(|(i, l)| {
-            let (kind, range, frusta) = light_frusta(l, i)?;
+            let (kind, range, frusta) = light_frusta(l, i, scene_bounds)?;
             Ok(FrameLight {
                 frusta: frusta
                     .into_iter()
@@ -224,11 +228,12 @@ impl FrameLight {
         matches!(self.frusta.as_slice(), [one] if matches!(one.light, Light::Point { .. }))
     }
 
-    /// How the light is shadowed: its frusta, and whether the one is a cube.
+    /// How the light is shadowed: its frusta, whether the one is a cube, and whether it is directional.
     pub(crate) fn shape(&self) -> LightShape {
         LightShape {
             frusta: self.frusta.len(),
             cube: self.is_cube(),
+            directional: self.kind == HrtsLightType::Directional,
         }
     }
 
@@ -253,10 +258,12 @@ impl FrameLight {
 }
 
 /// The type, range and frusta of `lights[index]` (every field checked): the light as given, or the
-/// frusta the plugin fits to a point light or to a spot light without a `view_proj`.
+/// frusta the plugin fits to a point light, or to a spot or directional light without a `view_proj` (a
+/// directional light's to `scene_bounds`, which must then be known).
 fn light_frusta(
     l: &HrtsLight,
     index: usize,
+    scene_bounds: Option<[glam::DVec3; 2]>,
 ) -> ApiResult<(HrtsLightType, Option<f32>, Vec<Light>)> {
     let field = |name: &str| format!("lights[{index}].{name}");
     finite(&l.direction, &field("direction"))?;
@@ -309,6 +316,19 @@ fn light_frusta(
             range,
             passes::spot_light_frusta(position, direction, l.outer_cone, range),
         ));
+    }
+    if kind == HrtsLightType::Directional && fitted {
+        let Some([lo, hi]) = scene_bounds else {
+            return Err(invalid(format!(
+                "{} is all zeros: the plugin fits a directional light's frustum to the scene's bounds, and this \
+                 frame has none (Vulkan geometry that moves or is deformed has no bounds of its own): give the \
+                 frame's bounds (has_bounds) or the light's view_proj",
+                field("view_proj")
+            )));
+        };
+        let light = passes::directional_light_frustum(direction, [lo.as_vec3(), hi.as_vec3()])
+            .map_err(|e| invalid(format!("{}: {e}", field("view_proj"))))?;
+        return Ok((kind, range, vec![light]));
     }
     let view_proj = mat4(&l.view_proj);
     // Passed on as given: the passes normalise in f64 (normalising here in f32 would round twice).
@@ -379,12 +399,13 @@ fn taps(value: u32, field: &str) -> ApiResult<u32> {
 }
 
 /// `HrtsShadowMode` values and the modes they name (both directions use this one table).
-const MODES: [(u32, ShadowMode); 5] = [
+const MODES: [(u32, ShadowMode); 6] = [
     (HrtsShadowMode::None as u32, ShadowMode::None),
     (HrtsShadowMode::Hard as u32, ShadowMode::Hard),
     (HrtsShadowMode::Soft as u32, ShadowMode::Soft),
     (HrtsShadowMode::Hybrid as u32, ShadowMode::Hybrid),
     (HrtsShadowMode::Area as u32, ShadowMode::Area),
+    (HrtsShadowMode::Auto as u32, ShadowMode::Auto),
 ];
 
 /// `HrtsFaces` values.
@@ -496,8 +517,14 @@ pub(crate) fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
     config.pcss.min_filter_radius =
         non_negative(c.pcss_min_filter_radius, "pcss_min_filter_radius")?;
     config.pcss.max_filter_radius = positive(c.pcss_max_filter_radius, "pcss_max_filter_radius")?;
-    config.pcss.angular_radius = positive(c.pcss_angular_radius, "pcss_angular_radius")?;
-    config.pcss.spot_radius = positive(c.pcss_spot_radius, "pcss_spot_radius")?;
+    // A light of no size is what mode auto shadows hard; every other mode needs a size.
+    let light_size = if mode == ShadowMode::Auto {
+        non_negative
+    } else {
+        positive
+    };
+    config.pcss.angular_radius = light_size(c.pcss_angular_radius, "pcss_angular_radius")?;
+    config.pcss.spot_radius = light_size(c.pcss_spot_radius, "pcss_spot_radius")?;
     config.pcss.blocker_search_taps = taps(c.pcss_blocker_search_taps, "pcss_blocker_search_taps")?;
     config.pcss.pcf_taps = taps(c.pcss_pcf_taps, "pcss_pcf_taps")?;
     config.hybrid.world_space_scale =
@@ -508,7 +535,8 @@ pub(crate) fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
     )?;
     config.pcss.validate()?;
     config.area.samples = c.area_samples;
-    if mode == ShadowMode::Area {
+    // Mode auto gives a sized directional light area shadows.
+    if mode == ShadowMode::Area || (mode == ShadowMode::Auto && config.pcss.angular_radius > 0.0) {
         config.area.validate(config.pcss.angular_radius)?;
     }
     Ok(config)
@@ -648,5 +676,79 @@ mod tests {
         assert_eq!(shadow_config(&c).expect("valid"), other);
         other.extra_outputs = ResourceSet::of(&[ResourceId::PrimBuffer]);
         assert!(config_to_c(&other).is_err());
+    }
+
+    /// Mode auto takes lights of no size (radii of 0), which every other mode refuses.
+    #[test]
+    fn mode_auto_takes_a_light_of_no_size() {
+        let mut c = config_to_c(&ShadowConfig::default()).expect("defaults");
+        c.pcss_angular_radius = 0.0;
+        c.pcss_spot_radius = 0.0;
+        for mode in [HrtsShadowMode::Hard, HrtsShadowMode::Area] {
+            c.mode = mode as u32;
+            let e = shadow_config(&c).expect_err("no size refused").message;
+            assert!(
+                e.contains("pcss_angular_radius must be a positive finite number"),
+                "{e}"
+            );
+        }
+        c.mode = HrtsShadowMode::Auto as u32;
+        let auto = shadow_config(&c).expect("auto takes no size");
+        assert_eq!(auto.mode, ShadowMode::Auto);
+        assert_eq!(auto.resolved(true).mode, ShadowMode::Hard);
+        assert_eq!(config_to_c(&auto).expect("representable").mode, c.mode);
+        c.pcss_spot_radius = -1.0;
+        assert!(shadow_config(&c).is_err());
+        // A sized sun may get area shadows: its size and samples are checked as for mode area.
+        c.pcss_spot_radius = 0.0;
+        c.pcss_angular_radius = 2.0;
+        let e = shadow_config(&c).expect_err("2 rad").message;
+        assert!(e.contains("angular radius"), "{e}");
+    }
+
+    fn c_light(light_type: HrtsLightType, direction: [f32; 3]) -> HrtsLight {
+        HrtsLight {
+            light_type: light_type as u32,
+            position: [0.0; 3],
+            direction,
+            view_proj: [0.0; 16],
+            range: 0.0,
+            outer_cone: 0.0,
+        }
+    }
+
+    /// A directional light without a matrix is fitted to the scene's bounds, as
+    /// `passes::directional_light_frustum` fits it; without bounds, or without a direction, it is refused.
+    #[test]
+    fn a_directional_light_without_a_matrix_is_fitted_to_the_bounds() {
+        let sun = c_light(HrtsLightType::Directional, [0.3, -1.0, 0.2]);
+        let bounds = [
+            glam::DVec3::new(-4.0, 0.0, -3.0),
+            glam::DVec3::new(4.0, 2.5, 5.0),
+        ];
+        let (kind, range, frusta) = light_frusta(&sun, 0, Some(bounds)).expect("fitted");
+        assert_eq!((kind, range), (HrtsLightType::Directional, None));
+        let expected = passes::directional_light_frustum(
+            Vec3::new(0.3, -1.0, 0.2),
+            [bounds[0].as_vec3(), bounds[1].as_vec3()],
+        )
+        .expect("fits");
+        assert_eq!(frusta, [expected]);
+        let e = light_frusta(&sun, 2, None).expect_err("no bounds").message;
+        assert!(
+            e.contains("lights[2].view_proj") && e.contains("bounds") && e.contains("has_bounds"),
+            "{e}"
+        );
+        let dark = c_light(HrtsLightType::Directional, [0.0; 3]);
+        let e = light_frusta(&dark, 0, Some(bounds))
+            .expect_err("no direction")
+            .message;
+        assert!(e.contains("lights[0].direction is zero"), "{e}");
+        // A matrix given is kept.
+        let mut given = sun;
+        given.view_proj = expected.view_proj().to_cols_array();
+        given.view_proj[12] += 0.5;
+        let (_, _, frusta) = light_frusta(&given, 0, None).expect("given");
+        assert_eq!(frusta[0].view_proj().to_cols_array(), given.view_proj);
     }
 }

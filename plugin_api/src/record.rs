@@ -34,9 +34,10 @@ impl Context {
         if f.frame_index == u64::MAX {
             return Err(invalid("frame_index UINT64_MAX is reserved"));
         }
-        let inputs = frame_inputs(f)?;
         let bounds = frame_bounds(f)?;
         let deformed = deformed_meshes(f, self.geometry.as_ref())?;
+        let bounds = self.scene_bounds(bounds, !deformed.is_empty());
+        let inputs = frame_inputs(f, bounds)?;
         if inputs.len() != self.lights.len() {
             return Err(invalid(format!(
                 "light_count {} differs from the {} lights configured",
@@ -107,7 +108,7 @@ impl Context {
             .filter(|s| continues && s.index == f.frame_index);
         let schedule = match kept {
             Some(_) => None,
-            None => Some(self.schedule(&inputs, bounds, !deformed.is_empty())),
+            None => Some(self.schedule(&inputs, bounds)),
         };
         let recorded: Vec<Vec<bool>> = schedule
             .as_deref()

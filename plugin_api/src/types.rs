@@ -6,7 +6,7 @@ use std::ffi::c_char;
 
 /// Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 /// version differs.
-pub const HRTS_API_VERSION: u32 = 5 << 22 | 6 << 12;
+pub const HRTS_API_VERSION: u32 = 5 << 22 | 7 << 12;
 
 /// A flag in the C structs: 0 is false, any other value true. (A Rust `bool` would make any byte but 0
 /// and 1 undefined behaviour when the engine writes it.)
@@ -257,13 +257,20 @@ pub enum HrtsShadowMode {
     /// are points of its spherical emitter of radius `pcss_spot_radius` (on the disc through its centre
     /// facing the pixel). Noise-free and deterministic; compute binning only; a point light is one cube map.
     Area = 4,
+    /// The plugin chooses per light by its size: `HRTS_SHADOW_MODE_HARD` for a light of zero size
+    /// (`pcss_angular_radius` 0 for a directional light, `pcss_spot_radius` 0 for a spot or point light),
+    /// `HRTS_SHADOW_MODE_AREA` for a sized one. The frame report's `decision_reason` says which ("auto:
+    /// hard (zero-size light)" or "auto: area (sized light)"). A light whose choice changes (its type, or
+    /// its configured size) has its passes rebuilt.
+    Auto = 5,
 }
 
 /// Light type.
 #[repr(u32)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum HrtsLightType {
-    /// Parallel light along `direction`, orthographic `view_proj`.
+    /// Parallel light along `direction`: the engine's orthographic `view_proj`, or, when `view_proj` is all
+    /// zeros, the frustum the plugin fits to the scene's bounds every frame.
     Directional = 0,
     /// Spot light at `position` pointing along `direction`: the engine's perspective `view_proj`, or, when
     /// `view_proj` is all zeros, frusta the plugin fits to `outer_cone` and `range`.
@@ -439,10 +446,11 @@ pub struct HrtsConfig {
     pub binning_path: u32,
     /// Shadow map size (default 3072, as in the talk).
     pub shadow_map_size: u32,
-    /// PCSS: angular radius of a directional emitter in radians (default 0.02).
+    /// PCSS: angular radius of a directional emitter in radians (default 0.02). Positive; 0 (a light of no
+    /// size) only with `HRTS_SHADOW_MODE_AUTO`.
     pub pcss_angular_radius: f32,
     /// Radius of a spot or point light's spherical emitter in world units (default 0.05): PCSS, the
-    /// hybrid and area shadows.
+    /// hybrid and area shadows. Positive; 0 (a light of no size) only with `HRTS_SHADOW_MODE_AUTO`.
     pub pcss_spot_radius: f32,
     /// PCSS blocker-search taps (default 16).
     pub pcss_blocker_search_taps: u32,
@@ -635,9 +643,16 @@ pub struct HrtsLight {
     /// for point lights).
     pub direction: [f32; 3],
     /// The light's view-projection enclosing shadow casters and receivers (column-major): orthographic
-    /// for a directional light (required), perspective with its eye at `position` for a spot light, or
-    /// all zeros for the plugin to fit a spot light's frusta itself (ignored for point lights). A fitted
-    /// frustum has its near plane at `range / 1024` (0.01 without a range) and its far plane at infinity.
+    /// for a directional light, perspective with its eye at `position` for a spot light, or all zeros for
+    /// the plugin to fit the light's frusta itself (ignored for point lights).
+    ///
+    /// A fitted directional frustum is orthographic along `direction`, fitted every frame to the scene's
+    /// bounds (`HrtsFrame::bounds` when `has_bounds` is set, else those of CPU geometry or of Vulkan
+    /// geometry that does not change): their extent across the light maps exactly onto the frustum, their
+    /// depth range widened by 1% on both sides plus a tiny margin. A frame that knows no bounds (Vulkan
+    /// geometry that moves or is deformed, without `has_bounds`) is refused with a message. A fitted spot
+    /// light frustum has its near plane at `range / 1024` (0.01 without a range) and its far plane at
+    /// infinity.
     pub view_proj: [f32; 16],
     /// Spot and point lights: distance beyond which the light has no effect, or 0 for unlimited. It sets
     /// the near plane of the frusta the plugin fits. A frustum holding no receiver in view within the
@@ -685,7 +700,8 @@ pub struct HrtsFrame {
     /// World-space bounds (min xyz, max xyz) of every triangle of the geometry this frame, read when
     /// `has_bounds` is set. They let the plugin cull light frusta by the scene's extent when the geometry
     /// moves; without them it culls moving Vulkan geometry by the view and the lights' ranges alone
-    /// (CPU geometry and static Vulkan geometry use the bounds they were given).
+    /// (CPU geometry and static Vulkan geometry use the bounds they were given). A directional light given
+    /// without a `view_proj` is fitted to them.
     pub bounds: [f32; 6],
     /// Whether `bounds` holds this frame's bounds.
     pub has_bounds: HrtsBool,
@@ -831,7 +847,8 @@ pub struct HrtsFrameReport {
     pub frusta_culled: u32,
     /// `HrtsLightDecision` of the light this frame.
     pub decision: u32,
-    /// Why, in words (NUL-terminated, truncated to fit): the frusta recorded and those culled, by name.
+    /// Why, in words (NUL-terminated, truncated to fit): the frusta recorded and those culled, by name;
+    /// under `HRTS_SHADOW_MODE_AUTO`, the mode chosen and why ("auto: hard (zero-size light)").
     pub decision_reason: [c_char; 128],
     /// GPU milliseconds of all of this light's passes in the frame (every frustum, the minimum over
     /// them, and the light's share of nothing else).

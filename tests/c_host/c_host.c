@@ -146,6 +146,14 @@ static Emitter directional(V3 dir) {
     return e;
 }
 
+/* A directional light travelling along `dir` whose frustum the plugin fits to the scene's bounds every frame
+ * (view_proj all zeros). */
+static Emitter fitted_sun(V3 dir) {
+    Emitter e = directional(dir);
+    memset(e.c.view_proj, 0, sizeof e.c.view_proj);
+    return e;
+}
+
 /* A spot light at `pos` aiming at `target`, with a perspective (standard depth) frustum of `fov` radians. */
 static Emitter spot(V3 pos, V3 target, double fov) {
     Emitter e;
@@ -1119,11 +1127,68 @@ static void moving_geometry_bounds(const HrtsVulkanDevice *vk) {
     CHECK(hrts_record_frame(ctx, &f) == HRTS_RESULT_ERROR_INVALID_ARGUMENT && strstr(hrts_last_error(ctx), "bounds"),
           "inverted bounds refused: %s", hrts_last_error(ctx));
     submit_and_wait(cmd);
+    /* a sun the plugin fits needs the scene's bounds: moving Vulkan geometry has none of its own, so the frame
+     * must give them */
+    Emitter sun = fitted_sun(v3(0.45, -1.0, 0.2));
+    set_lights(&sun, 1);
+    cmd = begin();
+    f = frame(cmd, next_frame++);
+    CHECK(hrts_record_frame(ctx, &f) == HRTS_RESULT_ERROR_INVALID_ARGUMENT && strstr(hrts_last_error(ctx), "view_proj") &&
+              strstr(hrts_last_error(ctx), "has_bounds"),
+          "a fitted sun without bounds refused: %s", hrts_last_error(ctx));
+    submit_and_wait(cmd);
+    cmd = begin();
+    f = frame(cmd, next_frame++);
+    f.has_bounds = 1;
+    memcpy(f.bounds, SCENE_BOUNDS, sizeof SCENE_BOUNDS);
+    HrtsResult fitted = finish_frame(cmd, hrts_record_frame(ctx, &f), vis);
+    int ne = 0, sh = 0, li = 0;
+    int sun_mismatches = fitted == HRTS_RESULT_OK ? count_mismatches(vis, edge_tolerance(), &sun, &ne, &sh, &li) : -1;
+    printf("moving geometry, a sun fitted to the frame's bounds: %d shadowed, %d mismatches\n", sh, sun_mismatches);
+    CHECK(fitted == HRTS_RESULT_OK && sun_mismatches == 0 && sh > 100, "a fitted sun with the frame's bounds: %s",
+          hrts_last_error(ctx));
     /* the engine's buffers may go once the frames that read them completed */
     VK(vkDeviceWaitIdle(device));
     CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
     free_buffer(vb);
     free_buffer(ib);
+}
+
+/* ---------- the plugin's plan for a light ---------- */
+/* A sun of no size given in HRTS_SHADOW_MODE_AUTO without a matrix, as an engine hands over its lights: the
+ * plugin fits its frustum to the CPU geometry's bounds and chooses hard shadows (no shadow map); the report
+ * says so, and the shadow is exact. A light of no size in any other mode is refused. */
+static void auto_fitted_sun(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
+    setup_camera(0.0);
+    Emitter sun = fitted_sun(v3(0.45, -1.0, 0.2));
+    set_lights(&sun, 1);
+    upload_gbuffer();
+    HrtsContext *ctx = create_context(vk, 2);
+    HrtsConfig cfg = config(HRTS_SHADOW_MODE_AUTO);
+    cfg.pcss_angular_radius = 0.0f;
+    HrtsTargets t = targets();
+    CHECK(hrts_configure(ctx, &cfg) == HRTS_RESULT_OK && hrts_set_geometry_cpu(ctx, g) == HRTS_RESULT_OK &&
+              hrts_set_targets(ctx, &t) == HRTS_RESULT_OK,
+          "auto sun: setup: %s", hrts_last_error(ctx));
+    static float vis[W * H];
+    uint64_t index = next_frame;
+    CHECK(run_frame(ctx, vis) == HRTS_RESULT_OK, "auto sun: frame: %s", hrts_last_error(ctx));
+    HrtsFrameReport rep;
+    CHECK(report(ctx, index, 0, &rep) == HRTS_RESULT_OK, "auto sun: report: %s", hrts_last_error(ctx));
+    int near_edge, shadowed, lit;
+    int mismatches = count_mismatches(vis, edge_tolerance(), &sun, &near_edge, &shadowed, &lit);
+    printf("auto, a sun of no size fitted by the plugin: %s; %d shadowed, %d near-edge, %d mismatches\n",
+           rep.decision_reason, shadowed, near_edge, mismatches);
+    CHECK(strstr(rep.decision_reason, "auto: hard (zero-size light)") && rep.decision == HRTS_LIGHT_DECISION_SHADOWED &&
+              rep.pass_status[HRTS_PASS_RAY_TRACE] == HRTS_PASS_STATUS_RAN &&
+              rep.pass_status[HRTS_PASS_SHADOW_MAP] == HRTS_PASS_STATUS_NOT_IN_PLAN,
+          "auto sun: hard shadows reported: %s", rep.decision_reason);
+    CHECK(mismatches == 0 && shadowed > 100, "auto sun: %d mismatches, %d shadowed", mismatches, shadowed);
+    cfg.mode = HRTS_SHADOW_MODE_HARD;
+    CHECK(hrts_configure(ctx, &cfg) == HRTS_RESULT_ERROR_INVALID_ARGUMENT &&
+              strstr(hrts_last_error(ctx), "pcss_angular_radius"),
+          "a light of no size in mode hard refused: %s", hrts_last_error(ctx));
+    CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "auto sun: destroy");
 }
 
 /* ---------- the engine's depth as it is ---------- */
@@ -3085,6 +3150,8 @@ int main(void) {
     phase = "several lights";
     several_lights(&vk, &g);
     native_local_lights(&vk, &g);
+    phase = "auto mode, fitted sun";
+    auto_fitted_sun(&vk, &g);
     phase = "frames in flight";
     frames_in_flight(&vk, &g);
     phase = "moving instances";

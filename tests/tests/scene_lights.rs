@@ -8,13 +8,14 @@
 mod common;
 
 use common::{
-    assert_exact_area, assert_no_validation_errors, compare_with_reference, device,
-    scene_visibility_params,
+    assert_exact_area, assert_exact_visibility, assert_no_validation_errors,
+    compare_with_reference, device, scene_visibility_params,
 };
 use glam::Vec3;
 use host_demo::accuracy::{compare_area_counts, AreaComparison};
 use host_demo::plugin::{
-    c_fitted_spot_light, c_point_light, LightFrameReport, LightsFrame, PluginRenderer,
+    c_directional_light, c_fitted_spot_light, c_point_light, LightFrameReport, LightsFrame,
+    PluginRenderer,
 };
 use host_demo::scene_plan::{
     plan_scene, scene_camera, LightDecision, NoPassReason, PlanSettings, ScenePlan,
@@ -101,7 +102,9 @@ fn all_hard(plan: &ScenePlan) -> ScenePlan {
     let mut hard = plan.clone();
     for light in &mut hard.lights {
         if let LightDecision::Shadowed(s) = &mut light.decision {
+            // Hard shadows ignore the light's size, and take only sizes above 0 (0 is mode auto's).
             s.config.mode = ShadowMode::Hard;
+            s.config.pcss = passes::PcssConfig::default();
             s.frame_plan = passes::FramePlan::derive(s.config.plan_request());
         }
     }
@@ -129,7 +132,7 @@ fn assert_lights_match_reference(
     for (light, report) in plugin_lights.iter().zip(&frame.lights) {
         let name = &plan.lights[light.scene_light].light.name;
         let has = |r: ResourceId| report.report.resources.iter().any(|x| x.resource == r);
-        let sized = light.shadowed.config.mode == ShadowMode::Hybrid;
+        let sized = light.shadowed.resolved_config().mode == ShadowMode::Hybrid;
         assert_eq!(has(ResourceId::ShadowMap), sized, "{name}: shadow map");
         assert_eq!(has(ResourceId::Pcss), sized, "{name}: PCSS");
         assert!(has(ResourceId::PrimListEntries), "{name}: primitive map");
@@ -189,7 +192,9 @@ fn assert_lights_match_reference(
             report.frusta,
             shadowed.frusta.len(),
             report.decision,
-            plan.lights[i].shadowed().map_or("-", |s| s.config.mode.name()),
+            plan.lights[i]
+                .shadowed()
+                .map_or("-", |s| s.resolved_config().mode.name()),
             c.pixels,
             c.shadowed,
             c.near_edge,
@@ -563,7 +568,7 @@ fn assert_only_changed_reran(
         }
         assert_eq!(report.light_builds, earlier, "{what}: {name} was rebuilt");
         let expected = match (
-            light.shadowed.config.mode,
+            light.shadowed.resolved_config().mode,
             light.shadowed.config.static_light,
         ) {
             (ShadowMode::Hard | ShadowMode::Area, _) => {
@@ -816,6 +821,205 @@ fn emitters_touching_geometry_match_the_reference_sample_for_sample() {
         None,
         (200, 40),
     );
+}
+
+/// Boxes on open ground seen from above, with no light of their own (the tests give theirs natively).
+fn open_boxes() -> SceneFile {
+    let boxes = [
+        (
+            "ground",
+            Vec3::new(-4.0, -0.1, -4.0),
+            Vec3::new(4.0, 0.0, 4.0),
+        ),
+        (
+            "crate",
+            Vec3::new(-0.5, 0.0, -0.5),
+            Vec3::new(0.5, 1.0, 0.5),
+        ),
+        ("block", Vec3::new(1.0, 0.0, 0.6), Vec3::new(1.6, 0.5, 1.4)),
+        (
+            "shelf",
+            Vec3::new(-2.0, 1.2, 0.8),
+            Vec3::new(-0.8, 1.25, 1.8),
+        ),
+    ];
+    boxes_scene(
+        &boxes,
+        Vec::new(),
+        Vec3::new(3.5, 3.5, 4.5),
+        Vec3::new(0.0, 0.3, 0.0),
+    )
+}
+
+/// The sun of [`open_boxes`].
+fn sun_direction() -> Vec3 {
+    Vec3::new(0.45, -1.0, 0.25).normalize()
+}
+
+/// Every light's layer of `file` from its camera after `frames` frames of `lights` under `configs`, and
+/// each light's report of the last frame.
+fn native_frame(
+    device: &Device,
+    file: &SceneFile,
+    configs: &[ShadowConfig],
+    lights: Vec<hrts_plugin::HrtsLight>,
+    frames: usize,
+) -> (Vec<LightFrameReport>, Vec<Vec<f32>>) {
+    let mut plugin = plugin_for(device, file);
+    plugin.configure_lights(device, configs).expect("configure");
+    let matrices = CameraMatrices::of_camera(&camera(file), WIDTH, HEIGHT);
+    let mut reports = Vec::new();
+    for _ in 0..frames {
+        reports = plugin
+            .render_c_lights(device, &matrices, lights.clone())
+            .expect("frame")
+            .lights;
+    }
+    let (_, layers) = plugin.read_frame(device).expect("read back");
+    (reports, layers)
+}
+
+/// A sun given without a matrix (the C ABI's directional light with `view_proj` all zeros): the plugin fits
+/// its frustum to the frame's bounds, and its visibility is the same, pixel for pixel, as the same sun's
+/// given the host's own fitted matrix (`scene::DirectionalLight::view_proj` of the same bounds); both are
+/// the exact shadow.
+#[test]
+fn a_sun_fitted_by_the_plugin_shadows_as_the_hosts_matrix_does() {
+    let device = device();
+    let file = open_boxes();
+    let direction = sun_direction();
+    let host = scene::DirectionalLight { direction }.view_proj(&file.scene.bounds());
+    let config = ShadowConfig {
+        mode: ShadowMode::Hard,
+        antialiasing: false,
+        ..settings(false).base
+    };
+    let (reports, layers) = native_frame(
+        &device,
+        &file,
+        &[config, config],
+        vec![
+            c_directional_light(direction, host),
+            c_directional_light(direction, glam::Mat4::ZERO),
+        ],
+        1,
+    );
+    let params = scene_visibility_params(
+        &file.scene,
+        &camera(&file),
+        WIDTH,
+        HEIGHT,
+        reference::Light::Directional {
+            direction: direction.as_dvec3(),
+        },
+    );
+    let r = reference_visibility(&RefScene::new(&file.scene), &params);
+    for (name, (layer, report)) in ["host's matrix", "fitted by the plugin"]
+        .iter()
+        .zip(layers.iter().zip(&reports))
+    {
+        let c = compare_with_reference(&r, layer, None, None);
+        println!(
+            "sun, {name}: {} pixels, {} shadowed, {} near an edge, {} mismatches; {}",
+            c.pixels, c.shadowed, c.near_edge, c.mismatches, report.decision
+        );
+        assert_exact_visibility(&c, 0.05);
+        assert_eq!(
+            report.decision,
+            "directional light: its frustum holds receivers in view"
+        );
+    }
+    let differing = layers[0]
+        .iter()
+        .zip(&layers[1])
+        .filter(|(a, b)| a.to_bits() != b.to_bits())
+        .count();
+    assert_eq!(differing, 0, "pixels where the fitted sun differs");
+    assert_no_validation_errors(&device);
+}
+
+/// One configuration in mode auto for two lights of no angular radius and an emitter radius of 0.2 m: the
+/// sun (its size the angular radius, 0) gets exact hard shadows, the point lamp (its size the emitter's
+/// radius) exact area shadows as one cube map; each report says which and why, and each layer is exact.
+#[test]
+fn mode_auto_shadows_a_zero_size_sun_hard_and_a_sized_lamp_area() {
+    let device = device();
+    let file = open_boxes();
+    let direction = sun_direction();
+    let lamp = Vec3::new(0.6, 2.2, 0.9);
+    let (radius, samples) = (0.2, 16);
+    let mut config = ShadowConfig {
+        mode: ShadowMode::Auto,
+        antialiasing: false,
+        area: AreaConfig { samples },
+        ..settings(false).base
+    };
+    config.pcss.angular_radius = 0.0;
+    config.pcss.spot_radius = radius;
+    // The second frame: the first one's lists grow to what it needed.
+    let (reports, layers) = native_frame(
+        &device,
+        &file,
+        &[config, config],
+        vec![
+            c_directional_light(direction, glam::Mat4::ZERO),
+            c_point_light(lamp, 0.0),
+        ],
+        2,
+    );
+    let (sun, lamp_report) = (&reports[0], &reports[1]);
+    println!("sun: {}\nlamp: {}", sun.decision, lamp_report.decision);
+    assert!(
+        sun.decision.ends_with("; auto: hard (zero-size light)"),
+        "{}",
+        sun.decision
+    );
+    assert!(
+        lamp_report.decision.contains("cube")
+            && lamp_report.decision.ends_with("; auto: area (sized light)"),
+        "{}",
+        lamp_report.decision
+    );
+    for report in &reports {
+        let has = |r: ResourceId| report.report.resources.iter().any(|x| x.resource == r);
+        assert!(has(ResourceId::RtVisibility) && !has(ResourceId::ShadowMap));
+        assert!(!has(ResourceId::RtAntialiased));
+    }
+    let rs = RefScene::new(&file.scene);
+    let camera = camera(&file);
+    let params = scene_visibility_params(
+        &file.scene,
+        &camera,
+        WIDTH,
+        HEIGHT,
+        reference::Light::Directional {
+            direction: direction.as_dvec3(),
+        },
+    );
+    let c = compare_with_reference(&reference_visibility(&rs, &params), &layers[0], None, None);
+    println!(
+        "sun (hard): {} pixels, {} shadowed, {} near an edge, {} mismatches",
+        c.pixels, c.shadowed, c.near_edge, c.mismatches
+    );
+    assert_exact_visibility(&c, 0.05);
+    let offsets: Vec<glam::DVec2> = passes::area::local_area_offsets(samples)
+        .iter()
+        .map(|o| o.as_dvec2())
+        .collect();
+    let r = local_area_reference(
+        &rs,
+        &point_light_params(&file, &camera, lamp),
+        lamp.as_dvec3(),
+        f64::from(radius),
+        &offsets,
+    );
+    let c = compare_area_counts(&r, &layers[1], None);
+    println!(
+        "lamp (area, R {radius}, {samples} samples): {} px, {} unstable, {} penumbra, {} umbra, {} mismatches",
+        c.pixels, c.unstable, c.penumbra, c.umbra, c.mismatches
+    );
+    assert_exact_area("auto lamp", &c, 100, 25);
+    assert_no_validation_errors(&device);
 }
 
 /// The receiver points of `params`' view (NaN where the camera ray hits nothing).

@@ -6,16 +6,18 @@
 //! Per light, in this order:
 //! - a light that casts no shadow, emits nothing (zero colour or intensity), or whose influence (its cone
 //!   and range) misses every receiver in view gets **no pass**: it is not given to the plugin, and its
-//!   visibility is 1;
-//! - a **zero-size** light gets exact ray-traced hard shadows: mode hard, so no shadow map and no PCSS
-//!   are allocated;
-//! - a **sized** light gets exact soft shadows (mode area): its angular radius (directional) becomes
-//!   `pcss_angular_radius`, its radius (spot, point) `pcss_spot_radius`; the hybrid and PCSS stay
-//!   available through the configuration.
+//!   visibility is 1. These decisions stay with the host: a light the plugin is never given costs
+//!   nothing;
+//! - every other light is given in mode **auto** with its size: its angular radius (directional) as
+//!   `pcss_angular_radius`, its radius (spot, point) as `pcss_spot_radius`, 0 for a zero-size light. The
+//!   plugin chooses ([`ShadowConfig::resolved`]): a **zero-size** light gets exact ray-traced hard
+//!   shadows (mode hard: no shadow map and no PCSS are allocated), a **sized** light exact soft shadows
+//!   (mode area). The plan describes the passes of the mode the plugin resolves, by the same function.
 //!
-//! A shadowed light is one light of the plugin:
-//! - a directional light, with one orthographic frustum enclosing the scene
-//!   ([`DirectionalLight::view_proj`]);
+//! A shadowed light is one light of the plugin, given as a light, without a matrix:
+//! - a directional light by its direction (`HRTS_LIGHT_TYPE_DIRECTIONAL` with no matrix): the plugin
+//!   fits one orthographic frustum enclosing the scene's bounds every frame
+//!   ([`passes::directional_light_frustum`], the construction of `scene::DirectionalLight::view_proj`);
 //! - a spot light by its position, axis, cone and range (`HRTS_LIGHT_TYPE_SPOT` with no matrix): the
 //!   plugin fits one perspective frustum to a cone up to 60°, the five cube faces around its axis to a
 //!   wider one;
@@ -38,11 +40,11 @@ mod reach;
 
 use crate::plugin::{c_directional_light, c_fitted_spot_light, c_point_light};
 use anyhow::{bail, Result};
-use glam::{DVec3, Vec3};
-use hrts_plugin::{HrtsLight, HRTS_MAX_LIGHTS};
+use glam::{DVec3, Mat4, Vec3};
+use hrts_plugin::{HrtsLight, HrtsLightType, HRTS_MAX_LIGHTS};
 use passes::{FaceMode, FramePlan, ResourceId, ShadowConfig, ShadowMode};
 use reach::{receivers_in_view, up_hint, Cone, Pyramid, Reach};
-use scene::{Aabb, Camera, DirectionalLight, LightKind, LightSize, SceneFile, SceneLight};
+use scene::{Camera, LightKind, LightSize, SceneFile, SceneLight};
 use std::fmt::Write as _;
 
 /// The pyramid enclosing a spot light's cone in the reach test is this much wider than the cone.
@@ -52,7 +54,7 @@ const CONE_WIDENING: f32 = 1.01;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlanSettings {
     /// The configuration every shadowed light starts from: primitive map, shadow map size, PCSS taps and
-    /// filter, hybrid blend, antialiasing. The plan sets the mode, the light size, `static_light` and
+    /// filter, hybrid blend, antialiasing. The plan sets mode auto, the light size, `static_light` and
     /// `static_geometry` (and both faces in the primitive map of spot and point lights).
     pub base: ShadowConfig,
     /// Frame width in pixels (with the height, the aspect of the camera's frustum).
@@ -89,15 +91,29 @@ impl NoPassReason {
 /// The passes of a light the plugin shadows.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ShadowedLight {
-    /// The light's configuration.
+    /// The light's configuration as the plugin is given it (mode auto, and the light's size).
     pub config: ShadowConfig,
-    /// The passes and resources the plugin derives from the configuration.
+    /// The passes and resources the plugin derives from the configuration it resolves for the light
+    /// ([`ShadowedLight::resolved_config`]).
     pub frame_plan: FramePlan,
     /// The light as the plugin takes it.
     pub light: HrtsLight,
     /// The frusta the plugin shadows it through, by name: "whole" for one, else cube faces ("+X" ...
     /// "-Z" for a point light; "front", "right", "left", "up", "down" around a wide spot light's axis).
     pub frusta: &'static [&'static str],
+}
+
+impl ShadowedLight {
+    /// Whether the plugin is given a directional light.
+    pub fn is_directional(&self) -> bool {
+        self.light.light_type == HrtsLightType::Directional as u32
+    }
+
+    /// The configuration the plugin builds the light's passes with: mode auto resolved by the light's size
+    /// ([`ShadowConfig::resolved`], as the plugin resolves it).
+    pub fn resolved_config(&self) -> ShadowConfig {
+        self.config.resolved(self.is_directional())
+    }
 }
 
 /// What the plan does with a light.
@@ -127,26 +143,30 @@ impl LightPlan {
         }
     }
 
-    /// The decision and its reason, as a phrase: "hard (zero-size light: ...)", "no pass (...)".
+    /// The decision and its reason, as a phrase: "hard (zero-size light: ...)", "no pass (...)": the mode
+    /// the plugin resolves for the light, and what it computes.
     pub fn describe_decision(&self) -> String {
-        let Some(shadowed) = self.shadowed() else {
-            let LightDecision::NoPass(reason) = self.decision else {
-                unreachable!("a light is shadowed or not")
-            };
-            return format!("no pass ({}): visibility 1", reason.describe());
+        let shadowed = match &self.decision {
+            LightDecision::NoPass(reason) => {
+                return format!("no pass ({}): visibility 1", reason.describe())
+            }
+            LightDecision::Shadowed(shadowed) => shadowed,
         };
-        match self.light.size {
-            LightSize::Zero => "hard (zero-size light: exact ray-traced hard shadows; no shadow map, no PCSS)".to_owned(),
-            LightSize::AngularRadius(a) => format!(
-                "area (sized sun: exact soft shadows, the visible fraction of {} light samples within {a} rad, each tested against the exact triangles; no shadow map)",
-                shadowed.config.area.samples
+        let config = shadowed.resolved_config();
+        let samples = config.area.samples;
+        match (config.mode, self.light.kind) {
+            (ShadowMode::Hard, _) => "hard (zero-size light: exact ray-traced hard shadows; no shadow map, no PCSS)".to_owned(),
+            (ShadowMode::Area, LightKind::Directional { .. }) => format!(
+                "area (sized sun: exact soft shadows, the visible fraction of {samples} light samples within {} rad, each tested against the exact triangles; no shadow map)",
+                config.pcss.angular_radius
             ),
-            LightSize::Radius(r) => format!(
-                "area (sized {} light: exact soft shadows, the visible fraction of {} samples of its emitter of radius {r} m, each tested against the exact triangles; no shadow map{})",
-                if self.light.kind.direction().is_some() { "spot" } else { "point" },
-                shadowed.config.area.samples,
+            (ShadowMode::Area, kind) => format!(
+                "area (sized {} light: exact soft shadows, the visible fraction of {samples} samples of its emitter of radius {} m, each tested against the exact triangles; no shadow map{})",
+                if kind.direction().is_some() { "spot" } else { "point" },
+                config.pcss.spot_radius,
                 if shadowed.frusta.len() > 1 { ", per frustum" } else { "" }
             ),
+            (mode, _) => mode.name().to_owned(),
         }
     }
 }
@@ -262,11 +282,14 @@ impl ScenePlan {
                     faces.join(", ")
                 ),
             };
-            let c = &shadowed.config;
+            let c = &shadowed.resolved_config();
             let _ = writeln!(
                 s,
-                "      config: mode {}, FXAA {}, static_light {}, dynamic_geometry {}, map {}², shadow map {}",
-                c.mode.name(),
+                "      config: {}, FXAA {}, static_light {}, dynamic_geometry {}, map {}², shadow map {}",
+                shadowed
+                    .config
+                    .auto_reason(shadowed.is_directional())
+                    .map_or_else(|| format!("mode {}", c.mode.name()), str::to_owned),
                 if shadowed.frame_plan.runs(passes::PassId::Fxaa) {
                     "on"
                 } else {
@@ -382,13 +405,12 @@ pub fn plan_scene(file: &SceneFile, camera: &Camera, settings: &PlanSettings) ->
     let dynamic_geometry = !moving_objects.is_empty();
     let aspect = settings.width as f32 / settings.height as f32;
     let receivers = receivers_in_view(file, camera, aspect);
-    let bounds = file.scene.bounds();
     let lights: Vec<LightPlan> = file
         .lights
         .iter()
         .map(|light| LightPlan {
             light: light.clone(),
-            decision: decide(light, &receivers, &bounds, settings, dynamic_geometry),
+            decision: decide(light, &receivers, settings, dynamic_geometry),
         })
         .collect();
     let plan = ScenePlan {
@@ -411,7 +433,6 @@ pub fn plan_scene(file: &SceneFile, camera: &Camera, settings: &PlanSettings) ->
 fn decide(
     light: &SceneLight,
     receivers: &[[DVec3; 3]],
-    bounds: &Aabb,
     settings: &PlanSettings,
     dynamic_geometry: bool,
 ) -> LightDecision {
@@ -427,8 +448,8 @@ fn decide(
     }
     let (position, range, cone, c_light) = match light.kind {
         LightKind::Directional { direction } => {
-            let view_proj = DirectionalLight { direction }.view_proj(bounds);
-            let c_light = c_directional_light(direction, view_proj);
+            // No matrix: the plugin fits the frustum to the scene's bounds.
+            let c_light = c_directional_light(direction, Mat4::ZERO);
             return shadowed(light, settings, dynamic_geometry, c_light, 1);
         }
         LightKind::Spot {
@@ -472,7 +493,8 @@ fn decide(
     shadowed(light, settings, dynamic_geometry, c_light, frusta)
 }
 
-/// A shadowed light: its configuration from the settings' base and the light's size and flags.
+/// A shadowed light: its configuration from the settings' base, mode auto with the light's size, and its
+/// flags.
 fn shadowed(
     light: &SceneLight,
     settings: &PlanSettings,
@@ -483,28 +505,26 @@ fn shadowed(
     let mut config = settings.base;
     config.static_geometry = !dynamic_geometry;
     config.static_light = light.is_static;
+    // The plugin chooses by the size: hard shadows for no size, exact soft shadows (area) for a size.
+    config.mode = ShadowMode::Auto;
+    let directional = matches!(light.kind, LightKind::Directional { .. });
     match light.size {
-        LightSize::Zero => config.mode = ShadowMode::Hard,
-        LightSize::AngularRadius(a) => {
-            // Exact soft shadows; the hybrid and PCSS stay available through the configuration.
-            config.mode = ShadowMode::Area;
-            config.pcss.angular_radius = a;
-        }
-        LightSize::Radius(r) => {
-            // Exact soft shadows of the spherical emitter, as for a sized sun.
-            config.mode = ShadowMode::Area;
-            config.pcss.spot_radius = r;
-        }
+        LightSize::Zero if directional => config.pcss.angular_radius = 0.0,
+        LightSize::Zero => config.pcss.spot_radius = 0.0,
+        LightSize::AngularRadius(a) => config.pcss.angular_radius = a,
+        LightSize::Radius(r) => config.pcss.spot_radius = r,
     }
-    if !matches!(light.kind, LightKind::Directional { .. }) {
+    if !directional {
         // A front-only primitive map needs a directional light.
         config.map.faces = FaceMode::Both;
     }
+    let resolved = config.resolved(directional);
     LightDecision::Shadowed(Box::new(ShadowedLight {
         config,
-        frame_plan: FramePlan::derive(config.plan_request()),
+        frame_plan: FramePlan::derive(resolved.plan_request()),
         light: c_light,
-        frusta: if matches!(light.kind, LightKind::Point { .. }) && config.shadows_point_as_cube() {
+        frusta: if matches!(light.kind, LightKind::Point { .. }) && resolved.shadows_point_as_cube()
+        {
             &passes::CUBE_MAP_NAME
         } else {
             passes::frustum_names(frusta)
@@ -606,22 +626,64 @@ mod tests {
     fn a_zero_size_light_gets_hard_shadows_without_shadow_map_or_pcss() {
         let p = only(ground_and_box(vec![sun(LightSize::Zero)]));
         let s = p.shadowed().expect("shadowed");
-        assert_eq!(s.config.mode, ShadowMode::Hard);
+        // Given in mode auto with no size: the plugin resolves hard shadows.
+        assert_eq!(s.config.mode, ShadowMode::Auto);
+        assert_eq!(s.config.pcss.angular_radius, 0.0);
+        assert_eq!(s.resolved_config().mode, ShadowMode::Hard);
         assert_eq!(s.frusta, ["whole"]);
         assert_eq!(s.light.light_type, HrtsLightType::Directional as u32);
+        // No matrix: the plugin fits the sun's frustum to the scene's bounds.
+        assert!(s.light.view_proj.iter().all(|&x| x == 0.0));
         for r in [ResourceId::ShadowMap, ResourceId::Pcss] {
             assert!(!s.frame_plan.resources().contains(r), "{r:?}");
         }
         assert!(!s.frame_plan.runs(PassId::ShadowMap) && !s.frame_plan.runs(PassId::Pcss));
         assert!(s.frame_plan.runs(PassId::RayTrace));
         assert!(p.describe_decision().starts_with("hard"));
+        let file = ground_and_box(vec![sun(LightSize::Zero)]);
+        let text = plan(&file).describe();
+        assert!(
+            text.contains("config: auto: hard (zero-size light), FXAA on"),
+            "{text}"
+        );
+    }
+
+    /// The frustum the plugin fits to a directional light given without a matrix is the one the scene's
+    /// own construction gives ([`scene::DirectionalLight::view_proj`]), bit for bit, for the bounds the
+    /// demo gives the plugin with every frame (the scene's).
+    #[test]
+    fn the_plugins_directional_fit_is_the_scenes() {
+        let file = ground_and_box(Vec::new());
+        let mut example = ground_and_box(Vec::new());
+        example.scene = example.scene.translated(Vec3::new(300.0, -20.0, 1e3));
+        let flat =
+            scene::Scene::axis_box("flat", Vec3::new(-2.0, 1.0, -3.0), Vec3::new(4.0, 1.0, 1.0));
+        for scene in [&file.scene, &example.scene, &flat] {
+            let bounds = scene.bounds();
+            for direction in [
+                Vec3::new(0.3, -1.0, 0.2).normalize(),
+                Vec3::NEG_Y,
+                Vec3::new(0.001, -1.0, 0.0),
+                Vec3::new(-1.0, -0.05, 0.2),
+            ] {
+                let host = scene::DirectionalLight { direction }.view_proj(&bounds);
+                let plugin = passes::directional_light_frustum(direction, [bounds.min, bounds.max])
+                    .expect("fitted");
+                assert_eq!(
+                    plugin.view_proj().to_cols_array().map(f32::to_bits),
+                    host.to_cols_array().map(f32::to_bits),
+                    "{direction}"
+                );
+            }
+        }
     }
 
     #[test]
     fn sized_suns_and_spot_lights_get_area_shadows() {
         let p = only(ground_and_box(vec![sun(LightSize::AngularRadius(0.03))]));
         let s = p.shadowed().expect("shadowed");
-        assert_eq!(s.config.mode, ShadowMode::Area);
+        assert_eq!(s.config.mode, ShadowMode::Auto);
+        assert_eq!(s.resolved_config().mode, ShadowMode::Area);
         assert_eq!(s.config.pcss.angular_radius, 0.03);
         assert!(s.frame_plan.runs(PassId::RayTrace) && !s.frame_plan.runs(PassId::ShadowMap));
         assert!(p.describe_decision().starts_with("area"));
@@ -632,7 +694,7 @@ mod tests {
             Some(10.0),
         )]));
         let s = p.shadowed().expect("shadowed");
-        assert_eq!(s.config.mode, ShadowMode::Area);
+        assert_eq!(s.resolved_config().mode, ShadowMode::Area);
         assert_eq!(s.config.pcss.spot_radius, 0.05);
         assert!(p.describe_decision().starts_with("area (sized spot light"));
         assert_eq!(s.config.map.faces, FaceMode::Both);
@@ -729,9 +791,27 @@ mod tests {
         assert_eq!((s.light.position, s.light.range), ([2.0, 1.5, 2.0], 20.0));
         // Area shadows of a point light: its six faces as one cube map.
         assert_eq!(s.frusta, ["cube"]);
-        assert_eq!(s.config.mode, ShadowMode::Area);
+        assert_eq!(s.resolved_config().mode, ShadowMode::Area);
         assert_eq!(s.config.pcss.spot_radius, 0.1);
         assert!(p.describe_decision().starts_with("area (sized point light"));
+        // A zero-size lamp: no emitter radius, which the plugin resolves to hard shadows (one cube map).
+        let small = light(
+            "lamp",
+            LightKind::Point {
+                position: Vec3::new(2.0, 1.5, 2.0),
+                range: Some(20.0),
+            },
+            LightSize::Zero,
+        );
+        let p = only(ground_and_box(vec![small]));
+        let s = p.shadowed().expect("shadowed");
+        assert_eq!(
+            (s.config.mode, s.config.pcss.spot_radius),
+            (ShadowMode::Auto, 0.0)
+        );
+        assert_eq!(s.resolved_config().mode, ShadowMode::Hard);
+        assert_eq!(s.frusta, ["cube"]);
+        assert!(p.describe_decision().starts_with("hard (zero-size light"));
         // A wide spot light: the front face and the four across its axis, no back face.
         let wide = spot(Vec3::new(0.0, 3.0, 0.0), Vec3::NEG_Y, 1.3, None);
         let p = only(ground_and_box(vec![wide]));
@@ -792,7 +872,7 @@ mod tests {
             .map(|l| {
                 (
                     l.light.name.as_str(),
-                    l.shadowed().map(|s| s.config.mode),
+                    l.shadowed().map(|s| s.resolved_config().mode),
                     l.shadowed().map_or(0, |s| s.frusta.len()),
                 )
             })

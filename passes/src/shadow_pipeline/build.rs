@@ -72,11 +72,20 @@ impl ShadowPipeline {
                 inputs.surface.encoding
             )));
         }
+        if config.mode == ShadowMode::Auto {
+            return Err(PassError::InvalidConfig(
+                "mode auto is chosen per light by its size: build the pipeline for the light's resolved \
+                 configuration (ShadowConfig::resolved)"
+                    .into(),
+            ));
+        }
         let caps = device.capabilities();
         config.map.validate(caps)?;
         config.shadow_map.validate(caps)?;
         if config.mode == ShadowMode::Area {
-            config.area.validate(config.pcss.angular_radius)?;
+            // The light's size is checked per frame: a directional light's angular radius, a spot or
+            // point light's emitter radius.
+            config.area.validate_samples()?;
             if choose_binning_path(caps, config.map.binning)? != BinningPath::Compute {
                 return Err(PassError::InvalidConfig(
                     "area shadows widen each triangle's footprint per texel, which compute binning does: \

@@ -98,17 +98,50 @@ impl From<PrimitiveMapConfig> for ShadowConfig {
 
 impl ShadowConfig {
     /// Whether a point light under this configuration is shadowed as one cube map
-    /// ([`PrimitiveMapConfig::cube`]): hard or area shadows (or none) with compute binning. Soft and hybrid
-    /// shadows need a shadow map per frustum: such a point light is shadowed through its six faces as
+    /// ([`PrimitiveMapConfig::cube`]): hard, area or auto shadows (or none) with compute binning. Soft and
+    /// hybrid shadows need a shadow map per frustum: such a point light is shadowed through its six faces as
     /// spot lights, and the minimum over them.
     pub fn shadows_point_as_cube(&self) -> bool {
         matches!(
             self.mode,
-            ShadowMode::Hard | ShadowMode::None | ShadowMode::Area
+            ShadowMode::Hard | ShadowMode::None | ShadowMode::Area | ShadowMode::Auto
         ) && matches!(
             self.map.binning,
             crate::BinningRequest::Auto | crate::BinningRequest::Compute
         ) && self.map.faces == crate::FaceMode::Both
+    }
+
+    /// The size of a light under this configuration, by its kind: the angular radius of a `directional`
+    /// light (`pcss.angular_radius`, radians), else the radius of the spot or point light's emitter
+    /// (`pcss.spot_radius`, world units).
+    pub fn light_size(&self, directional: bool) -> f32 {
+        if directional {
+            self.pcss.angular_radius
+        } else {
+            self.pcss.spot_radius
+        }
+    }
+
+    /// This configuration for one light, `directional` or a spot or point light: [`ShadowMode::Auto`]
+    /// resolved by the light's size ([`ShadowConfig::light_size`], [`ShadowMode::for_light_size`]): hard
+    /// shadows for a light of zero size, area shadows for a sized one. Any other mode is kept.
+    pub fn resolved(&self, directional: bool) -> Self {
+        match self.mode {
+            ShadowMode::Auto => Self {
+                mode: ShadowMode::for_light_size(self.light_size(directional)),
+                ..*self
+            },
+            _ => *self,
+        }
+    }
+
+    /// Why [`ShadowConfig::resolved`] gives the light its mode, for reports: "auto: hard (zero-size light)"
+    /// or "auto: area (sized light)"; `None` for a mode given as it is.
+    pub fn auto_reason(&self, directional: bool) -> Option<&'static str> {
+        (self.mode == ShadowMode::Auto).then(|| match self.resolved(directional).mode {
+            ShadowMode::Area => "auto: area (sized light)",
+            _ => "auto: hard (zero-size light)",
+        })
     }
 
     /// The frame-plan request of this configuration.
@@ -138,4 +171,43 @@ pub struct ShadowInputs<'a> {
     /// directly, instead of an image of the pipeline's own that is then copied (none: its own). Its former
     /// contents are discarded; it is left in `UnorderedAccess` state.
     pub direct_output: Option<&'a Image>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Auto resolves by the size of the light's own kind: a directional light's angular radius, a spot or
+    /// point light's emitter radius; other modes stay.
+    #[test]
+    fn auto_resolves_by_the_size_of_the_lights_kind() {
+        let mut auto = ShadowConfig {
+            mode: ShadowMode::Auto,
+            ..ShadowConfig::default()
+        };
+        auto.pcss.angular_radius = 0.0;
+        auto.pcss.spot_radius = 0.1;
+        let sun = auto.resolved(true);
+        assert_eq!(sun.mode, ShadowMode::Hard);
+        assert_eq!(
+            sun,
+            ShadowConfig {
+                mode: ShadowMode::Hard,
+                ..auto
+            }
+        );
+        assert_eq!(auto.auto_reason(true), Some("auto: hard (zero-size light)"));
+        assert_eq!(auto.resolved(false).mode, ShadowMode::Area);
+        assert_eq!(auto.auto_reason(false), Some("auto: area (sized light)"));
+        auto.pcss.angular_radius = 0.01;
+        auto.pcss.spot_radius = 0.0;
+        assert_eq!(auto.resolved(true).mode, ShadowMode::Area);
+        assert_eq!(auto.resolved(false).mode, ShadowMode::Hard);
+        let hybrid = ShadowConfig::default();
+        for directional in [false, true] {
+            assert_eq!(hybrid.resolved(directional), hybrid);
+            assert_eq!(hybrid.auto_reason(directional), None);
+        }
+        assert!(auto.shadows_point_as_cube() && auto.resolved(false).shadows_point_as_cube());
+    }
 }

@@ -3,7 +3,7 @@
 use super::{
     camera_in_frame, camera_relative, FrameConstants, FrameInputs, FrameState, ShadowPipeline,
 };
-use crate::area::{area_samples, local_area_reach, local_area_samples};
+use crate::area::{area_samples, check_angular_radius, local_area_reach, local_area_samples};
 use crate::frame_plan::{PassId, PassStatus, ResourceId, ResourceSet, ShadowMode, SkipReason};
 use crate::gpu_types::{MapPush, PcssConstants, RayTraceConstants};
 use crate::light::{Light, LightFrame};
@@ -60,7 +60,10 @@ impl ShadowPipeline {
         // by its emitter's radius, within the reach of every frustum (the same shape for a cube's faces).
         let (penumbra, emitter_radius, reach) = match (area, light.position) {
             (false, _) => (0.0, 0.0, None),
-            (true, None) => (pc.angular_radius.tan(), 0.0, None),
+            (true, None) => {
+                check_angular_radius(pc.angular_radius)?;
+                (pc.angular_radius.tan(), 0.0, None)
+            }
             (true, Some(position)) => {
                 let reach = local_area_reach(light.frusta[0], position, pc.spot_radius)?;
                 (0.0, pc.spot_radius, Some(reach))
