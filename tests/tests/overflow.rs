@@ -56,7 +56,11 @@ fn assert_past_capacity_is_safe_and_exact(
     // 65536 entries here, so every list's bounds are kept).
     assert!(offsets.overflowed.iter().all(|&o| !o));
     let past: Vec<usize> = (0..texels)
-        .filter(|&t| offsets.range(t).is_some_and(|r| r.end > capacity && !r.is_empty()))
+        .filter(|&t| {
+            offsets
+                .range(t)
+                .is_some_and(|r| r.end > capacity && !r.is_empty())
+        })
         .collect();
     assert_eq!(st.texels_past_capacity as usize, past.len());
     for &t in &past {
@@ -203,12 +207,23 @@ fn groups_of_lists_past_16_bit_offsets_stay_exact() {
     let runs = frames(&device, &view, config, 2);
     let (report, images) = &runs[1];
     let st = report.stats;
-    let overflowed = images.list_offsets.overflowed.iter().filter(|&&o| o).count();
+    let overflowed = images
+        .list_offsets
+        .overflowed
+        .iter()
+        .filter(|&&o| o)
+        .count();
     println!("{st:?}; {overflowed} texels in overflowed groups");
     assert!(st.longest_list > 4096, "{st:?}");
     assert!(overflowed >= 16, "no group overflowed: {st:?}");
     assert_eq!(st.texels_past_capacity as usize, overflowed, "{st:?}");
-    for (t, _) in images.list_offsets.overflowed.iter().enumerate().filter(|(_, &o)| o) {
+    for (t, _) in images
+        .list_offsets
+        .overflowed
+        .iter()
+        .enumerate()
+        .filter(|(_, &o)| o)
+    {
         assert_eq!(images.occupancy[t], [255, 0, 0, 255], "texel {t}");
     }
     let v = compare_visibility(&rs, &view, images);

@@ -39,8 +39,8 @@ pub use config::{
     DEFAULT_ENTRY_BUDGET, GUARD_VALUE, GUARD_WORDS, MIN_ENTRY_BUDGET,
 };
 pub use offsets::{
-    packed_offset_words, packed_texels, unpack_list_offsets, ListOffsets, OFFSET_GROUP, OFFSET_GROUP_OVERFLOW,
-    OFFSET_GROUP_WORDS,
+    packed_offset_words, packed_texels, unpack_list_offsets, ListOffsets, OFFSET_GROUP,
+    OFFSET_GROUP_OVERFLOW, OFFSET_GROUP_WORDS,
 };
 use scratch::{storage_buffer, BindTargets, SharedTexels, PAIR_BYTES};
 pub use scratch::{MapScratch, MapScratchPool, ScratchBindings};

@@ -40,8 +40,7 @@ pub struct ListOffsets {
 impl ListOffsets {
     /// The range of texel `t`'s list, if the map kept it (not in an overflowed group).
     pub fn range(&self, t: usize) -> Option<std::ops::Range<usize>> {
-        (!*self.overflowed.get(t)?)
-            .then(|| self.offsets[t] as usize..self.offsets[t + 1] as usize)
+        (!*self.overflowed.get(t)?).then(|| self.offsets[t] as usize..self.offsets[t + 1] as usize)
     }
 
     /// Entries of all lists.
@@ -71,7 +70,11 @@ pub fn unpack_list_offsets(packed: &[u32], texels: usize) -> Result<ListOffsets,
         let g = t / OFFSET_GROUP;
         let over = packed[g * OFFSET_GROUP_WORDS] & OFFSET_GROUP_OVERFLOW != 0;
         let word = packed[g * OFFSET_GROUP_WORDS + 1 + (t % OFFSET_GROUP) / 2];
-        let local = if t % 2 == 0 { word & 0xFFFF } else { word >> 16 };
+        let local = if t % 2 == 0 {
+            word & 0xFFFF
+        } else {
+            word >> 16
+        };
         offsets.push(base(g) + if over { 0 } else { local });
         overflowed.push(over);
     }
@@ -129,8 +132,8 @@ mod tests {
             assert_eq!(unpacked.offsets, scanned, "{texels} texels");
             assert!(unpacked.overflowed.iter().all(|&o| !o));
             assert_eq!(unpacked.total(), scanned[texels]);
-            for t in 0..texels {
-                assert_eq!(unpacked.range(t).unwrap().len(), counts[t] as usize);
+            for (t, &count) in counts.iter().enumerate() {
+                assert_eq!(unpacked.range(t).unwrap().len(), count as usize);
             }
         }
     }
@@ -145,7 +148,10 @@ mod tests {
             let in_group = (16..32).contains(&t);
             assert_eq!(unpacked.overflowed[t], in_group, "texel {t}");
             if !in_group {
-                assert_eq!(unpacked.range(t), Some(scanned[t] as usize..scanned[t + 1] as usize));
+                assert_eq!(
+                    unpacked.range(t),
+                    Some(scanned[t] as usize..scanned[t + 1] as usize)
+                );
             }
         }
         assert_eq!(unpacked.range(16), None);
@@ -167,7 +173,10 @@ mod tests {
     fn short_read_backs_are_refused() {
         assert!(unpack_list_offsets(&[0; 17], 16).is_err());
         assert!(unpack_list_offsets(&[0; 18], 16).is_ok());
-        assert_eq!(packed_texels(packed_offset_words(1024 * 1024) as usize), 1024 * 1024);
+        assert_eq!(
+            packed_texels(packed_offset_words(1024 * 1024) as usize),
+            1024 * 1024
+        );
         assert_eq!(packed_texels(packed_offset_words(17) as usize), 32);
         assert_eq!(packed_texels(0), 0);
     }

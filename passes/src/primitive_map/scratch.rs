@@ -299,12 +299,7 @@ impl ScratchBindings {
             }
             Binner::Raster(p) => device.create_bind_group(
                 p.layout(),
-                &[
-                    b(&s.bin_tris),
-                    b(t.receivers),
-                    b(&s.counts),
-                    b(t.entries),
-                ],
+                &[b(&s.bin_tris), b(t.receivers), b(&s.counts), b(t.entries)],
             )?,
         };
         let tile_scan = PrefixScan::new(
