@@ -430,24 +430,32 @@ fn a_cube_map_outgrowing_its_pairs_stays_exact_and_grows() {
     assert_no_validation_errors(&device);
 }
 
+/// An 8 m ground square with a 1 m crate at the origin and a low block beside it.
+const GROUND_CRATE_BLOCK: [(&str, Vec3, Vec3); 3] = [
+    (
+        "ground",
+        Vec3::new(-4.0, -0.1, -4.0),
+        Vec3::new(4.0, 0.0, 4.0),
+    ),
+    (
+        "crate",
+        Vec3::new(-0.5, 0.0, -0.5),
+        Vec3::new(0.5, 1.0, 0.5),
+    ),
+    ("block", Vec3::new(1.0, 0.0, 0.6), Vec3::new(1.6, 0.5, 1.4)),
+];
+
 /// Lights lying on geometry: a point light exactly in the plane of a box's top (the top's triangles are
 /// edge-on to it, and the box's sides straddle its faces' planes), and a point light touching a wall
 /// (every triangle of the wall lies in the light's plane of the face looking along it, or behind another).
 #[test]
 fn lights_in_a_triangles_plane_match_the_exact_reference() {
     let device = device();
+    let [ground, crate_box, block] = GROUND_CRATE_BLOCK;
     let boxes = [
-        (
-            "ground",
-            Vec3::new(-4.0, -0.1, -4.0),
-            Vec3::new(4.0, 0.0, 4.0),
-        ),
-        (
-            "crate",
-            Vec3::new(-0.5, 0.0, -0.5),
-            Vec3::new(0.5, 1.0, 0.5),
-        ),
-        ("block", Vec3::new(1.0, 0.0, 0.6), Vec3::new(1.6, 0.5, 1.4)),
+        ground,
+        crate_box,
+        block,
         (
             "wall",
             Vec3::new(-4.0, 0.0, -2.6),
@@ -825,18 +833,11 @@ fn emitters_touching_geometry_match_the_reference_sample_for_sample() {
 
 /// Boxes on open ground seen from above, with no light of their own (the tests give theirs natively).
 fn open_boxes() -> SceneFile {
+    let [ground, crate_box, block] = GROUND_CRATE_BLOCK;
     let boxes = [
-        (
-            "ground",
-            Vec3::new(-4.0, -0.1, -4.0),
-            Vec3::new(4.0, 0.0, 4.0),
-        ),
-        (
-            "crate",
-            Vec3::new(-0.5, 0.0, -0.5),
-            Vec3::new(0.5, 1.0, 0.5),
-        ),
-        ("block", Vec3::new(1.0, 0.0, 0.6), Vec3::new(1.6, 0.5, 1.4)),
+        ground,
+        crate_box,
+        block,
         (
             "shelf",
             Vec3::new(-2.0, 1.2, 0.8),
