@@ -1,5 +1,7 @@
-//! Exclusive prefix sum of a `u32` buffer on the GPU, in place: one level per 1024-fold reduction
-//! (`scan.comp`), then the scanned block totals added back down.
+//! Exclusive prefix sum of a `u32` buffer on the GPU, in place (`scan.comp`). Up to [`FLAT_BLOCKS`] blocks of
+//! 1024 it takes two dispatches: the blocks' totals, then each block scanned from the sum of the totals
+//! before it, which its workgroup adds up itself. Larger scans take one level per 1024-fold reduction,
+//! then the scanned block totals added back down.
 //!
 //! Reads and writes: the data buffer. Owns: the block-total buffers of each level.
 
@@ -11,6 +13,10 @@ use rhi::{
 
 /// Elements one workgroup scans.
 const BLOCK: u64 = 1024;
+
+/// The most blocks a scan takes in two dispatches (4M elements): each workgroup of the second reads the
+/// totals of the blocks before it.
+pub const FLAT_BLOCKS: u64 = 4096;
 
 /// Push constants of `scan.comp`.
 #[repr(C)]
@@ -42,8 +48,11 @@ impl ScanPipeline {
 /// An exclusive scan of the first `n` elements of an input buffer into an output buffer (the same
 /// buffer for a scan in place): after it, output element i holds the sum of the input elements before i.
 pub struct PrefixScan {
-    /// (bind group of level data + its block totals, elements of the level), from the data upwards.
+    /// (bind group of level data + its block totals, elements of the level), from the data upwards: one
+    /// level for a flat scan.
     levels: Vec<(BindGroup, u32)>,
+    /// Whether the scan takes two dispatches over one level ([`FLAT_BLOCKS`]; one block takes one).
+    flat: bool,
     _sums: Vec<Buffer>,
 }
 
@@ -59,6 +68,7 @@ impl PrefixScan {
     ) -> Result<Self, PassError> {
         let mut sums: Vec<Buffer> = Vec::new();
         let mut counts = vec![n];
+        let flat = (2..=FLAT_BLOCKS).contains(&u64::from(n).div_ceil(BLOCK));
         loop {
             let blocks = u64::from(*counts.last().unwrap_or(&1))
                 .div_ceil(BLOCK)
@@ -69,7 +79,7 @@ impl PrefixScan {
                 BufferUsage::STORAGE,
                 MemoryLocation::GpuOnly,
             )?);
-            if blocks == 1 {
+            if blocks == 1 || flat {
                 break;
             }
             counts.push(blocks as u32);
@@ -93,6 +103,7 @@ impl PrefixScan {
         }
         Ok(Self {
             levels,
+            flat,
             _sums: sums,
         })
     }
@@ -101,10 +112,19 @@ impl PrefixScan {
     /// values are visible to later storage accesses after the UAV barrier this records last.
     pub fn record(&self, enc: &mut Encoder<'_>, pipeline: &ScanPipeline) -> Result<(), PassError> {
         let blocks = |n: u32| u64::from(n).div_ceil(BLOCK).max(1) as u32;
-        // Up the levels scanning each block (mode 0), then down adding the block totals (mode 1).
-        let up = self.levels.iter().map(|level| (level, 0));
-        let down = self.levels.iter().rev().skip(1).map(|level| (level, 1));
-        for ((group, n), mode) in up.chain(down) {
+        let passes: Vec<(&(BindGroup, u32), u32)> = if self.flat {
+            // The blocks' totals (mode 2), then each block from the totals before it (mode 3).
+            self.levels
+                .iter()
+                .flat_map(|level| [(level, 2), (level, 3)])
+                .collect()
+        } else {
+            // Up the levels scanning each block (mode 0), then down adding the block totals (mode 1).
+            let up = self.levels.iter().map(|level| (level, 0));
+            let down = self.levels.iter().rev().skip(1).map(|level| (level, 1));
+            up.chain(down).collect()
+        };
+        for ((group, n), mode) in passes {
             let push = ScanPush { n: *n, mode };
             enc.dispatch(
                 &pipeline.0,

@@ -1,6 +1,6 @@
-//! The GPU prefix scan behind the primitive map's list offsets equals the CPU's exclusive prefix sum, at
-//! sizes of one, two and three levels of 1024-element blocks, on random data, in place and from one
-//! buffer into another.
+//! The GPU prefix scan behind the primitive map's list offsets equals the CPU's exclusive prefix sum: in two
+//! dispatches up to 4096 blocks of 1024 elements (one, two, many blocks), and in three levels beyond, on
+//! random data, in place and from one buffer into another.
 
 mod common;
 
@@ -13,9 +13,11 @@ fn gpu_scan_equals_the_cpu_prefix_sum() {
     let device = device();
     let pipeline = ScanPipeline::new(&device).expect("scan pipeline");
     let mut state = 0x2545_f491_4f6c_dd1d_u64;
-    for (case, n) in [1u32, 1000, 1024, 1025, 300_000, 1_100_000]
-        .into_iter()
-        .enumerate()
+    for (case, n) in [
+        1u32, 1000, 1024, 1025, 300_000, 1_100_000, 4_194_304, 5_000_000,
+    ]
+    .into_iter()
+    .enumerate()
     {
         let in_place = case % 2 == 0;
         let data: Vec<u32> = (0..n)
