@@ -32,6 +32,20 @@ layout(push_constant) uniform Push { MapPush pc; };
 // rest of its subgroup's: one atomic per subgroup and round.
 uint accepted[16];
 
+// Whether a texel in [t0, t1] may accept the triangle under receiver culling: the largest receiver word of
+// the (at most 2x2) 4x4-texel tiles they lie in is at least every texel's, so when it is 0 (no ray origin)
+// or below the triangle's nearest depth key, bin_accepts rejects every texel of the range.
+bool tiles_may_accept(BinTri bt, uvec4 grid, uvec2 t0, uvec2 t1) {
+    uvec2 a0 = t0 & ~uvec2(3u), a1 = t1 & ~uvec2(3u);
+    uint word = 0u;
+    for (uint y = a0.y; y <= a1.y; y += 4u) {
+        for (uint x = a0.x; x <= a1.x; x += 4u) {
+            word = max(word, receiver[tile_word(grid, uvec2(x, y), pc.texels)]);
+        }
+    }
+    return word != 0u && bt.cmd.w <= unordered(word);
+}
+
 void main() {
     uint bins = pc.faces == 1u ? pc.triangles : min(faces[0].grid.z, pc.pairs);
     uint listed = faces[0].totals.x;
@@ -93,7 +107,8 @@ void main() {
             }
             float widest = widen.x == 0.0 ? 0.0 : penumbra_texels(bt, deepest, widen);
             if (bin_tile_overlaps(bt, (vec2(t0) + vec2(t1)) * 0.5 + 0.5, (vec2(t1) - vec2(t0)) * 0.5,
-                                  widest)) {
+                                  widest)
+                && (pc.cull == 0u || tiles_may_accept(bt, grid, t0, t1))) {
                 for (uint y = t0.y; y <= t1.y; ++y) {
                     for (uint x = t0.x; x <= t1.x; ++x) {
                         uint texel = texel_index(grid, uvec2(x, y));

@@ -11,8 +11,9 @@
 //   scene).
 // - mode 1 (mark): each pixel's texel (read back by the ray trace, so both agree on it bit for bit), and
 //   per texel the largest depth key of its ray origins: a triangle farther from the light than all of them
-//   cannot shadow the texel, and a texel without ray origins needs no list at all. The texels first
-//   marked are counted (the map's texels with receivers).
+//   cannot shadow the texel, and a texel without ray origins needs no list at all. The same per 4x4 tile
+//   of texels (map_state.glsl's tile_word), for the bin walk to skip whole tiles. The texels first marked
+//   are counted (the map's texels with receivers).
 // - mode 2 (texels): each pixel's texel alone, exactly as mode 1 writes it, for a ray trace whose pixel
 //   texels another light's build overwrote since (the lights share them).
 // Each invocation places a 2x2 quad of pixels; the per-frustum counters are reduced per subgroup, then per
@@ -58,6 +59,14 @@ uint face_of(vec3 o) {
         return rel.y >= 0.0 ? 2u : 3u;
     }
     return rel.z >= 0.0 ? 4u : 5u;
+}
+
+// Raises receiver word `w` (NONE: none) to at least `reach`; words only grow, so a stale read errs towards
+// the atomic.
+void raise(uint w, uint reach) {
+    if (w != NONE && receiver[w] < reach) {
+        atomicMax(receiver[w], reach);
+    }
 }
 
 // This invocation's part so far, for frustum `held` (NONE: nothing yet).
@@ -107,6 +116,8 @@ void main() {
 
     uint open_texel = NONE;
     uint open_reach = 0u;
+    uint open_tile = NONE;
+    uint open_tile_reach = 0u;
     uint marked = 0u;
     bool perspective = pc.to_light.w != 0.0;
     for (uint q = 0u; q < 4u; ++q) {
@@ -156,6 +167,13 @@ void main() {
             open_reach = 0u;
         }
         open_reach = max(open_reach, reach);
+        uint tile = tile_word(faces[f].grid, texel, pc.texels);
+        if (tile != open_tile) {
+            raise(open_tile, open_tile_reach);
+            open_tile = tile;
+            open_tile_reach = 0u;
+        }
+        open_tile_reach = max(open_tile_reach, reach);
     }
 
     // Each frustum held in the subgroup (usually one), reduced across it.
@@ -192,6 +210,16 @@ void main() {
         } else if (open && receiver[open_texel] < open_reach
                    && atomicMax(receiver[open_texel], open_reach) == 0u) {
             marked += 1u;
+        }
+        // The open tiles likewise.
+        uint first_tile = subgroupMin(open_tile);
+        if (first_tile == subgroupMax(open_tile != NONE ? open_tile : 0u)) {
+            uint m = subgroupMax(open_tile_reach);
+            if (subgroupElect()) {
+                raise(first_tile, m);
+            }
+        } else {
+            raise(open_tile, open_tile_reach);
         }
         uint group_marked = subgroupAdd(marked);
         if (subgroupElect() && group_marked > 0u) {

@@ -27,6 +27,14 @@ uint texel_index(uvec4 grid, uvec2 t) {
     return grid.x + t.y * grid.y + t.x;
 }
 
+// The index in the receiver map of the tile word of texel `t` (after the map's `texels` texel words): the
+// largest word of the texels of its 4x4 tile, of the tiles sharing its index (distinct tiles of one grid
+// never do, their first texels' indices differing by multiples of 4; the last tile of one grid and the first
+// of the next may: their word is then the larger of both, which only keeps more).
+uint tile_word(uvec4 grid, uvec2 t, uint texels) {
+    return texels + (texel_index(grid, t & ~uvec2(3u)) >> 2);
+}
+
 // Monotonic float <-> uint encoding for atomicMin/atomicMax on floats; 0 is below every encoded value, so
 // a zero-cleared word means "nothing recorded".
 uint ordered(float f) {

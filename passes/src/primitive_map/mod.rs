@@ -42,7 +42,7 @@ pub use offsets::{
     packed_offset_words, packed_texels, unpack_list_offsets, ListOffsets, OFFSET_GROUP,
     OFFSET_GROUP_OVERFLOW, OFFSET_GROUP_WORDS,
 };
-use scratch::{storage_buffer, BindTargets, SharedTexels, PAIR_BYTES};
+use scratch::{receiver_words, storage_buffer, BindTargets, SharedTexels, PAIR_BYTES};
 pub use scratch::{MapScratch, MapScratchPool, ScratchBindings};
 
 /// Threads of the compute binning dispatch (a grid-stride loop over the bin items).
@@ -147,7 +147,11 @@ impl PrimitiveMap {
             copy,
         )?;
         let receivers = if inputs.occupancy_view {
-            std::sync::Arc::new(storage("primitive map receivers", texels * 4, copy)?)
+            std::sync::Arc::new(storage(
+                "primitive map receivers",
+                receiver_words(texels) * 4,
+                copy,
+            )?)
         } else {
             inputs.scratch.receivers(device, texels)?
         };

@@ -13,6 +13,13 @@ const BIN_TRI_BYTES: u64 = 64;
 /// Bytes of one (triangle, texel) pair of the pair list (`map_bin.comp`).
 pub(super) const PAIR_BYTES: u64 = 8;
 
+/// Words of a receiver map of `texels` texels: one per texel, then one per 4×4-texel tile of the grids (the
+/// largest of its texels' words, `map_state.glsl`'s `tile_word`), which lets the bin walk skip a tile whose
+/// texels hold no ray origin, or only origins nearer the light than the triangle.
+pub(super) fn receiver_words(texels: u64) -> u64 {
+    texels + texels / 4 + 2
+}
+
 /// A GPU-only storage buffer of `bytes` (at least 4) with `usage` besides storage.
 pub(super) fn storage_buffer(
     device: &Device,
@@ -153,7 +160,8 @@ impl MapScratchPool {
         })
     }
 
-    /// A receiver map of at least `texels` texels: the pool's, or a new one as large.
+    /// A receiver map of at least `texels` texels and their tile words ([`receiver_words`]): the pool's, or
+    /// a new one as large.
     pub fn receivers(
         &self,
         device: &Device,
@@ -161,12 +169,12 @@ impl MapScratchPool {
     ) -> Result<std::sync::Arc<Buffer>, PassError> {
         shared_in(
             &self.receivers,
-            |r| r.size() >= texels * 4,
+            |r| r.size() >= receiver_words(texels) * 4,
             |_| {
                 Ok(std::sync::Arc::new(storage_buffer(
                     device,
                     "primitive map receivers",
-                    texels * 4,
+                    receiver_words(texels) * 4,
                     BufferUsage::COPY_DST | BufferUsage::COPY_SRC,
                 )?))
             },
