@@ -1,10 +1,11 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 // Compute binning of the primitive map, load-balanced over bin items: item i is one 4x4-texel tile of one
-// bin triangle's bounding box, found by binary search in the scanned tile offsets, so a large triangle (a
-// ground plane, a wall) is spread over many threads instead of stalling one. A tile the triangle cannot
-// reach is skipped whole (bin_tile_overlaps), and a texel's receiver word is read only where the triangle
-// overlaps it. A light of one frustum has one bin triangle per prim-buffer triangle; a point light one per
+// bin triangle's bounding box, found by binary search in the scanned tile offsets between two entries of the
+// search index (map_index.comp), so a large triangle (a ground plane, a wall) is spread over many threads
+// instead of stalling one. A tile the triangle cannot reach is skipped whole (bin_tile_overlaps), as is one
+// whose 4x4-texel tiles hold no ray origin or only nearer ones (tiles_may_accept), and a texel's receiver
+// word is read only where the triangle overlaps it. A light of one frustum has one bin triangle per prim-buffer triangle; a point light one per
 // (triangle, face) pair its setup kept.
 // mode 0 counts the accepted (triangle, texel) pairs (map_store.glsl) and appends them to the pair list;
 // mode 1 stores them: from the pair list when it holds every pair the count accepted (one walk in all),
@@ -25,6 +26,7 @@ layout(set = 0, binding = 4) writeonly buffer Entries { uint entries[]; };
 layout(set = 0, binding = 5) buffer State { MapState faces[]; };
 layout(set = 0, binding = 6) readonly buffer PairOwners { uint pair_owner[]; };
 layout(set = 0, binding = 7) buffer PairList { uvec2 pair_list[]; };
+layout(set = 0, binding = 8) readonly buffer SearchIndex { uint search_index[]; };
 layout(push_constant) uniform Push { MapPush pc; };
 #include "map_store.glsl"
 
@@ -47,7 +49,7 @@ bool tiles_may_accept(BinTri bt, uvec4 grid, uvec2 t0, uvec2 t1) {
 }
 
 void main() {
-    uint bins = pc.faces == 1u ? pc.triangles : min(faces[0].grid.z, pc.pairs);
+    uint bins = bin_count(pc, faces[0].grid.z);
     uint listed = faces[0].totals.x;
     if (pc.mode == 1u && pc.list_capacity > 0u && listed <= pc.list_capacity) {
         // Fill from the pair list the count wrote: no second walk.
@@ -58,6 +60,7 @@ void main() {
         return;
     }
     uint items = tile_offsets[bins];
+    uint chunk = search_chunk(items);
     // Rounds of one item per invocation; every invocation of a workgroup runs every round of its
     // workgroup (the subgroup operations below need the whole subgroup).
     for (uint round_base = gl_WorkGroupID.x * gl_WorkGroupSize.x; round_base < items;
@@ -67,8 +70,11 @@ void main() {
         uint tri = 0u;
         if (item < items) {
             // The last bin triangle whose first item is at or before `item` (those without items share
-            // their successor's offset and are never found).
-            uint lo = 0u, hi = bins;
+            // their successor's offset and are never found): at or after the one holding item
+            // entry * chunk and at or before the one holding item (entry + 1) * chunk (map_index.comp).
+            uint entry = item / chunk;
+            uint lo = search_index[entry];
+            uint hi = entry + 1u <= (items - 1u) / chunk ? search_index[entry + 1u] + 1u : bins;
             while (hi - lo > 1u) {
                 uint mid = (lo + hi) / 2u;
                 if (tile_offsets[mid] <= item) {

@@ -21,6 +21,21 @@ struct BinTri {
                             // homogeneous edge functions, which keep exactly the part in front (below)
 #define BIN_TILE 4u
 
+// Entries of the bin walk's search index (map_index.comp; passes::primitive_map::SEARCH_INDEX_WORDS).
+#define SEARCH_INDEX_SIZE 65536u
+
+// The bin triangles of the frame (MapPush `p`): the triangles for a light of one frustum, else the
+// (triangle, face) pairs the setup kept (`kept`: the first state's grid.z), within those the bin items hold.
+uint bin_count(MapPush p, uint kept) {
+    return p.faces == 1u ? p.triangles : min(kept, p.pairs);
+}
+
+// Items per entry of the search index for `items` items: entry k stands for item k * chunk, and the
+// entries in use, (items - 1) / chunk + 1, are at most SEARCH_INDEX_SIZE.
+uint search_chunk(uint items) {
+    return max(items / SEARCH_INDEX_SIZE + (items % SEARCH_INDEX_SIZE != 0u ? 1u : 0u), 1u);
+}
+
 // A texel is accepted when its square grown by the triangle's margin overlaps it; the margin is at least
 // this many texels (it absorbs the rounding of the edge functions below).
 #define ACCEPT_MARGIN (1.0 / 512.0)

@@ -81,6 +81,7 @@ pub(super) struct MapPipelines {
     pub(super) fit: ComputePipeline,
     pub(super) receivers: ComputePipeline,
     pub(super) setup: ComputePipeline,
+    pub(super) index: ComputePipeline,
     pub(super) scan: ScanPipeline,
     pub(super) binner: Binner,
     pub(super) pack: ComputePipeline,
@@ -266,12 +267,18 @@ impl PrimitiveMap {
                 &buffers(5),
                 push,
             )?,
+            index: device.create_compute_pipeline(
+                "map index",
+                &shader("map_index.comp")?,
+                &buffers(3),
+                push,
+            )?,
             scan: ScanPipeline::new(device)?,
             binner: match path {
                 BinningPath::Compute => Binner::Compute(device.create_compute_pipeline(
                     "map bin",
                     &shader("map_bin.comp")?,
-                    &buffers(8),
+                    &buffers(9),
                     push,
                 )?),
                 raster => Binner::Raster(Self::raster_pipeline(device, raster)?),
@@ -537,6 +544,15 @@ impl PrimitiveMap {
         )?;
         enc.barriers(&[Barrier::Uav]);
         self.bound.tile_scan.record(enc, &self.pipes.scan)?;
+        if matches!(self.pipes.binner, Binner::Compute(_)) {
+            enc.dispatch(
+                &self.pipes.index,
+                &self.bound.index_group,
+                bytemuck::bytes_of(&push),
+                [scratch::SEARCH_INDEX_WORDS.div_ceil(64) as u32, 1, 1],
+            )?;
+            enc.barriers(&[Barrier::Uav]);
+        }
         enc.end_pass();
 
         let label = self.path.label();

@@ -13,6 +13,10 @@ const BIN_TRI_BYTES: u64 = 64;
 /// Bytes of one (triangle, texel) pair of the pair list (`map_bin.comp`).
 pub(super) const PAIR_BYTES: u64 = 8;
 
+/// Entries of the bin walk's search index (`SEARCH_INDEX_SIZE` in `map_bin.glsl`, built by
+/// `map_index.comp`): the bin triangle holding every (items / 65536)-th item.
+pub(super) const SEARCH_INDEX_WORDS: u64 = 65536;
+
 /// Words of a receiver map of `texels` texels: one per texel, then one per 4×4-texel tile of the grids (the
 /// largest of its texels' words, `map_state.glsl`'s `tile_word`), which lets the bin walk skip a tile whose
 /// texels hold no ray origin, or only origins nearer the light than the triangle.
@@ -43,6 +47,7 @@ pub struct MapScratch {
     pub(super) tile_offsets: Buffer,
     pub(super) pair_owners: Buffer,
     pub(super) counts: Buffer,
+    pub(super) search_index: Buffer,
     /// The texels the counts hold.
     pub(super) texels: u64,
     /// The bin triangles the buffers hold.
@@ -59,6 +64,7 @@ impl MapScratch {
             &self.tile_offsets,
             &self.pair_owners,
             &self.counts,
+            &self.search_index,
         ]
         .iter()
         .map(|b| b.size())
@@ -153,6 +159,11 @@ impl MapScratchPool {
                     (texels + 1) * 4,
                     BufferUsage::COPY_DST | BufferUsage::COPY_SRC,
                 )?,
+                search_index: storage(
+                    "primitive map search index",
+                    SEARCH_INDEX_WORDS * 4,
+                    BufferUsage::default(),
+                )?,
                 texels,
                 bins,
                 owners,
@@ -243,6 +254,8 @@ pub struct ScratchBindings {
     /// The compute binning's pair list (none for the raster paths).
     pub(super) pair_list: Option<std::sync::Arc<Buffer>>,
     pub(super) setup_group: BindGroup,
+    /// Builds the bin walk's search index from the scanned tile offsets.
+    pub(super) index_group: BindGroup,
     pub(super) bin_group: BindGroup,
     pub(super) tile_scan: PrefixScan,
     /// The counts scanned in place into the lists' offsets (the fill's cursors).
@@ -300,6 +313,7 @@ impl ScratchBindings {
                         b(t.state),
                         b(&s.pair_owners),
                         b(&list),
+                        b(&s.search_index),
                     ],
                 )?;
                 pair_list = Some(list);
@@ -324,6 +338,14 @@ impl ScratchBindings {
             &s.counts,
             (texels + 1) as u32,
         )?;
+        let index_group = device.create_bind_group(
+            pipes.index.layout(),
+            &[
+                Resource::Buffer(&s.tile_offsets),
+                Resource::Buffer(&s.search_index),
+                Resource::Buffer(t.state),
+            ],
+        )?;
         let pack_group = device.create_bind_group(
             pipes.pack.layout(),
             &[
@@ -336,6 +358,7 @@ impl ScratchBindings {
             scratch,
             pair_list,
             setup_group,
+            index_group,
             bin_group,
             tile_scan,
             offset_scan,
