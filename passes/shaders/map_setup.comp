@@ -336,6 +336,29 @@ uint setup(uint f, vec3 v0, vec3 v1, vec3 v2, float distance, out BinTri bt) {
 
 shared uint group_kept;
 
+// At least the tangent of a cube face's half-angle (passes::light::CUBE_FACE_TAN_HALF, 1 + 1/256), with
+// room for the rounding of the test below.
+const float FACE_PYRAMID_TAN = 1.02;
+
+// Whether the triangle may meet the pyramid of cube face `f` (+X, -X, +Y, -Y, +Z, -Z) around a point light
+// at `light` (hard shadows: every segment of the face ends at the light): the pyramid is the intersection of four half-spaces through the light, |u| <= T d and |w| <= T d
+// for the depth d along the face's axis and the two other coordinates u, w, so a triangle whose three
+// vertices lie outside one of them lies wholly outside it (and outside the face's frustum, which the pyramid
+// holds). A cheap test before the face's projection; the setup decides the rest exactly.
+bool meets_face_pyramid(uint f, vec3 light, vec3 v0, vec3 v1, vec3 v2) {
+    uint axis = f / 2u;
+    float s = (f & 1u) == 0u ? 1.0 : -1.0;
+    uvec4 outside = uvec4(0u);     // vertices outside each half-space
+    for (uint i = 0u; i < 3u; ++i) {
+        vec3 rel = (i == 0u ? v0 : (i == 1u ? v1 : v2)) - light;
+        float reach = FACE_PYRAMID_TAN * s * rel[axis];
+        float u = rel[(axis + 1u) % 3u];
+        float w = rel[(axis + 2u) % 3u];
+        outside += uvec4(bvec4(u > reach, -u > reach, w > reach, -w > reach));
+    }
+    return !any(equal(outside, uvec4(3u)));
+}
+
 void main() {
     if (gl_LocalInvocationIndex == 0u) {
         group_kept = 0u;
@@ -375,7 +398,10 @@ void main() {
         // subgroup and face reserves the slots of the pairs kept.
         for (uint f = 0u; f < pc.faces; ++f) {
             BinTri bt = BinTri(vec4(0.0), vec4(0.0), uvec4(0u), vec4(0.0));
-            uint tiles = live ? setup(f, v0, v1, v2, distance, bt) : 0u;
+            // Hard shadows only: an area light's segments end on its emitter, off the pyramid's apex.
+            bool meets = live
+                && (pc.emitter_radius > 0.0 || meets_face_pyramid(f, pc.to_light.xyz, v0, v1, v2));
+            uint tiles = meets ? setup(f, v0, v1, v2, distance, bt) : 0u;
             bool keep = tiles > 0u;
             uint count = subgroupAdd(keep ? 1u : 0u);
             uint first = 0u;

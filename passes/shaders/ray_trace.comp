@@ -149,6 +149,9 @@ void main() {
         return;
     }
     float nearest = t_max;
+    // Without a blocker-distance output (hard shadows) any hit before the light decides the pixel, so the
+    // walk stops after the first; otherwise it finds the nearest.
+    bool first_hit = k.misc.z == 0u;
     uint begin = 0u, end = 0u;
     bool listed = texel != TEXEL_NO_RAY && list_range(texel, begin, end);
     // An empty list is complete wherever it lies; a list is complete when it ends within the capacity.
@@ -156,8 +159,12 @@ void main() {
     // list.
     bool binned = ms.grid.z <= ms.grid.w;
     if (listed && binned && (end <= ms.totals.z || begin == end)) {
-        for (uint i = begin; i < end; ++i) {
-            consider(entries[i], nearest);
+        // Checked every 8 entries, so that the walk within them keeps its loads in flight.
+        for (uint i = begin; i < end && !(first_hit && nearest < t_max); i += 8u) {
+            uint stop = min(i + 8u, end);
+            for (uint j = i; j < stop; ++j) {
+                consider(entries[j], nearest);
+            }
         }
     } else {
         // Past the entry or pair capacity, in a group whose list offsets overflowed (or, never seen, a pixel
@@ -165,7 +172,7 @@ void main() {
         // exhaustive and exact. Unrolled 16x by hand: llvmpipe (lavapipe) silently ends a shader's loops after 65535
         // iterations in total, which would drop every triangle past that index; unrolled, its cap is 1M.
         uint total = min(k.misc.y, uint(tris.length()));
-        for (uint base = 0u; base < total; base += 16u) {
+        for (uint base = 0u; base < total && !(first_hit && nearest < t_max); base += 16u) {
             CONSIDER4(base) CONSIDER4(base + 4u) CONSIDER4(base + 8u) CONSIDER4(base + 12u)
         }
     }

@@ -288,6 +288,38 @@ fn a_point_light_inside_a_closed_room_matches_the_exact_reference() {
     assert_eq!(plan.plugin_lights().len(), 1, "{}", plan.describe());
 }
 
+/// Small blocks on the diagonals between a point light's cube faces, 1 m from the lamp: every vertex of
+/// each lies within a few degrees of the edge between two faces' pyramids, where the setup's cheap pyramid
+/// test (`map_setup.comp`, `meets_face_pyramid`) decides whether a face lists them at all. A test that kept
+/// less than the pyramid (a tangent below 1) would drop them from both faces and lose their shadows.
+#[test]
+fn blockers_on_the_edges_between_cube_faces_match_the_exact_reference() {
+    let device = device();
+    let lamp = Vec3::new(0.15, 2.5, 0.1);
+    let mut file = closed_room(lamp);
+    let half = Vec3::splat(0.025);
+    for (i, direction) in [
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(0.0, -1.0, -1.0),
+        Vec3::new(-1.0, -1.0, -1.0),
+        Vec3::new(-1.0, 0.0, -1.0),
+        Vec3::new(1.0, -1.0, -1.0),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let centre = lamp + direction.normalize();
+        file.scene.append(&scene::Scene::axis_box(
+            &format!("die {i}"),
+            centre - half,
+            centre + half,
+        ));
+        file.static_objects.push(true);
+    }
+    file.scene.validate().expect("valid scene");
+    assert_lights_match_reference(&device, &file, &camera(&file), 200, 5, &[]);
+}
+
 /// The closed room of [`a_point_light_inside_a_closed_room_matches_the_exact_reference`] with its lamp.
 fn closed_room(lamp: Vec3) -> SceneFile {
     let boxes = [
