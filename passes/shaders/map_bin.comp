@@ -5,8 +5,8 @@
 // search index (map_index.comp), so a large triangle (a ground plane, a wall) is spread over many threads
 // instead of stalling one. A tile the triangle cannot reach is skipped whole (bin_tile_overlaps), as is one
 // whose 4x4-texel tiles hold no ray origin or only nearer ones (tiles_may_accept), and a texel's receiver
-// word is read only where the triangle overlaps it. A light of one frustum has one bin triangle per prim-buffer triangle; a point light one per
-// (triangle, face) pair its setup kept.
+// word is read only where the triangle overlaps it. A light of one frustum has one bin triangle per
+// prim-buffer triangle; a point light one per (triangle, face) pair its setup kept.
 // mode 0 counts the accepted (triangle, texel) pairs (map_store.glsl) and appends them to the pair list;
 // mode 1 stores them: from the pair list when it holds every pair the count accepted (one walk in all),
 // else by walking the tiles again.

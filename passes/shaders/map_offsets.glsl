@@ -1,7 +1,7 @@
 // The primitive map's list offsets, packed (passes::primitive_map::offsets mirrors it): the texels in groups
 // of 16 consecutive indices, 9 words per group: word 0 is the offset of the group's first list (bit 31: a
-// list of the group starts 65536 or more entries after it, so the group's local offsets do not fit and its
-// texels are traced exhaustively), words 1..8 the 16-bit offset of each texel's list from it (texel 16g + i
+// list of the group starts 65536 or more entries after it, or its lists end at 2^31 entries or more, so
+// the group's offsets are not kept and its texels are traced exhaustively), words 1..8 the 16-bit offset of each texel's list from it (texel 16g + i
 // in the low half of word 1 + i/2 for even i, the high half for odd i). A final group's word 0 holds the
 // entries of all lists. 2.25 bytes per texel instead of 4. Needs the includer's `offsets[]`.
 

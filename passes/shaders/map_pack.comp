@@ -36,7 +36,10 @@ void main() {
     if (g <= groups) {
         uint first = g * OFFSET_GROUP;
         uint base = offset_of(first);
-        bool overflow = offset_of(first + OFFSET_GROUP - 1u) - base > 0xFFFFu;
+        // Overflowed too: a group whose lists end at 2^31 entries or more, where the bases' top bit is the
+        // mark (its last list's end is the next group's base).
+        bool overflow = offset_of(first + OFFSET_GROUP - 1u) - base > 0xFFFFu
+            || offset_of(first + OFFSET_GROUP) >= OFFSET_GROUP_OVERFLOW;
         offsets[g * OFFSET_GROUP_WORDS] = base | (overflow ? OFFSET_GROUP_OVERFLOW : 0u);
         uint capacity = ms.totals.z;
         uint begin = base;

@@ -341,9 +341,10 @@ shared uint group_kept;
 const float FACE_PYRAMID_TAN = 1.02;
 
 // Whether the triangle may meet the pyramid of cube face `f` (+X, -X, +Y, -Y, +Z, -Z) around a point light
-// at `light` (hard shadows: every segment of the face ends at the light): the pyramid is the intersection of four half-spaces through the light, |u| <= T d and |w| <= T d
-// for the depth d along the face's axis and the two other coordinates u, w, so a triangle whose three
-// vertices lie outside one of them lies wholly outside it (and outside the face's frustum, which the pyramid
+// at `light` (hard shadows: every segment of the face ends at the light): the pyramid is the intersection
+// of four half-spaces through the light, |u| <= T d and |w| <= T d for the depth d along the face's axis
+// and the two other coordinates u, w, so a triangle whose three vertices lie outside one of them lies
+// wholly outside it (and outside the face's frustum, which the pyramid
 // holds). A cheap test before the face's projection; the setup decides the rest exactly.
 bool meets_face_pyramid(uint f, vec3 light, vec3 v0, vec3 v1, vec3 v2) {
     uint axis = f / 2u;

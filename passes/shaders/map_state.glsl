@@ -29,8 +29,8 @@ uint texel_index(uvec4 grid, uvec2 t) {
 
 // The index in the receiver map of the tile word of texel `t` (after the map's `texels` texel words): the
 // largest word of the texels of its 4x4 tile, of the tiles sharing its index (distinct tiles of one grid
-// never do, their first texels' indices differing by multiples of 4; the last tile of one grid and the first
-// of the next may: their word is then the larger of both, which only keeps more).
+// never do, their first texels' indices differing by multiples of 4; tiles of neighbouring grids of a cube
+// map may: their word is then the largest of theirs, which only keeps more).
 uint tile_word(uvec4 grid, uvec2 t, uint texels) {
     return texels + (texel_index(grid, t & ~uvec2(3u)) >> 2);
 }

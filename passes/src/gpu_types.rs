@@ -189,7 +189,8 @@ pub struct MapStats {
     pub entries: u32,
     /// Entries the map could hold this frame (it grows to fit from the next frame on, within its budget).
     pub capacity: u32,
-    /// Texels whose list did not fit the capacity: traced exhaustively (exact, slower).
+    /// Texels traced exhaustively (exact, slower): those whose list did not fit the capacity, and every
+    /// texel of a group of 16 whose lists' offsets did not fit the packed offsets' 16 bits.
     pub texels_past_capacity: u32,
     /// A point light's (triangle, face) pairs kept by the setup (0 for a light of one frustum). Past the
     /// pairs the map held (`pair_capacity`), the frame traced every ray exhaustively (exact, slower), and

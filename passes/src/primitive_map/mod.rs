@@ -501,10 +501,17 @@ impl PrimitiveMap {
             .collect();
 
         enc.begin_pass("primitive map: fit");
-        enc.barriers(&[Barrier::Global {
-            before: S::UnorderedAccess,
-            after: S::CopyDest,
-        }]);
+        // The state's last read was the previous build's copy into its read-back (a transfer).
+        enc.barriers(&[
+            Barrier::Global {
+                before: S::UnorderedAccess,
+                after: S::CopyDest,
+            },
+            Barrier::Global {
+                before: S::CopySource,
+                after: S::CopyDest,
+            },
+        ]);
         enc.update_buffer(&self.state, 0, bytemuck::cast_slice(&reset))?;
         enc.fill_buffer(&self.receivers, 0);
         enc.fill_buffer(&self.bound.scratch.counts, 0);

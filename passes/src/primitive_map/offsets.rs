@@ -1,8 +1,8 @@
 //! The layout of the primitive map's list offsets (`map_offsets.glsl` reads it, `map_pack.comp` writes it):
 //! the texels in groups of [`OFFSET_GROUP`] consecutive indices, [`OFFSET_GROUP_WORDS`] `u32` per group.
 //! Word 0 is the offset of the group's first list, with [`OFFSET_GROUP_OVERFLOW`] set when a list of the
-//! group starts 65536 or more entries after it (its local offsets do not fit: its texels are traced
-//! exhaustively, exact); words 1..=8 hold the 16-bit offset of each texel's list from word 0 (texel
+//! group starts 65536 or more entries after it, or its lists end at 2^31 entries or more (its offsets are
+//! not kept: its texels are traced exhaustively, exact); words 1..=8 hold the 16-bit offset of each texel's list from word 0 (texel
 //! `16g + i` in the low half of word `1 + i / 2` for even `i`, the high half for odd `i`). One more group
 //! follows the last, its word 0 the entries of all lists. 2.25 bytes per texel instead of 4.
 
@@ -97,7 +97,8 @@ mod tests {
         for g in 0..=texels.div_ceil(OFFSET_GROUP) {
             let first = g * OFFSET_GROUP;
             let base = at(first);
-            let over = at(first + OFFSET_GROUP - 1) - base > 0xFFFF;
+            let over = at(first + OFFSET_GROUP - 1) - base > 0xFFFF
+                || at(first + OFFSET_GROUP) >= OFFSET_GROUP_OVERFLOW;
             out[g * OFFSET_GROUP_WORDS] = base | if over { OFFSET_GROUP_OVERFLOW } else { 0 };
             for i in (0..OFFSET_GROUP).step_by(2) {
                 out[g * OFFSET_GROUP_WORDS + 1 + i / 2] = if over {
@@ -156,6 +157,17 @@ mod tests {
         }
         assert_eq!(unpacked.range(16), None);
         assert_eq!(unpacked.total(), 47 * 3 + 70_000);
+    }
+
+    #[test]
+    fn lists_ending_past_2_pow_31_mark_their_group() {
+        let mut counts = vec![3u32; 48];
+        counts[15] = 1 << 31;
+        let scanned = scan(&counts);
+        let unpacked = unpack_list_offsets(&pack(&scanned), 48).unwrap();
+        // Group 0's last list ends past 2^31, and the bases after it carry the mark's bit.
+        assert!(unpacked.overflowed.iter().all(|&o| o));
+        assert_eq!(unpacked.range(3), None);
     }
 
     #[test]

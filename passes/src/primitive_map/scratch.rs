@@ -14,7 +14,7 @@ const BIN_TRI_BYTES: u64 = 64;
 pub(super) const PAIR_BYTES: u64 = 8;
 
 /// Entries of the bin walk's search index (`SEARCH_INDEX_SIZE` in `map_bin.glsl`, built by
-/// `map_index.comp`): the bin triangle holding every (items / 65536)-th item.
+/// `map_index.comp`): the bin triangle holding every ⌈items / 65536⌉-th item.
 pub(super) const SEARCH_INDEX_WORDS: u64 = 65536;
 
 /// Words of a receiver map of `texels` texels: one per texel, then one per 4×4-texel tile of the grids (the
