@@ -369,7 +369,8 @@ enum HrtsResource
   HRTS_RESOURCE_PRIM_LIST_OFFSETS = 1,
   // Primitive map list entries, a buffer of `uint32_t` triangle indices (`R32_UINT`, width = capacity).
   HRTS_RESOURCE_PRIM_LIST_ENTRIES = 2,
-  // Occupancy view, `R8G8B8A8_UNORM`, N² (grey: list length on a log scale; red: past the capacity).
+  // Occupancy view, `R8G8B8A8_UNORM`, N² (grey: list length on a log scale; red: traced exhaustively, past
+  // the capacity or in an overflowed group of the packed offsets).
   HRTS_RESOURCE_OCCUPANCY = 3,
   // Ray-traced visibility, `R32_SFLOAT`, 1 = lit.
   HRTS_RESOURCE_RT_VISIBILITY = 4,
@@ -869,7 +870,8 @@ typedef struct HrtsFrameReport {
   uint32_t binning_path;
   // Conservative-raster tier used (0 for the compute and software paths).
   uint32_t tier;
-  // Texels whose list did not fit the entry capacity (traced exhaustively: exact, slower).
+  // Texels traced exhaustively (exact, slower): those whose list did not fit the entry capacity, and every
+  // texel of a group of 16 whose lists' offsets did not fit the packed list offsets.
   uint32_t texels_past_capacity;
   // Longest list of any texel.
   uint32_t longest_list;

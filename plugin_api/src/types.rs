@@ -205,7 +205,8 @@ pub enum HrtsResource {
     PrimListOffsets = 1,
     /// Primitive map list entries, a buffer of `uint32_t` triangle indices (`R32_UINT`, width = capacity).
     PrimListEntries = 2,
-    /// Occupancy view, `R8G8B8A8_UNORM`, N² (grey: list length on a log scale; red: past the capacity).
+    /// Occupancy view, `R8G8B8A8_UNORM`, N² (grey: list length on a log scale; red: traced exhaustively, past
+    /// the capacity or in an overflowed group of the packed offsets).
     Occupancy = 3,
     /// Ray-traced visibility, `R32_SFLOAT`, 1 = lit.
     RtVisibility = 4,
@@ -798,7 +799,8 @@ pub struct HrtsFrameReport {
     pub binning_path: u32,
     /// Conservative-raster tier used (0 for the compute and software paths).
     pub tier: u32,
-    /// Texels whose list did not fit the entry capacity (traced exhaustively: exact, slower).
+    /// Texels traced exhaustively (exact, slower): those whose list did not fit the entry capacity, and every
+    /// texel of a group of 16 whose lists' offsets did not fit the packed list offsets.
     pub texels_past_capacity: u32,
     /// Longest list of any texel.
     pub longest_list: u32,
