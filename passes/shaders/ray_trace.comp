@@ -159,25 +159,11 @@ void main() {
     // list.
     bool binned = ms.grid.z <= ms.grid.w;
     if (listed && binned && (end <= ms.totals.z || begin == end)) {
-        // Four entries at a time: their indices, then their triangles, are loaded before any is tested,
-        // so that a long list costs two memory latencies per four entries rather than two per entry (the
-        // longest list of a frame is its critical path; eight at a time cost more registers than they
-        // saved). The first-hit exit is checked between batches.
-        uint triangles = uint(tris.length());
-        for (uint i = begin; i < end && !(first_hit && nearest < t_max); i += 4u) {
-            uint index[4];
-            for (uint j = 0u; j < 4u; ++j) {
-                index[j] = i + j < end ? entries[i + j] : triangles;
-            }
-            Triangle batch[4];
-            for (uint j = 0u; j < 4u; ++j) {
-                batch[j] = tris[min(index[j], triangles - 1u)];
-            }
-            for (uint j = 0u; j < 4u; ++j) {
-                float d = index[j] < triangles ? intersect(batch[j]) : -1.0;
-                if (d > 0.0 && d < nearest) {
-                    nearest = d;
-                }
+        // Checked every 8 entries, so that the walk within them keeps its loads in flight.
+        for (uint i = begin; i < end && !(first_hit && nearest < t_max); i += 8u) {
+            uint stop = min(i + 8u, end);
+            for (uint j = i; j < stop; ++j) {
+                consider(entries[j], nearest);
             }
         }
     } else {
