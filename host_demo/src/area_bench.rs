@@ -24,10 +24,11 @@ const SAMPLES: [u32; 4] = [16, 32, 64, 128];
 /// The PCSS compared with: an 8K shadow map, standard penumbra, 16 + 32 taps.
 const PCSS_MAP: u32 = 8192;
 
-fn area_config(angular_radius: f32, samples: u32) -> ShadowConfig {
+fn area_config(args: &BenchArgs, angular_radius: f32, samples: u32) -> ShadowConfig {
     ShadowConfig {
         mode: ShadowMode::Area,
         antialiasing: false,
+        map: args.map(),
         pcss: PcssConfig {
             angular_radius,
             ..PcssConfig::default()
@@ -79,6 +80,25 @@ fn area_ms(r: &Run) -> (f64, f64) {
     )
 }
 
+/// The median trace-only GPU ms of the ray-tracing-pipeline peer on the frame `renderer` last rendered
+/// (`None` on a device without ray tracing).
+fn peer_trace_ms(
+    device: &Device,
+    renderer: &crate::plugin::PluginRenderer,
+    view: &View,
+    angular_radius: f32,
+    samples: u32,
+    frames: u32,
+) -> Result<Option<f64>> {
+    if !device.capabilities().ray_tracing_pipeline {
+        return Ok(None);
+    }
+    let inputs = view.frame_inputs();
+    let run =
+        crate::peer::run_area_peer(device, renderer, &inputs, angular_radius, samples, frames)?;
+    Ok(Some(run.trace_ms))
+}
+
 /// Runs the area benchmark over the chosen models and returns its Markdown tables.
 pub fn run_area_bench(device: &Device, args: &BenchArgs) -> Result<String> {
     let models = models_folder(args)?;
@@ -89,8 +109,9 @@ pub fn run_area_bench(device: &Device, args: &BenchArgs) -> Result<String> {
         "Device: {} ({}); {}×{}; directional light of angular radius {r}; medians of {} frames after the \
          first (GPU timestamps, ms).\n\n\
          | model | triangles | area map build ms | area trace ms | area ms | PCSS {PCSS_MAP}² ms | area / PCSS | \
-         entries | mean list | longest list | texels past capacity | map MiB | wrong px (unstable) |\n\
-         |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+         RT peer trace ms | area / peer | entries | mean list | longest list | texels past capacity | \
+         pixels walking the BVH | map MiB | wrong px (unstable) |\n\
+         |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         caps.device_name,
         caps.driver,
         args.width,
@@ -110,7 +131,9 @@ pub fn run_area_bench(device: &Device, args: &BenchArgs) -> Result<String> {
     for model in chosen {
         let view = view_of(model, &models, args)?;
         bar.set_message(format!("{} area", model.file));
-        let (renderer, area) = run(device, &view, area_config(r, n), args.frames)?;
+        let (renderer, area) = run(device, &view, area_config(args, r, n), args.frames)?;
+        bar.set_message(format!("{} RT peer", model.file));
+        let peer = peer_trace_ms(device, &renderer, &view, r, n, args.frames)?;
         bar.inc(1);
         let wrong = if args.no_reference {
             "—".to_owned()
@@ -127,8 +150,12 @@ pub fn run_area_bench(device: &Device, args: &BenchArgs) -> Result<String> {
         let (build, trace) = area_ms(&area);
         let pcss_ms = median_of(&pcss.times, &["shadow map", "PCSS"]).unwrap_or(f64::NAN);
         let st = &area.report.stats;
+        let (peer_cell, ratio_cell) = match peer {
+            Some(ms) => (format!("{ms:.3}"), format!("{:.2}", (build + trace) / ms)),
+            None => ("—".to_owned(), "—".to_owned()),
+        };
         main.push_str(&format!(
-            "| {} | {} | {build:.3} | {trace:.3} | {:.3} | {pcss_ms:.3} | {:.2} | {} | {:.1} | {} | {} | {:.1} | {wrong} |\n",
+            "| {} | {} | {build:.3} | {trace:.3} | {:.3} | {pcss_ms:.3} | {:.2} | {peer_cell} | {ratio_cell} | {} | {:.1} | {} | {} | {} | {:.1} | {wrong} |\n",
             model.file,
             view.scene.triangle_count(),
             build + trace,
@@ -137,6 +164,7 @@ pub fn run_area_bench(device: &Device, args: &BenchArgs) -> Result<String> {
             st.mean_list(),
             st.longest_list,
             st.texels_past_capacity,
+            st.pixels_walked,
             map_bytes(&area.report) as f64 / f64::from(1 << 20),
         ));
         let mut cells = Vec::new();
@@ -146,7 +174,12 @@ pub fn run_area_bench(device: &Device, args: &BenchArgs) -> Result<String> {
             .chain(SAMPLES.iter().map(|&samples| (r, samples)))
         {
             bar.set_message(format!("{} r {radius}, {samples} samples", model.file));
-            let (_, point) = run(device, &view, area_config(radius, samples), args.frames)?;
+            let (_, point) = run(
+                device,
+                &view,
+                area_config(args, radius, samples),
+                args.frames,
+            )?;
             let (build, trace) = area_ms(&point);
             cells.push(format!(
                 "{:.3} ({:.1})",
@@ -160,7 +193,9 @@ pub fn run_area_bench(device: &Device, args: &BenchArgs) -> Result<String> {
     bar.finish_and_clear();
     main.push_str(&format!(
         "\narea map build = every `primitive map:` pass and the statistics; area trace = the pass that tests \
-         the {n} samples; PCSS = shadow map + PCSS (standard penumbra, 16 + 32 taps). Wrong px: pixels whose \
+         the {n} samples; PCSS = shadow map + PCSS (standard penumbra, 16 + 32 taps); RT peer trace = the same \
+         {n} samples of every pixel as {n} any-hit rays through the driver's ray-tracing pipeline, trace only \
+         (— on a device without ray tracing). Wrong px: pixels whose \
          visible sample count differs from the exact reference of the same samples, outside the pixels with a \
          sample within the reference's tolerance of an edge (unstable).\n"
     ));

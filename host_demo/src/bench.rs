@@ -70,14 +70,35 @@ pub struct BenchArgs {
     /// With --area, or --lights --emitter-size: light samples per pixel.
     #[arg(long, default_value_t = passes::DEFAULT_AREA_SAMPLES)]
     pub area_samples: u32,
-    /// With --lights: sized lights with exact soft shadows (mode area) instead of hard ones: spot and
-    /// point lights get a spherical emitter of this fraction of the scene's bounding radius, the sun
-    /// --angular-radius. 0: zero-size lights (hard shadows).
-    #[arg(long, default_value_t = 0.0, requires = "lights")]
-    pub emitter_size: f32,
+    /// With --lights: sized lights with exact soft shadows (mode area) instead of hard ones, one run per
+    /// size (comma-separated): spot and point lights get a spherical emitter whose radius is this fraction
+    /// of the scene's extent (the diagonal of its bounds), the sun --angular-radius; each sized light is
+    /// also traced by the ray-tracing-pipeline peer at equal samples. 0: zero-size lights (hard shadows).
+    /// Default: hard shadows alone.
+    #[arg(long, value_delimiter = ',', requires = "lights")]
+    pub emitter_size: Vec<f32>,
+    /// A texel whose list would pass this many entries keeps none: its pixels walk the BVH.
+    #[arg(long, default_value_t = passes::primitive_map::DEFAULT_LIST_LIMIT)]
+    pub list_limit: u32,
+    /// Bin items per pixel with a ray past which a frame builds no list and every pixel walks the BVH
+    /// (0: always the BVH; inf: always lists).
+    #[arg(long, default_value_t = passes::primitive_map::DEFAULT_BIN_BUDGET)]
+    pub bin_budget: f32,
     /// With --lights: the primitive map's N (texels per side; a point light's cube faces share N²).
     #[arg(long, default_value_t = passes::PrimitiveMapConfig::DEFAULT_SIZE, requires = "lights", value_parser = clap::value_parser!(u32).range(1..=i64::from(u16::MAX)))]
     pub map_size: u32,
+}
+
+impl BenchArgs {
+    /// The primitive map the benchmark's configurations take: the default with the given list limit and
+    /// bin budget (and, for --lights, N).
+    pub fn map(&self) -> PrimitiveMapConfig {
+        PrimitiveMapConfig {
+            list_limit: self.list_limit,
+            bin_budget: self.bin_budget,
+            ..PrimitiveMapConfig::default()
+        }
+    }
 }
 
 /// One benchmark model: a file of `../shared/models`, how it is shown, and the talk's GTX 980 times (ms)
@@ -311,7 +332,7 @@ fn measure(device: &Device, model: &Model, models: &Path, args: &BenchArgs) -> R
             let config = ShadowConfig {
                 map: PrimitiveMapConfig {
                     binning: request,
-                    ..PrimitiveMapConfig::default()
+                    ..args.map()
                 },
                 ..ShadowConfig::default()
             };

@@ -3,8 +3,11 @@
 //! point light at three positions inside, planned as `render --scene` plans a glTF scene and drawn through
 //! the plugin's C ABI (a point light given as a point light: the plugin builds its cube faces as one map);
 //! with `--point-lights N`, N point lights in one context. Per light: frusta recorded of those built, GPU
-//! ms of its passes (the median over the frames after the first of the per-frame sum over its frusta),
-//! per pass, memory, and its lists (entries, mean and longest list, texels past capacity).
+//! ms of its passes (the median over the frames after the first of the per-frame sum over its frusta, and
+//! the slowest frame), per pass, memory, and its lists (entries, mean and longest list, texels past
+//! capacity or the list limit, whether the frame built lists at all, pixels that walked the BVH).
+//! `--emitter-size` runs every light at each size given, sized lights with exact soft shadows, each also
+//! traced by the ray-tracing-pipeline peer at equal samples (trace only).
 
 use crate::bench::BenchArgs;
 use crate::gbuffer::GBufferLayout;
@@ -14,7 +17,10 @@ use crate::scene_render::SceneRenderer;
 use crate::CameraMatrices;
 use anyhow::{Context, Result};
 use glam::Vec3;
-use passes::{AreaConfig, PrimitiveMapConfig, ResourceId, ShadowConfig, ShadowMode};
+use passes::{
+    directional_light_frustum, spot_light_frusta, AreaConfig, FrameInputs, Light, MapStats,
+    PrimitiveMapConfig, ResourceId, ShadowConfig, ShadowMode,
+};
 use rhi::Device;
 use scene::{Aabb, Camera, LightKind, LightSize, SceneFile, SceneLight};
 use std::fmt::Write as _;
@@ -60,6 +66,28 @@ fn at(bounds: &Aabb, f: Vec3) -> Vec3 {
 /// The sizes of the benchmark's lights: `None` for zero-size lights, else the sun's angular radius and the
 /// spot and point lights' emitter radius (scene units).
 type Sizes = Option<(f32, f32)>;
+
+/// The light the plugin shadows for `light` (its first frustum for a spot light of one frustum), for the
+/// ray-tracing-pipeline peer; `None` for a spot light of several frusta.
+fn peer_light(light: &SceneLight, bounds: &Aabb) -> Result<Option<Light>> {
+    Ok(match light.kind {
+        LightKind::Directional { direction } => Some(directional_light_frustum(
+            direction,
+            [bounds.min, bounds.max],
+        )?),
+        LightKind::Spot {
+            position,
+            direction,
+            outer_cone,
+            range,
+            ..
+        } => match spot_light_frusta(position, direction, outer_cone, range).as_slice() {
+            [one] => Some(*one),
+            _ => None,
+        },
+        LightKind::Point { position, range } => Some(Light::Point { position, range }),
+    })
+}
 
 /// The benchmark's lights for a scene whose bounds are `bounds`: name and light.
 fn lights(scene: &LightScene, bounds: &Aabb, sizes: Sizes) -> Vec<(String, SceneLight)> {
@@ -122,17 +150,47 @@ struct LightCost {
     /// Frusta recorded in the last frame, and built.
     frusta: (u32, u32),
     gpu_ms: f64,
+    /// The slowest frame's GPU ms (the first one included).
+    max_ms: f64,
     map_ms: f64,
     trace_ms: f64,
+    /// The ray-tracing-pipeline peer's trace-only ms at equal samples (sized lights with one frustum).
+    peer_ms: Option<f64>,
     bytes: u64,
     entries: u64,
     mean_list: f64,
     longest: u32,
     past_capacity: u64,
+    /// The last frame's routes, summed over the light's frusta.
+    routes: Routes,
     /// Median ms of each pass (summed over the light's frusta), in the order first seen.
     passes: Vec<(String, f64)>,
     /// Bytes of the build scratch the context's lights share.
     scratch_bytes: u64,
+}
+
+/// Where a light's pixels found their triangles in the last frame, summed over its frusta.
+#[derive(Default)]
+struct Routes {
+    /// Bin items of the footprints.
+    bin_items: u64,
+    /// Frusta that built no list (bin items past the budget).
+    skipped: u32,
+    /// Texels whose list passed the list limit.
+    past_limit: u64,
+    /// Pixels that walked the BVH.
+    walked: u64,
+}
+
+impl Routes {
+    fn of<'a>(stats: impl IntoIterator<Item = &'a MapStats>) -> Self {
+        stats.into_iter().fold(Self::default(), |r, st| Self {
+            bin_items: r.bin_items + u64::from(st.bin_items),
+            skipped: r.skipped + u32::from(st.lists_skipped),
+            past_limit: r.past_limit + u64::from(st.texels_past_limit),
+            walked: r.walked + u64::from(st.pixels_walked),
+        })
+    }
 }
 
 /// Median of `v` (0 when empty).
@@ -188,11 +246,42 @@ fn medians(frames: &[LightsFrame]) -> (f64, f64, f64) {
     )
 }
 
+/// The peer's trace-only ms for `light` of size `size` (angular radius or emitter radius) on the frame
+/// `plugin` last rendered through `camera` (`None` without ray tracing or without a light for it).
+fn peer_ms(
+    device: &Device,
+    plugin: &PluginRenderer,
+    camera: &Camera,
+    light: Option<Light>,
+    size: f32,
+    args: &BenchArgs,
+) -> Result<Option<f64>> {
+    let Some(light) = light.filter(|_| device.capabilities().ray_tracing_pipeline) else {
+        return Ok(None);
+    };
+    let m = CameraMatrices::of_camera(camera, args.width, args.height);
+    let inputs = FrameInputs {
+        view: m.view,
+        proj: m.proj,
+        camera_position: m.position,
+        light,
+    };
+    let run = crate::peer::run_area_peer(
+        device,
+        plugin,
+        &inputs,
+        size,
+        args.area_samples,
+        args.frames,
+    )?;
+    Ok(Some(run.trace_ms))
+}
+
 fn measure_light(
     device: &Device,
     file: &SceneFile,
     camera: &Camera,
-    name: &str,
+    (name, peer): (&str, Option<(Light, f32)>),
     args: &BenchArgs,
 ) -> Result<LightCost> {
     let settings = PlanSettings {
@@ -203,7 +292,7 @@ fn measure_light(
             },
             map: PrimitiveMapConfig {
                 size: args.map_size,
-                ..PrimitiveMapConfig::default()
+                ..args.map()
             },
             ..ShadowConfig::default()
         },
@@ -218,8 +307,13 @@ fn measure_light(
         frames.push(renderer.render(device, camera, &plan)?);
     }
     let (gpu_ms, map_ms, trace_ms) = medians(&frames[1..]);
+    let max_ms = slowest(&frames);
     let last = frames.last().context("no frame rendered")?;
     let reports: Vec<_> = last.lights.iter().map(|l| &l.report).collect();
+    let peer_ms = match peer {
+        Some((light, size)) => peer_ms(device, renderer.plugin(), camera, Some(light), size, args)?,
+        None => None,
+    };
     let entries: u64 = reports.iter().map(|r| u64::from(r.stats.entries)).sum();
     let texels: u64 = reports
         .iter()
@@ -229,8 +323,11 @@ fn measure_light(
         name: name.to_owned(),
         frusta: frusta_of(last),
         gpu_ms,
+        max_ms,
         map_ms,
         trace_ms,
+        peer_ms,
+        routes: Routes::of(reports.iter().map(|r| &r.stats)),
         bytes: reports
             .iter()
             .flat_map(|r| &r.resources)
@@ -259,6 +356,14 @@ fn measure_light(
             .max()
             .unwrap_or(0),
     })
+}
+
+/// The slowest of `frames`' GPU ms over their lights' own passes (the shared prim buffer excluded).
+fn slowest(frames: &[LightsFrame]) -> f64 {
+    frames
+        .iter()
+        .map(|f| frame_ms(f, |n| n != ResourceId::PrimBuffer.name()))
+        .fold(0.0, f64::max)
 }
 
 /// Frusta of `frame`'s lights: recorded, and built (recorded or culled).
@@ -294,7 +399,7 @@ fn measure_native_points(
         antialiasing: false,
         map: PrimitiveMapConfig {
             size: args.map_size,
-            ..PrimitiveMapConfig::default()
+            ..args.map()
         },
         ..ShadowConfig::default()
     };
@@ -311,12 +416,9 @@ fn measure_native_points(
         frames.push(plugin.render_c_lights(device, &matrices, lights.clone())?);
     }
     let (_, map_ms, trace_ms) = medians(&frames[1..]);
-    let gpu_ms = median(
-        frames[1..]
-            .iter()
-            .map(|f| f.lights.iter().map(|l| l.gpu_ms).sum())
-            .collect(),
-    );
+    let frame_ms = |f: &LightsFrame| f.lights.iter().map(|l| l.gpu_ms).sum::<f64>();
+    let gpu_ms = median(frames[1..].iter().map(frame_ms).collect());
+    let max_ms = frames.iter().map(frame_ms).fold(0.0, f64::max);
     let last = frames.last().context("no frame rendered")?;
     let light = last.lights.first().context("no light reported")?;
     let st = &light.report.stats;
@@ -324,8 +426,11 @@ fn measure_native_points(
         name,
         frusta: frusta_of(last),
         gpu_ms,
+        max_ms,
         map_ms,
         trace_ms,
+        peer_ms: None,
+        routes: Routes::of(last.lights.iter().map(|l| &l.report.stats)),
         bytes: last
             .lights
             .iter()
@@ -345,22 +450,38 @@ fn measure_native_points(
 /// Runs the light benchmark and returns its Markdown table.
 pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Result<String> {
     let caps = device.capabilities();
+    if let Some(bad) = args
+        .emitter_size
+        .iter()
+        .find(|&&f| !(f.is_finite() && f >= 0.0))
+    {
+        anyhow::bail!("--emitter-size {bad}: give fractions of the scene's extent, 0 or more");
+    }
+    let sizes: Vec<f32> = if args.emitter_size.is_empty() {
+        vec![0.0]
+    } else {
+        args.emitter_size.clone()
+    };
+    let sized = sizes.iter().any(|&f| f > 0.0);
     let mut out = format!(
         "Device: {} ({}); {}×{}, {}, primitive map N = {}, no FXAA; one light at a time, planned as \
          `render --scene` plans it; GPU ms = median over {} frames after the first of the light's passes \
-         summed over its frusta (the shared prim buffer excluded); memory = the light's own resources (each light \
-         writes its layer of an R32F storage output directly; the build scratch shared by all lights is listed \
-         below); frusta = recorded / built (the plugin skips those holding no receiver in view).\n\n\
-         | scene | light | frusta | GPU ms | × sun | map ms | ray trace ms | MiB | entries | mean list | longest | past capacity |\n\
-         |---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+         summed over its frusta (the shared prim buffer excluded), max = the slowest frame, the first \
+         included; memory = the light's own resources (each light writes its layer of an R32F storage output \
+         directly; the build scratch shared by all lights is listed below); frusta = recorded / built (the \
+         plugin skips those holding no receiver in view).\n\n\
+         | scene | light | emitter | frusta | GPU ms | max ms | × sun | map ms | ray trace ms | RT peer trace ms | \
+         MiB | entries | mean list | longest | bin items | lists | past limit | past capacity | BVH pixels |\n\
+         |---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|\n",
         caps.device_name,
         caps.driver,
         args.width,
         args.height,
-        if args.emitter_size > 0.0 {
+        if sized {
             format!(
-                "exact soft shadows (mode area, {} samples; light sizes below)",
-                args.area_samples
+                "exact soft shadows of sized lights (mode area, {} samples; emitter radius as a share of \
+                 the scene's extent, the sun {} rad)",
+                args.area_samples, args.angular_radius
             )
         } else {
             "hard shadows (zero-size lights)".to_owned()
@@ -374,7 +495,7 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
         .collect();
     let total: usize = chosen
         .iter()
-        .map(|s| 2 + s.points.len() + usize::from(args.point_lights > 0))
+        .map(|s| (2 + s.points.len() + usize::from(args.point_lights > 0)) * sizes.len())
         .sum();
     let bar = crate::progress(total as u64, "bench --lights");
     let mut sizes_line = String::new();
@@ -400,90 +521,123 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
             camera: Some(camera),
             skipped_primitives: 0,
         };
-        let emitter_radius = (args.emitter_size > 0.0).then(|| args.emitter_size * bounds.radius());
-        let sizes = emitter_radius.map(|r| (args.angular_radius, r));
-        if let Some(r) = emitter_radius {
-            let _ = writeln!(
-                sizes_line,
-                "- {}: emitter radius {r:.4} (scene units), sun {} rad",
-                scene_case.file, args.angular_radius
-            );
-        }
-        let mut costs = Vec::new();
-        for (name, light) in lights(scene_case, &bounds, sizes) {
-            bar.set_message(format!("{} {name}", scene_case.file));
-            costs.push(measure_light(
-                device,
-                &file_with(vec![light]),
-                &camera,
-                &name,
-                args,
-            )?);
-            bar.inc(1);
-        }
-        if args.point_lights > 0 {
-            bar.set_message(format!(
-                "{} {} point lights",
-                scene_case.file, args.point_lights
-            ));
-            let n = args.point_lights;
-            // On a ring around the interior's centre, alternating between two heights.
-            let positions: Vec<Vec3> = (0..n)
-                .map(|i| {
-                    let a = i as f32 / n as f32 * std::f32::consts::TAU;
-                    let f = Vec3::new(
-                        0.5 + 0.3 * a.cos(),
-                        if i % 2 == 0 { 0.2 } else { 0.5 },
-                        0.5 + 0.3 * a.sin(),
-                    );
-                    at(&bounds, f)
-                })
-                .collect();
-            costs.push(measure_native_points(
-                device,
-                &file_with(Vec::new()),
-                &camera,
-                &positions,
-                format!("{n} point lights, native, all together"),
-                args,
-                emitter_radius,
-            )?);
-        }
-        let sun = costs[0].gpu_ms;
-        for c in &costs {
-            let _ = writeln!(
-                out,
-                "| {} | {} | {} / {} | {:.3} | {:.1} | {:.3} | {:.3} | {:.1} | {} | {:.1} | {} | {} |",
-                scene_case.file.trim_end_matches(".obj"),
-                c.name,
-                c.frusta.0,
-                c.frusta.1,
-                c.gpu_ms,
-                if sun > 0.0 { c.gpu_ms / sun } else { 0.0 },
-                c.map_ms,
-                c.trace_ms,
-                c.bytes as f64 / f64::from(1 << 20),
-                c.entries,
-                c.mean_list,
-                c.longest,
-                c.past_capacity
-            );
-            let passes: Vec<String> = c
-                .passes
-                .iter()
-                .map(|(name, ms)| format!("{name} {ms:.3}"))
-                .collect();
-            let _ = writeln!(
-                per_pass,
-                "- {} {}: {}; shared build scratch {:.1} MiB",
-                scene_case.file.trim_end_matches(".obj"),
-                c.name,
-                passes.join(", "),
-                c.scratch_bytes as f64 / f64::from(1 << 20)
-            );
+        let extent = (bounds.max - bounds.min).length();
+        let mut sun = None;
+        for &fraction in &sizes {
+            let emitter_radius = (fraction > 0.0).then(|| fraction * extent);
+            let size_cell =
+                emitter_radius.map_or("0".to_owned(), |_| format!("{:.1} %", fraction * 100.0));
+            if let Some(r) = emitter_radius {
+                let _ = writeln!(
+                    sizes_line,
+                    "- {}: {} of the extent {extent:.3} = emitter radius {r:.4} (scene units)",
+                    scene_case.file, size_cell
+                );
+            }
+            let sizes_of = emitter_radius.map(|r| (args.angular_radius, r));
+            let mut costs = Vec::new();
+            for (name, light) in lights(scene_case, &bounds, sizes_of) {
+                bar.set_message(format!("{} {name} {size_cell}", scene_case.file));
+                let size = match (&light.size, sizes_of) {
+                    (_, None) => None,
+                    (scene::LightSize::AngularRadius(a), _) => Some(*a),
+                    (_, Some((_, r))) => Some(r),
+                };
+                let peer = match size {
+                    Some(size) => peer_light(&light, &bounds)?.map(|l| (l, size)),
+                    None => None,
+                };
+                costs.push(measure_light(
+                    device,
+                    &file_with(vec![light]),
+                    &camera,
+                    (&name, peer),
+                    args,
+                )?);
+                bar.inc(1);
+            }
+            if args.point_lights > 0 {
+                bar.set_message(format!(
+                    "{} {} point lights {size_cell}",
+                    scene_case.file, args.point_lights
+                ));
+                let n = args.point_lights;
+                // On a ring around the interior's centre, alternating between two heights.
+                let positions: Vec<Vec3> = (0..n)
+                    .map(|i| {
+                        let a = i as f32 / n as f32 * std::f32::consts::TAU;
+                        let f = Vec3::new(
+                            0.5 + 0.3 * a.cos(),
+                            if i % 2 == 0 { 0.2 } else { 0.5 },
+                            0.5 + 0.3 * a.sin(),
+                        );
+                        at(&bounds, f)
+                    })
+                    .collect();
+                costs.push(measure_native_points(
+                    device,
+                    &file_with(Vec::new()),
+                    &camera,
+                    &positions,
+                    format!("{n} point lights, native, all together"),
+                    args,
+                    emitter_radius,
+                )?);
+                bar.inc(1);
+            }
+            let sun_ms = *sun.get_or_insert(costs[0].gpu_ms);
+            for c in &costs {
+                let _ = writeln!(
+                    out,
+                    "| {} | {} | {size_cell} | {} / {} | {:.3} | {:.3} | {:.1} | {:.3} | {:.3} | {} | {:.1} | {} | {:.1} | {} | {} | {} | {} | {} | {} |",
+                    scene_case.file.trim_end_matches(".obj"),
+                    c.name,
+                    c.frusta.0,
+                    c.frusta.1,
+                    c.gpu_ms,
+                    c.max_ms,
+                    if sun_ms > 0.0 { c.gpu_ms / sun_ms } else { 0.0 },
+                    c.map_ms,
+                    c.trace_ms,
+                    c.peer_ms.map_or("—".to_owned(), |ms| format!("{ms:.3}")),
+                    c.bytes as f64 / f64::from(1 << 20),
+                    c.entries,
+                    c.mean_list,
+                    c.longest,
+                    c.routes.bin_items,
+                    if c.routes.skipped > 0 {
+                        format!("BVH ({} of {})", c.routes.skipped, c.frusta.0)
+                    } else {
+                        "built".to_owned()
+                    },
+                    c.routes.past_limit,
+                    c.past_capacity,
+                    c.routes.walked,
+                );
+                let passes: Vec<String> = c
+                    .passes
+                    .iter()
+                    .map(|(name, ms)| format!("{name} {ms:.3}"))
+                    .collect();
+                let _ = writeln!(
+                    per_pass,
+                    "- {} {} {size_cell}: {}; shared build scratch {:.1} MiB",
+                    scene_case.file.trim_end_matches(".obj"),
+                    c.name,
+                    passes.join(", "),
+                    c.scratch_bytes as f64 / f64::from(1 << 20)
+                );
+            }
         }
     }
     bar.finish_and_clear();
+    out.push_str(
+        "\n× sun: against the first size's sun. lists: built, or BVH when the frame's bin items passed the \
+         bin budget and every pixel walked the BVH; past limit: texels whose list passed the list limit (they \
+         walk the BVH); BVH pixels: pixels that walked the BVH. RT peer: the same samples of every pixel as \
+         any-hit rays through the driver's ray-tracing pipeline, trace only (— for hard shadows, a spot \
+         light of several frusta, several lights at once, or a device without ray tracing).\n",
+    );
     if !sizes_line.is_empty() {
         out.push_str("\nLight sizes:\n\n");
         out.push_str(&sizes_line);

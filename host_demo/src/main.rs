@@ -127,6 +127,14 @@ struct RenderArgs {
     /// sw (geometry-shader conservative raster).
     #[arg(long, default_value = "auto", value_parser = parse_binning)]
     binning: BinningRequest,
+    /// A texel whose list would pass this many entries keeps none: its pixels walk the BVH (moves cost,
+    /// never exactness).
+    #[arg(long, default_value_t = passes::primitive_map::DEFAULT_LIST_LIMIT)]
+    list_limit: u32,
+    /// Bin items per pixel with a ray past which a frame builds no list and every pixel walks the BVH
+    /// (0: always the BVH; inf: always lists; moves cost, never exactness).
+    #[arg(long, default_value_t = passes::primitive_map::DEFAULT_BIN_BUDGET)]
+    bin_budget: f32,
     /// Frames to render (timings are medians over all but the first; at least 2 with --scene, so that the
     /// second frame's report shows what was kept).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
@@ -493,6 +501,8 @@ fn map_config(args: &RenderArgs) -> PrimitiveMapConfig {
         faces: args.faces,
         binning: args.binning,
         entry_budget: u64::from(args.map_budget_mb) << 20,
+        list_limit: args.list_limit,
+        bin_budget: args.bin_budget,
         ..PrimitiveMapConfig::default()
     }
 }

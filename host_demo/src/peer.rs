@@ -1,11 +1,14 @@
 //! The ray-tracing-pipeline peer on the demo's frame: the same shadow rays as the primitive-map ray trace,
 //! traced through the GPU's ray-tracing pipeline over acceleration structures the driver builds from the
 //! demo's prim buffer ([`passes::rt_peer::RtPeerPass`]). What a user would pick instead of our technique.
+//! For area shadows ([`run_area_peer`]) each of a pixel's light samples is its own ray: the same samples
+//! as the plugin's area trace, so equal samples give equal answers.
 
 use crate::plugin::PluginRenderer;
 use crate::{read_images, FrameImages, FrameOutput};
 use anyhow::{Context as _, Result};
-use passes::rt_peer::{shadow_ray_constants, RtPeerPass};
+use passes::gpu_types::{AreaSamples, RayTraceConstants};
+use passes::rt_peer::{area_peer_constants, shadow_ray_constants, RtPeerPass};
 use passes::{FrameInputs, PassError};
 use rhi::{Device, ResourceState as S};
 
@@ -37,16 +40,54 @@ pub fn run_peer(
 ) -> Result<PeerRun> {
     let geometry = renderer.geometry();
     let targets = renderer.targets();
+    let size = (targets.depth.width(), targets.depth.height());
+    let constants = shadow_ray_constants(inputs, geometry.origin(), size.0, size.1)?;
+    run(device, renderer, &constants, None, frames)
+}
+
+/// [`run_peer`] for area shadows: each of the `samples` light samples of every pixel of a light of size
+/// `light_size` (a directional light's angular radius, a spot or point light's emitter radius) traced as
+/// its own any-hit ray, the samples the plugin's area trace takes. The visibility is the visible fraction.
+pub fn run_area_peer(
+    device: &Device,
+    renderer: &PluginRenderer,
+    inputs: &FrameInputs,
+    light_size: f32,
+    samples: u32,
+    frames: u32,
+) -> Result<PeerRun> {
+    let geometry = renderer.geometry();
+    let targets = renderer.targets();
+    let size = (targets.depth.width(), targets.depth.height());
+    let (constants, area) =
+        area_peer_constants(inputs, geometry.origin(), size, light_size, samples)?;
+    run(device, renderer, &constants, Some(&area), frames)
+}
+
+fn run(
+    device: &Device,
+    renderer: &PluginRenderer,
+    constants: &RayTraceConstants,
+    area: Option<&AreaSamples>,
+    frames: u32,
+) -> Result<PeerRun> {
+    let geometry = renderer.geometry();
+    let targets = renderer.targets();
     let (width, height) = (targets.depth.width(), targets.depth.height());
-    let constants = shadow_ray_constants(inputs, geometry.origin(), width, height)?;
-    let mut peer = RtPeerPass::new(
+    let normal = targets
+        .world_normal()
+        .context("the ray-tracing peer reads the analysis G-buffer's world normals")?;
+    let new = if area.is_some() {
+        RtPeerPass::new_area
+    } else {
+        RtPeerPass::new
+    };
+    let mut peer = new(
         device,
         renderer.prims(),
         geometry.triangle_count(),
         &targets.depth,
-        targets
-            .world_normal()
-            .context("the ray-tracing peer reads the analysis G-buffer's world normals")?,
+        normal,
         width,
         height,
     )?;
@@ -56,7 +97,11 @@ pub fn run_peer(
         device.submit_and_wait(|enc| {
             enc.attach_timer(&timer);
             peer.record_build(enc).map_err(into_rhi)?;
-            peer.record_trace(enc, &constants).map_err(into_rhi)
+            match area {
+                Some(samples) => peer.record_area_trace(enc, constants, samples),
+                None => peer.record_trace(enc, constants),
+            }
+            .map_err(into_rhi)
         })?;
         for t in timer.resolve()? {
             match t.name.as_str() {

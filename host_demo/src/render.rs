@@ -207,6 +207,11 @@ struct MapJson {
     longest_list: u32,
     entry_capacity: u32,
     texels_past_capacity: u32,
+    texels_past_limit: u32,
+    bin_items: u32,
+    lists_skipped: bool,
+    pixels_walked: u32,
+    walks_unfinished: u32,
     memory_bytes: u64,
 }
 
@@ -413,6 +418,11 @@ pub fn render_to_folder(
             longest_list: stats.longest_list,
             entry_capacity: stats.capacity,
             texels_past_capacity: stats.texels_past_capacity,
+            texels_past_limit: stats.texels_past_limit,
+            bin_items: stats.bin_items,
+            lists_skipped: stats.lists_skipped,
+            pixels_walked: stats.pixels_walked,
+            walks_unfinished: stats.walks_unfinished,
             memory_bytes: map_bytes(&report),
         },
         shadows: SoftJson {
@@ -467,13 +477,7 @@ pub fn render_to_folder(
             stats.longest_list,
             map_bytes(&report) as f64 / f64::from(1 << 20)
         );
-        if stats.texels_past_capacity > 0 {
-            println!(
-                "note: {} texels did not fit the entry capacity of {} this frame; they stayed exact, traced \
-                 against every triangle, and the lists grow to fit from the next frame on",
-                stats.texels_past_capacity, stats.capacity
-            );
-        }
+        println!("{}", crate::scene_render::routes_line(&stats, &timings));
     }
     // Only the settings of the passes the mode runs.
     let fxaa = format!("FXAA {}", if s.no_antialiasing { "off" } else { "on" });

@@ -184,14 +184,49 @@ fn describe_cost(report: &FrameReport) -> String {
         .collect();
     let st = &report.stats;
     format!(
-        "GPU {total:.3} ms ({}); lists: {} receiver px, {} triangles binned, {} entries, mean {:.1} / longest {}, {} texels past capacity",
+        "GPU {total:.3} ms ({}); lists: {} receiver px, {} triangles binned, {} entries, mean {:.1} / longest {}; {}",
         passes.join(", "),
         st.receiver_pixels,
         st.triangles_binned,
         st.entries,
         st.mean_list(),
         st.longest_list,
-        st.texels_past_capacity
+        routes_line(st, &per_pass)
+    )
+}
+
+/// Where a frame's pixels found their triangles, and what the trace cost (`ms`: GPU ms by pass name):
+/// how many walked the BVH rather than a list, and why (no list built this frame: its bin items passed the
+/// budget; texels past the list limit or the entry capacity).
+pub fn routes_line(st: &passes::MapStats, ms: &std::collections::BTreeMap<String, f64>) -> String {
+    let trace = ms.get("ray trace").copied().unwrap_or(0.0);
+    if st.pixels_walked == 0 {
+        return format!(
+            "every pixel walked its texel's list (trace {trace:.3} ms); {} bin items",
+            st.bin_items
+        );
+    }
+    let why = if st.lists_skipped {
+        format!(
+            "no list built: {} bin items passed the bin budget",
+            st.bin_items
+        )
+    } else {
+        format!(
+            "{} texels past the list limit, {} past the entry capacity of {} (the lists grow to fit the next \
+             frame)",
+            st.texels_past_limit, st.texels_past_capacity, st.capacity
+        )
+    };
+    format!(
+        "{} of {} pixels walked the BVH ({why}); trace {trace:.3} ms in all{}",
+        st.pixels_walked,
+        st.receiver_pixels,
+        if st.walks_unfinished > 0 {
+            format!(", {} WALKS UNFINISHED", st.walks_unfinished)
+        } else {
+            String::new()
+        }
     )
 }
 

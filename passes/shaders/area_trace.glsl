@@ -21,22 +21,20 @@
 // beyond every rounding; only the samples still open that a table cell is uncertain about are tested one by
 // one. Every sample is decided as the per-sample test alone decides it.
 // A sample towards which the receiver's normal does not face is blocked, as the reference has it.
+// Where the map holds no complete list for the pixel (trace_route.glsl), it walks the BVH over the prim
+// buffer (bvh_traverse.glsl) with the bundle of its segments or rays, and tests each triangle met exactly as
+// a list entry: the same answer, bit for bit. Either way a pixel stops once every sample is blocked.
 #include "triangle.glsl"
 #include "ray_trace_constants.glsl"
 #include "map_state.glsl"
 #include "area_samples.glsl"
-
-// The exhaustive trace's quick test of triangle i (one of 16 unrolled copies): the undecided ones wait in
-// `pending`, so that the shader holds resolve() twice rather than 17 times (llvmpipe compiles it in seconds).
-#define QUICK1(i) if ((i) < total) { uint q = quick(i); if (q == BLOCKS_ALL) { blocked = all_samples; } \
-                                     else if (q == UNDECIDED) { pending[pending_count++] = (i); } }
-#define QUICK4(i) QUICK1(i) QUICK1((i) + 1u) QUICK1((i) + 2u) QUICK1((i) + 3u)
+#include "bvh.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform Constants { RayTraceConstants k; };
 layout(set = 0, binding = 1) uniform sampler2D depth_tex;
 layout(set = 0, binding = 2) uniform sampler2D normal_tex;
-layout(set = 0, binding = 3) readonly buffer State { MapState ms; };
+layout(set = 0, binding = 3) buffer State { MapState ms; };
 layout(set = 0, binding = 4) readonly buffer PixelTexels { uint pixel_texel[]; };
 layout(set = 0, binding = 5) readonly buffer Offsets { uint offsets[]; };
 #include "map_offsets.glsl"
@@ -45,7 +43,10 @@ layout(set = 0, binding = 7) readonly buffer Prims { Triangle tris[]; };
 layout(set = 0, binding = 8, r32f) uniform writeonly image2D visibility;
 layout(set = 0, binding = 9) uniform Samples { AreaSamples samples; };
 layout(set = 0, binding = 10) readonly buffer EdgeTable { uvec4 edge_table[]; };
+layout(set = 0, binding = 11) readonly buffer Bvh { BvhNode bvh_nodes[]; };
 #include "shadow_ray.glsl"
+#include "trace_route.glsl"
+#include "bvh_traverse.glsl"
 
 // The workgroup's copy of the sample directions: the trace reads them at indices that differ from pixel to
 // pixel, which a uniform buffer serves one index at a time.
@@ -238,13 +239,18 @@ void consider(uint index) {
     }
 }
 
-// The exhaustive trace's undecided triangles of one block of 16, resolved after the block.
-uint pending[16];
-uint pending_count;
-
 bool all_blocked() {
     return blocked == all_samples;
 }
+
+void bvh_visit(uint index) {
+    consider(index);
+}
+
+bool bvh_done() {
+    return all_blocked();
+}
+
 
 void main() {
     sample_count = k.misc.w;
@@ -278,15 +284,7 @@ void main() {
     vec3 to_centre = k.light_pos.xyz - shadow_ray_receiver;
     if (local) {
         disc_c = k.light_pos.xyz - origin;
-        vec3 d = normalize(to_centre);
-        float inv = 1.0 / (1.0 + d.y);
-        vec3 t1 = vec3(1.0, 0.0, 0.0), t2 = vec3(0.0, 0.0, -1.0);
-        if (!isinf(inv) && !isnan(inv)) {
-            t1 = vec3(1.0 - d.x * d.x * inv, -d.x, -d.x * d.z * inv);
-            t2 = vec3(-d.z * d.x * inv, -d.z, 1.0 - d.z * d.z * inv);
-        }
-        disc_u = k.light_dir.w * t1;
-        disc_v = k.light_dir.w * t2;
+        disc_axes(k.light_pos.xyz, shadow_ray_receiver, k.light_dir.w, disc_u, disc_v);
     }
     for (uint i = 0u; i < sample_count; ++i) {
         all_samples[i >> 5u] |= 1u << (i & 31u);
@@ -295,24 +293,26 @@ void main() {
             blocked[i >> 5u] |= 1u << (i & 31u);
         }
     }
-    uint begin = 0u, end = 0u;
-    bool listed = texel != TEXEL_NO_RAY && list_range(texel, begin, end);
-    bool binned = ms.grid.z <= ms.grid.w;
-    if (listed && binned && (end <= ms.totals.z || begin == end)) {
+    uint begin, end;
+    if (complete_list(texel, begin, end)) {
         for (uint i = begin; i < end && !all_blocked(); ++i) {
             consider(entries[i]);
         }
-    } else {
-        // Past the entry capacity, or in a group whose list offsets overflowed: every triangle, exact
-        // (unrolled: see ray_trace.comp on llvmpipe's loop cap).
-        uint total = min(k.misc.y, uint(tris.length()));
-        for (uint base = 0u; base < total && !all_blocked(); base += 16u) {
-            pending_count = 0u;
-            QUICK4(base) QUICK4(base + 4u) QUICK4(base + 8u) QUICK4(base + 12u)
-            for (uint j = 0u; j < pending_count && !all_blocked(); ++j) {
-                consider(pending[j]);
-            }
+    } else if (!all_blocked()) {
+        // The bundle: the segments from the origin to the emitter's disc (its axes' combined reach bounds
+        // u U + v V over the unit disc), or the rays within the light's cone.
+        bvh_cone_o = origin;
+        if (local) {
+            bvh_cone_d = disc_c;
+            float reach = max(dot(disc_u, disc_u), dot(disc_v, disc_v)) + abs(dot(disc_u, disc_v));
+            bvh_cone_spread = sqrt(reach) * (1.0 + 1e-4);
+            bvh_cone_t_end = 1.0;
+        } else {
+            bvh_cone_d = samples.center.xyz;
+            bvh_cone_spread = samples.center.w * (1.0 + 1e-4) + 1e-6;
+            bvh_cone_t_end = 1.0 / 0.0;
         }
+        count_walk(bvh_walk(k.misc.y));
     }
     uvec4 seen = blocked & all_samples;
     uint hidden = bitCount(seen.x) + bitCount(seen.y) + bitCount(seen.z) + bitCount(seen.w);

@@ -10,6 +10,9 @@
 // mode 0 counts the accepted (triangle, texel) pairs (map_store.glsl) and appends them to the pair list;
 // mode 1 stores them: from the pair list when it holds every pair the count accepted (one walk in all),
 // else by walking the tiles again.
+// A frame whose bin items pass the bin budget (per pixel with a ray) walks nothing: the count marks it in the state (routes.y), no
+// list is built, and every pixel walks the BVH, whose cost follows the pixel's rays rather than the
+// footprints' sizes (a large light's widened footprints cover most of the map).
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_basic : require
@@ -27,6 +30,7 @@ layout(set = 0, binding = 5) buffer State { MapState faces[]; };
 layout(set = 0, binding = 6) readonly buffer PairOwners { uint pair_owner[]; };
 layout(set = 0, binding = 7) buffer PairList { uvec2 pair_list[]; };
 layout(set = 0, binding = 8) readonly buffer SearchIndex { uint search_index[]; };
+layout(set = 0, binding = 9) buffer Capped { uint capped[]; };
 layout(push_constant) uniform Push { MapPush pc; };
 #include "map_store.glsl"
 
@@ -50,6 +54,18 @@ bool tiles_may_accept(BinTri bt, uvec4 grid, uvec2 t0, uvec2 t1) {
 
 void main() {
     uint bins = bin_count(pc, faces[0].grid.z);
+    uint items = tile_offsets[bins];
+    uint rays = 0u;
+    for (uint f = 0u; f < pc.faces; ++f) {
+        rays += faces[f].receivers.x;
+    }
+    bool skipped = float(items) > pc.bin_budget * float(rays);
+    if (pc.mode == 0u && gl_GlobalInvocationID.x == 0u) {
+        faces[0].routes.xy = uvec2(items, skipped ? 1u : 0u);
+    }
+    if (skipped) {
+        return;
+    }
     uint listed = faces[0].totals.x;
     if (pc.mode == 1u && pc.list_capacity > 0u && listed <= pc.list_capacity) {
         // Fill from the pair list the count wrote: no second walk.
@@ -59,7 +75,6 @@ void main() {
         }
         return;
     }
-    uint items = tile_offsets[bins];
     uint chunk = search_chunk(items);
     // Rounds of one item per invocation; every invocation of a workgroup runs every round of its
     // workgroup (the subgroup operations below need the whole subgroup).

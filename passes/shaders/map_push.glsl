@@ -1,4 +1,4 @@
-// Mirrors passes::gpu_types::MapPush (80 bytes): push constants of the primitive-map passes.
+// Mirrors passes::gpu_types::MapPush (96 bytes): push constants of the primitive-map passes.
 struct MapPush {
     vec4 to_light;          // directional: xyz the direction towards the light, w 0; spot or point light:
                             // xyz its position (frame coordinates), w 1
@@ -18,4 +18,9 @@ struct MapPush {
     float emitter_radius;   // area shadows, spot or point light: the emitter's radius (0: otherwise)
     float near_radius;      // ... triangles nearer the light than this go into every texel with receivers
     float depth_floor;      // ... no point of a farther triangle below this depth key blocks a receiver
+    uint list_limit;        // a texel whose list would pass this many entries keeps none (it walks the BVH)
+    float bin_budget;       // bin items per pixel with a ray past which no list is built (every pixel walks
+                            // the BVH)
+    uint count_scale;       // entries each accepted pair counts (1; more in tests of huge sums)
+    uint pad;
 };

@@ -1,4 +1,4 @@
-// Mirrors passes::gpu_types::MapState (160 bytes): the primitive map's per-frame GPU state of one frustum,
+// Mirrors passes::gpu_types::MapState (192 bytes): the primitive map's per-frame GPU state of one frustum,
 // written by the map passes and read by the ray trace. The map covers the light-space bounds of the
 // receivers the camera sees (fitted every frame on the GPU), so nothing of it is spent on what no pixel can
 // look up. A point light's map holds one state per cube face (+X, -X, +Y, -Y, +Z, -Z), their grids packed
@@ -20,6 +20,12 @@ struct MapState {
                         // exhaustively), w: texels with receivers
     uvec4 grid;         // x: index of the grid's first texel, y: texels per grid row; first state only: z
                         // (triangle, face) pairs a point light's setup kept, w: pairs the bin items hold
+    uvec4 routes;       // first state only: x: bin items (4x4-texel tiles of the footprints; saturated), y: 1
+                        // when they passed the bin budget, so that no list was built and every pixel walks
+                        // the BVH, z: texels whose list passed the list limit (walked through the BVH),
+                        // w: unused
+    uvec4 walks;        // first state only, written by the trace: x: pixels that walked the BVH, y: walks
+                        // that could not finish (never on a conforming device), zw: unused
 };
 
 // The texel index of texel `t` of the grid whose state's `grid` is `grid`.

@@ -1,5 +1,5 @@
 // The texel test and the store of the compute and raster binning paths (after map_bin.glsl). Needs the
-// includer's `receiver`, `counts`, `entries` and `pc`.
+// includer's `receiver`, `counts`, `capped`, `entries` and `pc`.
 
 // Whether `texel`, centred at `centre`, gets triangle `t`: it overlaps the triangle, and (with `cull`) a
 // ray origin lies in it and the triangle is not wholly farther from the light than all of them. The
@@ -33,11 +33,18 @@ bool bin_accepts(BinTri t, uint texel, vec2 centre, bool cull, vec2 widen, float
 }
 
 // Counts (mode 0) or stores (mode 1) triangle `tri` in the list of `texel`.
+// Count: each pair adds pc.count_scale (1 but in tests that push the sums of entries past 2^32); the count
+// that passes the list limit marks the texel in the `capped` bitmask (its list is not kept: the scan takes
+// its count as 0, and its pixels walk the BVH).
 // Fill: the counts hold the scanned offsets of the lists by then, and serve as each list's cursor.
-// Nothing is written at or past the entry capacity: such texels are traced exhaustively, and reported.
+// Nothing is written at or past the entry capacity: the cursor of a texel whose list is not kept starts
+// there (map_pack.comp), and such texels walk the BVH.
 void bin_store(uint tri, uint texel) {
     if (pc.mode == 0u) {
-        atomicAdd(counts[texel], 1u);
+        uint before = atomicAdd(counts[texel], pc.count_scale);
+        if (before <= pc.list_limit && pc.list_limit - before < pc.count_scale) {
+            atomicOr(capped[texel >> 5], 1u << (texel & 31u));
+        }
         return;
     }
     uint slot = atomicAdd(counts[texel], 1u);

@@ -12,6 +12,7 @@ layout(set = 0, binding = 0) readonly buffer BinTris { BinTri bin_tris[]; };
 layout(set = 0, binding = 1) readonly buffer Receivers { uint receiver[]; };
 layout(set = 0, binding = 2) buffer Counts { uint counts[]; };
 layout(set = 0, binding = 3) writeonly buffer Entries { uint entries[]; };
+layout(set = 0, binding = 4) buffer Capped { uint capped[]; };
 layout(push_constant) uniform Push { MapPush pc; };
 #include "map_store.glsl"
 

@@ -1,5 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_basic : require
 // Per-pixel shadow ray through the deep primitive map.
 //
 // Numerics (see README "Numerical design"):
@@ -13,7 +15,8 @@
 //   or vertex of a closed mesh always hits at least one triangle. Zero-determinant (degenerate or
 //   edge-on) triangles are rejected without dividing.
 // - The list of the ray origin's texel holds every triangle that may cross the ray (see map_bin.glsl);
-//   texels past the entry capacity are traced exhaustively against the whole prim buffer: exact, slower.
+//   where the map holds no complete list (trace_route.glsl), the ray walks the BVH over the prim buffer
+//   (bvh_traverse.glsl), testing every triangle whose box it meets with the same test: the same answer.
 // - Directional light: the ray runs along -light_dir without end. Spot light: the ray runs from the offset
 //   origin to the light position and only hits before it count (t < distance). The texel is the ray
 //   origin's under the light's projection: orthographic or perspective, every point of the shadow ray
@@ -22,15 +25,13 @@
 #include "triangle.glsl"
 #include "ray_trace_constants.glsl"
 #include "map_state.glsl"
-
-#define CONSIDER1(i) if ((i) < total) { consider((i), nearest); }
-#define CONSIDER4(i) CONSIDER1(i) CONSIDER1((i) + 1u) CONSIDER1((i) + 2u) CONSIDER1((i) + 3u)
+#include "bvh.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform Constants { RayTraceConstants k; };
 layout(set = 0, binding = 1) uniform sampler2D depth_tex;
 layout(set = 0, binding = 2) uniform sampler2D normal_tex;
-layout(set = 0, binding = 3) readonly buffer State { MapState ms; };
+layout(set = 0, binding = 3) buffer State { MapState ms; };
 layout(set = 0, binding = 4) readonly buffer PixelTexels { uint pixel_texel[]; };
 layout(set = 0, binding = 5) readonly buffer Offsets { uint offsets[]; };
 #include "map_offsets.glsl"
@@ -38,7 +39,10 @@ layout(set = 0, binding = 6) readonly buffer Entries { uint entries[]; };
 layout(set = 0, binding = 7) readonly buffer Prims { Triangle tris[]; };
 layout(set = 0, binding = 8, r32f) uniform writeonly image2D visibility;
 layout(set = 0, binding = 9, r32f) uniform writeonly image2D blocker;
+layout(set = 0, binding = 10) readonly buffer Bvh { BvhNode bvh_nodes[]; };
 #include "shadow_ray.glsl"
+#include "trace_route.glsl"
+#include "bvh_traverse.glsl"
 
 // Ray in Woop's sheared space.
 int kx, ky, kz;
@@ -122,6 +126,21 @@ void consider(uint index, inout float nearest) {
     }
 }
 
+// The BVH walk's test of one triangle (bvh_traverse.glsl): the nearest hit so far bounds the walk.
+float walk_nearest;
+bool walk_first_hit;
+float walk_t_max;
+
+void bvh_visit(uint index) {
+    consider(index, walk_nearest);
+    bvh_cone_t_end = walk_nearest;
+}
+
+bool bvh_done() {
+    return walk_first_hit && walk_nearest < walk_t_max;
+}
+
+
 void write(ivec2 px, float vis, float bd) {
     imageStore(visibility, px, vec4(vis));
     if (k.misc.z != 0u) {
@@ -152,13 +171,8 @@ void main() {
     // Without a blocker-distance output (hard shadows) any hit before the light decides the pixel, so the
     // walk stops after the first; otherwise it finds the nearest.
     bool first_hit = k.misc.z == 0u;
-    uint begin = 0u, end = 0u;
-    bool listed = texel != TEXEL_NO_RAY && list_range(texel, begin, end);
-    // An empty list is complete wherever it lies; a list is complete when it ends within the capacity.
-    // A point light's frame that kept more (triangle, face) pairs than its bin items hold has no complete
-    // list.
-    bool binned = ms.grid.z <= ms.grid.w;
-    if (listed && binned && (end <= ms.totals.z || begin == end)) {
+    uint begin, end;
+    if (complete_list(texel, begin, end)) {
         // Checked every 8 entries, so that the walk within them keeps its loads in flight.
         for (uint i = begin; i < end && !(first_hit && nearest < t_max); i += 8u) {
             uint stop = min(i + 8u, end);
@@ -167,14 +181,15 @@ void main() {
             }
         }
     } else {
-        // Past the entry or pair capacity, in a group whose list offsets overflowed (or, never seen, a pixel
-        // the receiver pass gave no ray):
-        // exhaustive and exact. Unrolled 16x by hand: llvmpipe (lavapipe) silently ends a shader's loops after 65535
-        // iterations in total, which would drop every triangle past that index; unrolled, its cap is 1M.
-        uint total = min(k.misc.y, uint(tris.length()));
-        for (uint base = 0u; base < total && !(first_hit && nearest < t_max); base += 16u) {
-            CONSIDER4(base) CONSIDER4(base + 4u) CONSIDER4(base + 8u) CONSIDER4(base + 12u)
-        }
+        walk_nearest = nearest;
+        walk_first_hit = first_hit;
+        walk_t_max = t_max;
+        bvh_cone_o = o;
+        bvh_cone_d = dir;
+        bvh_cone_spread = 0.0;
+        bvh_cone_t_end = t_max;
+        count_walk(bvh_walk(k.misc.y));
+        nearest = walk_nearest;
     }
     if (nearest < t_max) {
         write(px, 0.0, nearest);

@@ -7,7 +7,8 @@ struct RayTraceConstants {
     vec4 light_dir;             // xyz: direction the light travels (unit); w: area shadows: tan(angular
                                 // radius) of a directional light, a spot or point light's emitter radius
                                 // (0: hard shadows)
-    uvec4 dims;                 // screen width, height, primitive map N, unused
+    uvec4 dims;                 // screen width, height, primitive map N; w: the ray-tracing peers, 1 for a
+                                // point light (its cube holds every direction), else 0
     vec4 offset;                // x: radians per pixel, y: offset in pixels, z: relative float bound of |P|,
                                 // w: one step of a normalized depth format (0 for float depth)
     uvec4 misc;                 // x: 1 = front-only map, y: triangles in the prim buffer,

@@ -82,6 +82,15 @@ pub struct MapPush {
     /// Area shadows of a spot or point light: a depth key below which no point of a farther triangle can
     /// block a receiver of the frustum ([`crate::area::LocalAreaReach`]).
     pub depth_floor: f32,
+    /// A texel whose list would pass this many entries keeps none: its pixels walk the BVH.
+    pub list_limit: u32,
+    /// Bin items (4×4-texel tiles of the footprints) per pixel with a ray past which no list is built and
+    /// every pixel walks the BVH.
+    pub bin_budget: f32,
+    /// Entries each accepted (triangle, texel) pair counts ([`crate::PrimitiveMapConfig::debug_count_scale`]).
+    pub count_scale: u32,
+    /// Padding.
+    pub pad: u32,
 }
 
 /// Constants of the primitive map's passes: the ray trace's (the receivers trace the same rays), and the
@@ -152,6 +161,12 @@ pub struct MapState {
     /// x: the grid's first texel, y: texels per grid row; first state only: z (triangle, face) pairs a
     /// point light's setup kept, w: pairs the bin items held.
     pub grid: UVec4,
+    /// First state only: x: bin items (saturated), y: 1 when they passed the bin budget (no list built:
+    /// every pixel walks the BVH), z: texels whose list passed the list limit (walked through the BVH).
+    pub routes: UVec4,
+    /// First state only, written by the trace: x: pixels that walked the BVH, y: walks that could not
+    /// finish (never on a conforming device).
+    pub walks: UVec4,
 }
 
 impl MapState {
@@ -168,6 +183,8 @@ impl MapState {
             totals: UVec4::new(0, 0, first(capacity), 0),
             stats: UVec4::ZERO,
             grid: UVec4::new(0, 0, 0, first(pairs)),
+            routes: UVec4::ZERO,
+            walks: UVec4::ZERO,
         }
     }
 }
@@ -189,9 +206,20 @@ pub struct MapStats {
     pub entries: u32,
     /// Entries the map could hold this frame (it grows to fit from the next frame on, within its budget).
     pub capacity: u32,
-    /// Texels traced exhaustively (exact, slower): those whose list did not fit the capacity, and every
-    /// texel of a group of 16 whose lists' offsets did not fit the packed offsets' 16 bits.
+    /// Texels whose list did not fit the capacity, and every texel of a group of 16 whose lists' offsets
+    /// did not fit the packed offsets' 15 bits: their pixels walk the BVH (exact).
     pub texels_past_capacity: u32,
+    /// Texels whose list passed the map's list limit, kept out of the lists: their pixels walk the BVH,
+    /// which costs less than such a list.
+    pub texels_past_limit: u32,
+    /// Bin items (4×4-texel tiles of the triangles' footprints) the frame's lists would have walked.
+    pub bin_items: u32,
+    /// Whether the bin items passed the map's bin budget: no list was built, every pixel walked the BVH.
+    pub lists_skipped: bool,
+    /// Pixels that walked the BVH rather than a list.
+    pub pixels_walked: u32,
+    /// BVH walks that could not finish (never on a conforming device: a failure the tests check for).
+    pub walks_unfinished: u32,
     /// A point light's (triangle, face) pairs kept by the setup (0 for a light of one frustum). Past the
     /// pairs the map held (`pair_capacity`), the frame traced every ray exhaustively (exact, slower), and
     /// the map grows for the next.
@@ -214,6 +242,11 @@ impl MapStats {
             entries: s.totals.y,
             capacity: s.totals.z,
             texels_past_capacity: s.stats.z,
+            texels_past_limit: s.routes.z,
+            bin_items: s.routes.x,
+            lists_skipped: s.routes.y != 0,
+            pixels_walked: s.walks.x,
+            walks_unfinished: s.walks.y,
             pairs: s.grid.z,
             pair_capacity: s.grid.w,
         }
@@ -337,7 +370,7 @@ const _: () = {
     assert!(std::mem::size_of::<GpuTriangle>() == 48);
     assert!(std::mem::size_of::<PrimBufferPush>() == 112);
     assert!(std::mem::offset_of!(PrimBufferPush, first_index) == 64);
-    assert!(std::mem::size_of::<MapPush>() == 80);
+    assert!(std::mem::size_of::<MapPush>() == 96);
     assert!(std::mem::offset_of!(MapPush, penumbra) == 64);
     assert!(std::mem::size_of::<AreaSamples>() == 2096);
     assert!(std::mem::offset_of!(AreaSamples, dirs) == 48);
@@ -346,7 +379,8 @@ const _: () = {
     assert!(std::mem::offset_of!(RayTraceConstants, light_pos) == 208);
     assert!(std::mem::offset_of!(RayTraceConstants, dims) == 160);
     assert!(std::mem::offset_of!(RayTraceConstants, offset) == 176);
-    assert!(std::mem::size_of::<MapState>() == 160);
+    assert!(std::mem::size_of::<MapState>() == 192);
+    assert!(std::mem::offset_of!(MapState, routes) == 160);
     assert!(std::mem::size_of::<MapConstants>() == 704);
     assert!(std::mem::offset_of!(MapState, totals) == 112);
     assert!(std::mem::offset_of!(MapState, grid) == 144);

@@ -5,6 +5,7 @@
 #![forbid(unsafe_code)]
 
 pub mod area;
+pub mod bvh;
 mod error;
 pub mod frame_plan;
 pub mod fxaa;

@@ -2,8 +2,13 @@
 //! area shadows, the visible fraction of the light's samples (`area_trace.glsl`, in a variant for
 //! directional lights and one for spot and point lights).
 //!
-//! Reads: depth, normal, the primitive map (state, per-pixel texels, list offsets and entries), prim buffer,
-//! constants (and the light samples, area shadows). Writes: visibility, blocker distance (hard rays only).
+//! Where the map holds no complete list for a pixel (no list built this frame, a texel past the entry
+//! capacity or the list limit), the pixel walks the BVH over the prim buffer instead (`crate::bvh`), with
+//! the same test: the same answer.
+//!
+//! Reads: depth, normal, the primitive map (state, per-pixel texels, list offsets and entries), prim buffer
+//! and its BVH, constants (and the light samples, area shadows). Writes: visibility, blocker distance (hard
+//! rays only), the count of the walks in the map's state.
 
 use crate::area::{area_edge_table, local_area_edge_table};
 use crate::gpu_types::{constant_buffer, AreaSamples, RayTraceConstants};
@@ -36,6 +41,8 @@ pub struct RayTraceInputs<'a> {
     pub map: &'a PrimitiveMap,
     /// Prim buffer.
     pub prims: &'a Buffer,
+    /// The BVH's nodes over the prim buffer ([`crate::bvh::SceneBvh::nodes`]).
+    pub bvh: &'a Buffer,
 }
 
 /// What the ray trace computes.
@@ -176,6 +183,8 @@ impl RayTracePass {
                 return Err(PassError::InvalidConfig("no blocker image".into()));
             }
         }
+        kinds.push(BindingKind::StorageBuffer);
+        resources.push(b(inputs.bvh));
         // A point light's cube map only ever traces a local light: the local variant is its one pipeline.
         let cube = inputs.map.config().cube;
         let (name, shader_name) = match kind {

@@ -1,11 +1,12 @@
 //! The ray-tracing-pipeline peer: what a user would pick instead of the deep primitive map. It traces the
 //! same shadow rays as the primitive-map ray trace (`shadow_ray.glsl`, same constants, depth and normals)
 //! through the GPU's ray-tracing pipeline, against acceleration structures the driver builds over the prim
-//! buffer, with any-hit shadow rays. Timed as two passes: "rt peer build" and "rt peer trace".
+//! buffer, with any-hit shadow rays; its area variant traces each of the area trace's N light samples of a
+//! pixel as its own ray (`rt_peer_area.rgen`). Timed as two passes: "rt peer build" and "rt peer trace".
 //!
-//! Reads: prim buffer, depth, normal, constants. Writes: visibility.
+//! Reads: prim buffer, depth, normal, constants (and the light samples). Writes: visibility.
 
-use crate::gpu_types::{GpuTriangle, RayTraceConstants};
+use crate::gpu_types::{AreaSamples, GpuTriangle, RayTraceConstants};
 use crate::light::{rebased, LightFrame};
 use crate::ray_trace::{RAY_OFFSET_FLOAT_BOUND, RAY_OFFSET_PIXELS};
 use crate::shadow_pipeline::{camera_in_frame, FrameInputs};
@@ -27,6 +28,8 @@ pub struct RtPeerPass {
     pipeline: RayTracingPipeline,
     group: BindGroup,
     constants: Buffer,
+    /// The light samples of the area variant.
+    samples: Option<Buffer>,
     width: u32,
     height: u32,
     /// `R32_SFLOAT` visibility, 1 = lit, 0 = shadowed, the value the primitive-map ray trace writes:
@@ -47,6 +50,45 @@ impl RtPeerPass {
         normal: &Image,
         width: u32,
         height: u32,
+    ) -> Result<Self, PassError> {
+        Self::with_variant(
+            device,
+            prims,
+            triangle_count,
+            (depth, normal),
+            (width, height),
+            false,
+        )
+    }
+
+    /// The area variant of [`RtPeerPass::new`]: each of the area trace's light samples of a pixel traced as
+    /// its own ray ([`RtPeerPass::record_area_trace`]); the visibility is the visible fraction.
+    pub fn new_area(
+        device: &Device,
+        prims: &Buffer,
+        triangle_count: u32,
+        depth: &Image,
+        normal: &Image,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, PassError> {
+        Self::with_variant(
+            device,
+            prims,
+            triangle_count,
+            (depth, normal),
+            (width, height),
+            true,
+        )
+    }
+
+    fn with_variant(
+        device: &Device,
+        prims: &Buffer,
+        triangle_count: u32,
+        (depth, normal): (&Image, &Image),
+        (width, height): (u32, u32),
+        area: bool,
     ) -> Result<Self, PassError> {
         device
             .ray_tracing_support()
@@ -73,34 +115,51 @@ impl RtPeerPass {
             bytemuck::bytes_of(&RayTraceConstants::zeroed()),
             BufferUsage::UNIFORM,
         )?;
+        let samples = area
+            .then(|| {
+                device.create_buffer_init(
+                    "rt peer light samples",
+                    bytemuck::bytes_of(&AreaSamples::zeroed()),
+                    BufferUsage::UNIFORM,
+                )
+            })
+            .transpose()?;
+        let mut bindings = vec![
+            BindingKind::UniformBuffer,
+            BindingKind::SampledImage,
+            BindingKind::SampledImage,
+            BindingKind::AccelerationStructure,
+            BindingKind::StorageImage,
+        ];
+        let mut resources = vec![
+            Resource::Buffer(&constants),
+            Resource::Image(depth),
+            Resource::Image(normal),
+            Resource::AccelerationStructure(&top),
+            Resource::Image(&visibility),
+        ];
+        if let Some(samples) = &samples {
+            bindings.push(BindingKind::UniformBuffer);
+            resources.push(Resource::Buffer(samples));
+        }
         let pipeline = device.create_ray_tracing_pipeline(&RayTracingPipelineDesc {
-            name: "rt peer",
-            raygen: &shader("rt_peer.rgen")?,
+            name: if area { "rt peer (area)" } else { "rt peer" },
+            raygen: &shader(if area {
+                "rt_peer_area.rgen"
+            } else {
+                "rt_peer.rgen"
+            })?,
             miss: &shader("rt_peer.rmiss")?,
-            bindings: &[
-                BindingKind::UniformBuffer,
-                BindingKind::SampledImage,
-                BindingKind::SampledImage,
-                BindingKind::AccelerationStructure,
-                BindingKind::StorageImage,
-            ],
+            bindings: &bindings,
             push_constant_size: 0,
         })?;
-        let group = device.create_bind_group(
-            pipeline.layout(),
-            &[
-                Resource::Buffer(&constants),
-                Resource::Image(depth),
-                Resource::Image(normal),
-                Resource::AccelerationStructure(&top),
-                Resource::Image(&visibility),
-            ],
-        )?;
+        let group = device.create_bind_group(pipeline.layout(), &resources)?;
         Ok(Self {
             top,
             pipeline,
             group,
             constants,
+            samples,
             width,
             height,
             visibility,
@@ -122,6 +181,44 @@ impl RtPeerPass {
     /// the visibility is rewritten whole and left in `UnorderedAccess` state, its writes ordered before
     /// later barriers from that state.
     pub fn record_trace(
+        &mut self,
+        enc: &mut Encoder<'_>,
+        constants: &RayTraceConstants,
+    ) -> Result<(), PassError> {
+        if self.samples.is_some() {
+            return Err(PassError::InvalidConfig(
+                "the area peer traces light samples: record_area_trace".into(),
+            ));
+        }
+        self.record(enc, constants)
+    }
+
+    /// The area variant's [`RtPeerPass::record_trace`]: `constants` as the area trace has them (the light's
+    /// size in `light_dir.w`, the samples per pixel in `misc.w`; `dims.w` 1 for a point light) and the
+    /// light's `samples` (host-visible: call while no submitted frame uses them).
+    pub fn record_area_trace(
+        &mut self,
+        enc: &mut Encoder<'_>,
+        constants: &RayTraceConstants,
+        samples: &AreaSamples,
+    ) -> Result<(), PassError> {
+        let Some(buffer) = self.samples.as_mut() else {
+            return Err(PassError::InvalidConfig(
+                "light samples are given to the area peer alone".into(),
+            ));
+        };
+        if !(1..=crate::area::MAX_AREA_SAMPLES).contains(&constants.misc.w) {
+            return Err(PassError::InvalidConfig(format!(
+                "{} light samples per pixel: 1 to {} are traced",
+                constants.misc.w,
+                crate::area::MAX_AREA_SAMPLES
+            )));
+        }
+        buffer.write(0, bytemuck::bytes_of(samples))?;
+        self.record(enc, constants)
+    }
+
+    fn record(
         &mut self,
         enc: &mut Encoder<'_>,
         constants: &RayTraceConstants,
@@ -197,4 +294,36 @@ pub fn shadow_ray_constants(
         surface_mode: crate::surface::SurfaceInput::default().mode(rhi::Format::Rgba32Float),
         surface: crate::surface::surface_vector(inputs.proj, rhi::Format::D32Float, 0.0),
     })
+}
+
+/// [`shadow_ray_constants`] for the area variant ([`RtPeerPass::record_area_trace`]) of a light of size
+/// `size` (a directional light's angular radius in radians, a spot or point light's emitter radius) and
+/// `samples` samples per pixel, with the light's samples: the very ones the area trace takes
+/// (`ShadowPipeline` derives its own the same way).
+pub fn area_peer_constants(
+    inputs: &FrameInputs,
+    origin: DVec3,
+    (width, height): (u32, u32),
+    size: f32,
+    samples: u32,
+) -> Result<(RayTraceConstants, AreaSamples), PassError> {
+    crate::AreaConfig { samples }.validate_samples()?;
+    let mut constants = shadow_ray_constants(inputs, origin, width, height)?;
+    let direction = constants.light_dir.truncate();
+    let area = if inputs.light.position().is_some() {
+        if !(size > 0.0 && size.is_finite()) {
+            return Err(PassError::InvalidConfig(format!(
+                "an emitter radius must be finite and above 0, not {size}"
+            )));
+        }
+        constants.light_dir.w = size;
+        crate::area::local_area_samples(samples)
+    } else {
+        crate::area::check_angular_radius(size)?;
+        constants.light_dir.w = size.tan();
+        crate::area::area_samples(direction, size, samples)
+    };
+    constants.misc.w = samples;
+    constants.dims.w = u32::from(matches!(inputs.light, crate::Light::Point { .. }));
+    Ok((constants, area))
 }

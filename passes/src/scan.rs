@@ -1,4 +1,5 @@
-//! Exclusive prefix sum of a `u32` buffer on the GPU, in place (`scan.comp`). Up to [`FLAT_BLOCKS`] blocks of
+//! Exclusive prefix sum of a `u32` buffer on the GPU, in place (`scan.comp`), saturating: a sum that reaches
+//! 2^32 reads `u32::MAX` rather than wrapping, every smaller one is exact. Up to [`FLAT_BLOCKS`] blocks of
 //! 1024 it takes two dispatches: the blocks' totals, then each block scanned from the sum of the totals
 //! before it, which its workgroup adds up itself. Larger scans take one level per 1024-fold reduction,
 //! then the scanned block totals added back down.
@@ -24,6 +25,9 @@ pub const FLAT_BLOCKS: u64 = 4096;
 struct ScanPush {
     n: u32,
     mode: u32,
+    /// Input values above this are read as 0.
+    cap: u32,
+    pad: u32,
 }
 
 /// The scan pipeline, shared by every [`PrefixScan`] of a device.
@@ -53,6 +57,8 @@ pub struct PrefixScan {
     levels: Vec<(BindGroup, u32)>,
     /// Whether the scan takes two dispatches over one level ([`FLAT_BLOCKS`]; one block takes one).
     flat: bool,
+    /// Input values above this are read as 0 ([`PrefixScan::with_input_cap`]).
+    cap: u32,
     _sums: Vec<Buffer>,
 }
 
@@ -104,28 +110,40 @@ impl PrefixScan {
         Ok(Self {
             levels,
             flat,
+            cap: u32::MAX,
             _sums: sums,
         })
+    }
+
+    /// The same scan, reading every input value above `cap` as 0.
+    pub fn with_input_cap(self, cap: u32) -> Self {
+        Self { cap, ..self }
     }
 
     /// Records the scan; the data buffer's earlier writes must be visible (UAV barrier) and its scanned
     /// values are visible to later storage accesses after the UAV barrier this records last.
     pub fn record(&self, enc: &mut Encoder<'_>, pipeline: &ScanPipeline) -> Result<(), PassError> {
         let blocks = |n: u32| u64::from(n).div_ceil(BLOCK).max(1) as u32;
-        let passes: Vec<(&(BindGroup, u32), u32)> = if self.flat {
+        let levels = self.levels.iter().enumerate();
+        let passes: Vec<(usize, &(BindGroup, u32), u32)> = if self.flat {
             // The blocks' totals (mode 2), then each block from the totals before it (mode 3).
-            self.levels
-                .iter()
-                .flat_map(|level| [(level, 2), (level, 3)])
+            levels
+                .flat_map(|(i, level)| [(i, level, 2), (i, level, 3)])
                 .collect()
         } else {
             // Up the levels scanning each block (mode 0), then down adding the block totals (mode 1).
-            let up = self.levels.iter().map(|level| (level, 0));
-            let down = self.levels.iter().rev().skip(1).map(|level| (level, 1));
+            let up = levels.clone().map(|(i, level)| (i, level, 0));
+            let down = levels.rev().skip(1).map(|(i, level)| (i, level, 1));
             up.chain(down).collect()
         };
-        for ((group, n), mode) in passes {
-            let push = ScanPush { n: *n, mode };
+        for (level, (group, n), mode) in passes {
+            let push = ScanPush {
+                n: *n,
+                mode,
+                // Only the input's values are capped (the levels above hold block totals).
+                cap: if level == 0 { self.cap } else { u32::MAX },
+                pad: 0,
+            };
             enc.dispatch(
                 &pipeline.0,
                 group,

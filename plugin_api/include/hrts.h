@@ -9,7 +9,7 @@
 
 // Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 // version differs.
-#define HRTS_API_VERSION ((5 << 22) | (7 << 12))
+#define HRTS_API_VERSION ((5 << 22) | (8 << 12))
 
 // The most lights one context shades (`hrts_configure_lights`); a point light counts once.
 #define HRTS_MAX_LIGHTS 64
@@ -586,6 +586,14 @@ typedef struct HrtsConfig {
   uint32_t map_initial_pairs;
   // Area shadows: light samples per pixel, 1..=128 (default 64).
   uint32_t area_samples;
+  // A texel whose list would hold more than this many entries keeps none: its pixels walk the BVH over
+  // the prim buffer instead, which then costs less (default 256; `0xFFFFFFFF`: no limit). It moves
+  // cost, never exactness.
+  uint32_t map_list_limit;
+  // Bin items (4x4-texel tiles of the triangles' footprints, widened by their penumbrae for area
+  // shadows) per pixel with a shadow ray past which a frame builds no list and every pixel walks the
+  // BVH (default 8; infinity: always lists; 0: always the BVH). It moves cost, never exactness.
+  float map_bin_budget;
 } HrtsConfig;
 
 // One draw of the geometry.
@@ -942,6 +950,17 @@ typedef struct HrtsFrameReport {
   uint32_t bin_pairs;
   // The (triangle, face) pairs the light's cube map held this frame.
   uint32_t bin_pair_capacity;
+  // Texels whose list passed `map_list_limit` and was not kept: their pixels walked the BVH.
+  uint32_t texels_past_limit;
+  // Bin items (4x4-texel tiles of the footprints) of the frame's lists (saturated at `0xFFFFFFFF`).
+  uint32_t bin_items;
+  // Frusta whose bin items passed `map_bin_budget`: they built no list, every pixel walked the BVH.
+  uint32_t frusta_without_lists;
+  // Pixels that walked the BVH rather than a list (texels past the capacity or the list limit, frusta
+  // without lists).
+  uint32_t pixels_walked;
+  // BVH walks that could not finish (a driver that ends long loops early): 0 on a conforming device.
+  uint32_t walks_unfinished;
 } HrtsFrameReport;
 
 // Every result, in value order.

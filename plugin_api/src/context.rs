@@ -972,6 +972,11 @@ impl Context {
         out.triangles_binned = sum(|r| r.stats.triangles_binned);
         out.bin_pairs = sum(|r| r.stats.pairs);
         out.bin_pair_capacity = sum(|r| r.stats.pair_capacity);
+        out.texels_past_limit = sum(|r| r.stats.texels_past_limit);
+        out.bin_items = sum(|r| r.stats.bin_items);
+        out.frusta_without_lists = sum(|r| u32::from(r.stats.lists_skipped));
+        out.pixels_walked = sum(|r| r.stats.pixels_walked);
+        out.walks_unfinished = sum(|r| r.stats.walks_unfinished);
         out.map_to_texels = reports
             .first()
             .map_or([0.0; 16], |r| r.map_to_texels.to_cols_array());

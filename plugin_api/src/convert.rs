@@ -505,6 +505,9 @@ pub(crate) fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
             initial_entries: c.map_initial_entries,
             cube: false,
             initial_pairs: c.map_initial_pairs,
+            list_limit: c.map_list_limit,
+            bin_budget: c.map_bin_budget,
+            debug_count_scale: 1,
         },
         ..ShadowConfig::default()
     };
@@ -582,6 +585,8 @@ pub(crate) fn config_to_c(config: &ShadowConfig) -> ApiResult<HrtsConfig> {
         map_initial_entries: config.map.initial_entries,
         map_initial_pairs: config.map.initial_pairs,
         area_samples: config.area.samples,
+        map_list_limit: config.map.list_limit,
+        map_bin_budget: config.map.bin_budget,
     })
 }
 

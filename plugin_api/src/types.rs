@@ -6,7 +6,7 @@ use std::ffi::c_char;
 
 /// Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 /// version differs.
-pub const HRTS_API_VERSION: u32 = 5 << 22 | 7 << 12;
+pub const HRTS_API_VERSION: u32 = 5 << 22 | 8 << 12;
 
 /// A flag in the C structs: 0 is false, any other value true. (A Rust `bool` would make any byte but 0
 /// and 1 undefined behaviour when the engine writes it.)
@@ -494,6 +494,14 @@ pub struct HrtsConfig {
     pub map_initial_pairs: u32,
     /// Area shadows: light samples per pixel, 1..=128 (default 64).
     pub area_samples: u32,
+    /// A texel whose list would hold more than this many entries keeps none: its pixels walk the BVH over
+    /// the prim buffer instead, which then costs less (default 256; `0xFFFFFFFF`: no limit). It moves
+    /// cost, never exactness.
+    pub map_list_limit: u32,
+    /// Bin items (4x4-texel tiles of the triangles' footprints, widened by their penumbrae for area
+    /// shadows) per pixel with a shadow ray past which a frame builds no list and every pixel walks the
+    /// BVH (default 8; infinity: always lists; 0: always the BVH). It moves cost, never exactness.
+    pub map_bin_budget: f32,
 }
 
 /// One draw of the geometry.
@@ -871,6 +879,17 @@ pub struct HrtsFrameReport {
     pub bin_pairs: u32,
     /// The (triangle, face) pairs the light's cube map held this frame.
     pub bin_pair_capacity: u32,
+    /// Texels whose list passed `map_list_limit` and was not kept: their pixels walked the BVH.
+    pub texels_past_limit: u32,
+    /// Bin items (4x4-texel tiles of the footprints) of the frame's lists (saturated at `0xFFFFFFFF`).
+    pub bin_items: u32,
+    /// Frusta whose bin items passed `map_bin_budget`: they built no list, every pixel walked the BVH.
+    pub frusta_without_lists: u32,
+    /// Pixels that walked the BVH rather than a list (texels past the capacity or the list limit, frusta
+    /// without lists).
+    pub pixels_walked: u32,
+    /// BVH walks that could not finish (a driver that ends long loops early): 0 on a conforming device.
+    pub walks_unfinished: u32,
 }
 
 /// A copy of a plugin resource into an engine buffer, recorded after a complete frame.

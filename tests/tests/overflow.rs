@@ -1,7 +1,7 @@
 //! A primitive map whose lists do not fit: nothing is written past the entry capacity (guard words stay
 //! untouched), the texels that did not fit are counted and shown red, the documented fallback (those
-//! texels traced against every triangle) keeps visibility exact, and the lists grow to fit the next frame
-//! within the memory budget.
+//! texels' pixels walk the BVH) keeps visibility exact, no count, sum or offset wraps even past 2^32
+//! entries, and the lists grow to fit the next frame within the memory budget.
 
 mod common;
 
@@ -170,13 +170,9 @@ fn lists_shrink_to_what_they_occupy() {
     assert_no_validation_errors(&device);
 }
 
-/// Lists so long that a group of 16 texels holds 65536 entries or more: the packed offsets cannot keep the
-/// group's 16-bit local offsets, so its texels are reported past the capacity and traced against every
-/// triangle, and the shadow stays exact. 4,500 stacked triangles above a ground square, turned a little
-/// each, all cover a disc of radius 0.5: every texel of its shadow lists all of them.
-#[test]
-fn groups_of_lists_past_16_bit_offsets_stay_exact() {
-    let device = device();
+/// 4,500 stacked triangles above a ground square, turned a little each, all covering a disc of radius 0.5:
+/// every texel of its shadow lists all of them.
+fn stacked_fan() -> scene::Scene {
     let mut fan = scene::MeshBuilder::new();
     let blades = 4500;
     for i in 0..blades {
@@ -194,7 +190,17 @@ fn groups_of_lists_past_16_bit_offsets_stay_exact() {
         glam::Vec3::new(-4.0, -0.1, -4.0),
         glam::Vec3::new(4.0, 0.0, 4.0),
     ));
-    let view = View::framed(fan, 96, 72);
+    fan
+}
+
+/// Lists so long that a group of 16 texels holds 32768 entries or more: the packed offsets cannot keep the
+/// group's 15-bit local offsets, so its texels are reported past the capacity and walk the BVH, and the
+/// shadow stays exact. The lists are built whatever their length (no list limit, no bin budget), over the
+/// stacked fan.
+#[test]
+fn groups_of_lists_past_15_bit_offsets_stay_exact() {
+    let device = device();
+    let view = View::framed(stacked_fan(), 96, 72);
     let rs = RefScene::new(&view.scene);
     // Every texel the triangles overlap is binned (no receiver culling), so that the 16 texels of a group
     // all hold lists: the fan's shadow spans about 30 texels of the 256² grid.
@@ -202,11 +208,15 @@ fn groups_of_lists_past_16_bit_offsets_stay_exact() {
         size: 256,
         guard: true,
         receiver_culling: false,
+        list_limit: u32::MAX,
+        bin_budget: f32::INFINITY,
         ..Default::default()
     };
     let runs = frames(&device, &view, config, 2);
     let (report, images) = &runs[1];
     let st = report.stats;
+    assert!(!st.lists_skipped, "{st:?}");
+    assert_eq!(st.walks_unfinished, 0, "{st:?}");
     let overflowed = images
         .list_offsets
         .overflowed
@@ -230,5 +240,59 @@ fn groups_of_lists_past_16_bit_offsets_stay_exact() {
     println!("mismatches {}, near-edge {}", v.mismatches, v.near_edge);
     assert_eq!(v.mismatches, 0, "{:?}", v.examples);
     assert_eq!(v.blocker_mismatches, 0, "{:?}", v.examples);
+    assert_no_validation_errors(&device);
+}
+
+/// Lists whose entries sum past 2^32: each pair of the stacked fan counts 2^16 entries (the map's debug
+/// count scale), so the texels' counts, about 3 x 10^8 each, sum to about 10^10. The saturating scan keeps
+/// every offset below 2^32 exact and marks the rest, nothing wraps: the report counts the entries as
+/// saturated, the texels past the capacity (every group past 2^31 entries among them) walk the BVH, no guard
+/// word is written, and the shadow stays exact.
+#[test]
+fn list_entries_past_2_pow_32_never_wrap_and_stay_exact() {
+    let device = device();
+    let view = View::framed(stacked_fan(), 96, 72);
+    let rs = RefScene::new(&view.scene);
+    let config = PrimitiveMapConfig {
+        size: 256,
+        guard: true,
+        list_limit: u32::MAX,
+        bin_budget: f32::INFINITY,
+        debug_count_scale: 1 << 16,
+        ..Default::default()
+    };
+    let runs = frames(&device, &view, config, 2);
+    for (report, images) in &runs {
+        let st = report.stats;
+        println!("{st:?}");
+        assert!(!st.lists_skipped, "{st:?}");
+        assert_eq!(st.entries, u32::MAX, "the entries' sum saturates: {st:?}");
+        assert!(st.texels_past_capacity > 0, "{st:?}");
+        assert!(st.pixels_walked > 0, "{st:?}");
+        assert_eq!(st.walks_unfinished, 0, "{st:?}");
+        let capacity = st.capacity as usize;
+        let written = images.list_entries[capacity..]
+            .iter()
+            .filter(|&&v| v != GUARD_VALUE)
+            .count();
+        assert_eq!(
+            written, 0,
+            "{written} guard words were written past the capacity"
+        );
+        // Past the capacity: the texels of overflowed groups and those whose list ends beyond it.
+        let offsets = &images.list_offsets;
+        let past = (0..offsets.overflowed.len())
+            .filter(|&t| {
+                offsets
+                    .range(t)
+                    .is_none_or(|r| !r.is_empty() && r.end > capacity)
+            })
+            .count();
+        assert_eq!(past, st.texels_past_capacity as usize, "{st:?}");
+        let v = compare_visibility(&rs, &view, images);
+        println!("mismatches {}, near-edge {}", v.mismatches, v.near_edge);
+        assert_eq!(v.mismatches, 0, "{:?}", v.examples);
+        assert_eq!(v.blocker_mismatches, 0, "{:?}", v.examples);
+    }
     assert_no_validation_errors(&device);
 }

@@ -33,11 +33,14 @@ fn check_paths(view: &View, size: u32, faces: FaceMode, paths: &[BinningRequest]
             panic!("{binning:?} binning is not on this device: {e}");
         }
         for receiver_culling in [false, true] {
+            // Every list kept, whatever its length, to compare with exact binning.
             let config = PrimitiveMapConfig {
                 size,
                 faces,
                 binning,
                 receiver_culling,
+                list_limit: u32::MAX,
+                bin_budget: f32::INFINITY,
                 ..Default::default()
             };
             let (report, images) = render(&device, view, config, true);

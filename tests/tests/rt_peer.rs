@@ -9,10 +9,10 @@
 mod common;
 
 use common::*;
-use host_demo::peer::run_peer;
+use host_demo::peer::{run_area_peer, run_peer};
 use host_demo::plugin::PluginRenderer;
 use host_demo::{FrameImages, View};
-use passes::{PassError, PrimitiveMapConfig};
+use passes::{AreaConfig, PassError, PcssConfig, PrimitiveMapConfig, ShadowConfig, ShadowMode};
 use reference::RefScene;
 use rhi::Device;
 
@@ -94,4 +94,68 @@ fn stanford_bunny_matches_exact_visibility() {
     let bunny = scene::load_obj(&model("02_stanford_bunny_69k.obj")).expect("bunny loads");
     let view = View::framed(bunny.with_ground_plane(), 200, 160);
     check(&view, 0.10);
+}
+
+/// Area shadows: the peer traces each of the area trace's light samples of a pixel as its own any-hit ray.
+/// Equal samples give equal answers: on every pixel the exact reference of the same samples calls stable,
+/// the peer's visible count equals the plugin's (and the reference's), whether the plugin walked its lists
+/// or the BVH.
+#[test]
+fn area_peer_counts_equal_the_plugins_on_stable_pixels() {
+    let device = device();
+    let view = plate_and_box_view(96, 72);
+    let (radius, samples) = (0.1, 32);
+    let rs = RefScene::new(&view.scene);
+    let inputs = view.frame_inputs();
+    let directions: Vec<glam::DVec3> =
+        passes::area::area_sample_directions(view.light.direction, radius, samples)
+            .iter()
+            .map(|w| w.as_dvec3())
+            .collect();
+    let r = reference::area_reference(&rs, &visibility_params(&view), &directions);
+    for bin_budget in [passes::primitive_map::DEFAULT_BIN_BUDGET, 0.0] {
+        let config = ShadowConfig {
+            mode: ShadowMode::Area,
+            antialiasing: false,
+            map: PrimitiveMapConfig {
+                size: 128,
+                bin_budget,
+                ..PrimitiveMapConfig::default()
+            },
+            pcss: PcssConfig {
+                angular_radius: radius,
+                ..PcssConfig::default()
+            },
+            area: AreaConfig { samples },
+            ..ShadowConfig::default()
+        };
+        let mut renderer = PluginRenderer::new(&device, &view, config).expect("renderer");
+        renderer.render(&device, &inputs).expect("render");
+        let ours = renderer
+            .read_back(&device, false)
+            .expect("read back")
+            .output;
+        let peer = match run_area_peer(&device, &renderer, &inputs, radius, samples, 3) {
+            Ok(peer) => peer,
+            Err(e) => match e.downcast_ref::<PassError>() {
+                Some(PassError::Unsupported(why)) => not_run(&device, why),
+                _ => panic!("the peer failed: {e:#}"),
+            },
+        };
+        let c = compare_area_counts(&r, &peer.visibility, None);
+        let differ = (0..ours.len())
+            .filter(|&i| r.stable[i] && ours[i] != peer.visibility[i])
+            .count();
+        println!(
+            "bin budget {bin_budget}: {} px, {} unstable, {} penumbra, {} mismatches against the \
+             reference, {differ} stable pixels differ from the plugin; trace {:.3} ms",
+            c.pixels, c.unstable, c.penumbra, c.mismatches, peer.trace_ms
+        );
+        assert_exact_area("area peer", &c, 50, 25);
+        assert_eq!(
+            differ, 0,
+            "the peer's counts differ from the plugin's on stable pixels"
+        );
+    }
+    assert_no_validation_errors(&device);
 }

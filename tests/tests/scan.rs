@@ -1,6 +1,7 @@
 //! The GPU prefix scan behind the primitive map's list offsets equals the CPU's exclusive prefix sum: in two
 //! dispatches up to 4096 blocks of 1024 elements (one, two, many blocks), and in three levels beyond, on
-//! random data, in place and from one buffer into another.
+//! random data, in place and from one buffer into another; and where the sums pass 2^32, it saturates
+//! (every sum below 2^32 exact, every larger one 0xFFFFFFFF) rather than wrapping.
 
 mod common;
 
@@ -13,8 +14,20 @@ fn gpu_scan_equals_the_cpu_prefix_sum() {
     let device = device();
     let pipeline = ScanPipeline::new(&device).expect("scan pipeline");
     let mut state = 0x2545_f491_4f6c_dd1d_u64;
-    for (case, n) in [
-        1u32, 1000, 1024, 1025, 300_000, 1_100_000, 4_194_304, 5_000_000,
+    // (elements, largest value): the last three sum past 2^32 within one block, within the flat scan's
+    // block totals, and in the multi-level scan's.
+    for (case, (n, largest)) in [
+        (1u32, 300u64),
+        (1000, 300),
+        (1024, 300),
+        (1025, 300),
+        (300_000, 300),
+        (1_100_000, 300),
+        (4_194_304, 300),
+        (5_000_000, 300),
+        (1000, 1 << 32),
+        (600_000, 1 << 14),
+        (5_000_000, 1 << 11),
     ]
     .into_iter()
     .enumerate()
@@ -25,7 +38,7 @@ fn gpu_scan_equals_the_cpu_prefix_sum() {
                 state ^= state << 13;
                 state ^= state >> 7;
                 state ^= state << 17;
-                (state % 300) as u32
+                (state % largest) as u32
             })
             .collect();
         let buffer = device
@@ -69,15 +82,18 @@ fn gpu_scan_equals_the_cpu_prefix_sum() {
             })
             .expect("submit");
         let gpu: Vec<u32> = bytemuck::pod_collect_to_vec(readback.read().expect("read"));
-        let mut running = 0u32;
+        let mut running = 0u64;
         let cpu: Vec<u32> = data
             .iter()
             .map(|&v| {
-                let before = running;
-                running += v;
+                let before = running.min(u64::from(u32::MAX)) as u32;
+                running += u64::from(v);
                 before
             })
             .collect();
+        if largest > 300 {
+            assert!(running > u64::from(u32::MAX), "case {case} must pass 2^32");
+        }
         let wrong = gpu.iter().zip(&cpu).filter(|(a, b)| a != b).count();
         assert_eq!(
             wrong, 0,

@@ -733,30 +733,6 @@ fn check_local_area(
     (min_penumbra, max_unstable_percent): (usize, usize),
 ) -> (AreaComparison, passes::MapStats) {
     let camera = camera(file);
-    let mut plugin = plugin_for(device, file);
-    let mut config = ShadowConfig {
-        mode: ShadowMode::Area,
-        antialiasing: false,
-        area: AreaConfig { samples },
-        ..settings(false).base
-    };
-    config.pcss.spot_radius = radius;
-    plugin
-        .configure_lights(device, &[config])
-        .expect("configure");
-    let matrices = CameraMatrices::of_camera(&camera, WIDTH, HEIGHT);
-    // The second frame: the first one's lists grow to what it needed.
-    let mut frame = None;
-    for _ in 0..2 {
-        frame = Some(
-            plugin
-                .render_c_lights(device, &matrices, vec![light])
-                .expect("frame"),
-        );
-    }
-    let frame = frame.expect("two frames");
-    let report = &frame.lights[0].report;
-    let (_, layers) = plugin.read_frame(device).expect("read back");
     let rs = RefScene::new(&file.scene);
     let params = point_light_params(file, &camera, centre);
     let offsets: Vec<glam::DVec2> = passes::area::local_area_offsets(samples)
@@ -779,16 +755,64 @@ fn check_local_area(
             })
             .collect()
     });
-    let c = compare_area_counts(&r, &layers[0], considered.as_deref());
-    println!(
-        "{name}: R {radius}, {samples} samples: {} px, {} unstable, {} penumbra, {} umbra, {} mismatches; {}; map {} entries, mean list {:.1}, longest {}, {} texels past capacity",
-        c.pixels, c.unstable, c.penumbra, c.umbra, c.mismatches, frame.lights[0].decision,
-        report.stats.entries, report.stats.mean_list(), report.stats.longest_list,
-        report.stats.texels_past_capacity
-    );
-    assert_exact_area(name, &c, min_penumbra, max_unstable_percent);
-    assert_no_validation_errors(device);
-    (c, report.stats)
+    let base = settings(false).base;
+    // The plugin's own choice of lists and BVH, then every pixel through the BVH: the same counts.
+    let mut first: Option<(AreaComparison, passes::MapStats, Vec<f32>)> = None;
+    for (route, bin_budget) in [("default", base.map.bin_budget), ("BVH", 0.0)] {
+        let mut config = ShadowConfig {
+            mode: ShadowMode::Area,
+            antialiasing: false,
+            area: AreaConfig { samples },
+            ..base
+        };
+        config.map.bin_budget = bin_budget;
+        config.pcss.spot_radius = radius;
+        let mut plugin = plugin_for(device, file);
+        plugin
+            .configure_lights(device, &[config])
+            .expect("configure");
+        let matrices = CameraMatrices::of_camera(&camera, WIDTH, HEIGHT);
+        // The second frame: the first one's lists grow to what it needed.
+        let mut frame = None;
+        for _ in 0..2 {
+            frame = Some(
+                plugin
+                    .render_c_lights(device, &matrices, vec![light])
+                    .expect("frame"),
+            );
+        }
+        let frame = frame.expect("two frames");
+        let report = &frame.lights[0].report;
+        let (_, mut layers) = plugin.read_frame(device).expect("read back");
+        let c = compare_area_counts(&r, &layers[0], considered.as_deref());
+        let st = report.stats;
+        println!(
+            "{name} ({route}): R {radius}, {samples} samples: {} px, {} unstable, {} penumbra, {} umbra, {} mismatches; {}; map {} entries, mean list {:.1}, longest {}, {} texels past capacity, {} past the limit, {} pixels walked the BVH",
+            c.pixels, c.unstable, c.penumbra, c.umbra, c.mismatches, frame.lights[0].decision,
+            st.entries, st.mean_list(), st.longest_list, st.texels_past_capacity,
+            st.texels_past_limit, st.pixels_walked
+        );
+        assert_exact_area(
+            &format!("{name} ({route})"),
+            &c,
+            min_penumbra,
+            max_unstable_percent,
+        );
+        assert_eq!(st.walks_unfinished, 0, "{name} ({route})");
+        assert_no_validation_errors(device);
+        match &first {
+            None => first = Some((c, st, layers.swap_remove(0))),
+            Some((_, _, default)) => {
+                assert!(st.lists_skipped && st.pixels_walked > 0, "{name}: {st:?}");
+                assert!(
+                    &layers[0] == default,
+                    "{name}: the BVH's counts differ from the default route's"
+                );
+            }
+        }
+    }
+    let (c, st, _) = first.expect("the default route ran");
+    (c, st)
 }
 
 /// A sized point lamp inside the closed room, as one cube map: every sample of every stable pixel as the

@@ -3,6 +3,7 @@
 //! everything when the geometry changes every frame.
 
 use super::{DrawSource, Geometry, PrimBufferPass, VertexLayout};
+use crate::bvh::SceneBvh;
 use crate::primitive_map::MapScratchPool;
 use crate::{PassError, MAX_FRAMES_IN_FLIGHT};
 use glam::Mat4;
@@ -57,6 +58,8 @@ struct FrameMesh {
 pub struct SharedGeometry {
     geometry: Geometry,
     pass: PrimBufferPass,
+    /// The hierarchy over the prim buffer, rebuilt with it.
+    bvh: SceneBvh,
     state: Mutex<PrimBufferState>,
     map_scratch: MapScratchPool,
 }
@@ -112,6 +115,7 @@ impl SharedGeometry {
     /// so the prim buffer is rebuilt every frame (else what moved or deformed).
     pub fn new(device: &Device, geometry: Geometry, dynamic: bool) -> Result<Arc<Self>, PassError> {
         let pass = PrimBufferPass::new(device, &geometry)?;
+        let bvh = SceneBvh::new(device, pass.prims(), geometry.triangle_count())?;
         let models: Vec<Mat4> = geometry.draws().map(|(_, d)| d.model).collect();
         Ok(Arc::new(Self {
             state: Mutex::new(PrimBufferState {
@@ -125,6 +129,7 @@ impl SharedGeometry {
             }),
             geometry,
             pass,
+            bvh,
             map_scratch: MapScratchPool::default(),
         }))
     }
@@ -137,6 +142,11 @@ impl SharedGeometry {
     /// The prim buffer (triangles in frame coordinates).
     pub fn prims(&self) -> &Buffer {
         self.pass.prims()
+    }
+
+    /// The bounding volume hierarchy over the prim buffer (rebuilt whenever the prim buffer is).
+    pub fn bvh(&self) -> &SceneBvh {
+        &self.bvh
     }
 
     /// The build scratch the primitive maps over this geometry share (one light's map is built at a time).
@@ -206,6 +216,12 @@ impl SharedGeometry {
                     },
                 })
             })?;
+        if triangles > 0 {
+            enc.barriers(&[rhi::Barrier::Uav]);
+            enc.begin_pass("bvh build");
+            self.bvh.record_build(enc)?;
+            enc.end_pass();
+        }
         let deformed_meshes: Vec<usize> = deformed.iter().map(|m| m.mesh).collect();
         let s = &mut *guard;
         for ((draw, (mesh, _)), _) in self

@@ -127,7 +127,7 @@ pub fn choose_binning_path(
 }
 
 /// Size and behaviour of the primitive map. No setting trades exactness: every one only moves cost.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PrimitiveMapConfig {
     /// N: texels per side of the light-space grid fitted to the receivers (default 1024).
     pub size: u32,
@@ -154,10 +154,30 @@ pub struct PrimitiveMapConfig {
     /// ray trace for the whole light. Needs compute binning.
     pub cube: bool,
     /// (Triangle, face) pairs a cube map starts with (0: two per triangle, at least 1024). A frame that
-    /// keeps more traces the light's rays exhaustively (exact, slower, reported) and the pairs grow for the
-    /// next, up to six per triangle.
+    /// keeps more walks every ray through the BVH (exact, reported) and the pairs grow for the next, up to
+    /// six per triangle.
     pub initial_pairs: u32,
+    /// A texel whose list would hold more than this many entries keeps none: its pixels walk the BVH over
+    /// the prim buffer (`crate::bvh`), which then costs less than the list (default
+    /// [`DEFAULT_LIST_LIMIT`]; `u32::MAX`: no limit).
+    pub list_limit: u32,
+    /// Bin items (4×4-texel tiles of the triangles' footprints, widened by their penumbrae for area
+    /// shadows) per pixel with a shadow ray, past which a frame builds no list and every pixel walks the
+    /// BVH: a large light's footprints cover most of the map, and the walk's cost follows the pixel's
+    /// segments instead (default [`DEFAULT_BIN_BUDGET`]; infinite: always lists; 0: always the BVH).
+    pub bin_budget: f32,
+    /// Debug: entries each (triangle, texel) pair counts (default 1), so that a test can push the sums of
+    /// list entries past 2^32 with a small scene. The fill still stores one entry per pair: the rest of an
+    /// inflated list holds what the entries held before (guard mode: [`GUARD_VALUE`], an index past every
+    /// triangle, which the traces skip), and nothing changes what the traces decide.
+    pub debug_count_scale: u32,
 }
+
+/// Default [`PrimitiveMapConfig::list_limit`].
+pub const DEFAULT_LIST_LIMIT: u32 = 256;
+
+/// Default [`PrimitiveMapConfig::bin_budget`].
+pub const DEFAULT_BIN_BUDGET: f32 = 8.0;
 
 /// Value of every guard word (never a valid prim-buffer index).
 pub const GUARD_VALUE: u32 = u32::MAX;
@@ -186,6 +206,9 @@ impl Default for PrimitiveMapConfig {
             guard: false,
             cube: false,
             initial_pairs: 0,
+            list_limit: DEFAULT_LIST_LIMIT,
+            bin_budget: DEFAULT_BIN_BUDGET,
+            debug_count_scale: 1,
         }
     }
 }
@@ -222,6 +245,17 @@ impl PrimitiveMapConfig {
                 "a front-only primitive map needs a directional light, not a point light's cube"
                     .into(),
             ));
+        }
+        if self.debug_count_scale == 0 {
+            return Err(PassError::InvalidConfig(
+                "primitive map debug count scale must be at least 1".into(),
+            ));
+        }
+        if self.bin_budget.is_nan() || self.bin_budget < 0.0 {
+            return Err(PassError::InvalidConfig(format!(
+                "primitive map bin budget {} must be a number of bin items per pixel, 0 or more",
+                self.bin_budget
+            )));
         }
         if self.entry_budget < MIN_ENTRY_BUDGET {
             return Err(PassError::InvalidConfig(format!(

@@ -36,7 +36,8 @@ mod scratch;
 
 pub use config::{
     choose_binning_path, BinningPath, BinningRequest, FaceMode, PrimitiveMapConfig,
-    DEFAULT_ENTRY_BUDGET, GUARD_VALUE, GUARD_WORDS, MIN_ENTRY_BUDGET,
+    DEFAULT_BIN_BUDGET, DEFAULT_ENTRY_BUDGET, DEFAULT_LIST_LIMIT, GUARD_VALUE, GUARD_WORDS,
+    MIN_ENTRY_BUDGET,
 };
 pub use offsets::{
     packed_offset_words, packed_texels, unpack_list_offsets, ListOffsets, OFFSET_GROUP,
@@ -211,6 +212,7 @@ impl PrimitiveMap {
             entries: &entries,
             pool: inputs.scratch,
             entry_capacity: capacity,
+            list_limit: config.list_limit,
         };
         let bound = ScratchBindings::new(device, &pipes, scratch, &targets, (texels, bins))?;
         Ok(Self {
@@ -278,7 +280,7 @@ impl PrimitiveMap {
                 BinningPath::Compute => Binner::Compute(device.create_compute_pipeline(
                     "map bin",
                     &shader("map_bin.comp")?,
-                    &buffers(9),
+                    &buffers(10),
                     push,
                 )?),
                 raster => Binner::Raster(Self::raster_pipeline(device, raster)?),
@@ -286,8 +288,8 @@ impl PrimitiveMap {
             pack: device.create_compute_pipeline(
                 "map pack",
                 &shader("map_pack.comp")?,
-                &buffers(3),
-                std::mem::size_of::<u32>() as u32,
+                &buffers(4),
+                std::mem::size_of::<[u32; 2]>() as u32,
             )?,
             occupancy: device.create_compute_pipeline(
                 "occupancy",
@@ -333,7 +335,7 @@ impl PrimitiveMap {
             vertex: &shader("prim_map.vert")?,
             geometry: geometry.as_deref(),
             fragment: &shader("prim_map_raster.frag")?,
-            bindings: &[BindingKind::StorageBuffer; 4],
+            bindings: &[BindingKind::StorageBuffer; 5],
             push_constant_size: std::mem::size_of::<MapPush>() as u32,
             color_formats: &[],
             depth: None,
@@ -426,6 +428,7 @@ impl PrimitiveMap {
             entries: &self.entries,
             pool,
             entry_capacity: self.capacity,
+            list_limit: self.config.list_limit,
         };
         let sizes = (self.config.texels(), self.bins);
         let bound = ScratchBindings::new(device, &self.pipes, scratch, &targets, sizes)?;
@@ -492,6 +495,9 @@ impl PrimitiveMap {
             list_capacity: self.bound.pair_list.as_ref().map_or(0, |l| {
                 (l.size() / PAIR_BYTES).min(u64::from(u32::MAX)) as u32
             }),
+            list_limit: self.config.list_limit,
+            bin_budget: self.config.bin_budget,
+            count_scale: self.config.debug_count_scale,
             ..*push
         };
         let with_mode = |mode| MapPush { mode, ..push };
@@ -515,6 +521,7 @@ impl PrimitiveMap {
         enc.update_buffer(&self.state, 0, bytemuck::cast_slice(&reset))?;
         enc.fill_buffer(&self.receivers, 0);
         enc.fill_buffer(&self.bound.scratch.counts, 0);
+        enc.fill_buffer(&self.bound.scratch.capped, 0);
         if self.config.guard {
             enc.fill_buffer(&self.entries, GUARD_VALUE);
         }
@@ -570,13 +577,16 @@ impl PrimitiveMap {
         enc.begin_pass("primitive map: scan");
         self.bound.offset_scan.record(enc, &self.pipes.scan)?;
         let groups = self.config.texels().div_ceil(OFFSET_GROUP as u64) + 1;
-        enc.dispatch(
-            &self.pipes.pack,
-            &self.bound.pack_group,
-            bytemuck::bytes_of(&(self.config.texels() as u32)),
-            [groups.div_ceil(64) as u32, 1, 1],
-        )?;
-        enc.barriers(&[Barrier::Uav]);
+        // The offsets and statistics, then the cursors of the lists not kept.
+        for mode in 0..2u32 {
+            enc.dispatch(
+                &self.pipes.pack,
+                &self.bound.pack_group,
+                bytemuck::cast_slice(&[self.config.texels() as u32, mode]),
+                [groups.div_ceil(64) as u32, 1, 1],
+            )?;
+            enc.barriers(&[Barrier::Uav]);
+        }
         enc.end_pass();
 
         enc.begin_pass(&format!("primitive map: fill ({label})"));
@@ -654,30 +664,37 @@ impl PrimitiveMap {
         Ok(())
     }
 
-    /// Draws the occupancy view when the map has one, and copies the state with the statistics the build
-    /// tallied into `state_readback` (host-readable once the frame completed; as large as the state).
-    pub fn record_occupancy(
+    /// Draws the occupancy view when the map has one.
+    pub fn record_occupancy(&self, enc: &mut Encoder<'_>) -> Result<(), PassError> {
+        let Some(view) = self.occupancy_view() else {
+            return Ok(());
+        };
+        enc.begin_pass("occupancy");
+        enc.barriers(&[Barrier::Image {
+            image: view,
+            before: S::Undefined,
+            after: S::UnorderedAccess,
+        }]);
+        let n = self.config.size;
+        let push = [n, self.config.texels() as u32];
+        // Each invocation draws a 2x2 quad of the first N rows of texels.
+        enc.dispatch(
+            &self.pipes.occupancy,
+            &self.occupancy_group,
+            bytemuck::cast_slice(&push),
+            [n.div_ceil(16), n.div_ceil(16), 1],
+        )?;
+        enc.end_pass();
+        Ok(())
+    }
+
+    /// Copies the state, with the statistics the build tallied and the walks the ray trace counted, into
+    /// `state_readback` (host-readable once the frame completed; as large as the state).
+    pub fn record_state_readback(
         &self,
         enc: &mut Encoder<'_>,
         state_readback: &Buffer,
     ) -> Result<(), PassError> {
-        enc.begin_pass("occupancy");
-        if self.occupancy_view {
-            enc.barriers(&[Barrier::Image {
-                image: &self.occupancy,
-                before: S::Undefined,
-                after: S::UnorderedAccess,
-            }]);
-            let n = self.config.size;
-            let push = [n, self.config.texels() as u32];
-            // Each invocation draws a 2x2 quad of the first N rows of texels.
-            enc.dispatch(
-                &self.pipes.occupancy,
-                &self.occupancy_group,
-                bytemuck::cast_slice(&push),
-                [n.div_ceil(16), n.div_ceil(16), 1],
-            )?;
-        }
         enc.barriers(&[Barrier::Global {
             before: S::UnorderedAccess,
             after: S::CopySource,
@@ -687,7 +704,6 @@ impl PrimitiveMap {
             before: S::CopyDest,
             after: S::HostRead,
         }]);
-        enc.end_pass();
         Ok(())
     }
 }

@@ -47,6 +47,8 @@ pub struct MapScratch {
     pub(super) tile_offsets: Buffer,
     pub(super) pair_owners: Buffer,
     pub(super) counts: Buffer,
+    /// One bit per texel: its count passed the list limit (`map_store.glsl`).
+    pub(super) capped: Buffer,
     pub(super) search_index: Buffer,
     /// The texels the counts hold.
     pub(super) texels: u64,
@@ -64,6 +66,7 @@ impl MapScratch {
             &self.tile_offsets,
             &self.pair_owners,
             &self.counts,
+            &self.capped,
             &self.search_index,
         ]
         .iter()
@@ -158,6 +161,11 @@ impl MapScratchPool {
                     "primitive map counts",
                     (texels + 1) * 4,
                     BufferUsage::COPY_DST | BufferUsage::COPY_SRC,
+                )?,
+                capped: storage(
+                    "primitive map capped texels",
+                    (texels / 32 + 1) * 4,
+                    BufferUsage::COPY_DST,
                 )?,
                 search_index: storage(
                     "primitive map search index",
@@ -274,6 +282,8 @@ pub(super) struct BindTargets<'a> {
     /// The pool the pair list comes from, and the pairs it must hold (the entry capacity).
     pub(super) pool: &'a MapScratchPool,
     pub(super) entry_capacity: u32,
+    /// The map's list limit: the scan reads longer counts as 0.
+    pub(super) list_limit: u32,
 }
 
 impl ScratchBindings {
@@ -314,6 +324,7 @@ impl ScratchBindings {
                         b(&s.pair_owners),
                         b(&list),
                         b(&s.search_index),
+                        b(&s.capped),
                     ],
                 )?;
                 pair_list = Some(list);
@@ -321,7 +332,13 @@ impl ScratchBindings {
             }
             Binner::Raster(p) => device.create_bind_group(
                 p.layout(),
-                &[b(&s.bin_tris), b(t.receivers), b(&s.counts), b(t.entries)],
+                &[
+                    b(&s.bin_tris),
+                    b(t.receivers),
+                    b(&s.counts),
+                    b(t.entries),
+                    b(&s.capped),
+                ],
             )?,
         };
         let tile_scan = PrefixScan::new(
@@ -337,7 +354,8 @@ impl ScratchBindings {
             &s.counts,
             &s.counts,
             (texels + 1) as u32,
-        )?;
+        )?
+        .with_input_cap(t.list_limit);
         let index_group = device.create_bind_group(
             pipes.index.layout(),
             &[
@@ -352,6 +370,7 @@ impl ScratchBindings {
                 Resource::Buffer(&s.counts),
                 Resource::Buffer(t.offsets),
                 Resource::Buffer(t.state),
+                Resource::Buffer(&s.capped),
             ],
         )?;
         Ok(Self {

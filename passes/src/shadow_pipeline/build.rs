@@ -157,6 +157,7 @@ impl ShadowPipeline {
                     normal: inputs.normal,
                     map: m,
                     prims: need_prims()?,
+                    bvh: shared.bvh().nodes(),
                 },
                 width,
                 height,

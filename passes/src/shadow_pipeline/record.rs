@@ -241,9 +241,7 @@ impl ShadowPipeline {
             }
             PassId::Occupancy => {
                 if let Some(map) = &self.map {
-                    let slot = &mut self.slots[frame.slot];
-                    map.record_occupancy(enc, &slot.stats_readback)?;
-                    slot.map_state_recorded = true;
+                    map.record_occupancy(enc)?;
                 }
             }
             PassId::RayTrace => {
@@ -253,6 +251,12 @@ impl ShadowPipeline {
                 self.outputs_to_uav(enc, pass);
                 if let Some(ray) = self.ray.as_mut() {
                     ray.record(enc, &c.ray, c.area.as_deref())?;
+                }
+                // The map's state with the build's statistics and the trace's walks, for the report.
+                if let Some(map) = &self.map {
+                    let slot = &mut self.slots[frame.slot];
+                    map.record_state_readback(enc, &slot.stats_readback)?;
+                    slot.map_state_recorded = true;
                 }
             }
             PassId::ShadowMapTest => {

@@ -1,0 +1,118 @@
+// A pixel's walk of the bounding volume hierarchy over the prim buffer (passes::bvh): every triangle whose
+// box meets the bundle of the pixel's rays or segments, nearer child first, until the includer is done.
+// The includer declares the node buffer `bvh_nodes[]` (bvh.glsl's BvhNode) before this file, and defines
+// `void bvh_visit(uint triangle)` (tests one triangle) and `bool bvh_done()` (whether the pixel is decided);
+// it sets the bundle (bvh_cone_*) before calling bvh_walk.
+//
+// The bundle is the cone of points o + t (d + r), 0 <= t <= t_end, |r| <= t * spread: a hard shadow ray
+// (spread 0, d its direction), the segments from o to the points of a spot or point light's emitter disc
+// (d from o to the disc's centre, spread its radius, t_end 1), or the rays from o within a directional
+// light's cone (d its centre direction, spread the bound on every sample's distance from it). Per axis the
+// cone's section at t spans [o + t (d - spread), o + t (d + spread)] (the box around the disc of radius
+// t spread), so a box is met only where both ends' linear conditions hold for a common t: a slab test.
+// Boxes are grown by 1e-5 of the largest coordinate involved, far beyond the rounding of the test: a box
+// the exact bundle meets is always walked.
+
+vec3 bvh_cone_o;
+vec3 bvh_cone_d;
+float bvh_cone_spread;
+float bvh_cone_t_end;
+
+void bvh_visit(uint triangle);
+bool bvh_done();
+
+// Whether the bundle meets the box [lo, hi]; `t_enter`, the first t at which it may.
+bool bvh_cone_meets(vec3 lo, vec3 hi, out float t_enter) {
+    t_enter = 0.0;
+    if (any(greaterThan(lo, hi))) {
+        return false;   // an empty box (a triangle that cannot be hit)
+    }
+    vec3 big = max(max(abs(lo), abs(hi)), abs(bvh_cone_o));
+    float grow = min(1e-5 * max(max(big.x, big.y), big.z), 1e30);
+    lo -= grow;
+    hi += grow;
+    float t0 = 0.0, t1 = bvh_cone_t_end;
+    for (int a = 0; a < 3; ++a) {
+        float o = bvh_cone_o[a];
+        float up = bvh_cone_d[a] + bvh_cone_spread;
+        float down = bvh_cone_d[a] - bvh_cone_spread;
+        // The section's upper end reaches the box's minimum: o + t up >= lo.
+        if (up > 0.0) {
+            t0 = max(t0, (lo[a] - o) / up);
+        } else if (up < 0.0) {
+            t1 = min(t1, (lo[a] - o) / up);
+        } else if (o < lo[a]) {
+            return false;
+        }
+        // The section's lower end stays below the box's maximum: o + t down <= hi.
+        if (down < 0.0) {
+            t0 = max(t0, (hi[a] - o) / down);
+        } else if (down > 0.0) {
+            t1 = min(t1, (hi[a] - o) / down);
+        } else if (o > hi[a]) {
+            return false;
+        }
+    }
+    t_enter = t0;
+    return t0 <= t1;
+}
+
+// The most nodes a walk holds (the hierarchy is less deep: each level's common prefix of the 62-bit
+// (Morton code, position) keys is longer than its parent's).
+const uint BVH_STACK = 64u;
+uint bvh_stack[BVH_STACK];
+
+// Walks the hierarchy over `triangles` triangles; false when the walk could not finish (never on a
+// conforming device: the stack cannot overflow and the rounds cover every node; the caller counts it).
+bool bvh_walk(uint triangles) {
+    if (triangles == 0u) {
+        return true;
+    }
+    uint sp = 0u;
+    uint node = 0u;
+    bool walking = true;
+    // Rounds of 64 steps: llvmpipe (lavapipe) ends any one loop after 65535 iterations.
+    for (uint round = 0u; round < 65535u && walking; ++round) {
+        for (uint step = 0u; step < 64u && walking; ++step) {
+            BvhNode nd = bvh_nodes[node];
+            float t_left, t_right;
+            bool left = bvh_cone_meets(nd.left_lo.xyz, nd.left_hi.xyz, t_left);
+            bool right = bvh_cone_meets(nd.right_lo.xyz, nd.right_hi.xyz, t_right);
+            uint left_child = floatBitsToUint(nd.left_lo.w);
+            uint right_child = floatBitsToUint(nd.right_lo.w);
+            uint leaves[2];
+            uint count = 0u;
+            if (left && left_child >= BVH_LEAF) {
+                leaves[count++] = left_child & ~BVH_LEAF;
+                left = false;
+            }
+            if (right && right_child >= BVH_LEAF) {
+                leaves[count++] = right_child & ~BVH_LEAF;
+                right = false;
+            }
+            for (uint i = 0u; i < count; ++i) {
+                bvh_visit(leaves[i]);
+            }
+            if (bvh_done()) {
+                return true;
+            }
+            if (left && right) {
+                if (sp == BVH_STACK) {
+                    return false;
+                }
+                bool left_first = t_left <= t_right;
+                bvh_stack[sp++] = left_first ? right_child : left_child;
+                node = left_first ? left_child : right_child;
+            } else if (left) {
+                node = left_child;
+            } else if (right) {
+                node = right_child;
+            } else if (sp > 0u) {
+                node = bvh_stack[--sp];
+            } else {
+                walking = false;
+            }
+        }
+    }
+    return !walking;
+}

@@ -1,0 +1,303 @@
+//! The BVH over the prim buffer (`passes::bvh`), built on the GPU, and the traces' walk of it.
+//!
+//! The hierarchy is read back and checked on the CPU: every triangle is one leaf, every node is reached
+//! once, each child's box is exactly the bounds of its subtree's vertices, and no path is 64 deep — over a
+//! real model, over triangles whose box centres all coincide (equal Morton codes throughout), and over one
+//! and two triangles.
+//!
+//! A walk of it gives the same answer as the lists, bit for bit: the same view traced with lists only, with
+//! the BVH only (a bin budget of 0) and with short lists (a list limit of 2, the longer ones walked) gives
+//! equal visibility, blocker distances and area counts, and equals the exact reference.
+
+mod common;
+
+use common::*;
+use glam::Vec3;
+use host_demo::renderer::with_blocker_distance;
+use host_demo::{FrameImages, ShadowRenderer, View};
+use passes::bvh::{BvhNode, BVH_LEAF};
+use passes::gpu_types::GpuTriangle;
+use passes::{
+    AreaConfig, BinningRequest, FrameReport, PcssConfig, PrimitiveMapConfig, ShadowConfig,
+    ShadowMode,
+};
+use reference::RefScene;
+use rhi::{Barrier, Buffer, BufferUsage, Device, MemoryLocation, ResourceState as S};
+
+/// Copies `buffer` to the host.
+fn read_buffer<T: bytemuck::Pod>(device: &Device, buffer: &Buffer) -> Vec<T> {
+    let readback = device
+        .create_buffer(
+            "read-back",
+            buffer.size(),
+            BufferUsage::COPY_DST,
+            MemoryLocation::GpuToCpu,
+        )
+        .expect("read-back buffer");
+    device
+        .submit_and_wait(|enc| {
+            enc.barriers(&[Barrier::Global {
+                before: S::UnorderedAccess,
+                after: S::CopySource,
+            }]);
+            enc.copy_buffer(buffer, &readback)?;
+            enc.barriers(&[Barrier::Global {
+                before: S::CopyDest,
+                after: S::HostRead,
+            }]);
+            Ok(())
+        })
+        .expect("copy");
+    bytemuck::pod_collect_to_vec(readback.read().expect("read"))
+}
+
+/// Renders `view` once with `config` and reads everything back.
+fn render_with(device: &Device, view: &View, config: ShadowConfig) -> (FrameReport, FrameImages) {
+    let geometry = view.upload(device).expect("upload");
+    let mut r =
+        ShadowRenderer::new(device, geometry, view.width, view.height, config).expect("renderer");
+    let report = r.render(device, &view.frame_inputs()).expect("render");
+    (report, r.read_back(device, false).expect("read back"))
+}
+
+/// Builds the BVH of `view`'s scene (a frame of hard shadows) and checks it against its triangles.
+fn check_hierarchy(device: &Device, view: &View) {
+    let geometry = view.upload(device).expect("upload");
+    let mut r = ShadowRenderer::new(
+        device,
+        geometry,
+        view.width,
+        view.height,
+        ShadowConfig {
+            mode: ShadowMode::Hard,
+            ..ShadowConfig::default()
+        },
+    )
+    .expect("renderer");
+    r.render(device, &view.frame_inputs()).expect("render");
+    let shared = r.pipeline().shared_geometry();
+    let triangles: Vec<GpuTriangle> = read_buffer(device, shared.prims());
+    let nodes: Vec<BvhNode> = read_buffer(device, shared.bvh().nodes());
+    let n = shared.geometry().triangle_count() as usize;
+    assert_eq!(triangles.len(), n);
+    let bounds = |t: &GpuTriangle| {
+        let [a, b, c] = t.v.map(|v| v.truncate());
+        (a.min(b).min(c), a.max(b).max(c))
+    };
+    let mut leaves = vec![0u32; n];
+    let mut reached = vec![0u32; nodes.len()];
+    // (child, its box as stored in the parent, depth)
+    let mut deepest = 0;
+    let mut pending: Vec<(u32, (Vec3, Vec3), usize)> = Vec::new();
+    let root = nodes[0];
+    if n == 1 {
+        assert_eq!(root.left_lo.w.to_bits(), BVH_LEAF);
+        assert_eq!(root.right_lo.w.to_bits(), BVH_LEAF);
+        assert_eq!(
+            (root.left_lo.truncate(), root.left_hi.truncate()),
+            bounds(&triangles[0])
+        );
+        return;
+    }
+    reached[0] = 1;
+    let children = |node: &BvhNode| {
+        [
+            (
+                node.left_lo.w.to_bits(),
+                (node.left_lo.truncate(), node.left_hi.truncate()),
+            ),
+            (
+                node.right_lo.w.to_bits(),
+                (node.right_lo.truncate(), node.right_hi.truncate()),
+            ),
+        ]
+    };
+    for (child, stored) in children(&root) {
+        pending.push((child, stored, 1));
+    }
+    // Exact subtree bounds, computed bottom-up after the walk.
+    let mut order = Vec::new();
+    while let Some((child, stored, depth)) = pending.pop() {
+        deepest = deepest.max(depth);
+        if child & BVH_LEAF != 0 {
+            let t = (child & !BVH_LEAF) as usize;
+            assert!(t < n, "leaf {t} past {n} triangles");
+            leaves[t] += 1;
+            assert_eq!(stored, bounds(&triangles[t]), "triangle {t}'s box");
+        } else {
+            let i = child as usize;
+            assert!(i < nodes.len(), "node {i} past {} nodes", nodes.len());
+            reached[i] += 1;
+            order.push((i, stored));
+            for (grandchild, box_) in children(&nodes[i]) {
+                pending.push((grandchild, box_, depth + 1));
+            }
+        }
+    }
+    assert!(deepest < 64, "a path {deepest} deep");
+    let twice = leaves.iter().filter(|&&c| c != 1).count();
+    assert_eq!(twice, 0, "{twice} triangles not exactly once in the leaves");
+    let unreached = reached.iter().filter(|&&c| c != 1).count();
+    assert_eq!(unreached, 0, "{unreached} nodes not reached exactly once");
+    // Each internal node's box as its parent stores it is the union of its children's boxes.
+    for (i, stored) in order {
+        let [(_, l), (_, r)] = children(&nodes[i]);
+        assert_eq!(stored, (l.0.min(r.0), l.1.max(r.1)), "node {i}'s box");
+    }
+    println!("{n} triangles: depth {deepest}");
+    assert_no_validation_errors(device);
+}
+
+#[test]
+fn the_bvh_holds_every_triangle_once_in_exact_boxes() {
+    let device = device();
+    let bunny = scene::load_obj(&model("02_stanford_bunny_69k.obj")).expect("bunny loads");
+    check_hierarchy(&device, &View::framed(bunny.with_ground_plane(), 64, 48));
+    // 3,000 triangles around one centre: every Morton code equal, the split by position alone.
+    let mut star = scene::MeshBuilder::new();
+    for i in 0..3000 {
+        let a = i as f32 * 0.618;
+        let u = Vec3::new(a.cos(), 0.3, a.sin());
+        star.add_triangle([u, -u, Vec3::new(0.0, 1.0 + i as f32 * 1e-3, 0.0)]);
+    }
+    let star = star.into_scene("star");
+    check_hierarchy(&device, &View::framed(star, 32, 24));
+    for count in [1, 2] {
+        let mut few = scene::MeshBuilder::new();
+        for i in 0..count {
+            let y = i as f32;
+            few.add_triangle([
+                Vec3::new(0.0, y, 0.0),
+                Vec3::new(1.0, y, 0.0),
+                Vec3::new(0.0, y, 1.0),
+            ]);
+        }
+        check_hierarchy(&device, &View::framed(few.into_scene("few"), 16, 16));
+    }
+}
+
+/// Lists only, the BVH only, and short lists (the longer walked): the three routes of a frame.
+fn routes(map: PrimitiveMapConfig) -> [(&'static str, PrimitiveMapConfig); 3] {
+    [
+        (
+            "lists",
+            PrimitiveMapConfig {
+                list_limit: u32::MAX,
+                bin_budget: f32::INFINITY,
+                ..map
+            },
+        ),
+        (
+            "BVH",
+            PrimitiveMapConfig {
+                bin_budget: 0.0,
+                ..map
+            },
+        ),
+        (
+            "lists of 2 at most",
+            PrimitiveMapConfig {
+                list_limit: 2,
+                bin_budget: f32::INFINITY,
+                ..map
+            },
+        ),
+    ]
+}
+
+/// Asserts where a route's pixels went.
+fn assert_route(name: &str, report: &FrameReport) {
+    let st = report.stats;
+    assert_eq!(st.walks_unfinished, 0, "{name}: {st:?}");
+    match name {
+        "lists" => assert!(st.pixels_walked == 0 && !st.lists_skipped, "{name}: {st:?}"),
+        "BVH" => assert!(
+            st.lists_skipped && st.pixels_walked > 0 && st.entries == 0,
+            "{name}: {st:?}"
+        ),
+        _ => assert!(
+            st.texels_past_limit > 0 && st.pixels_walked > 0 && st.entries > 0,
+            "{name}: {st:?}"
+        ),
+    }
+}
+
+#[test]
+fn hard_shadows_through_the_bvh_equal_the_lists_bit_for_bit() {
+    let device = device();
+    let view = View::framed(scene::procedural_default(), 160, 120);
+    let rs = RefScene::new(&view.scene);
+    let map = PrimitiveMapConfig {
+        size: 128,
+        binning: BinningRequest::Compute,
+        ..PrimitiveMapConfig::default()
+    };
+    let mut first: Option<FrameImages> = None;
+    for (name, map) in routes(map) {
+        let mut config = with_blocker_distance(ShadowConfig::from(map));
+        config.mode = ShadowMode::Hard;
+        let (report, images) = render_with(&device, &view, config);
+        assert_route(name, &report);
+        let c = compare_visibility(&rs, &view, &images);
+        println!(
+            "{name}: {} mismatches, {} near-edge, {:?}",
+            c.mismatches, c.near_edge, report.stats
+        );
+        assert_exact_visibility(&c, 0.04);
+        assert_eq!(c.blocker_mismatches, 0, "{name}: blocker distances");
+        match &first {
+            None => first = Some(images),
+            Some(lists) => {
+                assert!(
+                    images.visibility == lists.visibility,
+                    "{name}: visibility differs from the lists'"
+                );
+                assert!(
+                    images.blocker_distance == lists.blocker_distance,
+                    "{name}: blocker distances differ from the lists'"
+                );
+            }
+        }
+    }
+    assert_no_validation_errors(&device);
+}
+
+#[test]
+fn area_shadows_through_the_bvh_equal_the_lists_bit_for_bit() {
+    let device = device();
+    let view = plate_and_box_view(96, 72);
+    let rs = RefScene::new(&view.scene);
+    let (radius, samples) = (0.1, 32);
+    let map = PrimitiveMapConfig {
+        size: 128,
+        binning: BinningRequest::Compute,
+        ..PrimitiveMapConfig::default()
+    };
+    let mut first: Option<Vec<f32>> = None;
+    for (name, map) in routes(map) {
+        let config = ShadowConfig {
+            mode: ShadowMode::Area,
+            antialiasing: false,
+            map,
+            pcss: PcssConfig {
+                angular_radius: radius,
+                ..PcssConfig::default()
+            },
+            area: AreaConfig { samples },
+            ..ShadowConfig::default()
+        };
+        let (report, images) = render_with(&device, &view, config);
+        assert_route(name, &report);
+        let c = compare_area(&rs, &view, radius, samples, &images.output);
+        println!("{name}: {c:?}, {:?}", report.stats);
+        assert_exact_area(name, &c, 50, 25);
+        match &first {
+            None => first = Some(images.output),
+            Some(lists) => assert!(
+                &images.output == lists,
+                "{name}: area counts differ from the lists'"
+            ),
+        }
+    }
+    assert_no_validation_errors(&device);
+}
