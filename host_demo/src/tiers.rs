@@ -65,11 +65,14 @@ pub fn tier_matrix(device: &Device, scenes: &[(&str, View)], size: u32) -> Resul
     for (name, view) in scenes {
         let rs = RefScene::new(&view.scene);
         for request in available_requests(device) {
+            // Every list kept whatever its length, to compare with exact binning.
             let config = PrimitiveMapConfig {
                 size,
                 faces: FaceMode::Both,
                 binning: request,
                 receiver_culling: false,
+                list_limit: u32::MAX,
+                bin_budget: f32::INFINITY,
                 ..PrimitiveMapConfig::default()
             };
             let mut renderer = PluginRenderer::new(device, view, config)?;

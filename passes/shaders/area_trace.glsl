@@ -44,8 +44,12 @@ layout(set = 0, binding = 8, r32f) uniform writeonly image2D visibility;
 layout(set = 0, binding = 9) uniform Samples { AreaSamples samples; };
 layout(set = 0, binding = 10) readonly buffer EdgeTable { uvec4 edge_table[]; };
 layout(set = 0, binding = 11) readonly buffer Bvh { BvhNode bvh_nodes[]; };
+// The samples of every band of columns and rows of a grid over the samples' plane
+// (passes::area::SampleBands): a directional light's table, then a local light's.
+layout(set = 0, binding = 12) readonly buffer SampleBands { uvec4 sample_bands[]; };
 #include "shadow_ray.glsl"
 #include "trace_route.glsl"
+#define BVH_MASKED
 #include "bvh_traverse.glsl"
 
 // The workgroup's copy of the sample directions: the trace reads them at indices that differ from pixel to
@@ -193,8 +197,9 @@ uint quick(uint index) {
 
 // Decides the samples still open against the triangle quick() left undecided: the edge table decides most
 // samples of its lines at once (a local light's four lines in the unit disc), and the samples still open
-// that it is uncertain about are tested one by one.
-void resolve() {
+// that it is uncertain about are tested one by one (of `reach`, those whose segment or ray may meet the
+// triangle's box; every sample on the lists' path).
+void resolve(uvec4 reach) {
     uvec4 in_a, in_b, in_c, in_p, maybe_a, maybe_b, maybe_c, maybe_p;
     if (local) {
         line_masks(line_a.yzx, in_a, maybe_a);
@@ -209,7 +214,7 @@ void resolve() {
         maybe_p = all_samples;
     }
     uvec4 hidden = in_a & in_b & in_c & in_p & all_samples;
-    uvec4 open = maybe_a & maybe_b & maybe_c & maybe_p & all_samples & ~hidden & ~blocked;
+    uvec4 open = maybe_a & maybe_b & maybe_c & maybe_p & all_samples & reach & ~hidden & ~blocked;
     blocked |= hidden;
     for (uint word = 0u; word < 4u; ++word) {
         uint bits = open[word];
@@ -230,12 +235,12 @@ void resolve() {
     }
 }
 
-void consider(uint index) {
+void consider(uint index, uvec4 reach) {
     uint q = quick(index);
     if (q == BLOCKS_ALL) {
         blocked = all_samples;
     } else if (q == UNDECIDED) {
-        resolve();
+        resolve(reach);
     }
 }
 
@@ -243,12 +248,68 @@ bool all_blocked() {
     return blocked == all_samples;
 }
 
-void bvh_visit(uint index) {
-    consider(index);
+void bvh_visit(uint index, uvec4 reach) {
+    consider(index, reach);
 }
 
 bool bvh_done() {
     return all_blocked();
+}
+
+// The projection of the BVH walk's boxes (bvh_box_samples) onto the samples' plane: a corner c maps to
+// depth ((c - o).axis_u, (c - o).axis_v) / (c - o).normal - plane_offset, for corners in front of the
+// origin ((c - o).normal > 0). A local light: the emitter's disc plane through its centre P, whose (dual)
+// axes give the unit-disc offsets of the point where the ray from o through c meets it; a directional
+// light: the gnomonic plane at unit distance along C.
+vec3 plane_normal, plane_u, plane_v;
+vec2 plane_offset;
+float plane_depth;      // (P - o).normal for a local light, 1 for a directional one
+float plane_margin;     // grows each box's projection past the rounding of the projection
+
+// The bands of SAMPLE_BANDS columns (then rows) of a sample-band table: the bands starting at each column.
+const uint SAMPLE_BANDS = 16u;
+const uint BAND_COUNT = SAMPLE_BANDS * (SAMPLE_BANDS + 1u) / 2u;
+const uint bands_base = local ? 1u + 2u * BAND_COUNT : 0u;
+
+uint band_index(uint i0, uint i1) {
+    return i0 * SAMPLE_BANDS - i0 * (i0 - min(i0, 1u)) / 2u + (i1 - i0);
+}
+
+// The samples of `reach`, still open, whose segment or ray may meet the box [lo, hi]: those whose point in
+// the samples' plane may lie within the bounding rectangle of the box's central projection from the origin
+// (the projection of a convex set in front of the origin is the convex hull of its corners', and a segment
+// or ray from o through a point of the box reaches the plane at its sample's point), found in the sample
+// bands of the columns and rows the rectangle spans. A box with a corner not in front of the origin keeps
+// them all.
+uvec4 bvh_box_samples(vec3 lo, vec3 hi, uvec4 reach) {
+    uvec4 open = reach & ~blocked;
+    if (all(equal(open, uvec4(0u))) || !(plane_depth > 0.0)) {
+        return open;
+    }
+    vec2 rect_lo = vec2(1.0 / 0.0), rect_hi = vec2(-1.0 / 0.0);
+    for (uint corner = 0u; corner < 8u; ++corner) {
+        vec3 c = vec3((corner & 1u) != 0u ? hi.x : lo.x, (corner & 2u) != 0u ? hi.y : lo.y,
+                      (corner & 4u) != 0u ? hi.z : lo.z) - origin;
+        float depth = dot(c, plane_normal);
+        if (!(depth > 0.0)) {
+            return open;
+        }
+        vec2 p = plane_depth / depth * vec2(dot(c, plane_u), dot(c, plane_v)) - plane_offset;
+        rect_lo = min(rect_lo, p);
+        rect_hi = max(rect_hi, p);
+    }
+    float grow = plane_margin + 1e-3 * max(rect_hi.x - rect_lo.x, rect_hi.y - rect_lo.y)
+        + 1e-5 * max(max(abs(rect_lo.x), abs(rect_lo.y)), max(abs(rect_hi.x), abs(rect_hi.y)));
+    uvec4 header = sample_bands[bands_base];
+    float band_lo = uintBitsToFloat(header.x), cell = uintBitsToFloat(header.y);
+    vec2 first = (rect_lo - grow - band_lo) / cell, last = (rect_hi + grow - band_lo) / cell;
+    if (any(lessThan(last, vec2(0.0))) || any(greaterThan(first, vec2(float(SAMPLE_BANDS))))) {
+        return uvec4(0u);   // no sample's point lies there
+    }
+    uvec2 c0 = uvec2(clamp(floor(first), vec2(0.0), vec2(float(SAMPLE_BANDS - 1u))));
+    uvec2 c1 = uvec2(clamp(floor(last), vec2(0.0), vec2(float(SAMPLE_BANDS - 1u))));
+    return open & sample_bands[bands_base + 1u + band_index(c0.x, c1.x)]
+        & sample_bands[bands_base + 1u + BAND_COUNT + band_index(c0.y, c1.y)];
 }
 
 
@@ -296,7 +357,7 @@ void main() {
     uint begin, end;
     if (complete_list(texel, begin, end)) {
         for (uint i = begin; i < end && !all_blocked(); ++i) {
-            consider(entries[i]);
+            consider(entries[i], all_samples);
         }
     } else if (!all_blocked()) {
         // The bundle: the segments from the origin to the emitter's disc (its axes' combined reach bounds
@@ -307,12 +368,28 @@ void main() {
             float reach = max(dot(disc_u, disc_u), dot(disc_v, disc_v)) + abs(dot(disc_u, disc_v));
             bvh_cone_spread = sqrt(reach) * (1.0 + 1e-4);
             bvh_cone_t_end = 1.0;
+            // The disc's plane, spanned by its axes U and V, in the dual basis of (U, V): a point P + u U
+            // + v V of it gets (u, v) however far from orthogonal the axes' rounding leaves them.
+            vec3 n = cross(disc_u, disc_v);
+            plane_normal = dot(disc_c, n) < 0.0 ? -n : n;
+            vec3 du = cross(disc_v, n), dv = cross(n, disc_u);
+            plane_u = du / dot(disc_u, du);
+            plane_v = dv / dot(disc_v, dv);
+            plane_depth = dot(disc_c, plane_normal);
+            plane_offset = vec2(dot(disc_c, plane_u), dot(disc_c, plane_v));
+            plane_margin = 1e-4;
         } else {
             bvh_cone_d = samples.center.xyz;
             bvh_cone_spread = samples.center.w * (1.0 + 1e-4) + 1e-6;
             bvh_cone_t_end = 1.0 / 0.0;
+            plane_normal = samples.center.xyz;
+            plane_u = samples.axis_u.xyz;
+            plane_v = samples.axis_v.xyz;
+            plane_depth = 1.0;
+            plane_offset = vec2(0.0);
+            plane_margin = 1e-4 * samples.center.w;
         }
-        count_walk(bvh_walk(k.misc.y));
+        count_walk(bvh_walk(k.misc.y, all_samples));
     }
     uvec4 seen = blocked & all_samples;
     uint hidden = bitCount(seen.x) + bitCount(seen.y) + bitCount(seen.z) + bitCount(seen.w);

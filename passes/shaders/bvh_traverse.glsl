@@ -1,8 +1,9 @@
 // A pixel's walk of the bounding volume hierarchy over the prim buffer (passes::bvh): every triangle whose
 // box meets the bundle of the pixel's rays or segments, nearer child first, until the includer is done.
 // The includer declares the node buffer `bvh_nodes[]` (bvh.glsl's BvhNode) before this file, and defines
-// `void bvh_visit(uint triangle)` (tests one triangle) and `bool bvh_done()` (whether the pixel is decided);
-// it sets the bundle (bvh_cone_*) before calling bvh_walk.
+// `void bvh_visit(uint triangle, uvec4 samples)` (tests one triangle against the samples that may meet it)
+// and `bool bvh_done()` (whether the pixel is decided); it sets the bundle (bvh_cone_*) before calling
+// bvh_walk.
 //
 // The bundle is the cone of points o + t (d + r), 0 <= t <= t_end, |r| <= t * spread: a hard shadow ray
 // (spread 0, d its direction), the segments from o to the points of a spot or point light's emitter disc
@@ -12,14 +13,22 @@
 // t spread), so a box is met only where both ends' linear conditions hold for a common t: a slab test.
 // Boxes are grown by 1e-5 of the largest coordinate involved, far beyond the rounding of the test: a box
 // the exact bundle meets is always walked.
+//
+// With BVH_MASKED defined (the area trace), each node of the walk carries the samples whose segment or ray
+// may meet it: the includer's `uvec4 bvh_box_samples(vec3 lo, vec3 hi, uvec4 samples)` narrows its
+// parent's to those of a child's box, and a child none of whose samples is still open is not walked. A wide
+// bundle then costs what its samples can meet, not what its cone holds.
 
 vec3 bvh_cone_o;
 vec3 bvh_cone_d;
 float bvh_cone_spread;
 float bvh_cone_t_end;
 
-void bvh_visit(uint triangle);
+void bvh_visit(uint triangle, uvec4 samples);
 bool bvh_done();
+#ifdef BVH_MASKED
+uvec4 bvh_box_samples(vec3 lo, vec3 hi, uvec4 samples);
+#endif
 
 // Whether the bundle meets the box [lo, hi]; `t_enter`, the first t at which it may.
 bool bvh_cone_meets(vec3 lo, vec3 hi, out float t_enter) {
@@ -57,58 +66,89 @@ bool bvh_cone_meets(vec3 lo, vec3 hi, out float t_enter) {
     return t0 <= t1;
 }
 
+// The samples of `samples` whose segment or ray may meet the box [lo, hi], and where the bundle may enter
+// it: none when the bundle misses it.
+uvec4 bvh_child(vec3 lo, vec3 hi, uvec4 samples, out float t_enter) {
+    if (!bvh_cone_meets(lo, hi, t_enter)) {
+        return uvec4(0u);
+    }
+#ifdef BVH_MASKED
+    return bvh_box_samples(lo, hi, samples);
+#else
+    return samples;
+#endif
+}
+
 // The most nodes a walk holds (the hierarchy is less deep: each level's common prefix of the 62-bit
 // (Morton code, position) keys is longer than its parent's).
 const uint BVH_STACK = 64u;
 uint bvh_stack[BVH_STACK];
+#ifdef BVH_MASKED
+uvec4 bvh_stack_samples[BVH_STACK];
+#endif
 
-// Walks the hierarchy over `triangles` triangles; false when the walk could not finish (never on a
-// conforming device: the stack cannot overflow and the rounds cover every node; the caller counts it).
-bool bvh_walk(uint triangles) {
+// Walks the hierarchy over `triangles` triangles for `samples` (the hard trace's one ray: any non-zero
+// mask); false when the walk could not finish (never on a conforming device: the stack cannot overflow and
+// the rounds cover every node; the caller counts it).
+bool bvh_walk(uint triangles, uvec4 samples) {
     if (triangles == 0u) {
         return true;
     }
     uint sp = 0u;
     uint node = 0u;
+    uvec4 node_samples = samples;
     bool walking = true;
     // Rounds of 64 steps: llvmpipe (lavapipe) ends any one loop after 65535 iterations.
     for (uint round = 0u; round < 65535u && walking; ++round) {
         for (uint step = 0u; step < 64u && walking; ++step) {
             BvhNode nd = bvh_nodes[node];
             float t_left, t_right;
-            bool left = bvh_cone_meets(nd.left_lo.xyz, nd.left_hi.xyz, t_left);
-            bool right = bvh_cone_meets(nd.right_lo.xyz, nd.right_hi.xyz, t_right);
+            uvec4 left = bvh_child(nd.left_lo.xyz, nd.left_hi.xyz, node_samples, t_left);
+            uvec4 right = bvh_child(nd.right_lo.xyz, nd.right_hi.xyz, node_samples, t_right);
             uint left_child = floatBitsToUint(nd.left_lo.w);
             uint right_child = floatBitsToUint(nd.right_lo.w);
             uint leaves[2];
+            uvec4 leaf_samples[2];
             uint count = 0u;
-            if (left && left_child >= BVH_LEAF) {
-                leaves[count++] = left_child & ~BVH_LEAF;
-                left = false;
+            if (any(notEqual(left, uvec4(0u))) && left_child >= BVH_LEAF) {
+                leaves[count] = left_child & ~BVH_LEAF;
+                leaf_samples[count++] = left;
+                left = uvec4(0u);
             }
-            if (right && right_child >= BVH_LEAF) {
-                leaves[count++] = right_child & ~BVH_LEAF;
-                right = false;
+            if (any(notEqual(right, uvec4(0u))) && right_child >= BVH_LEAF) {
+                leaves[count] = right_child & ~BVH_LEAF;
+                leaf_samples[count++] = right;
+                right = uvec4(0u);
             }
             for (uint i = 0u; i < count; ++i) {
-                bvh_visit(leaves[i]);
+                bvh_visit(leaves[i], leaf_samples[i]);
             }
             if (bvh_done()) {
                 return true;
             }
-            if (left && right) {
+            bool go_left = any(notEqual(left, uvec4(0u)));
+            bool go_right = any(notEqual(right, uvec4(0u)));
+            if (go_left && go_right) {
                 if (sp == BVH_STACK) {
                     return false;
                 }
                 bool left_first = t_left <= t_right;
-                bvh_stack[sp++] = left_first ? right_child : left_child;
+                bvh_stack[sp] = left_first ? right_child : left_child;
+#ifdef BVH_MASKED
+                bvh_stack_samples[sp] = left_first ? right : left;
+#endif
+                ++sp;
                 node = left_first ? left_child : right_child;
-            } else if (left) {
-                node = left_child;
-            } else if (right) {
-                node = right_child;
+                node_samples = left_first ? left : right;
+            } else if (go_left || go_right) {
+                node = go_left ? left_child : right_child;
+                node_samples = go_left ? left : right;
             } else if (sp > 0u) {
-                node = bvh_stack[--sp];
+                --sp;
+                node = bvh_stack[sp];
+#ifdef BVH_MASKED
+                node_samples = bvh_stack_samples[sp];
+#endif
             } else {
                 walking = false;
             }

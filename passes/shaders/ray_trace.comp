@@ -131,7 +131,7 @@ float walk_nearest;
 bool walk_first_hit;
 float walk_t_max;
 
-void bvh_visit(uint index) {
+void bvh_visit(uint index, uvec4 samples) {
     consider(index, walk_nearest);
     bvh_cone_t_end = walk_nearest;
 }
@@ -188,7 +188,7 @@ void main() {
         bvh_cone_d = dir;
         bvh_cone_spread = 0.0;
         bvh_cone_t_end = t_max;
-        count_walk(bvh_walk(k.misc.y));
+        count_walk(bvh_walk(k.misc.y, uvec4(1u, 0u, 0u, 0u)));
         nearest = walk_nearest;
     }
     if (nearest < t_max) {

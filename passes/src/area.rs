@@ -399,9 +399,160 @@ fn edge_table(points: &[(f64, f64)], margin: f64, extent: f64) -> AreaEdgeTable 
     }
 }
 
+/// Columns (and rows) of a [`SampleBands`] table.
+pub const SAMPLE_BANDS: u32 = 16;
+
+/// The samples of every band of columns and of rows of a square grid over the samples' plane (a directional
+/// light's gnomonic plane, a local light's unit disc): the BVH walk of the area trace finds the samples whose
+/// points lie in a rectangle of the plane (a box's projection) with two look-ups, the samples of the band of
+/// columns it spans and of the band of rows, instead of testing each sample. Each column and row holds the
+/// samples within a margin of it, far above the rounding of the samples' f32 points, so that the two bands
+/// hold every sample of the rectangle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SampleBands {
+    /// The grid's first column's (and row's) lower coordinate.
+    pub lo: f32,
+    /// The side of a cell.
+    pub cell: f32,
+    /// The samples of columns `i0..=i1` at [`band_index`]`(i0, i1)`.
+    pub columns: Vec<UVec4>,
+    /// The samples of rows `j0..=j1` at [`band_index`]`(j0, j1)`.
+    pub rows: Vec<UVec4>,
+}
+
+/// The index of the band of columns (or rows) `i0..=i1` (`i0 <= i1 < SAMPLE_BANDS`) in a [`SampleBands`]
+/// table: the bands starting at each column in turn.
+pub fn band_index(i0: u32, i1: u32) -> usize {
+    (i0 * SAMPLE_BANDS - i0 * i0.saturating_sub(1) / 2 + (i1 - i0)) as usize
+}
+
+impl SampleBands {
+    /// Bands of `SAMPLE_BANDS` columns and rows over `[-extent, extent]^2` for the sample `points` (x, y),
+    /// each column and row holding the samples within `margin` of it.
+    fn new(points: &[(f64, f64)], extent: f64, margin: f64) -> Self {
+        let cell = 2.0 * extent / f64::from(SAMPLE_BANDS);
+        let lo = -extent;
+        let line = |coordinate: fn(&(f64, f64)) -> f64| {
+            let single: Vec<UVec4> = (0..SAMPLE_BANDS)
+                .map(|j| {
+                    let (a, b) = (lo + f64::from(j) * cell, lo + f64::from(j + 1) * cell);
+                    let mut mask = UVec4::ZERO;
+                    for (i, p) in points.iter().enumerate() {
+                        let c = coordinate(p);
+                        if c >= a - margin && c <= b + margin {
+                            mask[i / 32] |= 1 << (i % 32);
+                        }
+                    }
+                    mask
+                })
+                .collect();
+            let mut bands = vec![UVec4::ZERO; band_index(SAMPLE_BANDS - 1, SAMPLE_BANDS - 1) + 1];
+            for i0 in 0..SAMPLE_BANDS {
+                let mut mask = UVec4::ZERO;
+                for i1 in i0..SAMPLE_BANDS {
+                    mask |= single[i1 as usize];
+                    bands[band_index(i0, i1)] = mask;
+                }
+            }
+            bands
+        };
+        Self {
+            lo: lo as f32,
+            cell: cell as f32,
+            columns: line(|p| p.0),
+            rows: line(|p| p.1),
+        }
+    }
+
+    /// The table as the area trace reads it: a header (`lo`, `cell` as bits), the column bands, the row
+    /// bands.
+    pub fn gpu_words(&self) -> Vec<UVec4> {
+        let header = UVec4::new(self.lo.to_bits(), self.cell.to_bits(), SAMPLE_BANDS, 0);
+        std::iter::once(header)
+            .chain(self.columns.iter().copied())
+            .chain(self.rows.iter().copied())
+            .collect()
+    }
+
+    /// The samples whose points may lie in the rectangle `[lo, hi]` (as the shader looks them up).
+    pub fn samples_in(&self, lo: Vec2, hi: Vec2) -> UVec4 {
+        let top = self.lo + SAMPLE_BANDS as f32 * self.cell;
+        if hi.x < self.lo || hi.y < self.lo || lo.x > top || lo.y > top {
+            return UVec4::ZERO;
+        }
+        let cell =
+            |c: f32| (((c - self.lo) / self.cell).floor().max(0.0) as u32).min(SAMPLE_BANDS - 1);
+        self.columns[band_index(cell(lo.x), cell(hi.x))]
+            & self.rows[band_index(cell(lo.y), cell(hi.y))]
+    }
+}
+
+/// The sample bands of a directional light of `angular_radius` with `samples` samples, in its gnomonic
+/// plane.
+pub fn area_sample_bands(angular_radius: f32, samples: u32) -> SampleBands {
+    let points: Vec<(f64, f64)> = pattern(angular_radius, samples)
+        .map(|(cos_t, sin_t, phi)| {
+            let g = sin_t / cos_t;
+            (g * phi.cos(), g * phi.sin())
+        })
+        .collect();
+    let extent = edge_extent(angular_radius, samples);
+    SampleBands::new(&points, extent, 1e-3 * extent)
+}
+
+/// The sample bands of a spot or point light's `samples` samples on the unit disc.
+pub fn local_sample_bands(samples: u32) -> SampleBands {
+    let points: Vec<(f64, f64)> = local_pattern(samples)
+        .map(|(r, a)| (r * a.cos(), r * a.sin()))
+        .collect();
+    SampleBands::new(&points, local_edge_extent(samples), 1e-3)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sample_bands_hold_every_sample_of_a_rectangle() {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f32 / (1u64 << 53) as f32
+        };
+        for samples in [16, 64, 128] {
+            let local: Vec<Vec2> = local_area_offsets(samples);
+            let bands = local_sample_bands(samples);
+            let r = 0.05f32;
+            let directional = area_sample_bands(r, samples);
+            let table = area_samples(Vec3::new(0.3, -1.0, 0.2), r, samples);
+            let gnomonic: Vec<Vec2> = (0..samples as usize)
+                .map(|i| {
+                    let w = table.dirs[i].truncate();
+                    Vec2::new(
+                        w.dot(table.axis_u.truncate()),
+                        w.dot(table.axis_v.truncate()),
+                    ) / w.dot(table.center.truncate())
+                })
+                .collect();
+            for (points, bands, scale) in [(&local, &bands, 1.0), (&gnomonic, &directional, r)] {
+                for _ in 0..2000 {
+                    let a = Vec2::new(next(), next()) * 2.4 * scale - 1.2 * scale;
+                    let b = a + Vec2::new(next(), next()) * scale;
+                    let mask = bands.samples_in(a, b);
+                    for (i, p) in points.iter().enumerate() {
+                        if p.x >= a.x && p.x <= b.x && p.y >= a.y && p.y <= b.y {
+                            assert!(mask[i / 32] & (1 << (i % 32)) != 0, "sample {i} at {p}");
+                        }
+                    }
+                }
+                // A small rectangle holds few of the samples.
+                let few = bands.samples_in(Vec2::splat(0.1 * scale), Vec2::splat(0.15 * scale));
+                assert!(few.x.count_ones() + few.y.count_ones() + few.z.count_ones() < samples / 4);
+            }
+        }
+    }
 
     #[test]
     fn samples_lie_in_the_cone_and_cover_it_evenly() {

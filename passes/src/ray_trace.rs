@@ -10,7 +10,7 @@
 //! and its BVH, constants (and the light samples, area shadows). Writes: visibility, blocker distance (hard
 //! rays only), the count of the walks in the map's state.
 
-use crate::area::{area_edge_table, local_area_edge_table};
+use crate::area::{area_edge_table, area_sample_bands, local_area_edge_table, local_sample_bands};
 use crate::gpu_types::{constant_buffer, AreaSamples, RayTraceConstants};
 use crate::primitive_map::PrimitiveMap;
 use crate::{shader, PassError};
@@ -71,8 +71,8 @@ pub struct RayTracePass {
     /// cube map has the local variant as its one pipeline).
     local: Option<(ComputePipeline, BindGroup)>,
     constants: Buffer,
-    /// The area trace's light samples, and its edge tables (area shadows only).
-    samples: Option<(Buffer, Buffer)>,
+    /// The area trace's light samples, its edge tables and its sample bands (area shadows only).
+    samples: Option<(Buffer, Buffer, Buffer)>,
     /// `R32_SFLOAT` visibility, 1 = lit.
     pub visibility: Image,
     /// `R32_SFLOAT` distance from the ray origin to the nearest blocker; 0 where the receiver faces away
@@ -143,6 +143,18 @@ impl RayTracePass {
                     ),
                     BufferUsage::STORAGE,
                 )?,
+                // Likewise for the BVH walk's sample bands.
+                device.create_buffer_init(
+                    "area sample bands",
+                    bytemuck::cast_slice(
+                        &[
+                            area_sample_bands(angular_radius, samples).gpu_words(),
+                            local_sample_bands(samples).gpu_words(),
+                        ]
+                        .concat(),
+                    ),
+                    BufferUsage::STORAGE,
+                )?,
             )),
             RayTraceKind::Hard { .. } => None,
         };
@@ -171,7 +183,7 @@ impl RayTracePass {
             Resource::Image(&visibility),
         ];
         match (&samples, &blocker_distance, &unused_blocker) {
-            (Some((samples, table)), _, _) => {
+            (Some((samples, table, _)), _, _) => {
                 kinds.extend([BindingKind::UniformBuffer, BindingKind::StorageBuffer]);
                 resources.extend([b(samples), b(table)]);
             }
@@ -185,6 +197,10 @@ impl RayTracePass {
         }
         kinds.push(BindingKind::StorageBuffer);
         resources.push(b(inputs.bvh));
+        if let Some((_, _, bands)) = &samples {
+            kinds.push(BindingKind::StorageBuffer);
+            resources.push(b(bands));
+        }
         // A point light's cube map only ever traces a local light: the local variant is its one pipeline.
         let cube = inputs.map.config().cube;
         let (name, shader_name) = match kind {
@@ -251,7 +267,7 @@ impl RayTracePass {
         constants.misc.z = u32::from(self.blocker_distance.is_some());
         enc.update_buffer(&self.constants, 0, bytemuck::bytes_of(&constants))?;
         match (&self.samples, samples) {
-            (Some((buffer, _)), Some(samples)) => {
+            (Some((buffer, _, _)), Some(samples)) => {
                 enc.update_buffer(buffer, 0, bytemuck::bytes_of(samples))?;
             }
             (None, None) => {}

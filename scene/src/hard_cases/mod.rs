@@ -132,7 +132,7 @@ pub struct Frame {
 /// Whether the primitive map of a case may or must overflow (lists past the entry capacity).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Overflow {
-    /// No texel may pass the entry capacity: the case tests the texel lists, not the exhaustive fallback.
+    /// No texel may pass the entry capacity: the case tests the texel lists, not the BVH fallback.
     Forbidden,
     /// Overflow is allowed (its fallback is exact).
     Allowed,
@@ -145,7 +145,7 @@ pub enum Overflow {
 pub struct MapSpec {
     /// N: texels per side.
     pub size: u32,
-    /// Entry budget of the primitive map's lists, in entries (past it, texels are traced exhaustively),
+    /// Entry budget of the primitive map's lists, in entries (past it, texels walk the BVH),
     /// or `None` for the default budget.
     pub entry_budget: Option<u32>,
     /// Store only light-facing triangles (closed meshes); otherwise both faces.

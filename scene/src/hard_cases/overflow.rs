@@ -1,5 +1,5 @@
 //! The **overflow** family: entry budgets of 1K to 8K entries in a 128x128 map, which must be passed
-//! without writing out of bounds, and the exhaustive fallback of overflowed texels against far slivers.
+//! without writing out of bounds, and the BVH fallback of overflowed texels against far slivers.
 
 use glam::{DVec3, Vec3};
 
@@ -34,7 +34,7 @@ pub(super) fn overflow() -> Vec<HardCase> {
             Family::Overflow,
             "The demo scene in a 128x128 map with an entry budget of 1K to 8K entries and guard \
              words: texels past the capacity; nothing may be written past it and those texels \
-             are traced exhaustively.",
+             walk the BVH.",
             scene.clone(),
             DirectionalLight::slanted().direction,
             Some(camera),
@@ -50,11 +50,11 @@ pub(super) fn overflow() -> Vec<HardCase> {
     let (slivers, lit) = far_slivers();
     cases.push(
         case(
-            "exhaustive fallback vs far slivers",
+            "BVH fallback vs far slivers",
             Family::Overflow,
             "A lit ground over a buried grid whose lists pass a budget of 1K entries, light straight \
              down, and 1,000 tiny slivers 60 to 100 m away, each along a line through the centre: \
-             traced exhaustively, no sliver may shadow the ground.",
+             the texels past the budget walk the BVH, and no sliver may shadow the ground.",
             slivers,
             Vec3::NEG_Y,
             Some(look(Vec3::new(0.6, 1.2, 1.6), Vec3::ZERO)),
@@ -75,8 +75,8 @@ pub(super) fn overflow() -> Vec<HardCase> {
 /// A lit ground whose central texels overflow (a grid buried just under it), and 1,000 slivers 2 to 4 cm
 /// long, 60 to 100 m away, each lying along a line through the centre: under the vertical light, every
 /// receiver near the centre is within millimetres of some sliver's line, where the sliver's f32 edge
-/// functions round to zero. The exhaustive fallback of overflowed texels tests the shadow ray against all
-/// of them.
+/// functions round to zero. The fallback of overflowed texels (the BVH walk) tests the shadow ray against
+/// every sliver whose box it meets.
 fn far_slivers() -> (Scene, Aabb) {
     let mut buried = MeshBuilder::new();
     add_grid(
