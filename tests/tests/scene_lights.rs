@@ -146,7 +146,7 @@ fn assert_lights_match_reference(
     let hard = all_hard(&plan);
     let frame = renderer.render(device, camera, &hard).expect("hard frame");
     let images = renderer.read_back(device, &hard).expect("read back");
-    let rs = RefScene::new(&file.scene);
+    let rs = RefScene::with_casters(&file.scene, &file.shadow_casters);
     let reports = hard.plugin_lights();
     for (i, light) in hard.lights.iter().enumerate() {
         let name = &light.light.name;
@@ -263,6 +263,7 @@ fn boxes_scene(
     scene.validate().expect("valid scene");
     SceneFile {
         static_objects: vec![true; scene.objects.len()],
+        shadow_casters: vec![true; scene.objects.len()],
         scene,
         lights,
         camera: Some(Camera {
@@ -315,6 +316,7 @@ fn blockers_on_the_edges_between_cube_faces_match_the_exact_reference() {
             centre + half,
         ));
         file.static_objects.push(true);
+        file.shadow_casters.push(true);
     }
     file.scene.validate().expect("valid scene");
     assert_lights_match_reference(&device, &file, &camera(&file), 200, 5, &[]);
