@@ -277,6 +277,136 @@ fn boxes_scene(
     }
 }
 
+/// `file` written as glTF and loaded back (its `hrts` extras, `casts_shadows` on mesh nodes included).
+fn written_and_loaded(file: &SceneFile, name: &str) -> SceneFile {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("scene_lights");
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join(format!("{name}-{}.gltf", std::process::id()));
+    scene::gltf_scene::write_scene(&path, file, scene::gltf_scene::GltfEncoding::default())
+        .expect("write the scene");
+    let loaded = scene::load_gltf(&path).expect("load the scene");
+    let _ = std::fs::remove_file(&path);
+    loaded
+}
+
+/// Travel direction of the low sun of [`pillar_behind_the_camera`]: about 16° above the horizon, from
+/// behind the camera.
+const LOW_SUN: Vec3 = Vec3::new(0.15, -0.3, -1.0);
+
+/// A ground (a 10 cm slab) that casts shadows or not, a 5 m pillar behind the camera, out of view, and a
+/// zero-size low sun from behind both: the pillar's shadow runs some 15 m across the ground in view.
+fn pillar_behind_the_camera(ground_casts: bool) -> SceneFile {
+    let sun = SceneLight {
+        name: "sun".into(),
+        kind: LightKind::Directional {
+            direction: LOW_SUN.normalize(),
+        },
+        color: Vec3::ONE,
+        intensity: 3.0,
+        size: LightSize::Zero,
+        casts_shadows: true,
+        is_static: true,
+    };
+    let mut file = boxes_scene(
+        &[
+            (
+                "ground",
+                Vec3::new(-20.0, -0.1, -40.0),
+                Vec3::new(20.0, 0.0, 10.0),
+            ),
+            (
+                "pillar",
+                Vec3::new(-0.4, 0.0, 2.6),
+                Vec3::new(0.4, 5.0, 3.4),
+            ),
+        ],
+        vec![sun],
+        Vec3::new(0.0, 1.6, 0.0),
+        Vec3::new(0.0, 0.3, -6.0),
+    );
+    file.shadow_casters[0] = ground_casts;
+    file
+}
+
+/// A ground whose glTF node casts no shadows (`extras.hrts.casts_shadows` false: the plugin is given the
+/// pillar alone, behind the camera) still receives the pillar's shadow of a low sun from behind the camera:
+/// the plugin keeps the light (a caster out of view shadows receivers in view), the same pixels are
+/// shadowed as when the ground casts (within 2 %), and both match the exact reference of their casters.
+#[test]
+fn a_ground_that_casts_no_shadows_receives_a_shadow_cast_from_behind_the_camera() {
+    let device = device();
+    let mut shadowed = Vec::new();
+    for ground_casts in [true, false] {
+        let file = written_and_loaded(
+            &pillar_behind_the_camera(ground_casts),
+            if ground_casts {
+                "casting-ground"
+            } else {
+                "receiving-ground"
+            },
+        );
+        assert_eq!(file.shadow_casters, [ground_casts, true]);
+        let camera = camera(&file);
+        let plan = plan_scene(&file, &camera, &settings(false)).expect("plan");
+        let shadowed_light = plan.lights[0].shadowed().expect("the sun is shadowed");
+        assert_eq!(shadowed_light.resolved_config().mode, ShadowMode::Hard);
+        let mut renderer = SceneRenderer::new(&device, &file, WIDTH, HEIGHT).expect("renderer");
+        let frame = renderer.render(&device, &camera, &plan).expect("frame");
+        let images = renderer.read_back(&device, &plan).expect("read back");
+        let report = &frame.lights[0];
+        let rs = RefScene::with_casters(&file.scene, &file.shadow_casters);
+        let params = scene_visibility_params(
+            &file.scene,
+            &camera,
+            WIDTH,
+            HEIGHT,
+            reference::Light::Directional {
+                direction: LOW_SUN.normalize().as_dvec3(),
+            },
+        );
+        let r = reference_visibility(&rs, &params);
+        let c = compare_with_reference(&r, &images.visibility[0], None, None);
+        let gpu_shadowed = images.visibility[0].iter().filter(|&&v| v == 0.0).count();
+        println!(
+            "ground {}: {} frusta recorded, {} culled ({}); {} pixels compared, {} shadowed, {} near an edge, \
+             {} mismatches; {gpu_shadowed} shadowed by the plugin",
+            if ground_casts { "casting" } else { "casting nothing" },
+            report.frusta,
+            report.frusta_culled,
+            report.decision,
+            c.pixels,
+            c.shadowed,
+            c.near_edge,
+            c.mismatches
+        );
+        assert_eq!(c.non_finite, 0);
+        assert_eq!(
+            c.mismatches, 0,
+            "mismatching pixels (x, y, exact, gpu): {:?}",
+            c.examples
+        );
+        assert_eq!(
+            (report.frusta, report.frusta_culled),
+            (1, 0),
+            "{}",
+            report.decision
+        );
+        assert!(c.shadowed > 1000, "{} shadowed pixels", c.shadowed);
+        assert!(
+            c.near_edge * 100 < c.pixels * 5,
+            "{} near an edge",
+            c.near_edge
+        );
+        shadowed.push(gpu_shadowed);
+    }
+    let (casting, receiving) = (shadowed[0] as f64, shadowed[1] as f64);
+    assert!(
+        (casting - receiving).abs() <= 0.02 * casting,
+        "{casting} pixels shadowed with a casting ground, {receiving} with a ground that casts nothing"
+    );
+    assert_no_validation_errors(&device);
+}
+
 /// A point light inside a closed room (every wall, floor and ceiling triangle crosses the plane of some cube
 /// face: each face keeps exactly the part in front of the light), with a table, a pillar and a floating
 /// plate casting shadows on the floor and walls, seen from inside. Every triangle behind a face's plane is
