@@ -419,10 +419,17 @@ fn a_point_light_inside_a_closed_room_matches_the_exact_reference() {
     assert_eq!(plan.plugin_lights().len(), 1, "{}", plan.describe());
 }
 
-/// Small blocks on the diagonals between a point light's cube faces, 1 m from the lamp: every vertex of
-/// each lies within a few degrees of the edge between two faces' pyramids, where the setup's cheap pyramid
-/// test (`map_setup.comp`, `meets_face_pyramid`) decides whether a face lists them at all. A test that kept
-/// less than the pyramid (a tangent below 1) would drop them from both faces and lose their shadows.
+/// Blockers on the edges between a point light's cube faces, where the setup's cheap pyramid test
+/// (`map_setup.comp`, `meets_face_pyramid`: a face lists only triangles meeting its pyramid |u| <= T d,
+/// T = 1.02) decides whether a face lists them at all; a tangent T below 1 loses whatever lies in the gap
+/// it leaves between the faces' pyramids.
+///
+/// Small blocks on the diagonals, 1 m from the lamp in the closed room: every vertex lies within a few
+/// degrees of the edge between two faces (a tangent of 0.9 loses their shadows). And thin strips facing a
+/// lamp above a floor, one on each edge between its down face and a side face, 1 mm wide at 1 m: each
+/// straddles the plane between the two faces with every vertex within 1e-3 of it (|u| / d within 1e-3 of
+/// 1), so any tangent below 0.999 lists it in neither face. Their shadows are lines 4 mm wide on the floor,
+/// which close-up views of the floor (a millimetre a pixel) see as hundreds of shadowed pixels.
 #[test]
 fn blockers_on_the_edges_between_cube_faces_match_the_exact_reference() {
     let device = device();
@@ -450,6 +457,66 @@ fn blockers_on_the_edges_between_cube_faces_match_the_exact_reference() {
     }
     file.scene.validate().expect("valid scene");
     assert_lights_match_reference(&device, &file, &camera(&file), 200, 5, &[]);
+
+    let lamp = Vec3::new(0.1, 2.0, -0.05);
+    let file = floor_with_edge_strips(lamp);
+    // Each strip's shadow: the line where the plane between the two faces meets the floor, 2 m out from
+    // the lamp's foot, seen from 0.8 m above through a 6° field of view.
+    for outward in [Vec3::X, Vec3::NEG_X, Vec3::Z, Vec3::NEG_Z] {
+        let target = Vec3::new(lamp.x, 0.0, lamp.z) + outward * lamp.y;
+        let close_up = Camera {
+            position: target + outward * 0.25 + Vec3::Y * 0.8,
+            target,
+            up: Vec3::Y,
+            fov_y_radians: 6f32.to_radians(),
+            near: 0.05,
+        };
+        println!("close-up of the strip's shadow at {target}:");
+        assert_lights_match_reference(&device, &file, &close_up, 60, 5, &[]);
+    }
+}
+
+/// A 5 m floor and a point lamp 2 m above it at `lamp` with, on each edge between the lamp's down cube face
+/// and a side face, a strip 1 mm wide and 30 cm long, 1 m from the lamp: its long axis lies in the plane
+/// between the two faces, across the direction from the lamp, and it faces the lamp.
+fn floor_with_edge_strips(lamp: Vec3) -> SceneFile {
+    let mut file = boxes_scene(
+        &[(
+            "floor",
+            Vec3::new(-2.5, -0.1, -2.5),
+            Vec3::new(2.5, 0.0, 2.5),
+        )],
+        vec![point_light("lamp", lamp)],
+        Vec3::new(3.0, 3.0, 3.0),
+        lamp,
+    );
+    let (distance, width, length) = (1.0, 1e-3, 0.3);
+    for (name, outward) in [
+        ("strip +X", Vec3::X),
+        ("strip -X", Vec3::NEG_X),
+        ("strip +Z", Vec3::Z),
+        ("strip -Z", Vec3::NEG_Z),
+    ] {
+        // The plane between the side face and the down face holds `outward - Y` and the third axis.
+        let radial = (outward - Vec3::Y).normalize();
+        let across = (outward + Vec3::Y).normalize();
+        let along = radial.cross(across);
+        let centre = lamp + radial * distance;
+        let (w, l) = (across * width * 0.5, along * length * 0.5);
+        let corners = vec![
+            centre - w - l,
+            centre + w - l,
+            centre + w + l,
+            centre - w + l,
+        ];
+        // Triangles (0, 2, 1) and (0, 3, 2): their normal (along x across) points back at the lamp.
+        let strip = scene::Scene::single_object(corners, vec![0, 2, 1, 0, 3, 2], name);
+        file.scene.append(&strip);
+        file.static_objects.push(true);
+        file.shadow_casters.push(true);
+    }
+    file.scene.validate().expect("valid scene");
+    file
 }
 
 /// The closed room of [`a_point_light_inside_a_closed_room_matches_the_exact_reference`] with its lamp.
