@@ -1,9 +1,11 @@
 //! A glTF scene's lights through the plugin, as the scene's plan says (`host_demo::scene_plan`), on
-//! lavapipe: every shadowed light against the exact reference (a point light given to the plugin as a
-//! point light: hard, its six cube faces built as one map; sized, the minimum over the faces it records), a scene whose lights need nothing records no
-//! plugin pass, and changing one light reruns only that light's passes. Sized spot and point lights with
-//! area shadows: every sample of every stable pixel as the exact reference of the same emitter samples
-//! decides it (a lamp inside a closed room, spot lights of one and five frusta, emitters next to geometry).
+//! lavapipe: every shadowed light against the exact reference of the scene's shadow casters (a point light
+//! given to the plugin as a point light, hard or sized: its six cube faces built as one map; a ground that
+//! casts no shadows receiving one cast from behind the camera; blockers on the edges between cube faces),
+//! a scene whose lights need nothing records no plugin pass, and changing one light reruns only that
+//! light's passes. Sized spot and point lights with area shadows: every sample of every stable pixel as the
+//! exact reference of the same emitter samples decides it (a lamp inside a closed room, spot lights of one
+//! and five frusta, emitters next to geometry).
 
 mod common;
 

@@ -21,12 +21,12 @@
 //! - a spot light by its position, axis, cone and range (`HRTS_LIGHT_TYPE_SPOT` with no matrix): the
 //!   plugin fits one perspective frustum to a cone up to 60°, the five cube faces around its axis to a
 //!   wider one;
-//! - a point light by its position and range (`HRTS_LIGHT_TYPE_POINT`): the plugin shadows it through
-//!   the six faces of a cube around it.
+//! - a point light by its position and range (`HRTS_LIGHT_TYPE_POINT`): the plugin builds the six faces
+//!   of a cube around it as one primitive map (hard shadows, or area shadows of a sized lamp).
 //!
-//! Every frame the plugin records only the frusta that may hold a receiver in view within the light's
-//! range, and writes the minimum over them to the light's layer; its frame report says which it culled
-//! and why.
+//! Every frame the plugin records only the frusta (a wide spot light's faces, or a light's one frustum or
+//! cube map) where a caster may shadow a receiver in view within the light's range, and writes the
+//! minimum over a wide spot light's faces to its layer; its frame report says which it culled and why.
 //!
 //! "Receivers in view" are the scene's triangles that are not entirely outside one plane of the camera
 //! frustum (occlusion is not considered), and a triangle is within a light's reach when its bounding
