@@ -109,7 +109,11 @@ impl HalfSpace {
 
     /// How far outside `x` may lie and still count as inside.
     fn tolerance(&self, x: DVec3) -> f64 {
-        self.slack + self.slope * (x - self.anchor).length()
+        if self.slope == 0.0 {
+            self.slack
+        } else {
+            self.slack + self.slope * (x - self.anchor).length()
+        }
     }
 
     /// Whether `x` lies inside, within the tolerance.
@@ -216,7 +220,7 @@ impl ViewVolume {
         }
         let mut all = region;
         all.extend(shadow.half_spaces);
-        !vertices(&all).is_empty()
+        has_vertex(&all)
     }
 }
 
@@ -494,8 +498,27 @@ const MIN_DETERMINANT: f64 = 1e-12;
 /// [`SOLVE_ERROR`] over the three normals' determinant): the vertices of their intersection (some vertex
 /// exists when the intersection is non-empty and holds no line), and at worst some points near it.
 fn vertices(half_spaces: &[HalfSpace]) -> Vec<DVec3> {
+    let mut found = Vec::new();
+    each_vertex(half_spaces, |x| {
+        found.push(x);
+        true
+    });
+    found
+}
+
+/// Whether the half-spaces have a vertex ([`vertices`]), stopping at the first.
+fn has_vertex(half_spaces: &[HalfSpace]) -> bool {
+    let mut any = false;
+    each_vertex(half_spaces, |_| {
+        any = true;
+        false
+    });
+    any
+}
+
+/// Calls `visit` with each vertex of the half-spaces ([`vertices`]) while it returns true.
+fn each_vertex(half_spaces: &[HalfSpace], mut visit: impl FnMut(DVec3) -> bool) {
     let n = half_spaces.len();
-    let mut found: Vec<DVec3> = Vec::new();
     for i in 0..n {
         for j in i + 1..n {
             for k in j + 1..n {
@@ -521,13 +544,13 @@ fn vertices(half_spaces: &[HalfSpace]) -> Vec<DVec3> {
                     && half_spaces
                         .iter()
                         .all(|h| h.value(x) >= -(h.tolerance(x) + error))
+                    && !visit(x)
                 {
-                    found.push(x);
+                    return;
                 }
             }
         }
     }
-    found
 }
 
 /// The directions in which the intersection of the half-spaces is unbounded, as unit vectors: the edges
