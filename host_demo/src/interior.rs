@@ -287,6 +287,7 @@ impl Enclosure {
 pub fn scene_file(scene: Scene, light: SceneLight, camera: Camera) -> SceneFile {
     SceneFile {
         static_objects: vec![true; scene.objects.len()],
+        shadow_casters: vec![true; scene.objects.len()],
         scene,
         lights: vec![light],
         camera: Some(camera),

@@ -385,9 +385,10 @@ fn measure_native_points(
     args: &BenchArgs,
     emitter_radius: Option<f32>,
 ) -> Result<LightCost> {
-    let mut plugin = PluginRenderer::for_scene(
+    let mut plugin = PluginRenderer::for_scene_casters(
         device,
         &file.scene,
+        &file.shadow_casters,
         args.width,
         args.height,
         false,
@@ -516,6 +517,7 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
         };
         let file_with = |lights: Vec<SceneLight>| SceneFile {
             static_objects: vec![true; scene.objects.len()],
+            shadow_casters: vec![true; scene.objects.len()],
             scene: scene.clone(),
             lights,
             camera: Some(camera),

@@ -98,6 +98,7 @@ fn terrain(triangles: u32) -> SceneFile {
     SceneFile {
         scene,
         static_objects: vec![true; objects],
+        shadow_casters: vec![true; objects],
         lights: vec![SceneLight {
             name: "sun".into(),
             kind: LightKind::Directional {

@@ -130,8 +130,8 @@ pub struct PluginRenderer {
     output_usage: ImageUsage,
     timer: GpuTimer,
     dynamic_geometry: bool,
-    /// The scene's bounds, given with every frame: the demo does not animate its scenes, so they hold in
-    /// every frame even when the geometry counts as moving.
+    /// The bounds of the shadow casters, given with every frame: the demo does not animate its scenes, so
+    /// they hold in every frame even when the geometry counts as moving.
     bounds: Aabb,
     frames: u64,
     frames_with_plugin_passes: u64,
@@ -172,7 +172,7 @@ impl PluginRenderer {
     /// Uploads `scene` into the demo's buffers, creates the G-buffer for a `width` x `height` frame and a
     /// plugin context on `device` that has the geometry but no light yet ([`PluginRenderer::configure_lights`]).
     /// `dynamic_geometry`: the demo rebuilds its own prim buffer every frame, as the plugin does when a
-    /// light's configuration says so. `layout`: what the G-buffer keeps.
+    /// light's configuration says so. `layout`: what the G-buffer keeps. Every object casts shadows.
     pub fn for_scene(
         device: &Device,
         scene: &Scene,
@@ -181,15 +181,50 @@ impl PluginRenderer {
         dynamic_geometry: bool,
         layout: GBufferLayout,
     ) -> Result<Self> {
+        let casters = vec![true; scene.objects.len()];
+        Self::for_scene_casters(
+            device,
+            scene,
+            &casters,
+            width,
+            height,
+            dynamic_geometry,
+            layout,
+        )
+    }
+
+    /// [`PluginRenderer::for_scene`] where only the objects marked in `casters` (one flag per object) cast
+    /// shadows: the G-buffer draws every object, the plugin is given the casters alone (their draws, with
+    /// their bounds), as an engine leaves floors or decals out of its shadow casters.
+    pub fn for_scene_casters(
+        device: &Device,
+        scene: &Scene,
+        casters: &[bool],
+        width: u32,
+        height: u32,
+        dynamic_geometry: bool,
+        layout: GBufferLayout,
+    ) -> Result<Self> {
         if width == 0 || height == 0 {
             bail!("frame size must be non-zero");
+        }
+        if casters.len() != scene.objects.len() {
+            bail!(
+                "the scene has {} objects but {} shadow-caster flags",
+                scene.objects.len(),
+                casters.len()
+            );
+        }
+        let bounds = scene.objects_bounds(casters);
+        if !casters.iter().any(|&c| c) || bounds == Aabb::empty() {
+            bail!("no object of the scene casts shadows: the plugin needs at least one caster");
         }
         let geometry = upload_scene(device, scene).context("uploading the scene")?;
         let prim_buffer = PrimBufferPass::new(device, &geometry)?;
         let gbuffer = GBufferPass::new(device, prim_buffer.prims(), &layout)?;
         let targets = GBufferTargets::new(device, width, height, layout)?;
         let context = create_context(device)?;
-        set_geometry(&context, &geometry, &scene.bounds())?;
+        set_geometry(&context, &geometry, casters, &bounds)?;
         Ok(Self {
             context,
             geometry,
@@ -202,7 +237,7 @@ impl PluginRenderer {
             output_usage: ImageUsage::COPY_DST | ImageUsage::COPY_SRC | ImageUsage::SAMPLED,
             timer: device.create_timer(4)?,
             dynamic_geometry,
-            bounds: scene.bounds(),
+            bounds,
             frames: 0,
             frames_with_plugin_passes: 0,
             last_camera: None,
@@ -736,18 +771,27 @@ fn create_context(device: &Device) -> Result<Context> {
     Ok(Context(context))
 }
 
-/// Hands the demo's meshes (their vertex and index buffers) to the plugin, each with the scene's
-/// `bounds`, which enclose it (the plugin's frame origin is the centre of their union, as the demo's).
-fn set_geometry(context: &Context, geometry: &Geometry, bounds: &Aabb) -> Result<()> {
+/// Hands the demo's meshes (their vertex and index buffers) to the plugin with the draws of the objects
+/// marked in `casters` (the demo's draws are its objects, in order, over all meshes; a mesh without a
+/// caster is left out), each mesh with the casters' `bounds`, which enclose its draws given (the plugin's
+/// frame origin is their centre).
+fn set_geometry(
+    context: &Context,
+    geometry: &Geometry,
+    casters: &[bool],
+    bounds: &Aabb,
+) -> Result<()> {
     let mut b = [0.0f32; 6];
     b[..3].copy_from_slice(&bounds.min.to_array());
     b[3..].copy_from_slice(&bounds.max.to_array());
+    let mut casts = casters.iter();
     let draws: Vec<Vec<HrtsDraw>> = geometry
         .meshes()
         .iter()
         .map(|m| {
             m.draws()
                 .iter()
+                .filter(|_| casts.next().copied().unwrap_or(false))
                 .map(|d| HrtsDraw {
                     first_index: d.first_index,
                     index_count: d.index_count,
@@ -761,6 +805,7 @@ fn set_geometry(context: &Context, geometry: &Geometry, bounds: &Aabb) -> Result
         .meshes()
         .iter()
         .zip(&draws)
+        .filter(|(_, draws)| !draws.is_empty())
         .map(|(m, draws)| {
             let (vertices, vertex) = m.vertices();
             let (indices, index) = m.indices();

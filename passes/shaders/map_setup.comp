@@ -18,6 +18,7 @@
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_basic : require
 #include "triangle.glsl"
+#include "f32_bounds.glsl"
 #include "map_state.glsl"
 #include "map_project.glsl"
 #include "map_push.glsl"
@@ -39,15 +40,8 @@ const float SEGMENT_THICKNESS = 1.0 / 16.0;
 
 uint pack_texel(ivec2 t) { return uint(t.x) | (uint(t.y) << 16); }
 
-// Unit roundoff of f32.
-const float U = 5.9604645e-8;
 // Rounds a bound computed in f32 (a few positive terms) up past its own rounding.
 const float ROUND_UP = 1.0 + 1.0 / 65536.0;
-
-// |a| x |b| term by term: bounds |a x b| and the rounding of computing it.
-vec3 cross_mag(vec3 a, vec3 b) {
-    return vec3(a.y * b.z + a.z * b.y, a.z * b.x + a.x * b.z, a.x * b.y + a.y * b.x);
-}
 
 // The homogeneous line through two homogeneous texel points (their cross product: the light's plane through
 // an edge) and a bound on how far the computed coefficients are from the exact line through the exact
@@ -199,23 +193,6 @@ uint clipped_setup(float n, HPoint h[3], float min_depth, float margin_base, flo
     uvec2 tiles = (uvec2(hi_t - lo_t) + BIN_TILE) / BIN_TILE;
     bt.info = uvec4(pack_texel(lo_t), pack_texel(hi_t), MODE_CLIPPED, tiles.x);
     return tiles.x * tiles.y;
-}
-
-// A lower bound on the distance from `p` to the triangle (a, b, c): the larger of the distances to its
-// bounding box and to its plane (the plane's only for a well-shaped triangle, whose normal's rounding is
-// small), each lowered past its rounding.
-float distance_below(vec3 p, vec3 a, vec3 b, vec3 c) {
-    vec3 lo = min(min(a, b), c), hi = max(max(a, b), c);
-    float scale = max(max(max(abs(p.x), abs(p.y)), abs(p.z)),
-                      max(max(abs(lo.x), abs(lo.y)), max(max(abs(lo.z), abs(hi.x)), max(abs(hi.y), abs(hi.z)))));
-    float box = length(max(max(lo - p, p - hi), vec3(0.0)));
-    vec3 e0 = b - a, e1 = c - a;
-    vec3 nrm = cross(e0, e1);
-    float plane = 0.0;
-    if (length(nrm) > 1e-3 * length(e0) * length(e1)) {
-        plane = abs(dot(normalize(nrm), p - a)) * (1.0 - 1e-3);
-    }
-    return max(box, plane) - 1e-5 * scale;
 }
 
 // The bin item of the triangle (v0, v1, v2) in frustum `f`: its tiles (0: culled). Area shadows of a spot

@@ -55,7 +55,7 @@ pub use shadow_pipeline::{
     ShadowPipeline, MAX_FRAMES_IN_FLIGHT,
 };
 pub use surface::{NormalEncoding, NormalSpace, SurfaceInput};
-pub use view_cull::ViewVolume;
+pub use view_cull::{Casters, ViewVolume};
 
 mod shaders {
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));

@@ -29,9 +29,11 @@ pub enum Light {
         /// coordinates). Receivers outside it count as lit (no recorded occluder).
         view_proj: Mat4,
     },
-    /// Point light: a point emitter shadowed in every direction through its six cube faces
-    /// ([`point_light_faces`]), built as one primitive map (`PrimitiveMapConfig::cube`). Hard shadows
-    /// only: a shadow map and PCSS need one frustum (give the faces as spot lights for those).
+    /// Point light: an emitter shadowed in every direction through its six cube faces
+    /// ([`point_light_faces`]), built as one primitive map (`PrimitiveMapConfig::cube`): hard shadows, or
+    /// area shadows of a sized emitter (its radius from the configuration), with compute binning
+    /// ([`crate::ShadowConfig::shadows_point_as_cube`]). A shadow map and PCSS need one frustum each: for
+    /// those the light is given as its faces, spot lights ([`point_light_faces`]), and the minimum taken.
     Point {
         /// Emitter position (world coordinates): shadow rays end there.
         position: Vec3,

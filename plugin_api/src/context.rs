@@ -11,8 +11,9 @@ use crate::geometry::{cpu_geometry, geometry_from, vulkan_geometry, GeometrySour
 use crate::types::*;
 use passes::retire::{completed_before, RetireQueue};
 use passes::{
-    BinningRequest, FrameReport, MinCombine, NormalEncoding, PassStatus, ResourceId, ShadowConfig,
-    ShadowInputs, ShadowPipeline, SharedGeometry, SkipReason, SurfaceInput, ViewVolume,
+    BinningRequest, Casters, FrameReport, MinCombine, NormalEncoding, PassStatus, ResourceId,
+    ShadowConfig, ShadowInputs, ShadowPipeline, SharedGeometry, SkipReason, SurfaceInput,
+    ViewVolume,
 };
 use rhi::{Device, Format, Image, ImageDesc, ImageUsage};
 use std::sync::Arc;
@@ -193,8 +194,8 @@ pub(crate) struct OpenFrame {
     pub(crate) last_pass: u32,
 }
 
-/// Which frusta of each light a frame recorded: those that may hold a receiver in view within the light's
-/// range ([`passes::ViewVolume`]).
+/// Which frusta of each light a frame recorded: those where a caster may shadow a receiver in view within
+/// the light's range ([`passes::ViewVolume::may_shadow`]).
 pub(crate) struct FrameSchedule {
     pub(crate) index: u64,
     pub(crate) lights: Vec<LightSchedule>,
@@ -237,7 +238,7 @@ impl LightSchedule {
         match (recorded, self.recorded.len()) {
             (0, _) => (
                 HrtsLightDecision::OutOfView,
-                format!("{kind}: no frustum holds a receiver in view within range; lit"),
+                format!("{kind}: no caster may shadow a receiver in view within range; lit"),
             ),
             (_, 1) if self.names == passes::CUBE_MAP_NAME => (
                 HrtsLightDecision::Shadowed,
@@ -407,8 +408,8 @@ impl Context {
         Ok(())
     }
 
-    /// The scene's bounds this frame: `frame_bounds` when the engine gave them, else the geometry's own
-    /// bounds when they hold (not when the frame `deforms` a mesh, nor for Vulkan geometry that moves).
+    /// The shadow casters' bounds this frame: `frame_bounds` when the engine gave them, else the geometry's
+    /// own bounds when they hold (not when the frame `deforms` a mesh, nor for Vulkan geometry that moves).
     pub(crate) fn scene_bounds(
         &self,
         frame_bounds: Option<[glam::DVec3; 2]>,
@@ -423,35 +424,49 @@ impl Context {
         })
     }
 
-    /// Which frusta of each light may hold a receiver in view within the light's range this frame, within
-    /// the scene's `bounds` when they are known ([`Context::scene_bounds`]), and the mode auto chose for it.
+    /// Which frusta of each light may change a pixel in view this frame ([`ViewVolume::may_shadow`]): those
+    /// holding receivers in view within the light's range that a caster within the casters' `bounds` (when
+    /// they are known: [`Context::scene_bounds`]) may shadow; and the mode auto chose for it. A light
+    /// shadowed through shadow maps (soft, hybrid) is culled by the view and its range alone.
     pub(crate) fn schedule(
         &self,
         lights: &[FrameLight],
         bounds: Option<[glam::DVec3; 2]>,
     ) -> Vec<LightSchedule> {
-        let camera = lights
-            .first()
-            .and_then(|l| l.frusta.first())
-            .map(|f| ViewVolume::new(f.proj.as_dmat4() * f.view.as_dmat4(), bounds));
+        let camera = lights.first().and_then(|l| l.frusta.first()).map(|f| {
+            ViewVolume::new(
+                f.proj.as_dmat4() * f.view.as_dmat4(),
+                f.camera_position.as_dvec3(),
+            )
+        });
         lights
             .iter()
             .zip(&self.lights)
-            .map(|(light, config)| LightSchedule {
-                kind: light.kind,
-                auto: config.auto_reason(light.kind == HrtsLightType::Directional),
-                recorded: light
-                    .frusta
-                    .iter()
-                    .map(|f| {
-                        camera
-                            .as_ref()
-                            .is_none_or(|c| c.meets(&f.light, light.range))
-                    })
-                    .collect(),
-                names: (0..light.frusta.len())
-                    .map(|k| light.frustum_name(k))
-                    .collect(),
+            .map(|(light, config)| {
+                let directional = light.kind == HrtsLightType::Directional;
+                let casters =
+                    bounds
+                        .zip(config.traced_light_size(directional))
+                        .map(|(bounds, size)| Casters {
+                            bounds,
+                            light_size: f64::from(size),
+                        });
+                LightSchedule {
+                    kind: light.kind,
+                    auto: config.auto_reason(directional),
+                    recorded: light
+                        .frusta
+                        .iter()
+                        .map(|f| {
+                            camera.as_ref().is_none_or(|c| {
+                                c.may_shadow(&f.light, light.range, casters.as_ref())
+                            })
+                        })
+                        .collect(),
+                    names: (0..light.frusta.len())
+                        .map(|k| light.frustum_name(k))
+                        .collect(),
+                }
             })
             .collect()
     }

@@ -190,13 +190,22 @@ pub(crate) fn frame_bounds(f: &HrtsFrame) -> ApiResult<Option<[glam::DVec3; 2]>>
     bounds(&f.bounds).map(Some)
 }
 
-/// World-space bounds given as min xyz, max xyz: finite, min not above max.
+/// World-space bounds of shadow casters given as min xyz, max xyz: finite, min not above max on any
+/// axis (an empty or inverted box holds no triangle), and not all six zero (the box of a zero-initialised
+/// struct, which would cull every light whose shadows do not reach the origin).
 pub(crate) fn bounds(b: &[f32; 6]) -> ApiResult<[glam::DVec3; 2]> {
     finite(b, "bounds")?;
+    if b.iter().all(|&v| v == 0.0) {
+        return Err(invalid(
+            "bounds are all zero (a zero-initialised struct?): give min xyz and max xyz of every shadow caster",
+        ));
+    }
     let lo = Vec3::from_slice(&b[..3]).as_dvec3();
     let hi = Vec3::from_slice(&b[3..]).as_dvec3();
     if lo.cmpgt(hi).any() {
-        return Err(invalid("bounds: min exceeds max"));
+        return Err(invalid(format!(
+            "bounds are empty or inverted: min {lo} exceeds max {hi} (give min xyz, then max xyz)"
+        )));
     }
     Ok([lo, hi])
 }
@@ -320,7 +329,7 @@ fn light_frusta(
     if kind == HrtsLightType::Directional && fitted {
         let Some([lo, hi]) = scene_bounds else {
             return Err(invalid(format!(
-                "{} is all zeros: the plugin fits a directional light's frustum to the scene's bounds, and this \
+                "{} is all zeros: the plugin fits a directional light's frustum to the shadow casters' bounds, and this \
                  frame has none (Vulkan geometry that moves or is deformed has no bounds of its own): give the \
                  frame's bounds (has_bounds) or the light's view_proj",
                 field("view_proj")
@@ -755,5 +764,42 @@ mod tests {
         given.view_proj[12] += 0.5;
         let (_, _, frusta) = light_frusta(&given, 0, None).expect("given");
         assert_eq!(frusta[0].view_proj().to_cols_array(), given.view_proj);
+    }
+
+    /// Bounds of shadow casters: a box, possibly flat or a point; refused when not finite, empty or
+    /// inverted, or all zero (a zero-initialised struct).
+    #[test]
+    fn bounds_must_be_a_box_of_casters() {
+        let b = bounds(&[-1.0, 0.0, -2.0, 1.0, 3.0, 2.0]).expect("a box");
+        assert_eq!(
+            b,
+            [
+                glam::DVec3::new(-1.0, 0.0, -2.0),
+                glam::DVec3::new(1.0, 3.0, 2.0)
+            ]
+        );
+        bounds(&[-1.0, 0.0, -2.0, 1.0, 0.0, 2.0]).expect("a flat box");
+        bounds(&[1.0, 2.0, 3.0, 1.0, 2.0, 3.0]).expect("a point");
+        let e = bounds(&[0.0; 6]).expect_err("all zero").message;
+        assert!(
+            e.contains("all zero") && e.contains("zero-initialised"),
+            "{e}"
+        );
+        let e = bounds(&[0.0, 0.0, 0.0, -0.0, 0.0, 0.0])
+            .expect_err("all zero")
+            .message;
+        assert!(e.contains("all zero"), "{e}");
+        let e = bounds(&[5.0, 0.0, -2.0, 1.0, 3.0, 2.0])
+            .expect_err("inverted")
+            .message;
+        assert!(e.contains("empty or inverted") && e.contains("min"), "{e}");
+        let e = bounds(&[f32::INFINITY, 0.0, 0.0, -f32::INFINITY, 1.0, 1.0])
+            .expect_err("empty")
+            .message;
+        assert!(e.contains("NaN or infinity"), "{e}");
+        let e = bounds(&[0.0, f32::NAN, 0.0, 1.0, 1.0, 1.0])
+            .expect_err("NaN")
+            .message;
+        assert!(e.contains("NaN or infinity"), "{e}");
     }
 }

@@ -423,7 +423,8 @@ pub unsafe extern "C" fn hrts_set_geometry_vulkan(
 
 /// Sets the shadow-casting geometry from the engine's meshes as they are: `mesh_count` meshes, each with
 /// its own vertex and index buffers, layouts, index type, vertex format and dequantization, draws and
-/// bounds (the scene's bounds are their union; the frame origin is its centre). The prim buffer holds
+/// bounds (the casters' bounds, by which lights are culled, are their union; the frame origin is its
+/// centre). The prim buffer holds
 /// the triangles mesh after mesh, draw after draw; `hrts_set_draw_transforms` takes the draws in that
 /// order and `HrtsFrame::deformed` names meshes by their index here. A message about one mesh names it
 /// (`meshes[i]`). The buffers are read by the GPU every time the prim buffer is rebuilt: they must stay

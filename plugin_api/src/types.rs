@@ -171,20 +171,31 @@ pub enum HrtsPassStatus {
     UpToDate = 2,
     /// Shared by the context's lights (the prim buffer) and recorded this frame by an earlier light.
     Shared = 3,
-    /// Not recorded: no frustum of the light holds a receiver in view within its range this frame (see
-    /// `HrtsLightDecision`).
+    /// Not recorded: no frustum of the light holds a receiver in view within its range that a shadow caster
+    /// may shadow this frame (see `HrtsLightDecision`).
     Culled = 4,
 }
 
-/// What the plugin decided for a light in a frame (`HrtsFrameReport::decision`), from the camera, the
-/// geometry's bounds (CPU geometry, or static Vulkan geometry) and the light's frusta and range.
+/// What the plugin decided for a light in a frame (`HrtsFrameReport::decision`), from the camera, the light's
+/// frusta and range, and the bounds of the shadow casters when they are known (`HrtsFrame::bounds`, or
+/// those of CPU geometry or of static Vulkan geometry).
+///
+/// The rule: a frustum is skipped (its pixels lit, 1) only when no shadow it traces can fall on a receiver
+/// in view. Receivers are bounded by the camera alone (its frustum, widened by 1% to hold every ray origin)
+/// and the light's range, never by the casters' bounds: geometry left out of the casters (floors, terrain,
+/// decals) still receives, and a caster outside the view shadows receivers inside it. A frustum is skipped
+/// when it holds no receiver in view within the range, or, for hard and area shadows, when the casters'
+/// bounds swept away from the light (from every point of its emitter, or along every direction of a sized
+/// sun) miss every receiver in view within the range and the frustum. Soft and hybrid shadows (shadow maps)
+/// are culled by the view and the range alone. Where it is not skipped, a frustum's shadows are as exact
+/// as its mode.
 #[repr(u32)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum HrtsLightDecision {
-    /// Shadowed through the frusta that may hold a receiver in view within the light's range (all, or
+    /// Shadowed through the frusta that may shadow a receiver in view within the light's range (all, or
     /// some of a point light's or wide spot light's faces: `frusta_culled` says how many were skipped).
     Shadowed = 0,
-    /// No frustum of the light may hold a receiver in view within its range: no pass ran and its output
+    /// No frustum of the light may shadow a receiver in view within its range: no pass ran and its output
     /// layer is 1.
     OutOfView = 1,
 }
@@ -271,7 +282,7 @@ pub enum HrtsShadowMode {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum HrtsLightType {
     /// Parallel light along `direction`: the engine's orthographic `view_proj`, or, when `view_proj` is all
-    /// zeros, the frustum the plugin fits to the scene's bounds every frame.
+    /// zeros, the frustum the plugin fits to the shadow casters' bounds every frame.
     Directional = 0,
     /// Spot light at `position` pointing along `direction`: the engine's perspective `view_proj`, or, when
     /// `view_proj` is all zeros, frusta the plugin fits to `outer_cone` and `range`.
@@ -572,9 +583,11 @@ pub struct HrtsVulkanGeometry {
     pub draws: *const HrtsDraw,
     /// Number of draws.
     pub draw_count: u32,
-    /// World-space bounds of all the mesh's draws (min xyz, max xyz). The frame origin is the centre of
-    /// the union of every mesh's bounds (rounded to f32, so that vertex minus origin is exact for f32
-    /// vertices).
+    /// World-space bounds of all the mesh's draws (min xyz, max xyz): they must hold every triangle the
+    /// plugin is given (the shadow casters); a box that is empty, inverted or all zero (a zero-initialised
+    /// struct) is refused. The plugin culls lights by the union of every mesh's bounds
+    /// (`HrtsLightDecision`), and the frame origin is its centre (rounded to f32, so that vertex minus
+    /// origin is exact for f32 vertices).
     pub bounds: [f32; 6],
     /// `VkFormat` of a position: `VK_FORMAT_R32G32B32_SFLOAT` (or 0), or 16-bit
     /// `VK_FORMAT_R16G16B16A16_SFLOAT`, `_SNORM` or `_UNORM` (w ignored).
@@ -655,19 +668,22 @@ pub struct HrtsLight {
     /// for a directional light, perspective with its eye at `position` for a spot light, or all zeros for
     /// the plugin to fit the light's frusta itself (ignored for point lights).
     ///
-    /// A fitted directional frustum is orthographic along `direction`, fitted every frame to the scene's
-    /// bounds (`HrtsFrame::bounds` when `has_bounds` is set, else those of CPU geometry or of Vulkan
-    /// geometry that does not change): their extent across the light maps exactly onto the frustum, their
-    /// depth range widened by 1% on both sides plus a tiny margin. A frame that knows no bounds (Vulkan
+    /// A fitted directional frustum is orthographic along `direction`, fitted every frame to the shadow
+    /// casters' bounds (`HrtsFrame::bounds` when `has_bounds` is set, else those of CPU geometry or of
+    /// Vulkan geometry that does not change): their extent across the light maps exactly onto the
+    /// frustum, their depth range widened by 1% on both sides plus a tiny margin (receivers beyond that
+    /// depth range are shadowed all the same). A receiver outside the frustum across the light is lit: no
+    /// caster lies on its hard shadow ray, but a sized sun's penumbra may reach past the casters' extent
+    /// (give a `view_proj` that also covers those receivers). A frame that knows no bounds (Vulkan
     /// geometry that moves or is deformed, without `has_bounds`) is refused with a message. A fitted spot
     /// light frustum has its near plane at `range / 1024` (0.01 without a range) and its far plane at
     /// infinity.
     pub view_proj: [f32; 16],
     /// Spot and point lights: distance beyond which the light has no effect, or 0 for unlimited. It sets
-    /// the near plane of the frusta the plugin fits. A frustum holding no receiver in view within the
-    /// range is not recorded, and a pixel it alone would shade is lit (1): beyond the range the
-    /// visibility may be 1 where geometry blocks the light, since the light does not reach there.
-    /// Within the range shadows are exact.
+    /// the near plane of the frusta the plugin fits. A frustum that can shadow no receiver in view within
+    /// the range is not recorded (`HrtsLightDecision` states the rule), and a pixel it alone would shade
+    /// is lit (1): beyond the range the visibility may be 1 where geometry blocks the light, since the
+    /// light does not reach there. Within the range shadows are exact.
     pub range: f32,
     /// Spot lights whose frusta the plugin fits: half-angle of the cone in radians, in (0, π/2]. Up to
     /// π/3 one frustum covers it; wider cones use the five cube faces around the axis. Ignored otherwise.
@@ -706,11 +722,13 @@ pub struct HrtsFrame {
     pub output_layout_before: i32,
     /// `VkImageLayout` the output image is left in.
     pub output_layout_after: i32,
-    /// World-space bounds (min xyz, max xyz) of every triangle of the geometry this frame, read when
-    /// `has_bounds` is set. They let the plugin cull light frusta by the scene's extent when the geometry
-    /// moves; without them it culls moving Vulkan geometry by the view and the lights' ranges alone
-    /// (CPU geometry and static Vulkan geometry use the bounds they were given). A directional light given
-    /// without a `view_proj` is fitted to them.
+    /// World-space bounds (min xyz, max xyz) of every triangle of the geometry this frame (the shadow
+    /// casters; receivers that cast nothing need not be inside), read when `has_bounds` is set. A box that
+    /// is empty, inverted or all zero (a zero-initialised struct) is refused. They let the plugin cull
+    /// light frusta whose shadows cannot reach the view (`HrtsLightDecision` states the rule) when the
+    /// geometry moves; without them it culls moving Vulkan geometry by the view and the lights' ranges
+    /// alone (CPU geometry and static Vulkan geometry use the bounds they were given). A directional light
+    /// given without a `view_proj` is fitted to them.
     pub bounds: [f32; 6],
     /// Whether `bounds` holds this frame's bounds.
     pub has_bounds: HrtsBool,
@@ -848,12 +866,12 @@ pub struct HrtsFrameReport {
     /// geometry or targets call that changed nothing of this light leaves it as it was.
     pub light_builds: u32,
     /// Frusta the light was shadowed through this frame: those of its frusta (1, or the cube faces of a
-    /// point light (6) or of a wide spot light (5)) that may hold a receiver in view within its range. A
-    /// hard point light built as one cube map counts as 1.
+    /// point light (6) or of a wide spot light (5)) that may shadow a receiver in view within its range
+    /// (`HrtsLightDecision`). A point light built as one cube map counts as 1.
     /// Statistics and pass times above are summed over them, memory over every frustum (the longest
     /// list is the longest of any; `map_to_texels` is the first recorded frustum's).
     pub frusta: u32,
-    /// Frusta of the light skipped this frame: they hold no receiver in view within its range.
+    /// Frusta of the light skipped this frame: they can shadow no receiver in view within its range.
     pub frusta_culled: u32,
     /// `HrtsLightDecision` of the light this frame.
     pub decision: u32,

@@ -106,6 +106,8 @@ impl SlabRay {
 pub struct RefScene {
     triangles: Vec<[DVec3; 3]>,
     usable: Vec<bool>,
+    /// Per triangle: whether it blocks shadow rays (every triangle receives).
+    casts: Vec<bool>,
     nodes: Vec<Node>,
     order: Vec<u32>,
     /// Padding that absorbs slab-test rounding for the scene's coordinate range.
@@ -131,15 +133,44 @@ impl RefScene {
             .map(|ids| [vertex(ids[0]), vertex(ids[1]), vertex(ids[2])])
             .collect();
         let usable: Vec<bool> = triangles.iter().map(is_usable).collect();
+        let casts = vec![true; triangles.len()];
         let mut result = Self {
             triangles,
             usable,
+            casts,
             nodes: Vec::new(),
             order: Vec::new(),
             pad: 0.0,
         };
         result.build();
         result
+    }
+
+    /// [`RefScene::new`], where only the objects of `scene` marked in `casters` (one flag per object, in
+    /// the order of `scene.objects`) block shadow rays: every triangle is still seen by the camera and
+    /// receives shadows, as an object that an engine leaves out of the shadow casters.
+    ///
+    /// # Panics
+    ///
+    /// If `casters` does not hold one flag per object, or an object's triangles lie beyond the scene's.
+    pub fn with_casters(scene: &scene::Scene, casters: &[bool]) -> Self {
+        assert_eq!(
+            casters.len(),
+            scene.objects.len(),
+            "one shadow-caster flag per object"
+        );
+        let mut result = Self::new(scene);
+        result.casts = vec![false; result.triangles.len()];
+        for (object, _) in scene.objects.iter().zip(casters).filter(|(_, &c)| c) {
+            let first = object.first_triangle as usize;
+            result.casts[first..first + object.triangle_count as usize].fill(true);
+        }
+        result
+    }
+
+    /// Whether triangle `i` blocks shadow rays (false for an object given as a receiver only).
+    pub(crate) fn casts(&self, i: usize) -> bool {
+        self.casts.get(i).copied().unwrap_or(false)
     }
 
     /// Number of triangles (usable or not).

@@ -553,7 +553,7 @@ impl Receiver {
         let origin = self.position;
         let mut blocked = false;
         scene.traverse(origin, dir, self.offset, distance, 0.0, |i, t_max| {
-            if i == self.triangle {
+            if i == self.triangle || !scene.casts(i) {
                 return;
             }
             if let Some((s, _)) = intersect_watertight(origin, dir, &scene.triangle(i)) {

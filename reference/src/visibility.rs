@@ -154,7 +154,8 @@ pub struct VisibilityReference {
 ///    [`PixelClass::Shadowed`] with blocker distance 0.
 /// 3. **Shadow ray** `P + s * L`. For a point light at distance `d`, only
 ///    `s < d` counts (`d = inf` for a directional light). Every usable triangle
-///    `T != R` whose bounding box grown by `tolerance` the ray reaches for
+///    `T != R` that casts shadows (every one, unless the scene was built with
+///    [`RefScene::with_casters`]) whose bounding box grown by `tolerance` the ray reaches for
 ///    `s in [-tolerance, d + tolerance]` is examined:
 ///    - an *edge event* occurs when some edge of `T` is closer than `tolerance` to
 ///      the ray's line at a closest-approach parameter in `(-tolerance,
@@ -448,7 +449,7 @@ impl ShadowRay {
         let mut certain = f64::INFINITY;
         let mut first_event = f64::INFINITY;
         scene.traverse(self.origin, self.dir, -tol, far, tol, |i, t_max| {
-            if i == self.receiver {
+            if i == self.receiver || !scene.casts(i) {
                 return;
             }
             let tri = scene.triangle(i);

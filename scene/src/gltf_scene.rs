@@ -52,7 +52,7 @@
 //! | key | type | applies to | meaning | default |
 //! |---|---|---|---|---|
 //! | `static` | bool | any node; lights | never moves or changes | inherited from the nearest ancestor node that sets it; otherwise `true` unless an animation targets the node or an ancestor (or, for a skinned mesh, the file has any animation) |
-//! | `casts_shadows` | bool | light nodes; lights | the light casts shadows | `true` |
+//! | `casts_shadows` | bool | mesh and light nodes; lights | a light node's light, or a light: it casts shadows. A mesh node's mesh: it blocks light (it is drawn and receives shadows either way) | `true` |
 //! | `radius` | number, metres, ≥ 0 | spot/point light nodes; lights | radius of the spherical light | `0` |
 //! | `angular_radius` | number, radians, in `[0, pi/2)` | directional light nodes; lights | angular radius of the light's disc | `0` |
 //!
@@ -60,7 +60,10 @@
 //! value from its node's extras, else from the light definition's extras, else (`static`) from
 //! the nearest ancestor node that sets it, else the default. A mesh node is static when it or
 //! its nearest ancestor that says so sets `static: true`, or, when none says, when no animation
-//! moves it ([`SceneFile::static_objects`]): a file without animations is static.
+//! moves it ([`SceneFile::static_objects`]): a file without animations is static. A mesh node
+//! casts shadows unless its own extras set `casts_shadows: false` ([`SceneFile::shadow_casters`]:
+//! engines leave floors, terrain or decals out of the casters); on a node with both a mesh and a
+//! light the key applies to both.
 //!
 //! # Errors
 //!
@@ -100,7 +103,8 @@ pub use example::write_example_scene;
 pub use export::{write_scene, GltfEncoding};
 pub use writer::{Quantization, QuantizedComponent};
 
-/// A scene loaded from a glTF file: geometry, lights, which objects are static, the camera.
+/// A scene loaded from a glTF file: geometry, lights, which objects are static and which cast
+/// shadows, the camera.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SceneFile {
     /// World-space geometry, one [`Object`] per node with triangles, in hierarchy order.
@@ -108,6 +112,10 @@ pub struct SceneFile {
     /// For each object of [`scene`](SceneFile::scene) (same order and length): whether it is
     /// static, i.e. never moves or deforms.
     pub static_objects: Vec<bool>,
+    /// For each object of [`scene`](SceneFile::scene) (same order and length): whether it casts
+    /// shadows. An object that casts none (`casts_shadows: false` on its node) is still drawn and
+    /// still receives shadows, but is not given to the shadow renderer as a caster.
+    pub shadow_casters: Vec<bool>,
     /// The lights, in hierarchy order.
     pub lights: Vec<SceneLight>,
     /// The first perspective camera, if the file has one on a node.
@@ -536,7 +544,8 @@ impl Loader<'_> {
             let is_static = explicit.unwrap_or(!(moves || deforms));
             let parent_static = parent_explicit.unwrap_or(!moves);
             if let Some(mesh) = node.mesh() {
-                self.add_mesh(&node, &mesh, world, is_static)?;
+                let casts_shadows = hrts.casts_shadows.unwrap_or(true);
+                self.add_mesh(&node, &mesh, world, is_static, casts_shadows)?;
             }
             match node.light() {
                 Some(light) => {
@@ -544,7 +553,7 @@ impl Loader<'_> {
                     self.file.lights.push(light);
                 }
                 None => hrts
-                    .reject_light_keys()
+                    .reject_light_keys(node.mesh().is_some())
                     .map_err(|message| SceneError::InvalidExtras {
                         path: self.path.to_owned(),
                         owner: name.clone(),
@@ -570,13 +579,15 @@ impl Loader<'_> {
         Ok(self.file)
     }
 
-    /// Appends the triangle primitives of `mesh` at `node` as one object.
+    /// Appends the triangle primitives of `mesh` at `node` as one object, static or not and casting
+    /// shadows or not.
     fn add_mesh(
         &mut self,
         node: &gltf::Node,
         mesh: &gltf::Mesh,
         world: Mat4,
         is_static: bool,
+        casts_shadows: bool,
     ) -> Result<(), SceneError> {
         let flip = world.determinant() < 0.0;
         let first_triangle = self.file.scene.triangle_count();
@@ -671,6 +682,7 @@ impl Loader<'_> {
                 triangle_count: triangle_count as u32,
             });
             self.file.static_objects.push(is_static);
+            self.file.shadow_casters.push(casts_shadows);
         }
         Ok(())
     }

@@ -84,6 +84,22 @@ impl Scene {
         bounds
     }
 
+    /// Bounds of the vertices of the objects marked in `which` (one flag per object, in order; objects
+    /// without a flag are left out). Empty ([`Aabb::empty`]) if no marked object has a triangle.
+    pub fn objects_bounds(&self, which: &[bool]) -> Aabb {
+        let mut bounds = Aabb::empty();
+        for (object, _) in self.objects.iter().zip(which).filter(|(_, &marked)| marked) {
+            let first = object.first_triangle as usize * 3;
+            let last = first + object.triangle_count as usize * 3;
+            for &i in self.indices.get(first..last).unwrap_or_default() {
+                if let Some(&p) = self.positions.get(i as usize) {
+                    bounds.extend(p);
+                }
+            }
+        }
+        bounds
+    }
+
     /// Checks the invariants listed on [`Scene`], reporting problems against the path `<memory>`.
     pub fn validate(&self) -> Result<(), SceneError> {
         self.validate_as(Path::new(MEMORY_PATH))
@@ -269,6 +285,21 @@ mod tests {
         let b = s.bounds();
         assert_eq!((b.min, b.max), (Vec3::ZERO, Vec3::ONE));
         assert!(signed_volume(&s) > 0.0);
+    }
+
+    #[test]
+    fn bounds_of_some_objects() {
+        let s = tetrahedron();
+        let a = s.objects_bounds(&[true, false]);
+        assert_eq!((a.min, a.max), (Vec3::ZERO, Vec3::ONE));
+        let b = s.objects_bounds(&[false, true]);
+        assert_eq!((b.min, b.max), (Vec3::ZERO, Vec3::ONE));
+        assert_eq!(s.objects_bounds(&[true, true]), s.bounds());
+        assert_eq!(s.objects_bounds(&[false, false]), Aabb::empty());
+        let mut single = Scene::axis_box("low", Vec3::ZERO, Vec3::ONE);
+        single.append(&Scene::axis_box("high", Vec3::splat(5.0), Vec3::splat(6.0)));
+        let high = single.objects_bounds(&[false, true]);
+        assert_eq!((high.min, high.max), (Vec3::splat(5.0), Vec3::splat(6.0)));
     }
 
     #[test]

@@ -1118,7 +1118,7 @@ static void moving_geometry_bounds(const HrtsVulkanDevice *vk) {
           culled[1]);
     CHECK(mismatches[0] == 0 && mismatches[1] == 0, "moving geometry: %d and %d mismatches", mismatches[0],
           mismatches[1]);
-    /* bounds that are not finite, or inverted, are refused */
+    /* bounds that are not finite, inverted or all zero are refused */
     VkCommandBuffer cmd = begin();
     HrtsFrame f = frame(cmd, next_frame++);
     f.has_bounds = 1;
@@ -1126,6 +1126,11 @@ static void moving_geometry_bounds(const HrtsVulkanDevice *vk) {
     f.bounds[0] = 5.0f;
     CHECK(hrts_record_frame(ctx, &f) == HRTS_RESULT_ERROR_INVALID_ARGUMENT && strstr(hrts_last_error(ctx), "bounds"),
           "inverted bounds refused: %s", hrts_last_error(ctx));
+    /* so are the all-zero bounds of a zero-initialised struct, which would cull almost every light */
+    memset(f.bounds, 0, sizeof f.bounds);
+    CHECK(hrts_record_frame(ctx, &f) == HRTS_RESULT_ERROR_INVALID_ARGUMENT &&
+              strstr(hrts_last_error(ctx), "bounds are all zero"),
+          "all-zero bounds refused: %s", hrts_last_error(ctx));
     submit_and_wait(cmd);
     /* a sun the plugin fits needs the scene's bounds: moving Vulkan geometry has none of its own, so the frame
      * must give them */

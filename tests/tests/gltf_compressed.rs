@@ -55,6 +55,7 @@ fn boxes_on_ground() -> SceneFile {
     let spot_position = Vec3::new(-3.0, 4.0, 3.0);
     SceneFile {
         static_objects: vec![true; scene.objects.len()],
+        shadow_casters: vec![true; scene.objects.len()],
         scene,
         lights: vec![
             light(

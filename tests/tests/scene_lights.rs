@@ -1,9 +1,11 @@
 //! A glTF scene's lights through the plugin, as the scene's plan says (`host_demo::scene_plan`), on
-//! lavapipe: every shadowed light against the exact reference (a point light given to the plugin as a
-//! point light: hard, its six cube faces built as one map; sized, the minimum over the faces it records), a scene whose lights need nothing records no
-//! plugin pass, and changing one light reruns only that light's passes. Sized spot and point lights with
-//! area shadows: every sample of every stable pixel as the exact reference of the same emitter samples
-//! decides it (a lamp inside a closed room, spot lights of one and five frusta, emitters next to geometry).
+//! lavapipe: every shadowed light against the exact reference of the scene's shadow casters (a point light
+//! given to the plugin as a point light, hard or sized: its six cube faces built as one map; a ground that
+//! casts no shadows receiving one cast from behind the camera; blockers on the edges between cube faces),
+//! a scene whose lights need nothing records no plugin pass, and changing one light reruns only that
+//! light's passes. Sized spot and point lights with area shadows: every sample of every stable pixel as the
+//! exact reference of the same emitter samples decides it (a lamp inside a closed room, spot lights of one
+//! and five frusta, emitters next to geometry).
 
 mod common;
 
@@ -146,7 +148,7 @@ fn assert_lights_match_reference(
     let hard = all_hard(&plan);
     let frame = renderer.render(device, camera, &hard).expect("hard frame");
     let images = renderer.read_back(device, &hard).expect("read back");
-    let rs = RefScene::new(&file.scene);
+    let rs = RefScene::with_casters(&file.scene, &file.shadow_casters);
     let reports = hard.plugin_lights();
     for (i, light) in hard.lights.iter().enumerate() {
         let name = &light.light.name;
@@ -263,6 +265,7 @@ fn boxes_scene(
     scene.validate().expect("valid scene");
     SceneFile {
         static_objects: vec![true; scene.objects.len()],
+        shadow_casters: vec![true; scene.objects.len()],
         scene,
         lights,
         camera: Some(Camera {
@@ -274,6 +277,136 @@ fn boxes_scene(
         }),
         skipped_primitives: 0,
     }
+}
+
+/// `file` written as glTF and loaded back (its `hrts` extras, `casts_shadows` on mesh nodes included).
+fn written_and_loaded(file: &SceneFile, name: &str) -> SceneFile {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("scene_lights");
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join(format!("{name}-{}.gltf", std::process::id()));
+    scene::gltf_scene::write_scene(&path, file, scene::gltf_scene::GltfEncoding::default())
+        .expect("write the scene");
+    let loaded = scene::load_gltf(&path).expect("load the scene");
+    let _ = std::fs::remove_file(&path);
+    loaded
+}
+
+/// Travel direction of the low sun of [`pillar_behind_the_camera`]: about 16° above the horizon, from
+/// behind the camera.
+const LOW_SUN: Vec3 = Vec3::new(0.15, -0.3, -1.0);
+
+/// A ground (a 10 cm slab) that casts shadows or not, a 5 m pillar behind the camera, out of view, and a
+/// zero-size low sun from behind both: the pillar's shadow runs some 15 m across the ground in view.
+fn pillar_behind_the_camera(ground_casts: bool) -> SceneFile {
+    let sun = SceneLight {
+        name: "sun".into(),
+        kind: LightKind::Directional {
+            direction: LOW_SUN.normalize(),
+        },
+        color: Vec3::ONE,
+        intensity: 3.0,
+        size: LightSize::Zero,
+        casts_shadows: true,
+        is_static: true,
+    };
+    let mut file = boxes_scene(
+        &[
+            (
+                "ground",
+                Vec3::new(-20.0, -0.1, -40.0),
+                Vec3::new(20.0, 0.0, 10.0),
+            ),
+            (
+                "pillar",
+                Vec3::new(-0.4, 0.0, 2.6),
+                Vec3::new(0.4, 5.0, 3.4),
+            ),
+        ],
+        vec![sun],
+        Vec3::new(0.0, 1.6, 0.0),
+        Vec3::new(0.0, 0.3, -6.0),
+    );
+    file.shadow_casters[0] = ground_casts;
+    file
+}
+
+/// A ground whose glTF node casts no shadows (`extras.hrts.casts_shadows` false: the plugin is given the
+/// pillar alone, behind the camera) still receives the pillar's shadow of a low sun from behind the camera:
+/// the plugin keeps the light (a caster out of view shadows receivers in view), the same pixels are
+/// shadowed as when the ground casts (within 2 %), and both match the exact reference of their casters.
+#[test]
+fn a_ground_that_casts_no_shadows_receives_a_shadow_cast_from_behind_the_camera() {
+    let device = device();
+    let mut shadowed = Vec::new();
+    for ground_casts in [true, false] {
+        let file = written_and_loaded(
+            &pillar_behind_the_camera(ground_casts),
+            if ground_casts {
+                "casting-ground"
+            } else {
+                "receiving-ground"
+            },
+        );
+        assert_eq!(file.shadow_casters, [ground_casts, true]);
+        let camera = camera(&file);
+        let plan = plan_scene(&file, &camera, &settings(false)).expect("plan");
+        let shadowed_light = plan.lights[0].shadowed().expect("the sun is shadowed");
+        assert_eq!(shadowed_light.resolved_config().mode, ShadowMode::Hard);
+        let mut renderer = SceneRenderer::new(&device, &file, WIDTH, HEIGHT).expect("renderer");
+        let frame = renderer.render(&device, &camera, &plan).expect("frame");
+        let images = renderer.read_back(&device, &plan).expect("read back");
+        let report = &frame.lights[0];
+        let rs = RefScene::with_casters(&file.scene, &file.shadow_casters);
+        let params = scene_visibility_params(
+            &file.scene,
+            &camera,
+            WIDTH,
+            HEIGHT,
+            reference::Light::Directional {
+                direction: LOW_SUN.normalize().as_dvec3(),
+            },
+        );
+        let r = reference_visibility(&rs, &params);
+        let c = compare_with_reference(&r, &images.visibility[0], None, None);
+        let gpu_shadowed = images.visibility[0].iter().filter(|&&v| v == 0.0).count();
+        println!(
+            "ground {}: {} frusta recorded, {} culled ({}); {} pixels compared, {} shadowed, {} near an edge, \
+             {} mismatches; {gpu_shadowed} shadowed by the plugin",
+            if ground_casts { "casting" } else { "casting nothing" },
+            report.frusta,
+            report.frusta_culled,
+            report.decision,
+            c.pixels,
+            c.shadowed,
+            c.near_edge,
+            c.mismatches
+        );
+        assert_eq!(c.non_finite, 0);
+        assert_eq!(
+            c.mismatches, 0,
+            "mismatching pixels (x, y, exact, gpu): {:?}",
+            c.examples
+        );
+        assert_eq!(
+            (report.frusta, report.frusta_culled),
+            (1, 0),
+            "{}",
+            report.decision
+        );
+        assert!(c.shadowed > 1000, "{} shadowed pixels", c.shadowed);
+        assert!(
+            c.near_edge * 100 < c.pixels * 5,
+            "{} near an edge",
+            c.near_edge
+        );
+        shadowed.push(gpu_shadowed);
+    }
+    let (casting, receiving) = (shadowed[0] as f64, shadowed[1] as f64);
+    assert!(
+        (casting - receiving).abs() <= 0.02 * casting,
+        "{casting} pixels shadowed with a casting ground, {receiving} with a ground that casts nothing"
+    );
+    assert_no_validation_errors(&device);
 }
 
 /// A point light inside a closed room (every wall, floor and ceiling triangle crosses the plane of some cube
@@ -288,10 +421,17 @@ fn a_point_light_inside_a_closed_room_matches_the_exact_reference() {
     assert_eq!(plan.plugin_lights().len(), 1, "{}", plan.describe());
 }
 
-/// Small blocks on the diagonals between a point light's cube faces, 1 m from the lamp: every vertex of
-/// each lies within a few degrees of the edge between two faces' pyramids, where the setup's cheap pyramid
-/// test (`map_setup.comp`, `meets_face_pyramid`) decides whether a face lists them at all. A test that kept
-/// less than the pyramid (a tangent below 1) would drop them from both faces and lose their shadows.
+/// Blockers on the edges between a point light's cube faces, where the setup's cheap pyramid test
+/// (`map_setup.comp`, `meets_face_pyramid`: a face lists only triangles meeting its pyramid |u| <= T d,
+/// T = 1.02) decides whether a face lists them at all; a tangent T below 1 loses whatever lies in the gap
+/// it leaves between the faces' pyramids.
+///
+/// Small blocks on the diagonals, 1 m from the lamp in the closed room: every vertex lies within a few
+/// degrees of the edge between two faces (a tangent of 0.9 loses their shadows). And thin strips facing a
+/// lamp above a floor, one on each edge between its down face and a side face, 1 mm wide at 1 m: each
+/// straddles the plane between the two faces with every vertex within 1e-3 of it (|u| / d within 1e-3 of
+/// 1), so any tangent below 0.999 lists it in neither face. Their shadows are lines 4 mm wide on the floor,
+/// which close-up views of the floor (a millimetre a pixel) see as hundreds of shadowed pixels.
 #[test]
 fn blockers_on_the_edges_between_cube_faces_match_the_exact_reference() {
     let device = device();
@@ -315,9 +455,70 @@ fn blockers_on_the_edges_between_cube_faces_match_the_exact_reference() {
             centre + half,
         ));
         file.static_objects.push(true);
+        file.shadow_casters.push(true);
     }
     file.scene.validate().expect("valid scene");
     assert_lights_match_reference(&device, &file, &camera(&file), 200, 5, &[]);
+
+    let lamp = Vec3::new(0.1, 2.0, -0.05);
+    let file = floor_with_edge_strips(lamp);
+    // Each strip's shadow: the line where the plane between the two faces meets the floor, 2 m out from
+    // the lamp's foot, seen from 0.8 m above through a 6° field of view.
+    for outward in [Vec3::X, Vec3::NEG_X, Vec3::Z, Vec3::NEG_Z] {
+        let target = Vec3::new(lamp.x, 0.0, lamp.z) + outward * lamp.y;
+        let close_up = Camera {
+            position: target + outward * 0.25 + Vec3::Y * 0.8,
+            target,
+            up: Vec3::Y,
+            fov_y_radians: 6f32.to_radians(),
+            near: 0.05,
+        };
+        println!("close-up of the strip's shadow at {target}:");
+        assert_lights_match_reference(&device, &file, &close_up, 60, 5, &[]);
+    }
+}
+
+/// A 5 m floor and a point lamp 2 m above it at `lamp` with, on each edge between the lamp's down cube face
+/// and a side face, a strip 1 mm wide and 30 cm long, 1 m from the lamp: its long axis lies in the plane
+/// between the two faces, across the direction from the lamp, and it faces the lamp.
+fn floor_with_edge_strips(lamp: Vec3) -> SceneFile {
+    let mut file = boxes_scene(
+        &[(
+            "floor",
+            Vec3::new(-2.5, -0.1, -2.5),
+            Vec3::new(2.5, 0.0, 2.5),
+        )],
+        vec![point_light("lamp", lamp)],
+        Vec3::new(3.0, 3.0, 3.0),
+        lamp,
+    );
+    let (distance, width, length) = (1.0, 1e-3, 0.3);
+    for (name, outward) in [
+        ("strip +X", Vec3::X),
+        ("strip -X", Vec3::NEG_X),
+        ("strip +Z", Vec3::Z),
+        ("strip -Z", Vec3::NEG_Z),
+    ] {
+        // The plane between the side face and the down face holds `outward - Y` and the third axis.
+        let radial = (outward - Vec3::Y).normalize();
+        let across = (outward + Vec3::Y).normalize();
+        let along = radial.cross(across);
+        let centre = lamp + radial * distance;
+        let (w, l) = (across * width * 0.5, along * length * 0.5);
+        let corners = vec![
+            centre - w - l,
+            centre + w - l,
+            centre + w + l,
+            centre - w + l,
+        ];
+        // Triangles (0, 2, 1) and (0, 3, 2): their normal (along x across) points back at the lamp.
+        let strip = scene::Scene::single_object(corners, vec![0, 2, 1, 0, 3, 2], name);
+        file.scene.append(&strip);
+        file.static_objects.push(true);
+        file.shadow_casters.push(true);
+    }
+    file.scene.validate().expect("valid scene");
+    file
 }
 
 /// The closed room of [`a_point_light_inside_a_closed_room_matches_the_exact_reference`] with its lamp.

@@ -21,20 +21,24 @@
 //! - a spot light by its position, axis, cone and range (`HRTS_LIGHT_TYPE_SPOT` with no matrix): the
 //!   plugin fits one perspective frustum to a cone up to 60°, the five cube faces around its axis to a
 //!   wider one;
-//! - a point light by its position and range (`HRTS_LIGHT_TYPE_POINT`): the plugin shadows it through
-//!   the six faces of a cube around it.
+//! - a point light by its position and range (`HRTS_LIGHT_TYPE_POINT`): the plugin builds the six faces
+//!   of a cube around it as one primitive map (hard shadows, or area shadows of a sized lamp).
 //!
-//! Every frame the plugin records only the frusta that may hold a receiver in view within the light's
-//! range, and writes the minimum over them to the light's layer; its frame report says which it culled
-//! and why.
+//! Every frame the plugin records only the frusta (a wide spot light's faces, or a light's one frustum or
+//! cube map) where a caster may shadow a receiver in view within the light's range, and writes the
+//! minimum over a wide spot light's faces to its layer; its frame report says which it culled and why.
 //!
 //! "Receivers in view" are the scene's triangles that are not entirely outside one plane of the camera
 //! frustum (occlusion is not considered), and a triangle is within a light's reach when its bounding
 //! sphere meets the light's range and cone: the test keeps every light that may light a visible pixel,
 //! and may keep a few that do not.
 //!
-//! Caching: a light marked static sets `static_light`; any object that is not static makes the geometry
-//! dynamic for every light (the plugin shares one prim buffer between its lights).
+//! Shadow casters: the plugin is given the objects that cast shadows (`SceneFile::shadow_casters`); an
+//! object that casts none (a floor, terrain) is drawn and receives shadows, and is a receiver in view like
+//! any other.
+//!
+//! Caching: a light marked static sets `static_light`; any shadow caster that is not static makes the
+//! geometry dynamic for every light (the plugin shares one prim buffer between its lights).
 
 mod reach;
 
@@ -183,10 +187,13 @@ pub struct PluginLight<'a> {
 /// The plan of a scene seen by a camera.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ScenePlan {
-    /// Whether any object moves: the prim buffer is rebuilt every frame (and so every light-space pass).
+    /// Whether any shadow caster moves: the prim buffer is rebuilt every frame (and so every light-space
+    /// pass).
     pub dynamic_geometry: bool,
-    /// The objects that are not static.
+    /// The shadow casters that are not static.
     pub moving_objects: Vec<String>,
+    /// The objects that cast no shadows (drawn, receiving shadows, not given to the plugin).
+    pub receivers_only: Vec<String>,
     /// Triangles of the scene in view (receivers).
     pub receivers_in_view: usize,
     /// Triangles of the scene.
@@ -242,6 +249,13 @@ impl ScenePlan {
                 "static: the prim buffer is built once, and the shadow maps of static lights are kept".to_owned()
             }
         );
+        if !self.receivers_only.is_empty() {
+            let _ = writeln!(
+                s,
+                "casting no shadows (drawn and shadowed, not given to the plugin): {}",
+                self.receivers_only.join(", ")
+            );
+        }
         let _ = writeln!(
             s,
             "receivers in view: {} of {} triangles; the primitive map of every frustum is refitted to them every frame",
@@ -381,27 +395,38 @@ pub fn scene_camera(file: &SceneFile, aspect: f32) -> Camera {
 ///
 /// # Errors
 ///
-/// A frame size of zero, `static_objects` not matching the objects, or more shadowed lights than the
-/// plugin shades ([`HRTS_MAX_LIGHTS`]).
+/// A frame size of zero, `static_objects` or `shadow_casters` not matching the objects, no object casting
+/// shadows, or more shadowed lights than the plugin shades ([`HRTS_MAX_LIGHTS`]).
 pub fn plan_scene(file: &SceneFile, camera: &Camera, settings: &PlanSettings) -> Result<ScenePlan> {
     if settings.width == 0 || settings.height == 0 {
         bail!("the frame size must be positive");
     }
-    if file.static_objects.len() != file.scene.objects.len() {
-        bail!(
-            "the scene has {} objects but {} static flags",
-            file.scene.objects.len(),
-            file.static_objects.len()
-        );
+    let objects = file.scene.objects.len();
+    for (flags, what) in [
+        (&file.static_objects, "static"),
+        (&file.shadow_casters, "shadow-caster"),
+    ] {
+        if flags.len() != objects {
+            bail!(
+                "the scene has {objects} objects but {} {what} flags",
+                flags.len()
+            );
+        }
     }
-    let moving_objects: Vec<String> = file
-        .scene
-        .objects
-        .iter()
-        .zip(&file.static_objects)
-        .filter(|(_, &is_static)| !is_static)
-        .map(|(o, _)| o.name.clone())
-        .collect();
+    if !file.shadow_casters.iter().any(|&c| c) {
+        bail!("no object of the scene casts shadows: the plugin needs at least one caster");
+    }
+    let objects_where = |keep: &dyn Fn(bool, bool) -> bool| -> Vec<String> {
+        file.scene
+            .objects
+            .iter()
+            .zip(file.static_objects.iter().zip(&file.shadow_casters))
+            .filter(|(_, (&is_static, &casts))| keep(is_static, casts))
+            .map(|(o, _)| o.name.clone())
+            .collect()
+    };
+    let moving_objects = objects_where(&|is_static, casts| casts && !is_static);
+    let receivers_only = objects_where(&|_, casts| !casts);
     let dynamic_geometry = !moving_objects.is_empty();
     let aspect = settings.width as f32 / settings.height as f32;
     let receivers = receivers_in_view(file, camera, aspect);
@@ -416,6 +441,7 @@ pub fn plan_scene(file: &SceneFile, camera: &Camera, settings: &PlanSettings) ->
     let plan = ScenePlan {
         dynamic_geometry,
         moving_objects,
+        receivers_only,
         receivers_in_view: receivers.len(),
         triangles: file.scene.triangle_count(),
         lights,
@@ -553,6 +579,7 @@ mod tests {
         ));
         SceneFile {
             static_objects: vec![true; scene.objects.len()],
+            shadow_casters: vec![true; scene.objects.len()],
             scene,
             lights,
             camera: Some(Camera {
@@ -749,6 +776,7 @@ mod tests {
             Vec3::new(8.0, 0.0, 35.0),
         ));
         file.static_objects.push(true);
+        file.shadow_casters.push(true);
         let p = only(file);
         assert_eq!(p.decision, LightDecision::NoPass(NoPassReason::OutOfReach));
         // Reaching the box: shadowed.
@@ -926,5 +954,43 @@ mod tests {
             &settings()
         )
         .is_err());
+        let mut mismatched = ground_and_box(Vec::new());
+        mismatched.shadow_casters.pop();
+        let error = plan_scene(
+            &mismatched,
+            &mismatched.camera.expect("camera"),
+            &settings(),
+        )
+        .expect_err("a flag missing")
+        .to_string();
+        assert!(error.contains("1 shadow-caster flags"), "{error}");
+    }
+
+    #[test]
+    fn objects_that_cast_no_shadows_are_receivers_only() {
+        let mut file = ground_and_box(vec![sun(LightSize::Zero)]);
+        file.shadow_casters[0] = false;
+        // The ground casts nothing: it moving does not make the plugin's geometry dynamic, and it still
+        // receives (the sun is shadowed).
+        file.static_objects[0] = false;
+        let p = plan(&file);
+        assert!(!p.dynamic_geometry && p.moving_objects.is_empty());
+        assert_eq!(p.receivers_only, ["ground"]);
+        assert!(p.lights[0].shadowed().is_some());
+        let text = p.describe();
+        assert!(
+            text.contains(
+                "casting no shadows (drawn and shadowed, not given to the plugin): ground"
+            ),
+            "{text}"
+        );
+        file.shadow_casters[1] = false;
+        let error = plan_scene(&file, &file.camera.expect("camera"), &settings())
+            .expect_err("no caster")
+            .to_string();
+        assert!(
+            error.contains("no object of the scene casts shadows"),
+            "{error}"
+        );
     }
 }

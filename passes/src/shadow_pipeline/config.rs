@@ -122,6 +122,19 @@ impl ShadowConfig {
         }
     }
 
+    /// The size of the light whose segments the output of this configuration traces, once resolved
+    /// ([`ShadowConfig::resolved`]) for a `directional` light or a spot or point light: 0 for hard shadows
+    /// (and none), the light's size ([`ShadowConfig::light_size`]) for area shadows. `None` for the
+    /// shadow-map modes (soft, hybrid), whose filters reach past those segments. A frustum whose receivers
+    /// in view no caster can block along such segments is not recorded ([`crate::ViewVolume::may_shadow`]).
+    pub fn traced_light_size(&self, directional: bool) -> Option<f32> {
+        match self.resolved(directional).mode {
+            ShadowMode::Hard | ShadowMode::None => Some(0.0),
+            ShadowMode::Area => Some(self.light_size(directional)),
+            ShadowMode::Soft | ShadowMode::Hybrid | ShadowMode::Auto => None,
+        }
+    }
+
     /// This configuration for one light, `directional` or a spot or point light: [`ShadowMode::Auto`]
     /// resolved by the light's size ([`ShadowConfig::light_size`], [`ShadowMode::for_light_size`]): hard
     /// shadows for a light of zero size, area shadows for a sized one. Any other mode is kept.

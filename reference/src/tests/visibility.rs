@@ -136,6 +136,57 @@ fn box_over_plane_with_directional_light() {
     assert!(count(PixelClass::Shadowed) > 100 && count(PixelClass::Lit) > 1000);
 }
 
+/// The floor and the box of [`box_over_plane`] as two objects, floor first, the box casting shadows or not.
+fn floor_and_box_objects(box_casts: bool, floor_casts: bool) -> RefScene {
+    let mut scene = scene::Scene::single_object(
+        [(-10.0, -10.0), (10.0, -10.0), (10.0, 10.0), (-10.0, 10.0)]
+            .map(|(x, z)| Vec3::new(x, 0.0, z))
+            .to_vec(),
+        vec![0, 3, 1, 1, 3, 2],
+        "floor",
+    );
+    scene.append(&scene::Scene::axis_box(
+        "box",
+        Vec3::new(-1.0, 1.0, -1.0),
+        Vec3::new(1.0, 2.0, 1.0),
+    ));
+    RefScene::with_casters(&scene, &[floor_casts, box_casts])
+}
+
+/// An object that casts no shadows is still seen and still receives them, but blocks no shadow ray: the
+/// floor under a box that casts nothing is lit, and a floor that casts nothing changes nothing above it.
+#[test]
+fn objects_that_cast_no_shadows_only_receive() {
+    let params = params(Vec3::new(6.0, 10.0, 8.0), oblique_light());
+    let all = reference_visibility(&box_over_plane(), &params);
+    let floor_receives_only = reference_visibility(&floor_and_box_objects(true, false), &params);
+    assert_eq!(floor_receives_only.class, all.class);
+    let box_receives_only = reference_visibility(&floor_and_box_objects(false, true), &params);
+    check_invariants(&box_receives_only);
+    for p in [
+        Vec3::new(2.5, 0.0, 0.0),
+        Vec3::new(2.6, 0.0, 0.5),
+        Vec3::new(2.3, 0.0, -0.4),
+    ] {
+        let i = pixel_of(&params, p);
+        assert_eq!(all.class[i], PixelClass::Shadowed, "{p}");
+        assert_eq!(box_receives_only.class[i], PixelClass::Lit, "{p}");
+    }
+    // The box is still seen: its top is lit, its +x face (away from the light) in its own shadow.
+    let top = pixel_of(&params, Vec3::new(0.0, 2.0, 0.0));
+    assert!((2..14).contains(&(box_receives_only.receiver[top] as usize)));
+    assert_eq!(box_receives_only.class[top], PixelClass::Lit);
+    let side = pixel_of(&params, Vec3::new(1.0, 1.5, 0.0));
+    assert_eq!(box_receives_only.class[side], PixelClass::Shadowed);
+    let shadowed = |r: &VisibilityReference| {
+        r.class
+            .iter()
+            .filter(|&&c| c == PixelClass::Shadowed)
+            .count()
+    };
+    assert!(shadowed(&box_receives_only) < shadowed(&all) / 2);
+}
+
 #[test]
 fn light_from_below_the_receiver_shadows_it() {
     let scene = box_over_plane();

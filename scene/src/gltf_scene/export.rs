@@ -61,7 +61,12 @@ fn scene_document(file: &SceneFile, encoding: GltfEncoding) -> (Value, Vec<u8>) 
         GltfWriter::default()
     };
     let scene = &file.scene;
-    for (object, &is_static) in scene.objects.iter().zip(&file.static_objects) {
+    for ((object, &is_static), &casts_shadows) in scene
+        .objects
+        .iter()
+        .zip(&file.static_objects)
+        .zip(&file.shadow_casters)
+    {
         let first = object.first_triangle as usize * 3;
         let corners = &scene.indices[first..first + object.triangle_count as usize * 3];
         let mut remap = HashMap::new();
@@ -79,6 +84,9 @@ fn scene_document(file: &SceneFile, encoding: GltfEncoding) -> (Value, Vec<u8>) 
             "name": object.name,
             "extras": { "hrts": { "static": is_static } },
         });
+        if !casts_shadows {
+            node["extras"]["hrts"]["casts_shadows"] = false.into();
+        }
         if let Some(quantization) = encoding.quantize {
             let (mesh, translation, scale) =
                 w.quantized_mesh(&object.name, &positions, &indices, quantization);

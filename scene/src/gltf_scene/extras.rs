@@ -27,10 +27,13 @@ impl Hrts {
         }
     }
 
-    /// An error naming the first light-only key, for a node without a light.
-    pub(super) fn reject_light_keys(&self) -> Result<(), String> {
+    /// An error naming the first key that needs a light, for a node without a light (`has_mesh`:
+    /// whether it has a mesh, which takes `casts_shadows`).
+    pub(super) fn reject_light_keys(&self, has_mesh: bool) -> Result<(), String> {
+        if !has_mesh && self.casts_shadows.is_some() {
+            return Err("\"casts_shadows\" applies to mesh and light nodes, but this node has neither a mesh nor a KHR_lights_punctual light".into());
+        }
         let present = [
-            ("casts_shadows", self.casts_shadows.is_some()),
             ("radius", self.radius.is_some()),
             ("angular_radius", self.angular_radius.is_some()),
         ];

@@ -760,18 +760,33 @@ fn malformed_lights_and_extras() {
         assert!(matches!(error, SceneError::InvalidExtras { .. }), "{error}");
         assert!(error.to_string().contains(expected), "{error}");
     }
-    // Light settings on a node without a light.
+    // A light's size on a node without a light.
     let dir = TempDir::new();
     let (mut document, bin) = with_triangle().finish();
-    document["nodes"][0]["extras"] = json!({ "hrts": { "static": true, "casts_shadows": false } });
+    document["nodes"][0]["extras"] = json!({ "hrts": { "static": true, "radius": 0.1 } });
     let error = dir.load_embedded("mesh.gltf", &document, &bin).unwrap_err();
+    assert!(matches!(error, SceneError::InvalidExtras { .. }), "{error}");
+    assert!(
+        error.to_string().contains("\"radius\" applies to lights"),
+        "{error}"
+    );
+    // Shadow casting on a node with neither a mesh nor a light.
+    let mut w = with_triangle();
+    let group =
+        w.node(json!({ "name": "group", "extras": { "hrts": { "casts_shadows": false } } }));
+    w.root(group);
+    let (document, bin) = w.finish();
+    let error = dir
+        .load_embedded("group.gltf", &document, &bin)
+        .unwrap_err();
     assert!(matches!(error, SceneError::InvalidExtras { .. }), "{error}");
     assert!(
         error
             .to_string()
-            .contains("\"casts_shadows\" applies to lights"),
+            .contains("\"casts_shadows\" applies to mesh and light nodes"),
         "{error}"
     );
+    let (mut document, bin) = with_triangle().finish();
     // Extras that are not hrts objects are someone else's business.
     document["nodes"][0]["extras"] = json!(["anything", 1]);
     dir.load_embedded("mesh.gltf", &document, &bin).unwrap();
@@ -906,4 +921,36 @@ fn animations_decide_what_moves() {
     let names: Vec<&str> = file.scene.objects.iter().map(|o| o.name.as_str()).collect();
     assert_eq!(names, ["still", "cart", "wheel", "pinned"]);
     assert_eq!(file.static_objects, [true, false, false, true]);
+}
+
+/// A mesh node with `casts_shadows: false` (a floor an engine leaves out of the shadow casters) is loaded
+/// as an object that casts no shadows; its siblings cast them, and writing the scene keeps the flag.
+#[test]
+fn a_mesh_node_may_cast_no_shadows() {
+    let mut w = GltfWriter::default();
+    let square = w.mesh("square", &SQUARE, &[0, 1, 2, 0, 2, 3]);
+    let floor = w.node(json!({
+        "name": "floor", "mesh": square, "extras": { "hrts": { "casts_shadows": false } },
+    }));
+    let pillar =
+        w.node(json!({ "name": "pillar", "mesh": square, "translation": [0.0, 1.0, 0.0] }));
+    let plate = w.node(json!({
+        "name": "plate", "mesh": square, "translation": [0.0, 2.0, 0.0],
+        "extras": { "hrts": { "casts_shadows": true } },
+    }));
+    for node in [floor, pillar, plate] {
+        w.root(node);
+    }
+    let (document, bin) = w.finish();
+    let dir = TempDir::new();
+    let file = dir.load_embedded("floor.gltf", &document, &bin).unwrap();
+    let names: Vec<&str> = file.scene.objects.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(names, ["floor", "pillar", "plate"]);
+    assert_eq!(file.shadow_casters, [false, true, true]);
+    assert_eq!(file.static_objects, [true, true, true]);
+    let path = dir.0.join("written.gltf");
+    write_scene(&path, &file, GltfEncoding::default()).unwrap();
+    let written = load(&path).unwrap();
+    assert_eq!(written.shadow_casters, file.shadow_casters);
+    assert_eq!(written.scene, file.scene);
 }
