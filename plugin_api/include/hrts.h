@@ -754,9 +754,9 @@ typedef struct HrtsLight {
 // Where one mesh's positions are in one frame (`HrtsFrame::deformed`): a vertex buffer of that frame,
 // such as one of a ring of skinning outputs, one per frame in flight. It holds the mesh's vertex count in
 // the mesh's `vertex_format` and `vertex_stride`, and must stay alive until the frame completed. The
-// plugin keeps a descriptor per buffer for as long as frames in flight may use it (`frames_in_flight`
-// frames after the last that gave it): a buffer destroyed sooner must not be replaced by one that may
-// get the same handle within those frames.
+// plugin writes the buffer's descriptors anew in each frame that gives it and never reads them in another
+// frame: once the frame completed, the engine may destroy the buffer, and a buffer created after it may
+// get its handle.
 typedef struct HrtsMeshVertices {
   // Index of the mesh in the last geometry call (0 for `hrts_set_geometry_vulkan` and
   // `hrts_set_geometry_cpu`).

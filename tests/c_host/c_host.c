@@ -520,9 +520,14 @@ static void create_device(void) {
     app.apiVersion = VK_API_VERSION_1_3;
     /* Khronos synchronization validation: hazards between commands, command buffers and submissions */
     VkValidationFeatureEnableEXT enables[] = {VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
+    /* the driver's own handles (the layer wraps them in handles never reused otherwise), so that a buffer
+     * destroyed can come back at the same handle, as engines see it (reused_vertex_handle) */
+    VkValidationFeatureDisableEXT disables[] = {VK_VALIDATION_FEATURE_DISABLE_UNIQUE_HANDLES_EXT};
     VkValidationFeaturesEXT vf = {.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
     vf.enabledValidationFeatureCount = 1;
     vf.pEnabledValidationFeatures = enables;
+    vf.disabledValidationFeatureCount = 1;
+    vf.pDisabledValidationFeatures = disables;
     VkDebugUtilsMessengerCreateInfoEXT mi = {.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
     vf.pNext = &mi;
     mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
@@ -2054,6 +2059,75 @@ static void engine_meshes(const HrtsVulkanDevice *vk) {
 }
 
 /* ---------- a deforming mesh ---------- */
+/* A vertex buffer's handle reused: the engine destroys a skinned buffer once the frame that read it
+ * completed and creates one of the same size over other memory of its own block; the driver hands back the
+ * same VkBuffer handle. The next frame, within frames_in_flight of the first, must read the new buffer (the
+ * box deformed, B), not the destroyed one's memory (the box, A). `want` holds A's and B's visibility. */
+static void reused_vertex_handle(HrtsContext *ctx, const float *want_a, const float *want_b) {
+    enum { PX = W * H, TRIES = 64 };
+    const VkDeviceSize size = BOX_VERTICES * 8;
+    VkBufferCreateInfo ci = {.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    ci.size = size;
+    ci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    VkBuffer first;
+    VK(vkCreateBuffer(device, &ci, NULL, &first));
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(device, first, &req);
+    /* the engine's memory block: region 0 holds the box (A), region 1 the box deformed (B) */
+    VkDeviceSize region = (req.size + req.alignment - 1) / req.alignment * req.alignment;
+    VkMemoryAllocateInfo ai = {.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    ai.allocationSize = 2 * region;
+    ai.memoryTypeIndex =
+        memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    VkDeviceMemory block;
+    VK(vkAllocateMemory(device, &ai, NULL, &block));
+    void *map;
+    VK(vkMapMemory(device, block, 0, 2 * region, 0, &map));
+    box_snorm((uint16_t *)map, 0);
+    box_snorm((uint16_t *)((char *)map + region), 1);
+    VK(vkBindBufferMemory(device, first, block, 0));
+    static float vis[PX];
+    HrtsMeshVertices v = {1, (uint64_t)(uintptr_t)first, size, 0};
+    VkCommandBuffer cmd = begin();
+    HrtsFrame f = frame(cmd, next_frame++);
+    f.deformed = &v;
+    f.deformed_count = 1;
+    HrtsResult r = finish_frame(cmd, hrts_record_frame(ctx, &f), vis);
+    CHECK(r == HRTS_RESULT_OK, "reused handle: first frame: %s", hrts_last_error(ctx));
+    int differ_a = differing(vis, want_a, PX);
+    /* the frame completed (finish_frame waited for it): the buffer goes, others of its size come until one
+     * gets its handle */
+    const uint64_t handle = v.vertex_buffer;
+    vkDestroyBuffer(device, first, NULL);
+    VkBuffer tried[TRIES], again = VK_NULL_HANDLE;
+    int n = 0;
+    while (n < TRIES && again == VK_NULL_HANDLE) {
+        VK(vkCreateBuffer(device, &ci, NULL, &tried[n]));
+        if ((uint64_t)(uintptr_t)tried[n] == handle) again = tried[n];
+        n++;
+    }
+    int differ_b = -1;
+    if (again != VK_NULL_HANDLE) {
+        VK(vkBindBufferMemory(device, again, block, region));
+        cmd = begin();
+        f = frame(cmd, next_frame++);
+        f.deformed = &v;
+        f.deformed_count = 1;
+        r = finish_frame(cmd, hrts_record_frame(ctx, &f), vis);
+        CHECK(r == HRTS_RESULT_OK, "reused handle: second frame: %s", hrts_last_error(ctx));
+        differ_b = differing(vis, want_b, PX);
+    }
+    printf("reused vertex buffer handle: %s after %d buffers created; the frame before differs from the box in %d px, "
+           "the frame after from the box deformed in %d px\n",
+           again != VK_NULL_HANDLE ? "the handle came back" : "the handle did NOT come back", n, differ_a, differ_b);
+    CHECK(again != VK_NULL_HANDLE, "reused handle: the handle never came back: the case was not tested");
+    CHECK(differ_a == 0 && differ_b == 0, "reused handle: %d / %d px differ", differ_a, differ_b);
+    for (int k = 0; k < n; k++) vkDestroyBuffer(device, tried[k], NULL);
+    vkUnmapMemory(device, block);
+    vkFreeMemory(device, block, NULL);
+}
+
+
 /* The engine skins the box into one vertex buffer per frame in flight (2): buffer A holds the box, buffer B
  * the box deformed (its x < 0 half gone). Frames give them in turn through HrtsFrame::deformed, two frames
  * pending on the GPU at once, with frames that deform nothing between. Each frame's visibility equals, bit
@@ -2211,6 +2285,7 @@ static void deforming_mesh(const HrtsVulkanDevice *vk) {
     printf("bad deformed lists: %d of 5 refused as they must; the frame after differs from the static geometry in %d px\n",
            refused, after_differ);
     CHECK(after_differ == 0, "deforming: the frame after the refused lists differs in %d px", after_differ);
+    reused_vertex_handle(ctx, expected[A], expected[B]);
     VK(vkDeviceWaitIdle(device));
     CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
     vkDestroySemaphore(device, hold, NULL);
