@@ -811,7 +811,8 @@ typedef struct HrtsFrame {
   // The meshes deformed this frame (`deformed_count` entries; may be NULL if the count is 0): each
   // reads its positions from a vertex buffer of this frame instead of its own, and its triangles are
   // rebuilt this frame (from its own vertex buffer again in the next frame that does not deform it).
-  // Read by the call that begins the frame. A deformed mesh's bounds do not hold: give the frame's in
+  // Read by the call that begins the frame alone (the frame's later calls deform the same meshes): the
+  // array may be freed once that call returned. A deformed mesh's bounds do not hold: give the frame's in
   // `bounds`, or the plugin culls by the view and the lights' ranges alone.
   const struct HrtsMeshVertices *deformed;
   // Number of entries in `deformed`.

@@ -191,6 +191,8 @@ pub(crate) struct OpenFrame {
     pub(crate) index: u64,
     pub(crate) inputs: Vec<FrameLight>,
     pub(crate) last_pass: u32,
+    /// Whether the call that began the frame gave deformed meshes (their bounds do not hold).
+    pub(crate) deforms: bool,
 }
 
 /// Which frusta of each light a frame recorded: those that may hold a receiver in view within the light's
