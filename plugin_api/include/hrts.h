@@ -9,7 +9,7 @@
 
 // Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
 // version differs.
-#define HRTS_API_VERSION ((5 << 22) | (7 << 12))
+#define HRTS_API_VERSION ((5 << 22) | (8 << 12))
 
 // The most lights one context shades (`hrts_configure_lights`); a point light counts once.
 #define HRTS_MAX_LIGHTS 64
@@ -973,12 +973,28 @@ enum HrtsResult hrts_get_memory_stats(struct HrtsMemoryStats *out);
 const char *hrts_result_name(int32_t result);
 
 // The message of the last call on `context` if it failed, or, if `context` is NULL or not live, of the
-// last call on this thread if it failed; empty after a successful call. Valid until the next call on the
-// same context (or thread).
+// calling thread's last call; empty after a successful call. For a live context the string is the
+// calling thread's own copy, valid until the thread calls `hrts_last_error` on that context again or the
+// context is destroyed, whatever other threads do; for NULL, until the thread's next call into the plugin.
+// `hrts_get_last_error` copies the message into the caller's memory instead.
 //
 // # Safety
 // `context` is NULL or a handle returned by `hrts_context_create`.
 const char *hrts_last_error(const struct HrtsContext *context);
+
+// Copies the message of the last call on `context` if it failed (or, if `context` is NULL or not live,
+// of the calling thread's last call; empty after a successful call) into `buffer`, NUL-terminated and
+// truncated to `capacity` bytes, and returns the bytes the whole message needs with its NUL: a return
+// above `capacity` means the copy was truncated. `buffer` may be NULL (nothing is copied) to ask for the
+// size. Reading a context's message is safe while another thread calls it. Returns 0 only if the plugin
+// failed internally. (API 5.8.)
+//
+// # Safety
+// `context` is NULL or a handle returned by `hrts_context_create`; `buffer` is NULL or holds `capacity`
+// writable bytes.
+size_t hrts_get_last_error(const struct HrtsContext *context,
+                           char *buffer,
+                           size_t capacity);
 
 // Creates a context. On success `*out_context` receives its handle; on failure it is set to NULL.
 // Handles are never reused: a destroyed context's handle stays invalid (`HRTS_RESULT_ERROR_INVALID_CONTEXT`).

@@ -289,8 +289,6 @@ pub(crate) struct Context {
     pub(crate) frusta: Vec<LightShape>,
     /// Which frusta the last `frames_in_flight` frames recorded, oldest first.
     pub(crate) schedules: std::collections::VecDeque<FrameSchedule>,
-    /// The message of the last call if it failed.
-    pub(crate) last_error: Option<std::ffi::CString>,
 }
 
 impl Context {
@@ -333,7 +331,6 @@ impl Context {
             light_builds: vec![0],
             frusta: vec![LightShape::default()],
             schedules: Default::default(),
-            last_error: None,
         })
     }
 

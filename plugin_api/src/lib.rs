@@ -7,8 +7,8 @@
 //! `hrts_context_destroy`.
 //!
 //! Every function is behind a panic boundary, checks its pointers, struct sizes, enum values and numbers,
-//! and returns an `HrtsResult`; `hrts_last_error` gives the message of the last failure. A context must
-//! not be used from two threads at once.
+//! and returns an `HrtsResult`; `hrts_get_last_error` (or `hrts_last_error`) gives the message of the last
+//! failure, from any thread. A context must not be used from two threads at once.
 
 mod adopt;
 mod context;
@@ -32,6 +32,8 @@ thread_local! {
     /// The message of the thread's last call if it failed (clearing it allocates nothing, so the first call
     /// can still install allocation callbacks).
     static LAST_ERROR: RefCell<Option<CString>> = const { RefCell::new(None) };
+    /// The thread's copies of contexts' messages that `hrts_last_error` returned, by context handle.
+    static RETURNED_ERRORS: RefCell<Vec<(usize, CString)>> = const { RefCell::new(Vec::new()) };
 }
 
 fn c_message(message: &str) -> CString {
@@ -53,17 +55,20 @@ fn boundary(ctx: Option<*const HrtsContext>, f: impl FnOnce() -> ApiResult<()>) 
             format!("internal error (panic caught at the C boundary): {what}"),
         ))
     });
+    let message = outcome.as_ref().err().map(|e| c_message(&e.message));
+    if let Some(entry) = ctx.and_then(handles::lookup) {
+        entry.set_last_error(message.clone());
+    }
+    LAST_ERROR.with(|last| *last.borrow_mut() = message);
     match outcome {
         Ok(()) => HrtsResult::Ok,
-        Err(e) => {
-            let context = ctx.and_then(handles::lookup);
-            LAST_ERROR.with(|last| *last.borrow_mut() = Some(c_message(&e.message)));
-            if let Some(Ok(mut c)) = context.as_ref().map(|c| c.try_lock()) {
-                c.last_error = Some(c_message(&e.message));
-            }
-            e.code
-        }
+        Err(e) => e.code,
     }
+}
+
+/// Runs `f` behind the panic boundary for an export that returns no `HrtsResult`: `fallback` if it panics.
+fn unwinding_to<T>(fallback: T, f: impl FnOnce() -> T) -> T {
+    catch_unwind(AssertUnwindSafe(f)).unwrap_or(fallback)
 }
 
 /// Runs `f` on a live context.
@@ -78,13 +83,13 @@ fn with_context(
                 "context is NULL",
             ));
         }
-        let context = handles::lookup(ctx).ok_or_else(|| {
+        let entry = handles::lookup(ctx).ok_or_else(|| {
             ApiError::new(
                 HrtsResult::ErrorInvalidContext,
                 "context is not live (destroyed or never created)",
             )
         })?;
-        let mut guard = match context.try_lock() {
+        let mut guard = match entry.context.try_lock() {
             Ok(guard) => guard,
             Err(std::sync::TryLockError::WouldBlock) => {
                 return Err(ApiError::new(
@@ -99,7 +104,6 @@ fn with_context(
                 ))
             }
         };
-        guard.last_error = None;
         f(&mut guard)
     })
 }
@@ -246,33 +250,94 @@ pub unsafe extern "C" fn hrts_get_memory_stats(out: *mut HrtsMemoryStats) -> Hrt
 #[no_mangle]
 pub extern "C" fn hrts_result_name(result: i32) -> *const c_char {
     static NAMES: std::sync::OnceLock<Vec<CString>> = std::sync::OnceLock::new();
-    let names = NAMES.get_or_init(|| {
-        HrtsResult::ALL
-            .iter()
-            .map(|r| c_message(&r.c_name()))
-            .collect()
-    });
-    match HrtsResult::from_c(result) {
-        Some(r) => names[r as usize].as_ptr(),
-        None => c"HRTS_RESULT_UNKNOWN".as_ptr(),
-    }
+    unwinding_to(c"HRTS_RESULT_UNKNOWN".as_ptr(), || {
+        let names = NAMES.get_or_init(|| {
+            HrtsResult::ALL
+                .iter()
+                .map(|r| c_message(&r.c_name()))
+                .collect()
+        });
+        match HrtsResult::from_c(result) {
+            Some(r) => names[r as usize].as_ptr(),
+            None => c"HRTS_RESULT_UNKNOWN".as_ptr(),
+        }
+    })
 }
 
 /// The message of the last call on `context` if it failed, or, if `context` is NULL or not live, of the
-/// last call on this thread if it failed; empty after a successful call. Valid until the next call on the
-/// same context (or thread).
+/// calling thread's last call; empty after a successful call. For a live context the string is the
+/// calling thread's own copy, valid until the thread calls `hrts_last_error` on that context again or the
+/// context is destroyed, whatever other threads do; for NULL, until the thread's next call into the plugin.
+/// `hrts_get_last_error` copies the message into the caller's memory instead.
 ///
 /// # Safety
 /// `context` is NULL or a handle returned by `hrts_context_create`.
 #[no_mangle]
 pub unsafe extern "C" fn hrts_last_error(context: *const HrtsContext) -> *const c_char {
-    if let Some(c) = handles::lookup(context) {
-        if let Ok(c) = c.try_lock() {
-            // The message lives in the context, which the registry keeps alive until it is destroyed.
-            return c.last_error.as_ref().map_or(c"".as_ptr(), |m| m.as_ptr());
+    unwinding_to(c"".as_ptr(), || {
+        let Some(entry) = handles::lookup(context) else {
+            return LAST_ERROR.with(|e| e.borrow().as_ref().map_or(c"".as_ptr(), |m| m.as_ptr()));
+        };
+        let message = entry.last_error();
+        RETURNED_ERRORS.with(|copies| {
+            let mut copies = copies.borrow_mut();
+            // The copies of destroyed contexts go.
+            copies.retain(|&(handle, _)| {
+                handle == context as usize
+                    || handles::lookup(handle as *const HrtsContext).is_some()
+            });
+            let at = match copies
+                .iter()
+                .position(|&(handle, _)| handle == context as usize)
+            {
+                Some(at) => at,
+                None => {
+                    copies.push((context as usize, CString::default()));
+                    copies.len() - 1
+                }
+            };
+            // An unchanged message keeps the string returned before.
+            if copies[at].1 != message {
+                copies[at].1 = message;
+            }
+            copies[at].1.as_ptr()
+        })
+    })
+}
+
+/// Copies the message of the last call on `context` if it failed (or, if `context` is NULL or not live,
+/// of the calling thread's last call; empty after a successful call) into `buffer`, NUL-terminated and
+/// truncated to `capacity` bytes, and returns the bytes the whole message needs with its NUL: a return
+/// above `capacity` means the copy was truncated. `buffer` may be NULL (nothing is copied) to ask for the
+/// size. Reading a context's message is safe while another thread calls it. Returns 0 only if the plugin
+/// failed internally. (API 5.8.)
+///
+/// # Safety
+/// `context` is NULL or a handle returned by `hrts_context_create`; `buffer` is NULL or holds `capacity`
+/// writable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn hrts_get_last_error(
+    context: *const HrtsContext,
+    buffer: *mut c_char,
+    capacity: usize,
+) -> usize {
+    unwinding_to(0, || {
+        let message = match handles::lookup(context) {
+            Some(entry) => entry.last_error(),
+            None => LAST_ERROR.with(|e| e.borrow().clone().unwrap_or_default()),
+        };
+        let bytes = message.as_bytes_with_nul();
+        if !buffer.is_null() && capacity > 0 {
+            let copied = bytes.len().min(capacity) - 1;
+            // SAFETY: `buffer` holds `capacity` writable bytes (contract) and `copied` < `capacity`; the
+            // message is the plugin's own copy.
+            unsafe {
+                std::ptr::copy_nonoverlapping(bytes.as_ptr(), buffer.cast::<u8>(), copied);
+                buffer.add(copied).write(0);
+            }
         }
-    }
-    LAST_ERROR.with(|e| e.borrow().as_ref().map_or(c"".as_ptr(), |m| m.as_ptr()))
+        bytes.len()
+    })
 }
 
 /// Creates a context. On success `*out_context` receives its handle; on failure it is set to NULL.

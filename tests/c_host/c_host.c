@@ -2709,8 +2709,10 @@ static void misuse(HrtsContext *ctx, const HrtsVulkanDevice *vk) {
         phase = MISUSE[id].name;
         HrtsResult got = misuse_call(id, &m);
         char message[512];
-        snprintf(message, sizeof message, "%s", hrts_last_error(NULL));
-        int ok = got == MISUSE[id].want && message[0] != '\0';
+        /* the copy, and the size of the whole message: the same string hrts_last_error gives */
+        size_t needed = hrts_get_last_error(NULL, message, sizeof message);
+        int ok = got == MISUSE[id].want && message[0] != '\0' && needed == strlen(message) + 1 &&
+                 strcmp(message, hrts_last_error(NULL)) == 0;
         if (!ok)
             fprintf(stderr, "misuse case '%s': got %s, want %s, message \"%s\"\n", MISUSE[id].name, hrts_result_name(got),
                     hrts_result_name(MISUSE[id].want), message);
