@@ -1,7 +1,8 @@
-//! The C ABI as an engine uses it: a plain C program (tests/c_host/c_host.c), built here with the system
-//! compiler against the generated header and the plugin's shared library, creates its own Vulkan device,
-//! fills depth and normal images itself, records the plugin into its command buffer and checks the
-//! visibility against the exact shadow, then runs the misuse cases and 100 create/destroy cycles.
+//! The C ABI as an engine uses it: a plain C program (tests/c_host/c_host.c, with the engine it shares
+//! with the other C tests, engine.c), built here with the system compiler against the generated header
+//! and the plugin's shared library, creates its own Vulkan device, fills depth and normal images itself,
+//! records the plugin into its command buffer and checks the visibility against the exact shadow, then
+//! runs the misuse cases and 100 create/destroy cycles.
 
 mod native;
 
@@ -40,6 +41,7 @@ fn c_host_matches_the_exact_shadow_and_survives_misuse() {
         .arg("-I")
         .arg(root.join("plugin_api/include"))
         .arg(root.join("tests/c_host/c_host.c"))
+        .arg(root.join("tests/c_host/engine.c"))
         .arg("-o")
         .arg(&exe)
         .arg("-L")
