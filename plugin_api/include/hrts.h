@@ -1082,7 +1082,7 @@ enum HrtsResult hrts_set_geometry_vulkan_meshes(struct HrtsContext *context,
 // changed since the prim buffer was last built (and what depends on the prim buffer); frames already
 // recorded keep their transforms. No pass is rebuilt and nothing is recorded. With Vulkan geometry the
 // bounds of the geometry call no longer hold: give each frame's in `HrtsFrame::bounds` for the plugin to
-// cull by them.
+// cull by them. A call that fails changes nothing.
 //
 // # Safety
 // As for `hrts_get_capabilities`; `transforms` points at `16 * draw_count` floats.

@@ -529,7 +529,7 @@ impl Context {
     }
 
     /// Moves the geometry's draws: `transforms` holds 16 floats (column-major) per draw, over all meshes in
-    /// order.
+    /// order. Everything is checked before anything changes.
     pub(crate) fn set_draw_transforms(&mut self, transforms: &[f32]) -> ApiResult<()> {
         finite(transforms, "transforms")?;
         let models: Vec<glam::Mat4> = transforms
@@ -542,11 +542,11 @@ impl Context {
                 "set the geometry before moving its draws",
             )
         })?;
-        geometry.set_transforms(&models)?;
-        let stored_to_world = geometry.stored_to_world();
+        let moved = geometry.moved(&models)?;
         if let Some(built) = &self.built {
-            built.shared.set_transforms(&stored_to_world)?;
+            built.shared.set_transforms(&moved.stored_to_world)?;
         }
+        geometry.move_draws(moved);
         Ok(())
     }
 

@@ -1,7 +1,7 @@
 //! Conversion between the C types and the Rust ones, checking every value.
 
 use crate::context::LightShape;
-use crate::error::{check_size, invalid, ApiError, ApiResult};
+use crate::error::{check_aligned, check_size, invalid, ApiError, ApiResult};
 use crate::types::*;
 use glam::{Mat4, Vec3};
 use passes::{
@@ -127,7 +127,8 @@ pub(crate) fn frame_inputs(
             "lights is NULL",
         ));
     }
-    // SAFETY: the caller guarantees `lights` points at `light_count` lights (documented contract).
+    check_aligned(f.lights, "lights")?;
+    // SAFETY: aligned; the caller guarantees `lights` points at `light_count` lights (documented contract).
     let lights = unsafe { std::slice::from_raw_parts(f.lights, f.light_count as usize) };
     lights
         .iter()

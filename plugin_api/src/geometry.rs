@@ -1,7 +1,7 @@
 //! Geometry intake: the engine's CPU arrays or Vulkan buffers, checked and kept to rebuild the passes.
 
 use crate::convert::{bounds, enum_value, finite, mat4};
-use crate::error::{check_size, invalid, ApiError, ApiResult};
+use crate::error::{check_aligned, check_size, invalid, ApiError, ApiResult};
 use crate::types::*;
 use glam::{DVec3, Vec3};
 use passes::{Draw, Geometry, IndexFormat, IndexLayout, Mesh, VertexFormat, VertexLayout};
@@ -33,6 +33,16 @@ pub(crate) enum GeometrySource {
     },
 }
 
+/// The draws moved to new transforms, checked by [`GeometrySource::moved`].
+pub(crate) struct MovedDraws {
+    /// Each draw's object-to-world transform, over all meshes in order.
+    models: Vec<glam::Mat4>,
+    /// Each draw's transform from stored positions to world.
+    pub(crate) stored_to_world: Vec<glam::Mat4>,
+    /// The new bounds of CPU geometry.
+    cpu_bounds: Option<[DVec3; 2]>,
+}
+
 /// One mesh in the engine's buffers.
 pub(crate) struct VulkanMesh {
     vertices: (u64, u64),
@@ -46,46 +56,72 @@ pub(crate) struct VulkanMesh {
 }
 
 impl GeometrySource {
-    /// Each draw's transform from stored positions to world, over all meshes in order: its own, after the
-    /// dequantization of its Vulkan mesh.
-    pub(crate) fn stored_to_world(&self) -> Vec<glam::Mat4> {
-        match self {
-            Self::Cpu { draws, .. } => draws.iter().map(|d| d.model).collect(),
-            Self::Vulkan { meshes, .. } => meshes
-                .iter()
-                .flat_map(|m| m.draws.iter().map(|d| d.model * m.dequantize))
-                .collect(),
-        }
-    }
-
-    /// Moves the draws (one object-to-world transform each, over all meshes in order): CPU geometry
-    /// recomputes its bounds; the bounds given with Vulkan geometry no longer hold (frames may give theirs).
-    pub(crate) fn set_transforms(&mut self, models: &[glam::Mat4]) -> ApiResult<()> {
-        let draws: Vec<&mut Draw> = match self {
-            Self::Cpu { draws, .. } => draws.iter_mut().collect(),
-            Self::Vulkan { meshes, .. } => meshes.iter_mut().flat_map(|m| &mut m.draws).collect(),
+    /// What moving the draws to `models` (one object-to-world transform each, over all meshes in order)
+    /// gives, checked and changing nothing yet: each draw's transform from stored positions to world
+    /// (finite: a Vulkan mesh's dequantization is applied to it), and CPU geometry's new bounds.
+    pub(crate) fn moved(&self, models: &[glam::Mat4]) -> ApiResult<MovedDraws> {
+        let draws = match self {
+            Self::Cpu { draws, .. } => draws.len(),
+            Self::Vulkan { meshes, .. } => meshes.iter().map(|m| m.draws.len()).sum(),
         };
-        if models.len() != draws.len() {
+        if models.len() != draws {
             return Err(invalid(format!(
-                "draw_count {} differs from the {} draws of the geometry (over all its meshes)",
+                "draw_count {} differs from the {draws} draws of the geometry (over all its meshes)",
                 models.len(),
-                draws.len()
             )));
         }
-        for (d, m) in draws.into_iter().zip(models) {
-            d.model = *m;
-        }
-        match self {
+        let (stored_to_world, cpu_bounds) = match self {
             Self::Cpu {
                 positions,
                 indices,
                 draws,
-                bounds,
                 ..
-            } => *bounds = draw_bounds(positions, indices, draws)?,
-            Self::Vulkan { bounds_hold, .. } => *bounds_hold = false,
+            } => {
+                let moved: Vec<Draw> = draws
+                    .iter()
+                    .zip(models)
+                    .map(|(d, &model)| Draw { model, ..*d })
+                    .collect();
+                let bounds = draw_bounds(positions, indices, &moved)?;
+                (models.to_vec(), Some(bounds))
+            }
+            Self::Vulkan { meshes, .. } => {
+                let dequantize = meshes
+                    .iter()
+                    .flat_map(|m| m.draws.iter().map(|_| m.dequantize));
+                (
+                    models.iter().zip(dequantize).map(|(m, d)| *m * d).collect(),
+                    None,
+                )
+            }
+        };
+        if let Some(i) = stored_to_world.iter().position(|m| !m.is_finite()) {
+            return Err(invalid(format!(
+                "transform {i} is finite, but not once its mesh's dequantization (position_scale, position_offset) is applied"
+            )));
         }
-        Ok(())
+        Ok(MovedDraws {
+            models: models.to_vec(),
+            stored_to_world,
+            cpu_bounds,
+        })
+    }
+
+    /// Moves the draws as [`GeometrySource::moved`] checked: CPU geometry takes its new bounds; the bounds
+    /// given with Vulkan geometry no longer hold (frames may give theirs).
+    pub(crate) fn move_draws(&mut self, moved: MovedDraws) {
+        let draws: Vec<&mut Draw> = match self {
+            Self::Cpu { draws, .. } => draws.iter_mut().collect(),
+            Self::Vulkan { meshes, .. } => meshes.iter_mut().flat_map(|m| &mut m.draws).collect(),
+        };
+        for (d, m) in draws.into_iter().zip(moved.models) {
+            d.model = m;
+        }
+        match (self, moved.cpu_bounds) {
+            (Self::Cpu { bounds, .. }, Some(moved)) => *bounds = moved,
+            (Self::Vulkan { bounds_hold, .. }, _) => *bounds_hold = false,
+            (Self::Cpu { .. }, None) => {}
+        }
     }
 
     /// World-space bounds (min, max) of every triangle in every frame, for culling: always for CPU
@@ -131,7 +167,8 @@ fn draws_from(ptr: *const HrtsDraw, count: u32) -> ApiResult<Vec<Draw>> {
     if ptr.is_null() {
         return Err(ApiError::new(HrtsResult::ErrorNullPointer, "draws is NULL"));
     }
-    // SAFETY: the caller guarantees `ptr` points at `count` draws (documented contract).
+    check_aligned(ptr, "draws")?;
+    // SAFETY: aligned; the caller guarantees `ptr` points at `count` draws (documented contract).
     let draws = unsafe { std::slice::from_raw_parts(ptr, count as usize) };
     draws
         .iter()
@@ -190,6 +227,8 @@ pub(crate) fn cpu_geometry(g: &HrtsCpuGeometry) -> ApiResult<GeometrySource> {
     if g.vertex_count == 0 || g.index_count == 0 {
         return Err(invalid("vertex_count and index_count must be positive"));
     }
+    check_aligned(g.positions, "positions")?;
+    check_aligned(g.indices, "indices")?;
     if g.vertex_stride < 12 || !g.vertex_stride.is_multiple_of(4) {
         return Err(invalid(format!(
             "vertex_stride {} must be a multiple of 4 and at least 12",
@@ -197,8 +236,8 @@ pub(crate) fn cpu_geometry(g: &HrtsCpuGeometry) -> ApiResult<GeometrySource> {
         )));
     }
     let floats = (g.vertex_count as usize - 1) * (g.vertex_stride as usize / 4) + 3;
-    // SAFETY: the caller guarantees the arrays hold `vertex_count` strided positions and `index_count`
-    // indices (documented contract); they are copied before returning.
+    // SAFETY: aligned; the caller guarantees the arrays hold `vertex_count` strided positions and
+    // `index_count` indices (documented contract); they are copied before returning.
     let raw = unsafe { std::slice::from_raw_parts(g.positions, floats) };
     let step = g.vertex_stride as usize / 4;
     let positions: Vec<f32> = (0..g.vertex_count as usize)
@@ -402,12 +441,7 @@ pub(crate) fn deformed_meshes(
             format!("deformed is NULL with deformed_count {count}"),
         ));
     }
-    if !f.deformed.is_aligned() {
-        return Err(invalid(format!(
-            "deformed is not aligned to {} bytes",
-            std::mem::align_of::<HrtsMeshVertices>()
-        )));
-    }
+    check_aligned(f.deformed, "deformed")?;
     let geometry = geometry.ok_or_else(|| {
         ApiError::new(
             HrtsResult::ErrorInvalidState,

@@ -134,12 +134,7 @@ fn check_versioned<T: Versioned>(p: *const T, name: &str) -> ApiResult<()> {
             format!("{name} is NULL"),
         ));
     }
-    if !p.is_aligned() {
-        return Err(error::invalid(format!(
-            "{name} is not aligned to {} bytes",
-            std::mem::align_of::<T>()
-        )));
-    }
+    error::check_aligned(p, name)?;
     // SAFETY: a non-NULL pointer passed to the C ABI points at a struct of this family whatever its
     // version (documented contract), and every version starts with the `u32` size; it is aligned.
     let size = unsafe { p.cast::<u32>().read() };
@@ -523,7 +518,7 @@ pub unsafe extern "C" fn hrts_set_geometry_vulkan_meshes(
 /// changed since the prim buffer was last built (and what depends on the prim buffer); frames already
 /// recorded keep their transforms. No pass is rebuilt and nothing is recorded. With Vulkan geometry the
 /// bounds of the geometry call no longer hold: give each frame's in `HrtsFrame::bounds` for the plugin to
-/// cull by them.
+/// cull by them. A call that fails changes nothing.
 ///
 /// # Safety
 /// As for `hrts_get_capabilities`; `transforms` points at `16 * draw_count` floats.
@@ -540,7 +535,8 @@ pub unsafe extern "C" fn hrts_set_draw_transforms(
                 "transforms is NULL",
             ));
         }
-        // SAFETY: the caller guarantees `transforms` points at 16 * draw_count floats (documented).
+        error::check_aligned(transforms, "transforms")?;
+        // SAFETY: aligned; the caller guarantees `transforms` points at 16 * draw_count floats (documented).
         let all = unsafe { std::slice::from_raw_parts(transforms, draw_count as usize * 16) };
         c.set_draw_transforms(all)
     })

@@ -1151,6 +1151,53 @@ static void engine_meshes(const HrtsVulkanDevice *vk) {
     free_buffer(one_ib);
 }
 
+/* ---------- draw transforms: all or nothing ---------- */
+/* A hrts_set_draw_transforms call that fails changes nothing. Transforms that are finite but overflow once
+ * the box mesh's dequantization (scale 0.5, offset (0, 1.1, 0)) is applied are refused; the bounds of the
+ * geometry call still hold, so the next frame, lit by a sun the plugin fits to them, records as before:
+ * the same visibility bit for bit, the exact shadow, and no triangle rebuilt. */
+static void draw_transforms_all_or_nothing(const HrtsVulkanDevice *vk) {
+    enum { PX = W * H };
+    setup_camera(0.0);
+    Emitter sun = fitted_sun(v3(0.45, -1.0, 0.2));
+    set_lights(&sun, 1);
+    upload_gbuffer();
+    SplitScene s;
+    split_scene(&s);
+    static float before[PX], after[PX];
+    HrtsContext *ctx = meshes_context(vk, 2, s.meshes, SPLIT_MESHES);
+    CHECK(run_frame(ctx, before) == HRTS_RESULT_OK, "all or nothing: first frame: %s", hrts_last_error(ctx));
+    float transforms[SPLIT_MESHES][16];
+    for (int i = 0; i < SPLIT_MESHES; i++) memcpy(transforms[i], s.draws[i].transform, sizeof transforms[i]);
+    /* the box's y axis and y translation 3e38: finite, but 1.1 * 3e38 + 3e38 once dequantized is not */
+    transforms[1][5] = 3.0e38f;
+    transforms[1][13] = 3.0e38f;
+    HrtsResult r = hrts_set_draw_transforms(ctx, SPLIT_MESHES, &transforms[0][0]);
+    char message[512];
+    snprintf(message, sizeof message, "%s", hrts_last_error(ctx));
+    HrtsResult next = run_frame(ctx, after);
+    char next_message[512];
+    snprintf(next_message, sizeof next_message, "%s", hrts_last_error(ctx));
+    HrtsFrameReport rep;
+    int rebuilt = next == HRTS_RESULT_OK && report(ctx, next_frame - 1, 0, &rep) == HRTS_RESULT_OK
+                      ? (int)rep.prim_triangles_rebuilt
+                      : -1;
+    int differ = next == HRTS_RESULT_OK ? differing(after, before, PX) : -1;
+    int near_edge, shadowed, lit;
+    int mismatches = count_mismatches(before, edge_tolerance(), &sun, &near_edge, &shadowed, &lit);
+    printf("draw transforms overflowing once dequantized: %s (%s); the next frame: %s, %d px differ from the frame "
+           "before, %d triangles rebuilt, %d mismatches with the exact shadow\n",
+           hrts_result_name(r), message, hrts_result_name(next), differ, rebuilt, mismatches);
+    CHECK(r == HRTS_RESULT_ERROR_INVALID_ARGUMENT && strstr(message, "transform 1"), "all or nothing: %s (%s)",
+          hrts_result_name(r), message);
+    CHECK(next == HRTS_RESULT_OK, "all or nothing: the next frame: %s", next_message);
+    CHECK(differ == 0 && rebuilt == 0, "all or nothing: %d px differ, %d triangles rebuilt", differ, rebuilt);
+    CHECK(mismatches == 0 && shadowed > 300, "all or nothing: %d mismatches, %d shadowed", mismatches, shadowed);
+    VK(vkDeviceWaitIdle(device));
+    CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
+    free_split_scene(&s);
+}
+
 /* ---------- a deforming mesh ---------- */
 /* HrtsFrame::deformed is read by the call that begins the frame alone: the engine may free the array once
  * that call returned. A frame recorded in two calls (light space, then screen space) and one recorded pass by
@@ -1433,15 +1480,17 @@ static void deforming_mesh(const HrtsVulkanDevice *vk) {
 enum {
     CREATE_NULL_INFO, CREATE_NULL_OUT, CREATE_STRUCT_SIZE, CREATE_VERSION, CREATE_NULL_DEVICE, CREATE_NULL_GIPA,
     CREATE_DEVICE_STRUCT_SIZE, CREATE_FRAMES_IN_FLIGHT, CREATE_UNSUPPORTED_EXTENSION, CREATE_NO_SUCH_QUEUE_FAMILY,
-    CREATE_NO_SUCH_QUEUE, CAPS_NULL_CONTEXT, CAPS_NULL_OUT, CAPS_STRUCT_SIZE, CONFIG_N_ZERO, CONFIG_N_ABSURD,
+    CREATE_NO_SUCH_QUEUE, CREATE_MISALIGNED_DEVICE, CREATE_MISALIGNED_EXTENSIONS, CAPS_NULL_CONTEXT, CAPS_NULL_OUT, CAPS_STRUCT_SIZE, CONFIG_N_ZERO, CONFIG_N_ABSURD,
     CONFIG_BUDGET_ZERO, CONFIG_BUDGET_SMALL, CONFIG_FACES, CONFIG_BINNING, CONFIG_STRUCT_SIZE, CONFIG_OLDER_SMALLER, CONFIG_MISALIGNED, CONFIG_MODE,
     CONFIG_NAN_LIGHT_SIZE, CONFIG_NEGATIVE_WSS, CONFIG_PCF_TAPS, CONFIG_SHADOW_MAP_ZERO, CONFIG_DEFAULTS_NULL,
     CONFIG_FILTER, CONFIG_EXTRA_OUTPUT, CONFIG_FILTER_RADII, CONFIG_SLOPE_BIAS, LIGHTS_ZERO, LIGHTS_TOO_MANY,
     LIGHTS_NULL, LIGHTS_SECOND_INVALID, GEOMETRY_NULL_POSITIONS, GEOMETRY_STRIDE, GEOMETRY_NAN, GEOMETRY_INDEX,
-    GEOMETRY_NO_DRAWS, VULKAN_GEOMETRY_INDEX_TYPE, VULKAN_GEOMETRY_VERTEX_OFFSET_WRAP, VULKAN_GEOMETRY_INDEX_OFFSET_WRAP, MESHES_COUNT_ZERO,
+    GEOMETRY_NO_DRAWS, GEOMETRY_MISALIGNED_POSITIONS, GEOMETRY_MISALIGNED_INDICES, GEOMETRY_MISALIGNED_DRAWS,
+    TRANSFORMS_MISALIGNED, TRANSFORMS_COUNT, VULKAN_GEOMETRY_INDEX_TYPE, VULKAN_GEOMETRY_VERTEX_OFFSET_WRAP, VULKAN_GEOMETRY_INDEX_OFFSET_WRAP, MESHES_COUNT_ZERO,
     MESHES_NULL, MESHES_BUFFER_TOO_SMALL, TARGETS_ZERO_WIDTH, TARGETS_DEPTH_USAGE, TARGETS_OUTPUT_USAGE,
     TARGETS_NULL_NORMAL, TARGETS_ZERO_LAYERS, FRAME_ZERO_DIRECTION, FRAME_NAN_PROJECTION, FRAME_LIGHT_TYPE,
     FRAME_NULL_COMMAND_BUFFER, FRAME_STRUCT_SIZE, FRAME_NULL_LIGHTS, FRAME_LIGHT_COUNT_ZERO, FRAME_LIGHT_COUNT_OTHER,
+    FRAME_MISALIGNED_LIGHTS,
     FRAME_DEFORMED_NULL, FRAME_DEFORMED_MESH,
     FRAME_INDEX_REPEATED, FRAME_INDEX_BACKWARDS, REPORT_STRUCT_SIZE, REPORT_OLD_FRAME, REPORT_NO_SUCH_LIGHT,
     REPORT_NOT_COMPLETED, PASSES_EMPTY_MASK, PASSES_UNKNOWN_BIT, PASSES_RAY_TRACE_FIRST, PASSES_CAMERA_MOVED,
@@ -1466,6 +1515,8 @@ static const struct {
     [CREATE_UNSUPPORTED_EXTENSION] = {"create(claims an extension the device lacks)", HRTS_RESULT_ERROR_UNSUPPORTED},
     [CREATE_NO_SUCH_QUEUE_FAMILY] = {"create(queue family 99)", HRTS_RESULT_ERROR_UNSUPPORTED},
     [CREATE_NO_SUCH_QUEUE] = {"create(queue 7 of a one-queue family)", HRTS_RESULT_ERROR_UNSUPPORTED},
+    [CREATE_MISALIGNED_DEVICE] = {"create(misaligned HrtsVulkanDevice)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [CREATE_MISALIGNED_EXTENSIONS] = {"create(misaligned extension names)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [CAPS_NULL_CONTEXT] = {"capabilities(NULL context)", HRTS_RESULT_ERROR_NULL_POINTER},
     [CAPS_NULL_OUT] = {"capabilities(NULL out)", HRTS_RESULT_ERROR_NULL_POINTER},
     [CAPS_STRUCT_SIZE] = {"capabilities(wrong size)", HRTS_RESULT_ERROR_STRUCT_SIZE},
@@ -1497,6 +1548,11 @@ static const struct {
     [GEOMETRY_NAN] = {"geometry(NaN vertex)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [GEOMETRY_INDEX] = {"geometry(index out of range)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [GEOMETRY_NO_DRAWS] = {"geometry(no draws)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [GEOMETRY_MISALIGNED_POSITIONS] = {"geometry(misaligned positions)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [GEOMETRY_MISALIGNED_INDICES] = {"geometry(misaligned indices)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [GEOMETRY_MISALIGNED_DRAWS] = {"geometry(misaligned draws)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [TRANSFORMS_MISALIGNED] = {"draw transforms(misaligned)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [TRANSFORMS_COUNT] = {"draw transforms(3 for 2 draws)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [VULKAN_GEOMETRY_INDEX_TYPE] = {"vulkan geometry(unknown index type)", HRTS_RESULT_ERROR_INVALID_ENUM},
     [VULKAN_GEOMETRY_VERTEX_OFFSET_WRAP] = {"vulkan geometry(vertex offset UINT64_MAX - 3)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [VULKAN_GEOMETRY_INDEX_OFFSET_WRAP] = {"vulkan geometry(index offset UINT64_MAX - 3)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
@@ -1516,6 +1572,7 @@ static const struct {
     [FRAME_NULL_LIGHTS] = {"frame(NULL lights)", HRTS_RESULT_ERROR_NULL_POINTER},
     [FRAME_LIGHT_COUNT_ZERO] = {"frame(0 lights)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [FRAME_LIGHT_COUNT_OTHER] = {"frame(2 lights, 1 configured)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [FRAME_MISALIGNED_LIGHTS] = {"frame(misaligned lights)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [FRAME_DEFORMED_NULL] = {"frame(deformed NULL, deformed_count 1)", HRTS_RESULT_ERROR_NULL_POINTER},
     [FRAME_DEFORMED_MESH] = {"frame(deformed mesh 1 of 1)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [FRAME_INDEX_REPEATED] = {"frame(index of the last frame again)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
@@ -1557,6 +1614,15 @@ typedef struct {
     HrtsContext *fresh;  /* a context created after `gone` was destroyed */
 } Misuse;
 
+/* A copy of `bytes` bytes at `from` in `storage` (of `bytes` + 16 bytes), at an address that is no multiple of
+ * `alignment`: what a caller's misaligned pointer points at. */
+static const void *misaligned_copy(unsigned char *storage, const void *from, size_t bytes, size_t alignment) {
+    unsigned char *at = storage + 1;
+    while ((uintptr_t)at % alignment == 0) at++;
+    memcpy(at, from, bytes);
+    return at;
+}
+
 static HrtsResult misuse_call(int id, Misuse *m) {
     static float scratch[W * H];
     HrtsContext *ctx = m->ctx;
@@ -1597,6 +1663,18 @@ static HrtsResult misuse_call(int id, Misuse *m) {
         return hrts_context_create(&ci, &none);
     case CREATE_NO_SUCH_QUEUE_FAMILY: bad.queue_family_index = 99; ci.vulkan = &bad; return hrts_context_create(&ci, &none);
     case CREATE_NO_SUCH_QUEUE: bad.queue_index = 7; ci.vulkan = &bad; return hrts_context_create(&ci, &none);
+    case CREATE_MISALIGNED_DEVICE: {
+        static unsigned char storage[sizeof(HrtsVulkanDevice) + 16];
+        ci.vulkan = misaligned_copy(storage, m->vk, sizeof *m->vk, sizeof(void *));
+        return hrts_context_create(&ci, &none);
+    }
+    case CREATE_MISALIGNED_EXTENSIONS: {
+        static unsigned char storage[sizeof(char *) + 16];
+        bad.enabled_extensions = misaligned_copy(storage, fake_extension, sizeof(char *), sizeof(char *));
+        bad.enabled_extension_count = 1;
+        ci.vulkan = &bad;
+        return hrts_context_create(&ci, &none);
+    }
     case CAPS_NULL_CONTEXT: return hrts_get_capabilities(NULL, &caps);
     case CAPS_NULL_OUT: return hrts_get_capabilities(ctx, NULL);
     case CAPS_STRUCT_SIZE: caps.struct_size = 4; return hrts_get_capabilities(ctx, &caps);
@@ -1617,11 +1695,8 @@ static HrtsResult misuse_call(int id, Misuse *m) {
         return r;
     }
     case CONFIG_MISALIGNED: {
-        static unsigned char bytes[sizeof(HrtsConfig) + 16];
-        unsigned char *at = bytes + 1;
-        while (((uintptr_t)at % sizeof(uint32_t)) == 0) at++; /* HrtsConfig holds 4-byte fields */
-        memcpy(at, &c, sizeof c);
-        return hrts_configure(ctx, (const HrtsConfig *)(void *)at);
+        static unsigned char storage[sizeof(HrtsConfig) + 16];
+        return hrts_configure(ctx, misaligned_copy(storage, &c, sizeof c, sizeof(uint32_t))); /* 4-byte fields */
     }
     case CONFIG_MODE: c.mode = 9; return hrts_configure(ctx, &c);
     case CONFIG_NAN_LIGHT_SIZE: c.pcss_angular_radius = NAN; return hrts_configure(ctx, &c);
@@ -1654,6 +1729,29 @@ static HrtsResult misuse_call(int id, Misuse *m) {
         return hrts_set_geometry_cpu(ctx, &g);
     }
     case GEOMETRY_NO_DRAWS: g.draw_count = 0; return hrts_set_geometry_cpu(ctx, &g);
+    case GEOMETRY_MISALIGNED_POSITIONS: {
+        static unsigned char storage[sizeof positions + 16];
+        g.positions = misaligned_copy(storage, positions, sizeof positions, sizeof(float));
+        return hrts_set_geometry_cpu(ctx, &g);
+    }
+    case GEOMETRY_MISALIGNED_INDICES: {
+        static unsigned char storage[sizeof indices + 16];
+        g.indices = misaligned_copy(storage, indices, sizeof indices, sizeof(uint32_t));
+        return hrts_set_geometry_cpu(ctx, &g);
+    }
+    case GEOMETRY_MISALIGNED_DRAWS: {
+        static unsigned char storage[sizeof draws + 16];
+        g.draws = misaligned_copy(storage, draws, sizeof draws, sizeof(float));
+        return hrts_set_geometry_cpu(ctx, &g);
+    }
+    case TRANSFORMS_MISALIGNED:
+    case TRANSFORMS_COUNT: {
+        static float transforms[3][16];
+        static unsigned char storage[sizeof transforms + 16];
+        for (int i = 0; i < 3; i++) memcpy(transforms[i], draws[0].transform, sizeof transforms[i]);
+        if (id == TRANSFORMS_COUNT) return hrts_set_draw_transforms(ctx, 3, &transforms[0][0]);
+        return hrts_set_draw_transforms(ctx, 2, misaligned_copy(storage, transforms, sizeof transforms, sizeof(float)));
+    }
     case VULKAN_GEOMETRY_INDEX_TYPE: {
         HrtsVulkanGeometry vg = fake_vulkan_geometry(&g);
         vg.index_type = 5;
@@ -1694,6 +1792,11 @@ static HrtsResult misuse_call(int id, Misuse *m) {
     case FRAME_NULL_LIGHTS: f.lights = NULL; return hrts_record_frame(ctx, &f);
     case FRAME_LIGHT_COUNT_ZERO: f.light_count = 0; return hrts_record_frame(ctx, &f);
     case FRAME_LIGHT_COUNT_OTHER: f.lights = lights; f.light_count = 2; return hrts_record_frame(ctx, &f);
+    case FRAME_MISALIGNED_LIGHTS: {
+        static unsigned char storage[sizeof(HrtsLight) + 16];
+        f.lights = misaligned_copy(storage, &c_lights[0], sizeof(HrtsLight), sizeof(float));
+        return hrts_record_frame(ctx, &f);
+    }
     case FRAME_DEFORMED_NULL: f.deformed_count = 1; return hrts_record_frame(ctx, &f);
     case FRAME_DEFORMED_MESH: {
         HrtsMeshVertices v = {1, 1, 1024, 0};
@@ -2367,6 +2470,8 @@ int main(void) {
     quantized_positions(&vk, &g);
     phase = "engine meshes";
     engine_meshes(&vk);
+    phase = "draw transforms: all or nothing";
+    draw_transforms_all_or_nothing(&vk);
     phase = "deforming mesh";
     deforming_mesh(&vk);
     phase = "moving geometry";
