@@ -7,8 +7,27 @@
 #include <stddef.h>
 #include <stdint.h>
 
-// Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
-// version differs.
+// Version of this header: `(major << 22) | (minor << 12) | patch`.
+//
+// Versions. A minor version adds functions, enum values, and fields at the end of structs, never
+// elsewhere, and a struct it extends grows (a new field never takes the trailing padding of an older
+// version). A library reads the structs of every minor version of its major version from 5.1 on:
+// - `struct_size` (the `sizeof` of the caller's header) says a struct's version. The library reads the
+//   fields that version has and gives the newer ones the defaults their documentation states ("API 5.x:
+//   ..."); a struct the library fills is written up to the caller's `struct_size` only, the fields of
+//   newer versions left out.
+// - Arrays of structs without a `struct_size` (`HrtsDraw`, `HrtsLight`, `HrtsMeshVertices`) are read at
+//   the stride given beside them (`draw_stride`, `light_stride`, `deformed_stride`): the caller's `sizeof`
+//   of the element, which says its version. A stride of 0, as in the structs of callers before 5.8,
+//   reads the element as API 5.1 to 5.8 define it. An array of structs with a `struct_size`
+//   (`hrts_configure_lights`, `hrts_set_geometry_vulkan_meshes`) is read at its first element's, which
+//   every element must have.
+// - A size or stride that is the size of no version this library reads, or of a newer version than
+//   the library's (the caller's header is newer), fails with `HRTS_RESULT_ERROR_STRUCT_SIZE` and a
+//   message listing the sizes it reads.
+// - `hrts_context_create` refuses (`HRTS_RESULT_ERROR_VERSION`) another major version, a minor version
+//   newer than the library's, and 5.0, whose headers changed layouts without changing the version
+//   (`HrtsDraw` 72 then 76 bytes): its structs cannot be told apart.
 #define HRTS_API_VERSION ((5 << 22) | (8 << 12))
 
 // The most lights one context shades (`hrts_configure_lights`); a point light counts once.
@@ -43,9 +62,11 @@ typedef enum HrtsResult {
   HRTS_RESULT_OK = 0,
   // A required pointer argument was NULL.
   HRTS_RESULT_ERROR_NULL_POINTER = 1,
-  // `struct_size` does not match this library's struct (header/library mismatch).
+  // A `struct_size` or an array's element stride is the size of no version of the struct this library
+  // reads (header/library mismatch, or a header newer than the library).
   HRTS_RESULT_ERROR_STRUCT_SIZE = 2,
-  // The caller's `api_version` has another major version.
+  // The caller's `api_version` is of another major version, a newer minor version than the library's,
+  // or 5.0.
   HRTS_RESULT_ERROR_VERSION = 3,
   // An enumeration field holds an unknown value.
   HRTS_RESULT_ERROR_INVALID_ENUM = 4,
@@ -582,13 +603,15 @@ typedef struct HrtsConfig {
   uint32_t map_initial_entries;
   // (Triangle, face) pairs a point light's cube map starts with (default 0: two per triangle, at least
   // 1024; at most six per triangle). A frame that keeps more traces the light exhaustively (exact, slower; `bin_pairs` in the
-  // frame report) and the pairs grow to fit from the next frame on.
+  // frame report) and the pairs grow to fit from the next frame on. API 5.4: 0 for a configuration of
+  // 5.1 to 5.3.
   uint32_t map_initial_pairs;
-  // Area shadows: light samples per pixel, 1..=128 (default 64).
+  // Area shadows: light samples per pixel, 1..=128 (default 64). API 5.5: 64 for a configuration of 5.1
+  // to 5.4.
   uint32_t area_samples;
 } HrtsConfig;
 
-// One draw of the geometry.
+// One draw of the geometry: an element of `draws`, read at `draw_stride`.
 typedef struct HrtsDraw {
   // First index of the draw.
   uint32_t first_index;
@@ -619,6 +642,9 @@ typedef struct HrtsCpuGeometry {
   const struct HrtsDraw *draws;
   // Number of draws.
   uint32_t draw_count;
+  // Bytes from one draw to the next: `sizeof(HrtsDraw)` of the caller's header. API 5.8: 0 (as in the
+  // struct of a caller of 5.1 to 5.7) reads the 76-byte `HrtsDraw` of API 5.1 to 5.8.
+  size_t draw_stride;
 } HrtsCpuGeometry;
 
 // One mesh in the engine's Vulkan buffers (need `VK_BUFFER_USAGE_STORAGE_BUFFER_BIT`); read, never
@@ -665,6 +691,9 @@ typedef struct HrtsVulkanGeometry {
   float position_scale[3];
   // See `position_scale`.
   float position_offset[3];
+  // Bytes from one draw to the next: `sizeof(HrtsDraw)` of the caller's header. API 5.8: 0 (as in the
+  // struct of a caller of 5.1 to 5.7) reads the 76-byte `HrtsDraw` of API 5.1 to 5.8.
+  size_t draw_stride;
 } HrtsVulkanGeometry;
 
 // The engine's images the plugin reads and writes. All are 2D, one mip, one layer, same size.
@@ -719,7 +748,7 @@ typedef struct HrtsTargets {
   uint32_t output_format;
 } HrtsTargets;
 
-// One light of a frame.
+// One light of a frame: an element of `HrtsFrame::lights`, read at `light_stride`.
 typedef struct HrtsLight {
   // `HrtsLightType`.
   uint32_t light_type;
@@ -751,12 +780,12 @@ typedef struct HrtsLight {
   float outer_cone;
 } HrtsLight;
 
-// Where one mesh's positions are in one frame (`HrtsFrame::deformed`): a vertex buffer of that frame,
-// such as one of a ring of skinning outputs, one per frame in flight. It holds the mesh's vertex count in
-// the mesh's `vertex_format` and `vertex_stride`, and must stay alive until the frame completed. The
-// plugin writes the buffer's descriptors anew in each frame that gives it and never reads them in another
-// frame: once the frame completed, the engine may destroy the buffer, and a buffer created after it may
-// get its handle.
+// Where one mesh's positions are in one frame (an element of `HrtsFrame::deformed`, read at
+// `deformed_stride`): a vertex buffer of that frame, such as one of a ring of skinning outputs, one per
+// frame in flight. It holds the mesh's vertex count in the mesh's `vertex_format` and `vertex_stride`,
+// and must stay alive until the frame completed. The plugin writes the buffer's descriptors anew in each
+// frame that gives it and never reads them in another frame: once the frame completed, the engine may
+// destroy the buffer, and a buffer created after it may get its handle.
 typedef struct HrtsMeshVertices {
   // Index of the mesh in the last geometry call (0 for `hrts_set_geometry_vulkan` and
   // `hrts_set_geometry_cpu`).
@@ -817,6 +846,13 @@ typedef struct HrtsFrame {
   const struct HrtsMeshVertices *deformed;
   // Number of entries in `deformed`.
   uint32_t deformed_count;
+  // Bytes from one entry of `lights` to the next: `sizeof(HrtsLight)` of the caller's header. API 5.8: 0
+  // (as in the struct of a caller of 5.1 to 5.7) reads the 100-byte `HrtsLight` of API 5.1 to 5.8.
+  size_t light_stride;
+  // Bytes from one entry of `deformed` to the next: `sizeof(HrtsMeshVertices)` of the caller's header.
+  // API 5.8: 0 (as in the struct of a caller of 5.1 to 5.7) reads the 32-byte `HrtsMeshVertices` of API
+  // 5.1 to 5.8.
+  size_t deformed_stride;
 } HrtsFrame;
 
 // Shape of a plugin resource, for reading it back.
@@ -935,13 +971,14 @@ typedef struct HrtsFrameReport {
   // Whether the light's last pass wrote its layer of the output image directly, with no copy: the
   // output is `R32_SFLOAT` with STORAGE usage (the layer is then in the GENERAL layout between that
   // pass and the output-copy call, which takes it to `output_layout_after`), and the configuration does
-  // not read the final output back through `extra_outputs`.
+  // not read the final output back through `extra_outputs`. API 5.3.
   HrtsBool output_direct;
   // A point light shadowed as one cube map: the (triangle, face) pairs its setup kept this frame (0
   // for other lights). Past `bin_pair_capacity`, the frame traced every ray of the light against every
-  // triangle (exact, slower) and the pairs grow to fit from the next frame on.
+  // triangle (exact, slower) and the pairs grow to fit from the next frame on. API 5.4: not written into
+  // the report of a caller of 5.1 to 5.3.
   uint32_t bin_pairs;
-  // The (triangle, face) pairs the light's cube map held this frame.
+  // The (triangle, face) pairs the light's cube map held this frame. API 5.4, as `bin_pairs`.
   uint32_t bin_pair_capacity;
 } HrtsFrameReport;
 

@@ -24,10 +24,7 @@ pub(crate) fn device(info: &HrtsContextCreateInfo) -> ApiResult<Device> {
             device_filter: filter,
         })?);
     }
-    check_aligned(info.vulkan, "vulkan")?;
-    // SAFETY: non-NULL and aligned, checked above; the caller guarantees it points at a HrtsVulkanDevice.
-    let v = unsafe { &*info.vulkan };
-    crate::error::check_size::<HrtsVulkanDevice>(v.struct_size, "HrtsVulkanDevice")?;
+    let v = &crate::version::read(info.vulkan, "vulkan")?;
     let gipa = v.get_instance_proc_addr.ok_or_else(|| {
         ApiError::new(
             HrtsResult::ErrorNullPointer,

@@ -74,15 +74,3 @@ pub(crate) fn check_aligned<T>(p: *const T, what: &str) -> ApiResult<()> {
         )))
     }
 }
-
-/// Checks a caller-provided `struct_size`.
-pub(crate) fn check_size<T>(size: u32, name: &str) -> ApiResult<()> {
-    let expected = std::mem::size_of::<T>();
-    if size as usize != expected {
-        return Err(ApiError::new(
-            HrtsResult::ErrorStructSize,
-            format!("{name}.struct_size is {size}, this library's {name} is {expected} bytes (header/library mismatch)"),
-        ));
-    }
-    Ok(())
-}

@@ -1,8 +1,9 @@
 //! Geometry intake: the engine's CPU arrays or Vulkan buffers, checked and kept to rebuild the passes.
 
 use crate::convert::{bounds, enum_value, finite, mat4};
-use crate::error::{check_aligned, check_size, invalid, ApiError, ApiResult};
+use crate::error::{check_aligned, invalid, ApiError, ApiResult};
 use crate::types::*;
+use crate::version::read_elements;
 use glam::{DVec3, Vec3};
 use passes::{Draw, Geometry, IndexFormat, IndexLayout, Mesh, VertexFormat, VertexLayout};
 use rhi::{BufferUsage, Device, Format};
@@ -160,17 +161,12 @@ impl GeometrySource {
     }
 }
 
-fn draws_from(ptr: *const HrtsDraw, count: u32) -> ApiResult<Vec<Draw>> {
+/// The caller's `count` draws at `ptr`, `stride` bytes apart, checked.
+fn draws_from(ptr: *const HrtsDraw, count: u32, stride: usize) -> ApiResult<Vec<Draw>> {
     if count == 0 {
         return Err(invalid("draw_count is 0"));
     }
-    if ptr.is_null() {
-        return Err(ApiError::new(HrtsResult::ErrorNullPointer, "draws is NULL"));
-    }
-    check_aligned(ptr, "draws")?;
-    // SAFETY: aligned; the caller guarantees `ptr` points at `count` draws (documented contract).
-    let draws = unsafe { std::slice::from_raw_parts(ptr, count as usize) };
-    draws
+    read_elements(ptr, count as usize, stride, "draws")?
         .iter()
         .enumerate()
         .map(|(i, d)| {
@@ -217,7 +213,6 @@ fn draw_bounds(positions: &[f32], indices: &[u32], draws: &[Draw]) -> ApiResult<
 
 /// The geometry of `hrts_set_geometry_cpu`, copied and checked.
 pub(crate) fn cpu_geometry(g: &HrtsCpuGeometry) -> ApiResult<GeometrySource> {
-    check_size::<HrtsCpuGeometry>(g.struct_size, "HrtsCpuGeometry")?;
     if g.positions.is_null() || g.indices.is_null() {
         return Err(ApiError::new(
             HrtsResult::ErrorNullPointer,
@@ -246,7 +241,7 @@ pub(crate) fn cpu_geometry(g: &HrtsCpuGeometry) -> ApiResult<GeometrySource> {
     finite(&positions, "positions")?;
     // SAFETY: as above.
     let indices = unsafe { std::slice::from_raw_parts(g.indices, g.index_count as usize) }.to_vec();
-    let draws = draws_from(g.draws, g.draw_count)?;
+    let draws = draws_from(g.draws, g.draw_count, g.draw_stride)?;
     let [lo, hi] = draw_bounds(&positions, &indices, &draws)?;
     for (n, d) in draws.iter().enumerate() {
         if !d.index_count.is_multiple_of(3)
@@ -307,7 +302,6 @@ pub(crate) fn vulkan_geometry(
 
 /// One mesh of the engine, checked but for its buffers' sizes, and its bounds.
 fn vulkan_mesh(g: &HrtsVulkanGeometry) -> ApiResult<(VulkanMesh, [DVec3; 2])> {
-    check_size::<HrtsVulkanGeometry>(g.struct_size, "HrtsVulkanGeometry")?;
     if g.vertex_buffer == 0 || g.index_buffer == 0 {
         return Err(ApiError::new(
             HrtsResult::ErrorNullPointer,
@@ -324,7 +318,7 @@ fn vulkan_mesh(g: &HrtsVulkanGeometry) -> ApiResult<(VulkanMesh, [DVec3; 2])> {
         "HrtsIndexType",
     )?;
     let bounds = bounds(&g.bounds)?;
-    let draws = draws_from(g.draws, g.draw_count)?;
+    let draws = draws_from(g.draws, g.draw_count, g.draw_stride)?;
     let stored = match g.vertex_format {
         0 => Some(Format::Rgb32Float),
         raw => i32::try_from(raw)
@@ -441,7 +435,7 @@ pub(crate) fn deformed_meshes(
             format!("deformed is NULL with deformed_count {count}"),
         ));
     }
-    check_aligned(f.deformed, "deformed")?;
+    let deformed = read_elements(f.deformed, count, f.deformed_stride, "deformed")?;
     let geometry = geometry.ok_or_else(|| {
         ApiError::new(
             HrtsResult::ErrorInvalidState,
@@ -454,8 +448,6 @@ pub(crate) fn deformed_meshes(
             "deformed_count {count} exceeds the {meshes} meshes of the geometry"
         )));
     }
-    // SAFETY: non-NULL and aligned; the caller guarantees `deformed_count` entries (documented contract).
-    let deformed = unsafe { std::slice::from_raw_parts(f.deformed, count) };
     for (i, v) in deformed.iter().enumerate() {
         let mesh = v.mesh as usize;
         let layout = geometry.vertex_layout(mesh).ok_or_else(|| {

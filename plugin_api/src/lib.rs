@@ -19,6 +19,7 @@ mod handles;
 mod memory;
 mod record;
 mod types;
+mod version;
 
 use context::Context;
 use error::{ApiError, ApiResult};
@@ -108,55 +109,6 @@ fn with_context(
     })
 }
 
-/// The C structs whose first field is `u32 struct_size`: the `sizeof` of the struct the caller was built
-/// with, checked before the plugin makes a reference to the whole struct.
-///
-/// # Safety
-/// Implementors are `#[repr(C)]` and start with a `u32` `struct_size` field.
-unsafe trait Versioned {}
-
-macro_rules! versioned {
-    ($($t:ty)*) => {$(
-        // SAFETY: `#[repr(C)]`, first field `struct_size: u32` (types.rs).
-        unsafe impl Versioned for $t {}
-    )*};
-}
-versioned!(HrtsAllocationCallbacks HrtsMemoryStats HrtsContextCreateInfo HrtsCapabilities HrtsConfig
-    HrtsCpuGeometry HrtsVulkanGeometry HrtsTargets HrtsFrame HrtsResourceInfo HrtsResourceReadback
-    HrtsFrameReport);
-
-/// Checks a caller's versioned struct before it is read as a whole: not NULL, aligned, and of this
-/// library's size (a struct of an older, smaller version is refused without reading past its end).
-fn check_versioned<T: Versioned>(p: *const T, name: &str) -> ApiResult<()> {
-    if p.is_null() {
-        return Err(ApiError::new(
-            HrtsResult::ErrorNullPointer,
-            format!("{name} is NULL"),
-        ));
-    }
-    error::check_aligned(p, name)?;
-    // SAFETY: a non-NULL pointer passed to the C ABI points at a struct of this family whatever its
-    // version (documented contract), and every version starts with the `u32` size; it is aligned.
-    let size = unsafe { p.cast::<u32>().read() };
-    let type_name = std::any::type_name::<T>()
-        .rsplit("::")
-        .next()
-        .unwrap_or(name);
-    error::check_size::<T>(size, type_name)
-}
-
-fn deref<'a, T: Versioned>(p: *const T, name: &str) -> ApiResult<&'a T> {
-    check_versioned(p, name)?;
-    // SAFETY: checked non-NULL, aligned and of this version's size; valid per the documented contract.
-    Ok(unsafe { &*p })
-}
-
-fn deref_mut<'a, T: Versioned>(p: *mut T, name: &str) -> ApiResult<&'a mut T> {
-    check_versioned(p, name)?;
-    // SAFETY: as for `deref`; the caller gives the plugin exclusive use of `*p` during the call.
-    Ok(unsafe { &mut *p })
-}
-
 /// For Rust hosts linking the rlib: the pipeline resource an `HrtsResource` value names.
 pub fn resource_from_c(value: u32) -> Option<passes::ResourceId> {
     convert::resource_id(value).ok()
@@ -190,8 +142,7 @@ pub unsafe extern "C" fn hrts_set_allocation_callbacks(
     callbacks: *const HrtsAllocationCallbacks,
 ) -> HrtsResult {
     boundary(None, || {
-        let c = deref(callbacks, "callbacks")?;
-        error::check_size::<HrtsAllocationCallbacks>(c.struct_size, "HrtsAllocationCallbacks")?;
+        let c = version::read(callbacks, "callbacks")?;
         let (Some(allocate), Some(free)) = (c.allocate, c.free) else {
             return Err(ApiError::new(
                 HrtsResult::ErrorNullPointer,
@@ -228,16 +179,16 @@ pub unsafe extern "C" fn hrts_set_allocation_callbacks(
 #[no_mangle]
 pub unsafe extern "C" fn hrts_get_memory_stats(out: *mut HrtsMemoryStats) -> HrtsResult {
     boundary(None, || {
-        let out = deref_mut(out, "out")?;
-        error::check_size::<HrtsMemoryStats>(out.struct_size, "HrtsMemoryStats")?;
-        out.host_bytes_counted = memory::is_global_allocator().into();
-        out.host_bytes = if out.host_bytes_counted != 0 {
-            memory::live_host_bytes()
-        } else {
-            0
-        };
-        out.gpu_bytes = rhi::live_gpu_allocation_bytes();
-        Ok(())
+        version::write(out, "out", |out| {
+            out.host_bytes_counted = memory::is_global_allocator().into();
+            out.host_bytes = if out.host_bytes_counted != 0 {
+                memory::live_host_bytes()
+            } else {
+                0
+            };
+            out.gpu_bytes = rhi::live_gpu_allocation_bytes();
+            Ok(())
+        })
     })
 }
 
@@ -355,9 +306,8 @@ pub unsafe extern "C" fn hrts_context_create(
         // SAFETY: checked non-NULL and aligned; the caller gives a writable pointer (contract).
         let out = unsafe { &mut *out_context };
         *out = std::ptr::null_mut();
-        let info = deref(info, "info")?;
-        error::check_size::<HrtsContextCreateInfo>(info.struct_size, "HrtsContextCreateInfo")?;
-        *out = handles::register(Context::new(info)?);
+        let info = version::read(info, "info")?;
+        *out = handles::register(Context::new(&info)?);
         Ok(())
     })
 }
@@ -396,7 +346,9 @@ pub unsafe extern "C" fn hrts_get_capabilities(
     context: *mut HrtsContext,
     out: *mut HrtsCapabilities,
 ) -> HrtsResult {
-    with_context(context, |c| c.capabilities(deref_mut(out, "out")?))
+    with_context(context, |c| {
+        version::write(out, "out", |out| c.capabilities(out))
+    })
 }
 
 /// Fills `out` (with `out->struct_size` set) with the default configuration: hybrid shadows with FXAA,
@@ -406,7 +358,9 @@ pub unsafe extern "C" fn hrts_get_capabilities(
 /// `out` is NULL or valid.
 #[no_mangle]
 pub unsafe extern "C" fn hrts_config_defaults(out: *mut HrtsConfig) -> HrtsResult {
-    boundary(None, || convert::config_defaults(deref_mut(out, "out")?))
+    boundary(None, || {
+        version::write(out, "out", convert::config_defaults)
+    })
 }
 
 /// Sets one light's configuration: `hrts_configure_lights` with one light.
@@ -419,7 +373,7 @@ pub unsafe extern "C" fn hrts_configure(
     config: *const HrtsConfig,
 ) -> HrtsResult {
     with_context(context, |c| {
-        c.configure_lights(std::slice::from_ref(deref(config, "config")?))
+        c.configure_lights(&[version::read(config, "config")?])
     })
 }
 
@@ -439,15 +393,22 @@ pub unsafe extern "C" fn hrts_configure_lights(
     configs: *const HrtsConfig,
 ) -> HrtsResult {
     with_context(context, |c| {
-        let first = deref(configs, "configs")?;
+        if configs.is_null() {
+            return Err(ApiError::new(
+                HrtsResult::ErrorNullPointer,
+                "configs is NULL",
+            ));
+        }
         if light_count == 0 || light_count > HRTS_MAX_LIGHTS {
             return Err(error::invalid(format!(
                 "light_count {light_count} must be within 1..={HRTS_MAX_LIGHTS}"
             )));
         }
-        // SAFETY: non-NULL; the caller guarantees `light_count` configurations.
-        let all = unsafe { std::slice::from_raw_parts(first, light_count as usize) };
-        c.configure_lights(all)
+        c.configure_lights(&version::read_array(
+            configs,
+            light_count as usize,
+            "configs",
+        )?)
     })
 }
 
@@ -462,7 +423,7 @@ pub unsafe extern "C" fn hrts_set_geometry_cpu(
     geometry: *const HrtsCpuGeometry,
 ) -> HrtsResult {
     with_context(context, |c| {
-        c.set_geometry_cpu(deref(geometry, "geometry")?)
+        c.set_geometry_cpu(&version::read(geometry, "geometry")?)
     })
 }
 
@@ -477,7 +438,7 @@ pub unsafe extern "C" fn hrts_set_geometry_vulkan(
     geometry: *const HrtsVulkanGeometry,
 ) -> HrtsResult {
     with_context(context, |c| {
-        c.set_geometry_vulkan(std::slice::from_ref(deref(geometry, "geometry")?), false)
+        c.set_geometry_vulkan(&[version::read(geometry, "geometry")?], false)
     })
 }
 
@@ -500,14 +461,11 @@ pub unsafe extern "C" fn hrts_set_geometry_vulkan_meshes(
     mesh_count: u32,
 ) -> HrtsResult {
     with_context(context, |c| {
-        let first = deref(meshes, "meshes")?;
-        if mesh_count == 0 {
+        let all = version::read_array(meshes, mesh_count as usize, "meshes")?;
+        if all.is_empty() {
             return Err(error::invalid("mesh_count is 0"));
         }
-        // SAFETY: non-NULL, aligned and of this version's size; the caller guarantees `mesh_count`
-        // meshes.
-        let all = unsafe { std::slice::from_raw_parts(first, mesh_count as usize) };
-        c.set_geometry_vulkan(all, true)
+        c.set_geometry_vulkan(&all, true)
     })
 }
 
@@ -553,7 +511,9 @@ pub unsafe extern "C" fn hrts_set_targets(
     context: *mut HrtsContext,
     targets: *const HrtsTargets,
 ) -> HrtsResult {
-    with_context(context, |c| c.set_targets(deref(targets, "targets")?))
+    with_context(context, |c| {
+        c.set_targets(&version::read(targets, "targets")?)
+    })
 }
 
 /// Records every pass of one frame into `frame->command_buffer`: `hrts_record_passes` with
@@ -567,7 +527,7 @@ pub unsafe extern "C" fn hrts_record_frame(
     frame: *const HrtsFrame,
 ) -> HrtsResult {
     with_context(context, |c| {
-        c.record_passes(deref(frame, "frame")?, HRTS_PASS_MASK_ALL)
+        c.record_passes(&version::read(frame, "frame")?, HRTS_PASS_MASK_ALL)
     })
 }
 
@@ -605,7 +565,7 @@ pub unsafe extern "C" fn hrts_record_passes(
     pass_mask: u32,
 ) -> HrtsResult {
     with_context(context, |c| {
-        c.record_passes(deref(frame, "frame")?, pass_mask)
+        c.record_passes(&version::read(frame, "frame")?, pass_mask)
     })
 }
 
@@ -622,7 +582,7 @@ pub unsafe extern "C" fn hrts_get_resource_info(
     out: *mut HrtsResourceInfo,
 ) -> HrtsResult {
     with_context(context, |c| {
-        c.resource_info(light, resource, deref_mut(out, "out")?)
+        version::write(out, "out", |out| c.resource_info(light, resource, out))
     })
 }
 
@@ -638,7 +598,9 @@ pub unsafe extern "C" fn hrts_record_resource_readback(
     context: *mut HrtsContext,
     readback: *const HrtsResourceReadback,
 ) -> HrtsResult {
-    with_context(context, |c| c.record_readback(deref(readback, "readback")?))
+    with_context(context, |c| {
+        c.record_readback(&version::read(readback, "readback")?)
+    })
 }
 
 /// Fills `out` (with `out->struct_size` set) with what `light`'s passes did in frame `frame_index`: one
@@ -656,6 +618,6 @@ pub unsafe extern "C" fn hrts_get_frame_report(
     out: *mut HrtsFrameReport,
 ) -> HrtsResult {
     with_context(context, |c| {
-        c.report(frame_index, light, deref_mut(out, "out")?)
+        version::write(out, "out", |out| c.report(frame_index, light, out))
     })
 }

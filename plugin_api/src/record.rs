@@ -3,7 +3,7 @@
 
 use crate::context::{Built, Context, FrameProgress, OpenFrame};
 use crate::convert::{frame_bounds, frame_inputs, pass_from_index, resource_id, FrameLight};
-use crate::error::{check_size, invalid, ApiError, ApiResult};
+use crate::error::{invalid, ApiError, ApiResult};
 use crate::geometry::deformed_meshes;
 use crate::types::*;
 use passes::retire::completed_before;
@@ -19,7 +19,6 @@ pub(crate) const DEPTH_NORMAL_READERS: u32 = 1 << HrtsPass::PrimitiveMap as u32
 
 impl Context {
     pub(crate) fn record_passes(&mut self, f: &HrtsFrame, mask: u32) -> ApiResult<()> {
-        check_size::<HrtsFrame>(f.struct_size, "HrtsFrame")?;
         if f.command_buffer == 0 {
             return Err(ApiError::new(
                 HrtsResult::ErrorNullPointer,
@@ -252,7 +251,6 @@ impl Context {
     }
 
     pub(crate) fn record_readback(&mut self, r: &HrtsResourceReadback) -> ApiResult<()> {
-        check_size::<HrtsResourceReadback>(r.struct_size, "HrtsResourceReadback")?;
         if r.command_buffer == 0 || r.buffer == 0 {
             return Err(ApiError::new(
                 HrtsResult::ErrorNullPointer,

@@ -944,6 +944,7 @@ static HrtsVulkanGeometry vulkan_mesh(Buf vb, VkDeviceSize vb_size, Buf ib, VkDe
     m.index_buffer_size = ib_size;
     m.draws = draw;
     m.draw_count = 1;
+    m.draw_stride = sizeof *draw;
     return m;
 }
 
@@ -1390,6 +1391,8 @@ static void deforming_mesh(const HrtsVulkanDevice *vk) {
         bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
         VK(vkBeginCommandBuffer(cmds[slot], &bi));
         HrtsFrame f = frame(cmds[slot], next_frame++);
+        f.light_stride = sizeof(HrtsLight);
+        f.deformed_stride = sizeof(HrtsMeshVertices);
         if (plan[i] != NONE) {
             f.deformed = &given[plan[i]];
             f.deformed_count = 1;
@@ -1480,17 +1483,18 @@ static void deforming_mesh(const HrtsVulkanDevice *vk) {
 enum {
     CREATE_NULL_INFO, CREATE_NULL_OUT, CREATE_STRUCT_SIZE, CREATE_VERSION, CREATE_NULL_DEVICE, CREATE_NULL_GIPA,
     CREATE_DEVICE_STRUCT_SIZE, CREATE_FRAMES_IN_FLIGHT, CREATE_UNSUPPORTED_EXTENSION, CREATE_NO_SUCH_QUEUE_FAMILY,
-    CREATE_NO_SUCH_QUEUE, CREATE_MISALIGNED_DEVICE, CREATE_MISALIGNED_EXTENSIONS, CAPS_NULL_CONTEXT, CAPS_NULL_OUT, CAPS_STRUCT_SIZE, CONFIG_N_ZERO, CONFIG_N_ABSURD,
+    CREATE_NO_SUCH_QUEUE, CREATE_MISALIGNED_DEVICE, CREATE_MISALIGNED_EXTENSIONS, CREATE_NEWER_MINOR,
+    CREATE_VERSION_5_0, CAPS_NULL_CONTEXT, CAPS_NULL_OUT, CAPS_STRUCT_SIZE, CONFIG_N_ZERO, CONFIG_N_ABSURD,
     CONFIG_BUDGET_ZERO, CONFIG_BUDGET_SMALL, CONFIG_FACES, CONFIG_BINNING, CONFIG_STRUCT_SIZE, CONFIG_OLDER_SMALLER, CONFIG_MISALIGNED, CONFIG_MODE,
     CONFIG_NAN_LIGHT_SIZE, CONFIG_NEGATIVE_WSS, CONFIG_PCF_TAPS, CONFIG_SHADOW_MAP_ZERO, CONFIG_DEFAULTS_NULL,
     CONFIG_FILTER, CONFIG_EXTRA_OUTPUT, CONFIG_FILTER_RADII, CONFIG_SLOPE_BIAS, LIGHTS_ZERO, LIGHTS_TOO_MANY,
-    LIGHTS_NULL, LIGHTS_SECOND_INVALID, GEOMETRY_NULL_POSITIONS, GEOMETRY_STRIDE, GEOMETRY_NAN, GEOMETRY_INDEX,
+    LIGHTS_NULL, LIGHTS_SECOND_INVALID, LIGHTS_MIXED_VERSIONS, GEOMETRY_NULL_POSITIONS, GEOMETRY_STRIDE, GEOMETRY_NAN, GEOMETRY_INDEX,
     GEOMETRY_NO_DRAWS, GEOMETRY_MISALIGNED_POSITIONS, GEOMETRY_MISALIGNED_INDICES, GEOMETRY_MISALIGNED_DRAWS,
-    TRANSFORMS_MISALIGNED, TRANSFORMS_COUNT, VULKAN_GEOMETRY_INDEX_TYPE, VULKAN_GEOMETRY_VERTEX_OFFSET_WRAP, VULKAN_GEOMETRY_INDEX_OFFSET_WRAP, MESHES_COUNT_ZERO,
+    GEOMETRY_DRAW_STRIDE, TRANSFORMS_MISALIGNED, TRANSFORMS_COUNT, VULKAN_GEOMETRY_INDEX_TYPE, VULKAN_GEOMETRY_VERTEX_OFFSET_WRAP, VULKAN_GEOMETRY_INDEX_OFFSET_WRAP, MESHES_COUNT_ZERO,
     MESHES_NULL, MESHES_BUFFER_TOO_SMALL, TARGETS_ZERO_WIDTH, TARGETS_DEPTH_USAGE, TARGETS_OUTPUT_USAGE,
     TARGETS_NULL_NORMAL, TARGETS_ZERO_LAYERS, FRAME_ZERO_DIRECTION, FRAME_NAN_PROJECTION, FRAME_LIGHT_TYPE,
     FRAME_NULL_COMMAND_BUFFER, FRAME_STRUCT_SIZE, FRAME_NULL_LIGHTS, FRAME_LIGHT_COUNT_ZERO, FRAME_LIGHT_COUNT_OTHER,
-    FRAME_MISALIGNED_LIGHTS,
+    FRAME_MISALIGNED_LIGHTS, FRAME_NEWER_STRUCT_SIZE, FRAME_LIGHT_STRIDE, FRAME_DEFORMED_STRIDE,
     FRAME_DEFORMED_NULL, FRAME_DEFORMED_MESH,
     FRAME_INDEX_REPEATED, FRAME_INDEX_BACKWARDS, REPORT_STRUCT_SIZE, REPORT_OLD_FRAME, REPORT_NO_SUCH_LIGHT,
     REPORT_NOT_COMPLETED, PASSES_EMPTY_MASK, PASSES_UNKNOWN_BIT, PASSES_RAY_TRACE_FIRST, PASSES_CAMERA_MOVED,
@@ -1517,6 +1521,8 @@ static const struct {
     [CREATE_NO_SUCH_QUEUE] = {"create(queue 7 of a one-queue family)", HRTS_RESULT_ERROR_UNSUPPORTED},
     [CREATE_MISALIGNED_DEVICE] = {"create(misaligned HrtsVulkanDevice)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [CREATE_MISALIGNED_EXTENSIONS] = {"create(misaligned extension names)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [CREATE_NEWER_MINOR] = {"create(a newer minor version than the library's)", HRTS_RESULT_ERROR_VERSION},
+    [CREATE_VERSION_5_0] = {"create(API 5.0)", HRTS_RESULT_ERROR_VERSION},
     [CAPS_NULL_CONTEXT] = {"capabilities(NULL context)", HRTS_RESULT_ERROR_NULL_POINTER},
     [CAPS_NULL_OUT] = {"capabilities(NULL out)", HRTS_RESULT_ERROR_NULL_POINTER},
     [CAPS_STRUCT_SIZE] = {"capabilities(wrong size)", HRTS_RESULT_ERROR_STRUCT_SIZE},
@@ -1543,6 +1549,7 @@ static const struct {
     [LIGHTS_TOO_MANY] = {"configure_lights(HRTS_MAX_LIGHTS + 1)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [LIGHTS_NULL] = {"configure_lights(NULL configs)", HRTS_RESULT_ERROR_NULL_POINTER},
     [LIGHTS_SECOND_INVALID] = {"configure_lights(second light's mode unknown)", HRTS_RESULT_ERROR_INVALID_ENUM},
+    [LIGHTS_MIXED_VERSIONS] = {"configure_lights(a 5.4 HrtsConfig after a current one)", HRTS_RESULT_ERROR_STRUCT_SIZE},
     [GEOMETRY_NULL_POSITIONS] = {"geometry(NULL positions)", HRTS_RESULT_ERROR_NULL_POINTER},
     [GEOMETRY_STRIDE] = {"geometry(stride 6)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [GEOMETRY_NAN] = {"geometry(NaN vertex)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
@@ -1551,6 +1558,7 @@ static const struct {
     [GEOMETRY_MISALIGNED_POSITIONS] = {"geometry(misaligned positions)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [GEOMETRY_MISALIGNED_INDICES] = {"geometry(misaligned indices)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [GEOMETRY_MISALIGNED_DRAWS] = {"geometry(misaligned draws)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [GEOMETRY_DRAW_STRIDE] = {"geometry(draw_stride 72, the HrtsDraw of no version read)", HRTS_RESULT_ERROR_STRUCT_SIZE},
     [TRANSFORMS_MISALIGNED] = {"draw transforms(misaligned)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [TRANSFORMS_COUNT] = {"draw transforms(3 for 2 draws)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [VULKAN_GEOMETRY_INDEX_TYPE] = {"vulkan geometry(unknown index type)", HRTS_RESULT_ERROR_INVALID_ENUM},
@@ -1573,6 +1581,9 @@ static const struct {
     [FRAME_LIGHT_COUNT_ZERO] = {"frame(0 lights)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [FRAME_LIGHT_COUNT_OTHER] = {"frame(2 lights, 1 configured)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [FRAME_MISALIGNED_LIGHTS] = {"frame(misaligned lights)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [FRAME_NEWER_STRUCT_SIZE] = {"frame(a newer, larger HrtsFrame)", HRTS_RESULT_ERROR_STRUCT_SIZE},
+    [FRAME_LIGHT_STRIDE] = {"frame(light_stride 104)", HRTS_RESULT_ERROR_STRUCT_SIZE},
+    [FRAME_DEFORMED_STRIDE] = {"frame(deformed_stride 40)", HRTS_RESULT_ERROR_STRUCT_SIZE},
     [FRAME_DEFORMED_NULL] = {"frame(deformed NULL, deformed_count 1)", HRTS_RESULT_ERROR_NULL_POINTER},
     [FRAME_DEFORMED_MESH] = {"frame(deformed mesh 1 of 1)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [FRAME_INDEX_REPEATED] = {"frame(index of the last frame again)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
@@ -1652,6 +1663,8 @@ static HrtsResult misuse_call(int id, Misuse *m) {
     case CREATE_NULL_OUT: return hrts_context_create(&ci, NULL);
     case CREATE_STRUCT_SIZE: ci.struct_size -= 4; return hrts_context_create(&ci, &none);
     case CREATE_VERSION: ci.api_version += 1u << 22; return hrts_context_create(&ci, &none);
+    case CREATE_NEWER_MINOR: ci.api_version += 1u << 12; return hrts_context_create(&ci, &none);
+    case CREATE_VERSION_5_0: ci.api_version = 5u << 22; return hrts_context_create(&ci, &none);
     case CREATE_NULL_DEVICE: bad.device = 0; ci.vulkan = &bad; return hrts_context_create(&ci, &none);
     case CREATE_NULL_GIPA: bad.get_instance_proc_addr = NULL; ci.vulkan = &bad; return hrts_context_create(&ci, &none);
     case CREATE_DEVICE_STRUCT_SIZE: bad.struct_size = 8; ci.vulkan = &bad; return hrts_context_create(&ci, &none);
@@ -1712,6 +1725,7 @@ static HrtsResult misuse_call(int id, Misuse *m) {
     case LIGHTS_TOO_MANY: return hrts_configure_lights(ctx, HRTS_MAX_LIGHTS + 1, two);
     case LIGHTS_NULL: return hrts_configure_lights(ctx, 2, NULL);
     case LIGHTS_SECOND_INVALID: two[1].mode = 9; return hrts_configure_lights(ctx, 2, two);
+    case LIGHTS_MIXED_VERSIONS: two[1].struct_size = 108; return hrts_configure_lights(ctx, 2, two);
     case GEOMETRY_NULL_POSITIONS: g.positions = NULL; return hrts_set_geometry_cpu(ctx, &g);
     case GEOMETRY_STRIDE: g.vertex_stride = 6; return hrts_set_geometry_cpu(ctx, &g);
     case GEOMETRY_NAN: {
@@ -1744,6 +1758,7 @@ static HrtsResult misuse_call(int id, Misuse *m) {
         g.draws = misaligned_copy(storage, draws, sizeof draws, sizeof(float));
         return hrts_set_geometry_cpu(ctx, &g);
     }
+    case GEOMETRY_DRAW_STRIDE: g.draw_stride = 72; return hrts_set_geometry_cpu(ctx, &g);
     case TRANSFORMS_MISALIGNED:
     case TRANSFORMS_COUNT: {
         static float transforms[3][16];
@@ -1792,6 +1807,15 @@ static HrtsResult misuse_call(int id, Misuse *m) {
     case FRAME_NULL_LIGHTS: f.lights = NULL; return hrts_record_frame(ctx, &f);
     case FRAME_LIGHT_COUNT_ZERO: f.light_count = 0; return hrts_record_frame(ctx, &f);
     case FRAME_LIGHT_COUNT_OTHER: f.lights = lights; f.light_count = 2; return hrts_record_frame(ctx, &f);
+    case FRAME_NEWER_STRUCT_SIZE: f.struct_size = sizeof f + 8; return hrts_record_frame(ctx, &f);
+    case FRAME_LIGHT_STRIDE: f.light_stride = sizeof(HrtsLight) + 4; return hrts_record_frame(ctx, &f);
+    case FRAME_DEFORMED_STRIDE: {
+        HrtsMeshVertices v = {0, 1, 1024, 0};
+        f.deformed = &v;
+        f.deformed_count = 1;
+        f.deformed_stride = 40;
+        return hrts_record_frame(ctx, &f);
+    }
     case FRAME_MISALIGNED_LIGHTS: {
         static unsigned char storage[sizeof(HrtsLight) + 16];
         f.lights = misaligned_copy(storage, &c_lights[0], sizeof(HrtsLight), sizeof(float));
@@ -2540,12 +2564,7 @@ int main(void) {
     free_image(depth_img);
     free_image(normal_img);
     free_image(out_img);
-    vkDestroyCommandPool(device, pool, NULL);
-    vkDestroyDevice(device, NULL); /* the object tracker reports any object the plugin leaked here */
-    PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger =
-        (PFN_vkDestroyDebugUtilsMessengerEXT)vkGetInstanceProcAddr(instance, "vkDestroyDebugUtilsMessengerEXT");
-    destroy_messenger(instance, messenger, NULL);
-    vkDestroyInstance(instance, NULL);
+    destroy_device();
     printf("validation: %d errors, %d warnings (synchronization validation on)\n", validation_errors, validation_warnings);
     CHECK(validation_errors == 0, "%d validation errors", validation_errors);
     printf("%d passed, %d failed\n", passed, failed);

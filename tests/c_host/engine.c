@@ -211,13 +211,13 @@ int exact(int x, int y, double tol, const Emitter *e) {
 }
 
 /* ---------- Vulkan helpers ---------- */
-VkInstance instance;
+static VkInstance instance;
 VkPhysicalDevice phys;
 VkDevice device;
 VkQueue queue;
 uint32_t family;
 VkCommandPool pool;
-VkDebugUtilsMessengerEXT messenger;
+static VkDebugUtilsMessengerEXT messenger;
 int validation_errors, validation_warnings;
 const char *phase = "setup"; /* what the host is doing, for validation messages */
 
@@ -529,6 +529,17 @@ void create_device(void) {
     pi.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
     pi.queueFamilyIndex = family;
     VK(vkCreateCommandPool(device, &pi, NULL, &pool));
+}
+
+/* Destroys what create_device created; the validation layer's object tracker reports there any object the
+ * plugin leaked. */
+void destroy_device(void) {
+    vkDestroyCommandPool(device, pool, NULL);
+    vkDestroyDevice(device, NULL);
+    PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger =
+        (PFN_vkDestroyDebugUtilsMessengerEXT)vkGetInstanceProcAddr(instance, "vkDestroyDebugUtilsMessengerEXT");
+    destroy_messenger(instance, messenger, NULL);
+    vkDestroyInstance(instance, NULL);
 }
 
 HrtsVulkanDevice adopt_info(void) {

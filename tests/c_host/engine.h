@@ -93,13 +93,11 @@ typedef struct {
     void *map;
 } Buf;
 
-extern VkInstance instance;
 extern VkPhysicalDevice phys;
 extern VkDevice device;
 extern VkQueue queue;
 extern uint32_t family;
 extern VkCommandPool pool;
-extern VkDebugUtilsMessengerEXT messenger;
 extern int validation_errors, validation_warnings;
 extern const char *phase;
 uint32_t memory_type(uint32_t bits, VkMemoryPropertyFlags want);
@@ -121,6 +119,7 @@ VkSemaphore held_semaphore(void);
 void submit_held(VkCommandBuffer cmd, VkSemaphore hold, VkFence fence);
 void release_held(VkSemaphore hold);
 void create_device(void);
+void destroy_device(void);
 HrtsVulkanDevice adopt_info(void);
 HrtsContext *create_context(const HrtsVulkanDevice *v, uint32_t frames_in_flight);
 
