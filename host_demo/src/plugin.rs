@@ -830,6 +830,7 @@ fn set_geometry(
                 vertex_format: 0,
                 position_scale: [0.0; 3],
                 position_offset: [0.0; 3],
+                draw_stride: size_of::<HrtsDraw>(),
             }
         })
         .collect();
@@ -937,5 +938,7 @@ fn c_frame(
         has_bounds: 1,
         deformed: std::ptr::null(),
         deformed_count: 0,
+        light_stride: size_of::<HrtsLight>(),
+        deformed_stride: size_of::<HrtsMeshVertices>(),
     }
 }

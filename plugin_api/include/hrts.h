@@ -7,9 +7,28 @@
 #include <stddef.h>
 #include <stdint.h>
 
-// Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
-// version differs.
-#define HRTS_API_VERSION ((5 << 22) | (8 << 12))
+// Version of this header: `(major << 22) | (minor << 12) | patch`.
+//
+// Versions. A minor version adds functions, enum values, and fields at the end of structs, never
+// elsewhere, and a struct it extends grows (a new field never takes the trailing padding of an older
+// version). A library reads the structs of every minor version of its major version from 5.1 on:
+// - `struct_size` (the `sizeof` of the caller's header) says a struct's version. The library reads the
+//   fields that version has and gives the newer ones the defaults their documentation states ("API 5.x:
+//   ..."); a struct the library fills is written up to the caller's `struct_size` only, the fields of
+//   newer versions left out.
+// - Arrays of structs without a `struct_size` (`HrtsDraw`, `HrtsLight`, `HrtsMeshVertices`) are read at
+//   the stride given beside them (`draw_stride`, `light_stride`, `deformed_stride`): the caller's `sizeof`
+//   of the element, which says its version. A stride of 0, as in the structs of callers before 5.8,
+//   reads the element as API 5.1 to 5.8 define it. An array of structs with a `struct_size`
+//   (`hrts_configure_lights`, `hrts_set_geometry_vulkan_meshes`) is read at its first element's, which
+//   every element must have.
+// - A size or stride that is the size of no version this library reads, or of a newer version than
+//   the library's (the caller's header is newer), fails with `HRTS_RESULT_ERROR_STRUCT_SIZE` and a
+//   message listing the sizes it reads.
+// - `hrts_context_create` refuses (`HRTS_RESULT_ERROR_VERSION`) another major version, a minor version
+//   newer than the library's, and 5.0, whose headers changed layouts without changing the version
+//   (`HrtsDraw` 72 then 76 bytes): its structs cannot be told apart.
+#define HRTS_API_VERSION ((5 << 22) | (9 << 12))
 
 // The most lights one context shades (`hrts_configure_lights`); a point light counts once.
 #define HRTS_MAX_LIGHTS 64
@@ -43,9 +62,11 @@ typedef enum HrtsResult {
   HRTS_RESULT_OK = 0,
   // A required pointer argument was NULL.
   HRTS_RESULT_ERROR_NULL_POINTER = 1,
-  // `struct_size` does not match this library's struct (header/library mismatch).
+  // A `struct_size` or an array's element stride is the size of no version of the struct this library
+  // reads (header/library mismatch, or a header newer than the library).
   HRTS_RESULT_ERROR_STRUCT_SIZE = 2,
-  // The caller's `api_version` has another major version.
+  // The caller's `api_version` is of another major version, a newer minor version than the library's,
+  // or 5.0.
   HRTS_RESULT_ERROR_VERSION = 3,
   // An enumeration field holds an unknown value.
   HRTS_RESULT_ERROR_INVALID_ENUM = 4,
@@ -380,8 +401,8 @@ enum HrtsResource
   HRTS_RESOURCE_PRIM_LIST_OFFSETS = 1,
   // Primitive map list entries, a buffer of `uint32_t` triangle indices (`R32_UINT`, width = capacity).
   HRTS_RESOURCE_PRIM_LIST_ENTRIES = 2,
-  // Occupancy view, `R8G8B8A8_UNORM`, N² (grey: list length on a log scale; red: traced exhaustively, past
-  // the capacity or in an overflowed group of the packed offsets).
+  // Occupancy view, `R8G8B8A8_UNORM`, N² (grey: list length on a log scale; red: no list kept, its pixels
+  // walk the BVH: past the capacity or the list limit, or in an overflowed group of the packed offsets).
   HRTS_RESOURCE_OCCUPANCY = 3,
   // Ray-traced visibility, `R32_SFLOAT`, 1 = lit.
   HRTS_RESOURCE_RT_VISIBILITY = 4,
@@ -592,22 +613,25 @@ typedef struct HrtsConfig {
   // triangles). An engine that knows its scene can size them and avoid the frame of a growth.
   uint32_t map_initial_entries;
   // (Triangle, face) pairs a point light's cube map starts with (default 0: two per triangle, at least
-  // 1024; at most six per triangle). A frame that keeps more traces the light exhaustively (exact, slower; `bin_pairs` in the
-  // frame report) and the pairs grow to fit from the next frame on.
+  // 1024; at most six per triangle). A frame that keeps more walks every pixel of the light through the
+  // BVH (exact; `bin_pairs` in the frame report) and the pairs grow to fit from the next frame on. API 5.4: 0 for a configuration of
+  // 5.1 to 5.3.
   uint32_t map_initial_pairs;
-  // Area shadows: light samples per pixel, 1..=128 (default 64).
+  // Area shadows: light samples per pixel, 1..=128 (default 64). API 5.5: 64 for a configuration of 5.1
+  // to 5.4.
   uint32_t area_samples;
   // A texel whose list would hold more than this many entries keeps none: its pixels walk the BVH over
   // the prim buffer instead, which then costs less (default 256; `0xFFFFFFFF`: no limit). It moves
-  // cost, never exactness.
+  // cost, never exactness. API 5.9: older callers get the default.
   uint32_t map_list_limit;
   // Bin items (4x4-texel tiles of the triangles' footprints, widened by their penumbrae for area
   // shadows) per pixel with a shadow ray past which a frame builds no list and every pixel walks the
-  // BVH (default 8; infinity: always lists; 0: always the BVH). It moves cost, never exactness.
+  // BVH (default 8; infinity: always lists; 0: always the BVH). It moves cost, never exactness. API
+  // 5.9: older callers get the default.
   float map_bin_budget;
 } HrtsConfig;
 
-// One draw of the geometry.
+// One draw of the geometry: an element of `draws`, read at `draw_stride`.
 typedef struct HrtsDraw {
   // First index of the draw.
   uint32_t first_index;
@@ -638,6 +662,9 @@ typedef struct HrtsCpuGeometry {
   const struct HrtsDraw *draws;
   // Number of draws.
   uint32_t draw_count;
+  // Bytes from one draw to the next: `sizeof(HrtsDraw)` of the caller's header. API 5.8: 0 (as in the
+  // struct of a caller of 5.1 to 5.7) reads the 76-byte `HrtsDraw` of API 5.1 to 5.8.
+  size_t draw_stride;
 } HrtsCpuGeometry;
 
 // One mesh in the engine's Vulkan buffers (need `VK_BUFFER_USAGE_STORAGE_BUFFER_BIT`); read, never
@@ -686,6 +713,9 @@ typedef struct HrtsVulkanGeometry {
   float position_scale[3];
   // See `position_scale`.
   float position_offset[3];
+  // Bytes from one draw to the next: `sizeof(HrtsDraw)` of the caller's header. API 5.8: 0 (as in the
+  // struct of a caller of 5.1 to 5.7) reads the 76-byte `HrtsDraw` of API 5.1 to 5.8.
+  size_t draw_stride;
 } HrtsVulkanGeometry;
 
 // The engine's images the plugin reads and writes. All are 2D, one mip, one layer, same size.
@@ -740,7 +770,7 @@ typedef struct HrtsTargets {
   uint32_t output_format;
 } HrtsTargets;
 
-// One light of a frame.
+// One light of a frame: an element of `HrtsFrame::lights`, read at `light_stride`.
 typedef struct HrtsLight {
   // `HrtsLightType`.
   uint32_t light_type;
@@ -775,12 +805,12 @@ typedef struct HrtsLight {
   float outer_cone;
 } HrtsLight;
 
-// Where one mesh's positions are in one frame (`HrtsFrame::deformed`): a vertex buffer of that frame,
-// such as one of a ring of skinning outputs, one per frame in flight. It holds the mesh's vertex count in
-// the mesh's `vertex_format` and `vertex_stride`, and must stay alive until the frame completed. The
-// plugin keeps a descriptor per buffer for as long as frames in flight may use it (`frames_in_flight`
-// frames after the last that gave it): a buffer destroyed sooner must not be replaced by one that may
-// get the same handle within those frames.
+// Where one mesh's positions are in one frame (an element of `HrtsFrame::deformed`, read at
+// `deformed_stride`): a vertex buffer of that frame, such as one of a ring of skinning outputs, one per
+// frame in flight. It holds the mesh's vertex count in the mesh's `vertex_format` and `vertex_stride`,
+// and must stay alive until the frame completed. The plugin writes the buffer's descriptors anew in each
+// frame that gives it and never reads them in another frame: once the frame completed, the engine may
+// destroy the buffer, and a buffer created after it may get its handle.
 typedef struct HrtsMeshVertices {
   // Index of the mesh in the last geometry call (0 for `hrts_set_geometry_vulkan` and
   // `hrts_set_geometry_cpu`).
@@ -837,11 +867,19 @@ typedef struct HrtsFrame {
   // The meshes deformed this frame (`deformed_count` entries; may be NULL if the count is 0): each
   // reads its positions from a vertex buffer of this frame instead of its own, and its triangles are
   // rebuilt this frame (from its own vertex buffer again in the next frame that does not deform it).
-  // Read by the call that begins the frame. A deformed mesh's bounds do not hold: give the frame's in
+  // Read by the call that begins the frame alone (the frame's later calls deform the same meshes): the
+  // array may be freed once that call returned. A deformed mesh's bounds do not hold: give the frame's in
   // `bounds`, or the plugin culls by the view and the lights' ranges alone.
   const struct HrtsMeshVertices *deformed;
   // Number of entries in `deformed`.
   uint32_t deformed_count;
+  // Bytes from one entry of `lights` to the next: `sizeof(HrtsLight)` of the caller's header. API 5.8: 0
+  // (as in the struct of a caller of 5.1 to 5.7) reads the 100-byte `HrtsLight` of API 5.1 to 5.8.
+  size_t light_stride;
+  // Bytes from one entry of `deformed` to the next: `sizeof(HrtsMeshVertices)` of the caller's header.
+  // API 5.8: 0 (as in the struct of a caller of 5.1 to 5.7) reads the 32-byte `HrtsMeshVertices` of API
+  // 5.1 to 5.8.
+  size_t deformed_stride;
 } HrtsFrame;
 
 // Shape of a plugin resource, for reading it back.
@@ -896,8 +934,8 @@ typedef struct HrtsFrameReport {
   uint32_t binning_path;
   // Conservative-raster tier used (0 for the compute and software paths).
   uint32_t tier;
-  // Texels traced exhaustively (exact, slower): those whose list did not fit the entry capacity, and every
-  // texel of a group of 16 whose lists' offsets did not fit the packed list offsets.
+  // Texels whose pixels walked the BVH because their list did not fit the entry capacity, and every
+  // texel of a group of 16 whose lists' offsets did not fit the packed list offsets (exact).
   uint32_t texels_past_capacity;
   // Longest list of any texel.
   uint32_t longest_list;
@@ -960,15 +998,17 @@ typedef struct HrtsFrameReport {
   // Whether the light's last pass wrote its layer of the output image directly, with no copy: the
   // output is `R32_SFLOAT` with STORAGE usage (the layer is then in the GENERAL layout between that
   // pass and the output-copy call, which takes it to `output_layout_after`), and the configuration does
-  // not read the final output back through `extra_outputs`.
+  // not read the final output back through `extra_outputs`. API 5.3.
   HrtsBool output_direct;
   // A point light shadowed as one cube map: the (triangle, face) pairs its setup kept this frame (0
   // for other lights). Past `bin_pair_capacity`, the frame traced every ray of the light against every
-  // triangle (exact, slower) and the pairs grow to fit from the next frame on.
+  // triangle (exact, slower) and the pairs grow to fit from the next frame on. API 5.4: not written into
+  // the report of a caller of 5.1 to 5.3.
   uint32_t bin_pairs;
-  // The (triangle, face) pairs the light's cube map held this frame.
+  // The (triangle, face) pairs the light's cube map held this frame. API 5.4, as `bin_pairs`.
   uint32_t bin_pair_capacity;
-  // Texels whose list passed `map_list_limit` and was not kept: their pixels walked the BVH.
+  // Texels whose list passed `map_list_limit` and was not kept: their pixels walked the BVH. API 5.9:
+  // this field and the ones after it are written for callers of 5.9 and later.
   uint32_t texels_past_limit;
   // Bin items (4x4-texel tiles of the footprints) of the frame's lists (saturated at `0xFFFFFFFF`).
   uint32_t bin_items;
@@ -1009,12 +1049,28 @@ enum HrtsResult hrts_get_memory_stats(struct HrtsMemoryStats *out);
 const char *hrts_result_name(int32_t result);
 
 // The message of the last call on `context` if it failed, or, if `context` is NULL or not live, of the
-// last call on this thread if it failed; empty after a successful call. Valid until the next call on the
-// same context (or thread).
+// calling thread's last call; empty after a successful call. For a live context the string is the
+// calling thread's own copy, valid until the thread calls `hrts_last_error` on that context again or the
+// context is destroyed, whatever other threads do; for NULL, until the thread's next call into the plugin.
+// `hrts_get_last_error` copies the message into the caller's memory instead.
 //
 // # Safety
 // `context` is NULL or a handle returned by `hrts_context_create`.
 const char *hrts_last_error(const struct HrtsContext *context);
+
+// Copies the message of the last call on `context` if it failed (or, if `context` is NULL or not live,
+// of the calling thread's last call; empty after a successful call) into `buffer`, NUL-terminated and
+// truncated to `capacity` bytes, and returns the bytes the whole message needs with its NUL: a return
+// above `capacity` means the copy was truncated. `buffer` may be NULL (nothing is copied) to ask for the
+// size. Reading a context's message is safe while another thread calls it. Returns 0 only if the plugin
+// failed internally. (API 5.8.)
+//
+// # Safety
+// `context` is NULL or a handle returned by `hrts_context_create`; `buffer` is NULL or holds `capacity`
+// writable bytes.
+size_t hrts_get_last_error(const struct HrtsContext *context,
+                           char *buffer,
+                           size_t capacity);
 
 // Creates a context. On success `*out_context` receives its handle; on failure it is set to NULL.
 // Handles are never reused: a destroyed context's handle stays invalid (`HRTS_RESULT_ERROR_INVALID_CONTEXT`).
@@ -1103,7 +1159,7 @@ enum HrtsResult hrts_set_geometry_vulkan_meshes(struct HrtsContext *context,
 // changed since the prim buffer was last built (and what depends on the prim buffer); frames already
 // recorded keep their transforms. No pass is rebuilt and nothing is recorded. With Vulkan geometry the
 // bounds of the geometry call no longer hold: give each frame's in `HrtsFrame::bounds` for the plugin to
-// cull by them.
+// cull by them. A call that fails changes nothing.
 //
 // # Safety
 // As for `hrts_get_capabilities`; `transforms` points at `16 * draw_count` floats.

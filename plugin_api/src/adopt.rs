@@ -1,7 +1,7 @@
 //! The context's device: the engine's, adopted after checking what the plugin needs, or one of the
 //! plugin's own.
 
-use crate::error::{invalid, ApiError, ApiResult};
+use crate::error::{check_aligned, invalid, ApiError, ApiResult};
 use crate::types::*;
 use rhi::Device;
 
@@ -24,9 +24,7 @@ pub(crate) fn device(info: &HrtsContextCreateInfo) -> ApiResult<Device> {
             device_filter: filter,
         })?);
     }
-    // SAFETY: non-NULL, checked above; the caller guarantees it points at a HrtsVulkanDevice.
-    let v = unsafe { &*info.vulkan };
-    crate::error::check_size::<HrtsVulkanDevice>(v.struct_size, "HrtsVulkanDevice")?;
+    let v = &crate::version::read(info.vulkan, "vulkan")?;
     let gipa = v.get_instance_proc_addr.ok_or_else(|| {
         ApiError::new(
             HrtsResult::ErrorNullPointer,
@@ -71,7 +69,8 @@ fn extension_names(v: &HrtsVulkanDevice) -> ApiResult<Vec<String>> {
             "enabled_extensions is NULL but its count is not 0",
         ));
     }
-    // SAFETY: the caller guarantees `enabled_extension_count` valid C strings.
+    check_aligned(v.enabled_extensions, "enabled_extensions")?;
+    // SAFETY: aligned; the caller guarantees `enabled_extension_count` valid C strings.
     let names = unsafe {
         std::slice::from_raw_parts(v.enabled_extensions, v.enabled_extension_count as usize)
     };

@@ -6,9 +6,10 @@ use crate::convert::{
     binning_path_to_c, require_usage, resource_id, resource_index, shadow_config, surface_input,
     FrameLight, RESOURCES,
 };
-use crate::error::{check_size, invalid, ApiError, ApiResult};
+use crate::error::{invalid, ApiError, ApiResult};
 use crate::geometry::{cpu_geometry, geometry_from, vulkan_geometry, GeometrySource};
 use crate::types::*;
+use crate::version::{major_minor, OLDEST_MINOR};
 use passes::retire::{completed_before, RetireQueue};
 use passes::{
     BinningRequest, Casters, FrameReport, MinCombine, NormalEncoding, PassStatus, ResourceId,
@@ -192,6 +193,8 @@ pub(crate) struct OpenFrame {
     pub(crate) index: u64,
     pub(crate) inputs: Vec<FrameLight>,
     pub(crate) last_pass: u32,
+    /// Whether the call that began the frame gave deformed meshes (their bounds do not hold).
+    pub(crate) deforms: bool,
 }
 
 /// Which frusta of each light a frame recorded: those where a caster may shadow a receiver in view within
@@ -288,21 +291,32 @@ pub(crate) struct Context {
     pub(crate) frusta: Vec<LightShape>,
     /// Which frusta the last `frames_in_flight` frames recorded, oldest first.
     pub(crate) schedules: std::collections::VecDeque<FrameSchedule>,
-    /// The message of the last call if it failed.
-    pub(crate) last_error: Option<std::ffi::CString>,
 }
 
 impl Context {
     /// Creates a context on an adopted or own device.
     pub(crate) fn new(info: &HrtsContextCreateInfo) -> ApiResult<Self> {
-        if info.api_version >> 22 != HRTS_API_VERSION >> 22 {
+        let (major, minor) = major_minor(info.api_version);
+        let (ours, our_minor) = major_minor(HRTS_API_VERSION);
+        let refused = if major != ours {
+            Some(format!(
+                "this library is API {ours}.{our_minor}: it reads no other major version"
+            ))
+        } else if minor > our_minor {
+            Some(format!(
+                "this library is API {ours}.{our_minor}, older than the caller's header: use a library of API {major}.{minor} or later"
+            ))
+        } else if minor < OLDEST_MINOR {
+            Some(format!(
+                "the {ours}.0 headers changed struct layouts without changing the version (HrtsDraw 72 then 76 bytes), so a {ours}.0 caller's structs cannot be told apart: rebuild against a header of {ours}.{OLDEST_MINOR} or later"
+            ))
+        } else {
+            None
+        };
+        if let Some(why) = refused {
             return Err(ApiError::new(
                 HrtsResult::ErrorVersion,
-                format!(
-                    "caller built against API {}.x, this library is {}.x",
-                    info.api_version >> 22,
-                    HRTS_API_VERSION >> 22
-                ),
+                format!("the caller's header is API {major}.{minor}: {why}"),
             ));
         }
         let frames_in_flight = match info.frames_in_flight {
@@ -332,12 +346,10 @@ impl Context {
             light_builds: vec![0],
             frusta: vec![LightShape::default()],
             schedules: Default::default(),
-            last_error: None,
         })
     }
 
     pub(crate) fn capabilities(&self, out: &mut HrtsCapabilities) -> ApiResult<()> {
-        check_size::<HrtsCapabilities>(out.struct_size, "HrtsCapabilities")?;
         let caps = self.device.capabilities();
         let default_path = passes::choose_binning_path(caps, BinningRequest::Auto)
             .map_or(HrtsBinningPath::Compute, binning_path_to_c);
@@ -545,7 +557,7 @@ impl Context {
     }
 
     /// Moves the geometry's draws: `transforms` holds 16 floats (column-major) per draw, over all meshes in
-    /// order.
+    /// order. Everything is checked before anything changes.
     pub(crate) fn set_draw_transforms(&mut self, transforms: &[f32]) -> ApiResult<()> {
         finite(transforms, "transforms")?;
         let models: Vec<glam::Mat4> = transforms
@@ -558,16 +570,15 @@ impl Context {
                 "set the geometry before moving its draws",
             )
         })?;
-        geometry.set_transforms(&models)?;
-        let stored_to_world = geometry.stored_to_world();
+        let moved = geometry.moved(&models)?;
         if let Some(built) = &self.built {
-            built.shared.set_transforms(&stored_to_world)?;
+            built.shared.set_transforms(&moved.stored_to_world)?;
         }
+        geometry.move_draws(moved);
         Ok(())
     }
 
     pub(crate) fn set_targets(&mut self, t: &HrtsTargets) -> ApiResult<()> {
-        check_size::<HrtsTargets>(t.struct_size, "HrtsTargets")?;
         let surface = surface_input(t)?;
         let derived = surface.encoding == NormalEncoding::FromDepth;
         if t.depth_image == 0 || (t.normal_image == 0 && !derived) || t.output_image == 0 {
@@ -931,7 +942,6 @@ impl Context {
         light: u32,
         out: &mut HrtsFrameReport,
     ) -> ApiResult<()> {
-        check_size::<HrtsFrameReport>(out.struct_size, "HrtsFrameReport")?;
         let built = self.built.as_ref().ok_or_else(|| {
             ApiError::new(
                 HrtsResult::ErrorInvalidState,
@@ -1070,7 +1080,6 @@ impl Context {
         resource: u32,
         out: &mut HrtsResourceInfo,
     ) -> ApiResult<()> {
-        check_size::<HrtsResourceInfo>(out.struct_size, "HrtsResourceInfo")?;
         let id = resource_id(resource)?;
         let pipeline = self.ensure_built()?.light(light)?.single(light)?;
         match (pipeline.image(id), pipeline.buffer(id)) {

@@ -1,8 +1,9 @@
 //! Conversion between the C types and the Rust ones, checking every value.
 
 use crate::context::LightShape;
-use crate::error::{check_size, invalid, ApiError, ApiResult};
+use crate::error::{invalid, ApiError, ApiResult};
 use crate::types::*;
+use crate::version::read_elements;
 use glam::{Mat4, Vec3};
 use passes::{
     BinningPath, BinningRequest, FaceMode, FrameInputs, Light, NormalEncoding, NormalSpace, PassId,
@@ -121,14 +122,7 @@ pub(crate) fn frame_inputs(
             f.light_count
         )));
     }
-    if f.lights.is_null() {
-        return Err(ApiError::new(
-            HrtsResult::ErrorNullPointer,
-            "lights is NULL",
-        ));
-    }
-    // SAFETY: the caller guarantees `lights` points at `light_count` lights (documented contract).
-    let lights = unsafe { std::slice::from_raw_parts(f.lights, f.light_count as usize) };
+    let lights = read_elements(f.lights, f.light_count as usize, f.light_stride, "lights")?;
     lights
         .iter()
         .enumerate()
@@ -467,7 +461,6 @@ fn c_value<T: PartialEq>(value: T, table: &[(u32, T)]) -> u32 {
 
 /// The plugin's configuration from the C one (every field checked).
 pub(crate) fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
-    check_size::<HrtsConfig>(c.struct_size, "HrtsConfig")?;
     let mode = enum_value(c.mode, &MODES, "mode", "HrtsShadowMode")?;
     let faces = enum_value(c.faces, &FACES, "faces", "HrtsFaces")?;
     let binning = enum_value(
@@ -601,7 +594,6 @@ pub(crate) fn config_to_c(config: &ShadowConfig) -> ApiResult<HrtsConfig> {
 
 /// Fills `out` with the defaults of [`ShadowConfig::default`].
 pub(crate) fn config_defaults(out: &mut HrtsConfig) -> ApiResult<()> {
-    check_size::<HrtsConfig>(out.struct_size, "HrtsConfig")?;
     *out = config_to_c(&ShadowConfig::default())?;
     Ok(())
 }

@@ -62,14 +62,15 @@ pub(crate) fn invalid(message: impl Into<String>) -> ApiError {
     ApiError::new(HrtsResult::ErrorInvalidArgument, message)
 }
 
-/// Checks a caller-provided `struct_size`.
-pub(crate) fn check_size<T>(size: u32, name: &str) -> ApiResult<()> {
-    let expected = std::mem::size_of::<T>();
-    if size as usize != expected {
-        return Err(ApiError::new(
-            HrtsResult::ErrorStructSize,
-            format!("{name}.struct_size is {size}, this library's {name} is {expected} bytes (header/library mismatch)"),
-        ));
+/// Checks the caller's pointer `p` (`what` names it) is aligned for `T`, before the plugin reads a `T` or
+/// a slice of them there.
+pub(crate) fn check_aligned<T>(p: *const T, what: &str) -> ApiResult<()> {
+    if p.is_aligned() {
+        Ok(())
+    } else {
+        Err(invalid(format!(
+            "{what} is not aligned to {} bytes",
+            std::mem::align_of::<T>()
+        )))
     }
-    Ok(())
 }

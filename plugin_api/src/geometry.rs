@@ -1,8 +1,9 @@
 //! Geometry intake: the engine's CPU arrays or Vulkan buffers, checked and kept to rebuild the passes.
 
 use crate::convert::{bounds, enum_value, finite, mat4};
-use crate::error::{check_size, invalid, ApiError, ApiResult};
+use crate::error::{check_aligned, invalid, ApiError, ApiResult};
 use crate::types::*;
+use crate::version::read_elements;
 use glam::{DVec3, Vec3};
 use passes::{Draw, Geometry, IndexFormat, IndexLayout, Mesh, VertexFormat, VertexLayout};
 use rhi::{BufferUsage, Device, Format};
@@ -33,6 +34,16 @@ pub(crate) enum GeometrySource {
     },
 }
 
+/// The draws moved to new transforms, checked by [`GeometrySource::moved`].
+pub(crate) struct MovedDraws {
+    /// Each draw's object-to-world transform, over all meshes in order.
+    models: Vec<glam::Mat4>,
+    /// Each draw's transform from stored positions to world.
+    pub(crate) stored_to_world: Vec<glam::Mat4>,
+    /// The new bounds of CPU geometry.
+    cpu_bounds: Option<[DVec3; 2]>,
+}
+
 /// One mesh in the engine's buffers.
 pub(crate) struct VulkanMesh {
     vertices: (u64, u64),
@@ -46,46 +57,72 @@ pub(crate) struct VulkanMesh {
 }
 
 impl GeometrySource {
-    /// Each draw's transform from stored positions to world, over all meshes in order: its own, after the
-    /// dequantization of its Vulkan mesh.
-    pub(crate) fn stored_to_world(&self) -> Vec<glam::Mat4> {
-        match self {
-            Self::Cpu { draws, .. } => draws.iter().map(|d| d.model).collect(),
-            Self::Vulkan { meshes, .. } => meshes
-                .iter()
-                .flat_map(|m| m.draws.iter().map(|d| d.model * m.dequantize))
-                .collect(),
-        }
-    }
-
-    /// Moves the draws (one object-to-world transform each, over all meshes in order): CPU geometry
-    /// recomputes its bounds; the bounds given with Vulkan geometry no longer hold (frames may give theirs).
-    pub(crate) fn set_transforms(&mut self, models: &[glam::Mat4]) -> ApiResult<()> {
-        let draws: Vec<&mut Draw> = match self {
-            Self::Cpu { draws, .. } => draws.iter_mut().collect(),
-            Self::Vulkan { meshes, .. } => meshes.iter_mut().flat_map(|m| &mut m.draws).collect(),
+    /// What moving the draws to `models` (one object-to-world transform each, over all meshes in order)
+    /// gives, checked and changing nothing yet: each draw's transform from stored positions to world
+    /// (finite: a Vulkan mesh's dequantization is applied to it), and CPU geometry's new bounds.
+    pub(crate) fn moved(&self, models: &[glam::Mat4]) -> ApiResult<MovedDraws> {
+        let draws = match self {
+            Self::Cpu { draws, .. } => draws.len(),
+            Self::Vulkan { meshes, .. } => meshes.iter().map(|m| m.draws.len()).sum(),
         };
-        if models.len() != draws.len() {
+        if models.len() != draws {
             return Err(invalid(format!(
-                "draw_count {} differs from the {} draws of the geometry (over all its meshes)",
+                "draw_count {} differs from the {draws} draws of the geometry (over all its meshes)",
                 models.len(),
-                draws.len()
             )));
         }
-        for (d, m) in draws.into_iter().zip(models) {
-            d.model = *m;
-        }
-        match self {
+        let (stored_to_world, cpu_bounds) = match self {
             Self::Cpu {
                 positions,
                 indices,
                 draws,
-                bounds,
                 ..
-            } => *bounds = draw_bounds(positions, indices, draws)?,
-            Self::Vulkan { bounds_hold, .. } => *bounds_hold = false,
+            } => {
+                let moved: Vec<Draw> = draws
+                    .iter()
+                    .zip(models)
+                    .map(|(d, &model)| Draw { model, ..*d })
+                    .collect();
+                let bounds = draw_bounds(positions, indices, &moved)?;
+                (models.to_vec(), Some(bounds))
+            }
+            Self::Vulkan { meshes, .. } => {
+                let dequantize = meshes
+                    .iter()
+                    .flat_map(|m| m.draws.iter().map(|_| m.dequantize));
+                (
+                    models.iter().zip(dequantize).map(|(m, d)| *m * d).collect(),
+                    None,
+                )
+            }
+        };
+        if let Some(i) = stored_to_world.iter().position(|m| !m.is_finite()) {
+            return Err(invalid(format!(
+                "transform {i} is finite, but not once its mesh's dequantization (position_scale, position_offset) is applied"
+            )));
         }
-        Ok(())
+        Ok(MovedDraws {
+            models: models.to_vec(),
+            stored_to_world,
+            cpu_bounds,
+        })
+    }
+
+    /// Moves the draws as [`GeometrySource::moved`] checked: CPU geometry takes its new bounds; the bounds
+    /// given with Vulkan geometry no longer hold (frames may give theirs).
+    pub(crate) fn move_draws(&mut self, moved: MovedDraws) {
+        let draws: Vec<&mut Draw> = match self {
+            Self::Cpu { draws, .. } => draws.iter_mut().collect(),
+            Self::Vulkan { meshes, .. } => meshes.iter_mut().flat_map(|m| &mut m.draws).collect(),
+        };
+        for (d, m) in draws.into_iter().zip(moved.models) {
+            d.model = m;
+        }
+        match (self, moved.cpu_bounds) {
+            (Self::Cpu { bounds, .. }, Some(moved)) => *bounds = moved,
+            (Self::Vulkan { bounds_hold, .. }, _) => *bounds_hold = false,
+            (Self::Cpu { .. }, None) => {}
+        }
     }
 
     /// World-space bounds (min, max) of every triangle in every frame, for culling: always for CPU
@@ -124,16 +161,12 @@ impl GeometrySource {
     }
 }
 
-fn draws_from(ptr: *const HrtsDraw, count: u32) -> ApiResult<Vec<Draw>> {
+/// The caller's `count` draws at `ptr`, `stride` bytes apart, checked.
+fn draws_from(ptr: *const HrtsDraw, count: u32, stride: usize) -> ApiResult<Vec<Draw>> {
     if count == 0 {
         return Err(invalid("draw_count is 0"));
     }
-    if ptr.is_null() {
-        return Err(ApiError::new(HrtsResult::ErrorNullPointer, "draws is NULL"));
-    }
-    // SAFETY: the caller guarantees `ptr` points at `count` draws (documented contract).
-    let draws = unsafe { std::slice::from_raw_parts(ptr, count as usize) };
-    draws
+    read_elements(ptr, count as usize, stride, "draws")?
         .iter()
         .enumerate()
         .map(|(i, d)| {
@@ -180,7 +213,6 @@ fn draw_bounds(positions: &[f32], indices: &[u32], draws: &[Draw]) -> ApiResult<
 
 /// The geometry of `hrts_set_geometry_cpu`, copied and checked.
 pub(crate) fn cpu_geometry(g: &HrtsCpuGeometry) -> ApiResult<GeometrySource> {
-    check_size::<HrtsCpuGeometry>(g.struct_size, "HrtsCpuGeometry")?;
     if g.positions.is_null() || g.indices.is_null() {
         return Err(ApiError::new(
             HrtsResult::ErrorNullPointer,
@@ -190,6 +222,8 @@ pub(crate) fn cpu_geometry(g: &HrtsCpuGeometry) -> ApiResult<GeometrySource> {
     if g.vertex_count == 0 || g.index_count == 0 {
         return Err(invalid("vertex_count and index_count must be positive"));
     }
+    check_aligned(g.positions, "positions")?;
+    check_aligned(g.indices, "indices")?;
     if g.vertex_stride < 12 || !g.vertex_stride.is_multiple_of(4) {
         return Err(invalid(format!(
             "vertex_stride {} must be a multiple of 4 and at least 12",
@@ -197,8 +231,8 @@ pub(crate) fn cpu_geometry(g: &HrtsCpuGeometry) -> ApiResult<GeometrySource> {
         )));
     }
     let floats = (g.vertex_count as usize - 1) * (g.vertex_stride as usize / 4) + 3;
-    // SAFETY: the caller guarantees the arrays hold `vertex_count` strided positions and `index_count`
-    // indices (documented contract); they are copied before returning.
+    // SAFETY: aligned; the caller guarantees the arrays hold `vertex_count` strided positions and
+    // `index_count` indices (documented contract); they are copied before returning.
     let raw = unsafe { std::slice::from_raw_parts(g.positions, floats) };
     let step = g.vertex_stride as usize / 4;
     let positions: Vec<f32> = (0..g.vertex_count as usize)
@@ -207,7 +241,7 @@ pub(crate) fn cpu_geometry(g: &HrtsCpuGeometry) -> ApiResult<GeometrySource> {
     finite(&positions, "positions")?;
     // SAFETY: as above.
     let indices = unsafe { std::slice::from_raw_parts(g.indices, g.index_count as usize) }.to_vec();
-    let draws = draws_from(g.draws, g.draw_count)?;
+    let draws = draws_from(g.draws, g.draw_count, g.draw_stride)?;
     let [lo, hi] = draw_bounds(&positions, &indices, &draws)?;
     for (n, d) in draws.iter().enumerate() {
         if !d.index_count.is_multiple_of(3)
@@ -268,7 +302,6 @@ pub(crate) fn vulkan_geometry(
 
 /// One mesh of the engine, checked but for its buffers' sizes, and its bounds.
 fn vulkan_mesh(g: &HrtsVulkanGeometry) -> ApiResult<(VulkanMesh, [DVec3; 2])> {
-    check_size::<HrtsVulkanGeometry>(g.struct_size, "HrtsVulkanGeometry")?;
     if g.vertex_buffer == 0 || g.index_buffer == 0 {
         return Err(ApiError::new(
             HrtsResult::ErrorNullPointer,
@@ -285,7 +318,7 @@ fn vulkan_mesh(g: &HrtsVulkanGeometry) -> ApiResult<(VulkanMesh, [DVec3; 2])> {
         "HrtsIndexType",
     )?;
     let bounds = bounds(&g.bounds)?;
-    let draws = draws_from(g.draws, g.draw_count)?;
+    let draws = draws_from(g.draws, g.draw_count, g.draw_stride)?;
     let stored = match g.vertex_format {
         0 => Some(Format::Rgb32Float),
         raw => i32::try_from(raw)
@@ -402,12 +435,7 @@ pub(crate) fn deformed_meshes(
             format!("deformed is NULL with deformed_count {count}"),
         ));
     }
-    if !f.deformed.is_aligned() {
-        return Err(invalid(format!(
-            "deformed is not aligned to {} bytes",
-            std::mem::align_of::<HrtsMeshVertices>()
-        )));
-    }
+    let deformed = read_elements(f.deformed, count, f.deformed_stride, "deformed")?;
     let geometry = geometry.ok_or_else(|| {
         ApiError::new(
             HrtsResult::ErrorInvalidState,
@@ -420,8 +448,6 @@ pub(crate) fn deformed_meshes(
             "deformed_count {count} exceeds the {meshes} meshes of the geometry"
         )));
     }
-    // SAFETY: non-NULL and aligned; the caller guarantees `deformed_count` entries (documented contract).
-    let deformed = unsafe { std::slice::from_raw_parts(f.deformed, count) };
     for (i, v) in deformed.iter().enumerate() {
         let mesh = v.mesh as usize;
         let layout = geometry.vertex_layout(mesh).ok_or_else(|| {

@@ -4,12 +4,40 @@
 
 use crate::context::Context;
 use crate::types::HrtsContext;
-use std::sync::{Arc, Mutex};
+use std::ffi::CString;
+use std::sync::{Arc, Mutex, MutexGuard};
+
+/// A live context and the message of the last call on it.
+pub(crate) struct Entry {
+    /// The context, used by one thread at a time.
+    pub(crate) context: Mutex<Context>,
+    /// The message of the last call on the context if it failed. Locked only to set it or copy it out, so
+    /// that any thread can read it while another uses the context.
+    last_error: Mutex<Option<CString>>,
+}
+
+impl Entry {
+    fn last_error_slot(&self) -> MutexGuard<'_, Option<CString>> {
+        self.last_error
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    /// A copy of the message of the last call on the context (empty if it succeeded).
+    pub(crate) fn last_error(&self) -> CString {
+        self.last_error_slot().clone().unwrap_or_default()
+    }
+
+    /// Keeps the outcome of a call on the context: its message if it failed, `None` if it succeeded.
+    pub(crate) fn set_last_error(&self, message: Option<CString>) {
+        *self.last_error_slot() = message;
+    }
+}
 
 /// One slot: its current generation and the context created with it, if live.
 struct Slot {
     generation: u32,
-    context: Option<Arc<Mutex<Context>>>,
+    context: Option<Arc<Entry>>,
 }
 
 static SLOTS: Mutex<Vec<Slot>> = Mutex::new(Vec::new());
@@ -38,7 +66,7 @@ fn parts(handle: *const HrtsContext) -> Option<(usize, u32)> {
     Some((index as usize, (raw >> 32) as u32))
 }
 
-fn slots() -> std::sync::MutexGuard<'static, Vec<Slot>> {
+fn slots() -> MutexGuard<'static, Vec<Slot>> {
     SLOTS
         .lock()
         .unwrap_or_else(|poisoned| poisoned.into_inner())
@@ -47,7 +75,10 @@ fn slots() -> std::sync::MutexGuard<'static, Vec<Slot>> {
 /// Registers a new context and returns its handle.
 pub(crate) fn register(context: Context) -> *mut HrtsContext {
     let mut slots = slots();
-    let context = Some(Arc::new(Mutex::new(context)));
+    let context = Some(Arc::new(Entry {
+        context: Mutex::new(context),
+        last_error: Mutex::new(None),
+    }));
     match free_slot(&slots) {
         Some(i) => {
             let slot = &mut slots[i];
@@ -66,7 +97,7 @@ pub(crate) fn register(context: Context) -> *mut HrtsContext {
 }
 
 /// The live context a handle names.
-pub(crate) fn lookup(handle: *const HrtsContext) -> Option<Arc<Mutex<Context>>> {
+pub(crate) fn lookup(handle: *const HrtsContext) -> Option<Arc<Entry>> {
     let (index, generation) = parts(handle)?;
     let slots = slots();
     let slot = slots.get(index).filter(|s| s.generation == generation)?;
@@ -74,7 +105,7 @@ pub(crate) fn lookup(handle: *const HrtsContext) -> Option<Arc<Mutex<Context>>> 
 }
 
 /// Unregisters the context a handle names; returns it if it was live.
-pub(crate) fn unregister(handle: *const HrtsContext) -> Option<Arc<Mutex<Context>>> {
+pub(crate) fn unregister(handle: *const HrtsContext) -> Option<Arc<Entry>> {
     let (index, generation) = parts(handle)?;
     let mut slots = slots();
     let slot = slots

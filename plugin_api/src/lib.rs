@@ -7,8 +7,8 @@
 //! `hrts_context_destroy`.
 //!
 //! Every function is behind a panic boundary, checks its pointers, struct sizes, enum values and numbers,
-//! and returns an `HrtsResult`; `hrts_last_error` gives the message of the last failure. A context must
-//! not be used from two threads at once.
+//! and returns an `HrtsResult`; `hrts_get_last_error` (or `hrts_last_error`) gives the message of the last
+//! failure, from any thread. A context must not be used from two threads at once.
 
 mod adopt;
 mod context;
@@ -19,6 +19,7 @@ mod handles;
 mod memory;
 mod record;
 mod types;
+mod version;
 
 use context::Context;
 use error::{ApiError, ApiResult};
@@ -32,6 +33,8 @@ thread_local! {
     /// The message of the thread's last call if it failed (clearing it allocates nothing, so the first call
     /// can still install allocation callbacks).
     static LAST_ERROR: RefCell<Option<CString>> = const { RefCell::new(None) };
+    /// The thread's copies of contexts' messages that `hrts_last_error` returned, by context handle.
+    static RETURNED_ERRORS: RefCell<Vec<(usize, CString)>> = const { RefCell::new(Vec::new()) };
 }
 
 fn c_message(message: &str) -> CString {
@@ -53,17 +56,20 @@ fn boundary(ctx: Option<*const HrtsContext>, f: impl FnOnce() -> ApiResult<()>) 
             format!("internal error (panic caught at the C boundary): {what}"),
         ))
     });
+    let message = outcome.as_ref().err().map(|e| c_message(&e.message));
+    if let Some(entry) = ctx.and_then(handles::lookup) {
+        entry.set_last_error(message.clone());
+    }
+    LAST_ERROR.with(|last| *last.borrow_mut() = message);
     match outcome {
         Ok(()) => HrtsResult::Ok,
-        Err(e) => {
-            let context = ctx.and_then(handles::lookup);
-            LAST_ERROR.with(|last| *last.borrow_mut() = Some(c_message(&e.message)));
-            if let Some(Ok(mut c)) = context.as_ref().map(|c| c.try_lock()) {
-                c.last_error = Some(c_message(&e.message));
-            }
-            e.code
-        }
+        Err(e) => e.code,
     }
+}
+
+/// Runs `f` behind the panic boundary for an export that returns no `HrtsResult`: `fallback` if it panics.
+fn unwinding_to<T>(fallback: T, f: impl FnOnce() -> T) -> T {
+    catch_unwind(AssertUnwindSafe(f)).unwrap_or(fallback)
 }
 
 /// Runs `f` on a live context.
@@ -78,13 +84,13 @@ fn with_context(
                 "context is NULL",
             ));
         }
-        let context = handles::lookup(ctx).ok_or_else(|| {
+        let entry = handles::lookup(ctx).ok_or_else(|| {
             ApiError::new(
                 HrtsResult::ErrorInvalidContext,
                 "context is not live (destroyed or never created)",
             )
         })?;
-        let mut guard = match context.try_lock() {
+        let mut guard = match entry.context.try_lock() {
             Ok(guard) => guard,
             Err(std::sync::TryLockError::WouldBlock) => {
                 return Err(ApiError::new(
@@ -99,63 +105,8 @@ fn with_context(
                 ))
             }
         };
-        guard.last_error = None;
         f(&mut guard)
     })
-}
-
-/// The C structs whose first field is `u32 struct_size`: the `sizeof` of the struct the caller was built
-/// with, checked before the plugin makes a reference to the whole struct.
-///
-/// # Safety
-/// Implementors are `#[repr(C)]` and start with a `u32` `struct_size` field.
-unsafe trait Versioned {}
-
-macro_rules! versioned {
-    ($($t:ty)*) => {$(
-        // SAFETY: `#[repr(C)]`, first field `struct_size: u32` (types.rs).
-        unsafe impl Versioned for $t {}
-    )*};
-}
-versioned!(HrtsAllocationCallbacks HrtsMemoryStats HrtsContextCreateInfo HrtsCapabilities HrtsConfig
-    HrtsCpuGeometry HrtsVulkanGeometry HrtsTargets HrtsFrame HrtsResourceInfo HrtsResourceReadback
-    HrtsFrameReport);
-
-/// Checks a caller's versioned struct before it is read as a whole: not NULL, aligned, and of this
-/// library's size (a struct of an older, smaller version is refused without reading past its end).
-fn check_versioned<T: Versioned>(p: *const T, name: &str) -> ApiResult<()> {
-    if p.is_null() {
-        return Err(ApiError::new(
-            HrtsResult::ErrorNullPointer,
-            format!("{name} is NULL"),
-        ));
-    }
-    if !p.is_aligned() {
-        return Err(error::invalid(format!(
-            "{name} is not aligned to {} bytes",
-            std::mem::align_of::<T>()
-        )));
-    }
-    // SAFETY: a non-NULL pointer passed to the C ABI points at a struct of this family whatever its
-    // version (documented contract), and every version starts with the `u32` size; it is aligned.
-    let size = unsafe { p.cast::<u32>().read() };
-    let type_name = std::any::type_name::<T>()
-        .rsplit("::")
-        .next()
-        .unwrap_or(name);
-    error::check_size::<T>(size, type_name)
-}
-
-fn deref<'a, T: Versioned>(p: *const T, name: &str) -> ApiResult<&'a T> {
-    check_versioned(p, name)?;
-    // SAFETY: checked non-NULL, aligned and of this version's size; valid per the documented contract.
-    Ok(unsafe { &*p })
-}
-
-fn deref_mut<'a, T: Versioned>(p: *mut T, name: &str) -> ApiResult<&'a mut T> {
-    check_versioned(p, name)?;
-    // SAFETY: as for `deref`; the caller gives the plugin exclusive use of `*p` during the call.
-    Ok(unsafe { &mut *p })
 }
 
 /// For Rust hosts linking the rlib: the pipeline resource an `HrtsResource` value names.
@@ -191,8 +142,7 @@ pub unsafe extern "C" fn hrts_set_allocation_callbacks(
     callbacks: *const HrtsAllocationCallbacks,
 ) -> HrtsResult {
     boundary(None, || {
-        let c = deref(callbacks, "callbacks")?;
-        error::check_size::<HrtsAllocationCallbacks>(c.struct_size, "HrtsAllocationCallbacks")?;
+        let c = version::read(callbacks, "callbacks")?;
         let (Some(allocate), Some(free)) = (c.allocate, c.free) else {
             return Err(ApiError::new(
                 HrtsResult::ErrorNullPointer,
@@ -229,16 +179,16 @@ pub unsafe extern "C" fn hrts_set_allocation_callbacks(
 #[no_mangle]
 pub unsafe extern "C" fn hrts_get_memory_stats(out: *mut HrtsMemoryStats) -> HrtsResult {
     boundary(None, || {
-        let out = deref_mut(out, "out")?;
-        error::check_size::<HrtsMemoryStats>(out.struct_size, "HrtsMemoryStats")?;
-        out.host_bytes_counted = memory::is_global_allocator().into();
-        out.host_bytes = if out.host_bytes_counted != 0 {
-            memory::live_host_bytes()
-        } else {
-            0
-        };
-        out.gpu_bytes = rhi::live_gpu_allocation_bytes();
-        Ok(())
+        version::write(out, "out", |out| {
+            out.host_bytes_counted = memory::is_global_allocator().into();
+            out.host_bytes = if out.host_bytes_counted != 0 {
+                memory::live_host_bytes()
+            } else {
+                0
+            };
+            out.gpu_bytes = rhi::live_gpu_allocation_bytes();
+            Ok(())
+        })
     })
 }
 
@@ -246,33 +196,94 @@ pub unsafe extern "C" fn hrts_get_memory_stats(out: *mut HrtsMemoryStats) -> Hrt
 #[no_mangle]
 pub extern "C" fn hrts_result_name(result: i32) -> *const c_char {
     static NAMES: std::sync::OnceLock<Vec<CString>> = std::sync::OnceLock::new();
-    let names = NAMES.get_or_init(|| {
-        HrtsResult::ALL
-            .iter()
-            .map(|r| c_message(&r.c_name()))
-            .collect()
-    });
-    match HrtsResult::from_c(result) {
-        Some(r) => names[r as usize].as_ptr(),
-        None => c"HRTS_RESULT_UNKNOWN".as_ptr(),
-    }
+    unwinding_to(c"HRTS_RESULT_UNKNOWN".as_ptr(), || {
+        let names = NAMES.get_or_init(|| {
+            HrtsResult::ALL
+                .iter()
+                .map(|r| c_message(&r.c_name()))
+                .collect()
+        });
+        match HrtsResult::from_c(result) {
+            Some(r) => names[r as usize].as_ptr(),
+            None => c"HRTS_RESULT_UNKNOWN".as_ptr(),
+        }
+    })
 }
 
 /// The message of the last call on `context` if it failed, or, if `context` is NULL or not live, of the
-/// last call on this thread if it failed; empty after a successful call. Valid until the next call on the
-/// same context (or thread).
+/// calling thread's last call; empty after a successful call. For a live context the string is the
+/// calling thread's own copy, valid until the thread calls `hrts_last_error` on that context again or the
+/// context is destroyed, whatever other threads do; for NULL, until the thread's next call into the plugin.
+/// `hrts_get_last_error` copies the message into the caller's memory instead.
 ///
 /// # Safety
 /// `context` is NULL or a handle returned by `hrts_context_create`.
 #[no_mangle]
 pub unsafe extern "C" fn hrts_last_error(context: *const HrtsContext) -> *const c_char {
-    if let Some(c) = handles::lookup(context) {
-        if let Ok(c) = c.try_lock() {
-            // The message lives in the context, which the registry keeps alive until it is destroyed.
-            return c.last_error.as_ref().map_or(c"".as_ptr(), |m| m.as_ptr());
+    unwinding_to(c"".as_ptr(), || {
+        let Some(entry) = handles::lookup(context) else {
+            return LAST_ERROR.with(|e| e.borrow().as_ref().map_or(c"".as_ptr(), |m| m.as_ptr()));
+        };
+        let message = entry.last_error();
+        RETURNED_ERRORS.with(|copies| {
+            let mut copies = copies.borrow_mut();
+            // The copies of destroyed contexts go.
+            copies.retain(|&(handle, _)| {
+                handle == context as usize
+                    || handles::lookup(handle as *const HrtsContext).is_some()
+            });
+            let at = match copies
+                .iter()
+                .position(|&(handle, _)| handle == context as usize)
+            {
+                Some(at) => at,
+                None => {
+                    copies.push((context as usize, CString::default()));
+                    copies.len() - 1
+                }
+            };
+            // An unchanged message keeps the string returned before.
+            if copies[at].1 != message {
+                copies[at].1 = message;
+            }
+            copies[at].1.as_ptr()
+        })
+    })
+}
+
+/// Copies the message of the last call on `context` if it failed (or, if `context` is NULL or not live,
+/// of the calling thread's last call; empty after a successful call) into `buffer`, NUL-terminated and
+/// truncated to `capacity` bytes, and returns the bytes the whole message needs with its NUL: a return
+/// above `capacity` means the copy was truncated. `buffer` may be NULL (nothing is copied) to ask for the
+/// size. Reading a context's message is safe while another thread calls it. Returns 0 only if the plugin
+/// failed internally. (API 5.8.)
+///
+/// # Safety
+/// `context` is NULL or a handle returned by `hrts_context_create`; `buffer` is NULL or holds `capacity`
+/// writable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn hrts_get_last_error(
+    context: *const HrtsContext,
+    buffer: *mut c_char,
+    capacity: usize,
+) -> usize {
+    unwinding_to(0, || {
+        let message = match handles::lookup(context) {
+            Some(entry) => entry.last_error(),
+            None => LAST_ERROR.with(|e| e.borrow().clone().unwrap_or_default()),
+        };
+        let bytes = message.as_bytes_with_nul();
+        if !buffer.is_null() && capacity > 0 {
+            let copied = bytes.len().min(capacity) - 1;
+            // SAFETY: `buffer` holds `capacity` writable bytes (contract) and `copied` < `capacity`; the
+            // message is the plugin's own copy.
+            unsafe {
+                std::ptr::copy_nonoverlapping(bytes.as_ptr(), buffer.cast::<u8>(), copied);
+                buffer.add(copied).write(0);
+            }
         }
-    }
-    LAST_ERROR.with(|e| e.borrow().as_ref().map_or(c"".as_ptr(), |m| m.as_ptr()))
+        bytes.len()
+    })
 }
 
 /// Creates a context. On success `*out_context` receives its handle; on failure it is set to NULL.
@@ -295,9 +306,8 @@ pub unsafe extern "C" fn hrts_context_create(
         // SAFETY: checked non-NULL and aligned; the caller gives a writable pointer (contract).
         let out = unsafe { &mut *out_context };
         *out = std::ptr::null_mut();
-        let info = deref(info, "info")?;
-        error::check_size::<HrtsContextCreateInfo>(info.struct_size, "HrtsContextCreateInfo")?;
-        *out = handles::register(Context::new(info)?);
+        let info = version::read(info, "info")?;
+        *out = handles::register(Context::new(&info)?);
         Ok(())
     })
 }
@@ -336,7 +346,9 @@ pub unsafe extern "C" fn hrts_get_capabilities(
     context: *mut HrtsContext,
     out: *mut HrtsCapabilities,
 ) -> HrtsResult {
-    with_context(context, |c| c.capabilities(deref_mut(out, "out")?))
+    with_context(context, |c| {
+        version::write(out, "out", |out| c.capabilities(out))
+    })
 }
 
 /// Fills `out` (with `out->struct_size` set) with the default configuration: hybrid shadows with FXAA,
@@ -346,7 +358,9 @@ pub unsafe extern "C" fn hrts_get_capabilities(
 /// `out` is NULL or valid.
 #[no_mangle]
 pub unsafe extern "C" fn hrts_config_defaults(out: *mut HrtsConfig) -> HrtsResult {
-    boundary(None, || convert::config_defaults(deref_mut(out, "out")?))
+    boundary(None, || {
+        version::write(out, "out", convert::config_defaults)
+    })
 }
 
 /// Sets one light's configuration: `hrts_configure_lights` with one light.
@@ -359,7 +373,7 @@ pub unsafe extern "C" fn hrts_configure(
     config: *const HrtsConfig,
 ) -> HrtsResult {
     with_context(context, |c| {
-        c.configure_lights(std::slice::from_ref(deref(config, "config")?))
+        c.configure_lights(&[version::read(config, "config")?])
     })
 }
 
@@ -379,15 +393,22 @@ pub unsafe extern "C" fn hrts_configure_lights(
     configs: *const HrtsConfig,
 ) -> HrtsResult {
     with_context(context, |c| {
-        let first = deref(configs, "configs")?;
+        if configs.is_null() {
+            return Err(ApiError::new(
+                HrtsResult::ErrorNullPointer,
+                "configs is NULL",
+            ));
+        }
         if light_count == 0 || light_count > HRTS_MAX_LIGHTS {
             return Err(error::invalid(format!(
                 "light_count {light_count} must be within 1..={HRTS_MAX_LIGHTS}"
             )));
         }
-        // SAFETY: non-NULL; the caller guarantees `light_count` configurations.
-        let all = unsafe { std::slice::from_raw_parts(first, light_count as usize) };
-        c.configure_lights(all)
+        c.configure_lights(&version::read_array(
+            configs,
+            light_count as usize,
+            "configs",
+        )?)
     })
 }
 
@@ -402,7 +423,7 @@ pub unsafe extern "C" fn hrts_set_geometry_cpu(
     geometry: *const HrtsCpuGeometry,
 ) -> HrtsResult {
     with_context(context, |c| {
-        c.set_geometry_cpu(deref(geometry, "geometry")?)
+        c.set_geometry_cpu(&version::read(geometry, "geometry")?)
     })
 }
 
@@ -417,7 +438,7 @@ pub unsafe extern "C" fn hrts_set_geometry_vulkan(
     geometry: *const HrtsVulkanGeometry,
 ) -> HrtsResult {
     with_context(context, |c| {
-        c.set_geometry_vulkan(std::slice::from_ref(deref(geometry, "geometry")?), false)
+        c.set_geometry_vulkan(&[version::read(geometry, "geometry")?], false)
     })
 }
 
@@ -441,14 +462,11 @@ pub unsafe extern "C" fn hrts_set_geometry_vulkan_meshes(
     mesh_count: u32,
 ) -> HrtsResult {
     with_context(context, |c| {
-        let first = deref(meshes, "meshes")?;
-        if mesh_count == 0 {
+        let all = version::read_array(meshes, mesh_count as usize, "meshes")?;
+        if all.is_empty() {
             return Err(error::invalid("mesh_count is 0"));
         }
-        // SAFETY: non-NULL, aligned and of this version's size; the caller guarantees `mesh_count`
-        // meshes.
-        let all = unsafe { std::slice::from_raw_parts(first, mesh_count as usize) };
-        c.set_geometry_vulkan(all, true)
+        c.set_geometry_vulkan(&all, true)
     })
 }
 
@@ -459,7 +477,7 @@ pub unsafe extern "C" fn hrts_set_geometry_vulkan_meshes(
 /// changed since the prim buffer was last built (and what depends on the prim buffer); frames already
 /// recorded keep their transforms. No pass is rebuilt and nothing is recorded. With Vulkan geometry the
 /// bounds of the geometry call no longer hold: give each frame's in `HrtsFrame::bounds` for the plugin to
-/// cull by them.
+/// cull by them. A call that fails changes nothing.
 ///
 /// # Safety
 /// As for `hrts_get_capabilities`; `transforms` points at `16 * draw_count` floats.
@@ -476,7 +494,8 @@ pub unsafe extern "C" fn hrts_set_draw_transforms(
                 "transforms is NULL",
             ));
         }
-        // SAFETY: the caller guarantees `transforms` points at 16 * draw_count floats (documented).
+        error::check_aligned(transforms, "transforms")?;
+        // SAFETY: aligned; the caller guarantees `transforms` points at 16 * draw_count floats (documented).
         let all = unsafe { std::slice::from_raw_parts(transforms, draw_count as usize * 16) };
         c.set_draw_transforms(all)
     })
@@ -493,7 +512,9 @@ pub unsafe extern "C" fn hrts_set_targets(
     context: *mut HrtsContext,
     targets: *const HrtsTargets,
 ) -> HrtsResult {
-    with_context(context, |c| c.set_targets(deref(targets, "targets")?))
+    with_context(context, |c| {
+        c.set_targets(&version::read(targets, "targets")?)
+    })
 }
 
 /// Records every pass of one frame into `frame->command_buffer`: `hrts_record_passes` with
@@ -507,7 +528,7 @@ pub unsafe extern "C" fn hrts_record_frame(
     frame: *const HrtsFrame,
 ) -> HrtsResult {
     with_context(context, |c| {
-        c.record_passes(deref(frame, "frame")?, HRTS_PASS_MASK_ALL)
+        c.record_passes(&version::read(frame, "frame")?, HRTS_PASS_MASK_ALL)
     })
 }
 
@@ -545,7 +566,7 @@ pub unsafe extern "C" fn hrts_record_passes(
     pass_mask: u32,
 ) -> HrtsResult {
     with_context(context, |c| {
-        c.record_passes(deref(frame, "frame")?, pass_mask)
+        c.record_passes(&version::read(frame, "frame")?, pass_mask)
     })
 }
 
@@ -562,7 +583,7 @@ pub unsafe extern "C" fn hrts_get_resource_info(
     out: *mut HrtsResourceInfo,
 ) -> HrtsResult {
     with_context(context, |c| {
-        c.resource_info(light, resource, deref_mut(out, "out")?)
+        version::write(out, "out", |out| c.resource_info(light, resource, out))
     })
 }
 
@@ -578,7 +599,9 @@ pub unsafe extern "C" fn hrts_record_resource_readback(
     context: *mut HrtsContext,
     readback: *const HrtsResourceReadback,
 ) -> HrtsResult {
-    with_context(context, |c| c.record_readback(deref(readback, "readback")?))
+    with_context(context, |c| {
+        c.record_readback(&version::read(readback, "readback")?)
+    })
 }
 
 /// Fills `out` (with `out->struct_size` set) with what `light`'s passes did in frame `frame_index`: one
@@ -596,6 +619,6 @@ pub unsafe extern "C" fn hrts_get_frame_report(
     out: *mut HrtsFrameReport,
 ) -> HrtsResult {
     with_context(context, |c| {
-        c.report(frame_index, light, deref_mut(out, "out")?)
+        version::write(out, "out", |out| c.report(frame_index, light, out))
     })
 }

@@ -3,7 +3,7 @@
 
 use crate::context::{Built, Context, FrameProgress, OpenFrame};
 use crate::convert::{frame_bounds, frame_inputs, pass_from_index, resource_id, FrameLight};
-use crate::error::{check_size, invalid, ApiError, ApiResult};
+use crate::error::{invalid, ApiError, ApiResult};
 use crate::geometry::deformed_meshes;
 use crate::types::*;
 use passes::retire::completed_before;
@@ -19,7 +19,6 @@ pub(crate) const DEPTH_NORMAL_READERS: u32 = 1 << HrtsPass::PrimitiveMap as u32
 
 impl Context {
     pub(crate) fn record_passes(&mut self, f: &HrtsFrame, mask: u32) -> ApiResult<()> {
-        check_size::<HrtsFrame>(f.struct_size, "HrtsFrame")?;
         if f.command_buffer == 0 {
             return Err(ApiError::new(
                 HrtsResult::ErrorNullPointer,
@@ -34,9 +33,27 @@ impl Context {
         if f.frame_index == u64::MAX {
             return Err(invalid("frame_index UINT64_MAX is reserved"));
         }
-        let bounds = frame_bounds(f)?;
-        let deformed = deformed_meshes(f, self.geometry.as_ref())?;
-        let bounds = self.scene_bounds(bounds, !deformed.is_empty());
+        let lowest = mask.trailing_zeros();
+        let highest = 31 - mask.leading_zeros();
+        // A call of the frame being recorded that goes on after its last pass continues it, with the
+        // meshes its first call deformed; any other call begins a frame and alone reads `deformed` (the
+        // engine may free the array once that call returned).
+        let continued = match &self.progress.open {
+            Some(open) if open.index == f.frame_index && lowest > open.last_pass => Some(open),
+            Some(open) if open.index == f.frame_index => {
+                return Err(invalid(format!(
+                    "frame {} is being recorded up to pass {}: a call of the same frame must go on after it",
+                    open.index, open.last_pass
+                )))
+            }
+            _ => None,
+        };
+        let deformed = match continued {
+            Some(_) => Vec::new(),
+            None => deformed_meshes(f, self.geometry.as_ref())?,
+        };
+        let deforms = continued.map_or(!deformed.is_empty(), |open| open.deforms);
+        let bounds = self.scene_bounds(frame_bounds(f)?, deforms);
         let inputs = frame_inputs(f, bounds)?;
         if inputs.len() != self.lights.len() {
             return Err(invalid(format!(
@@ -50,6 +67,12 @@ impl Context {
             .zip(&self.lights)
             .map(|(light, config)| light.shadowed_as(config))
             .collect();
+        if continued.is_some_and(|open| open.inputs != inputs) {
+            return Err(invalid(
+                "the camera and lights must stay the same across the calls of one frame",
+            ));
+        }
+        let continues = continued.is_some();
         let mut used_layouts = Vec::new();
         if mask & DEPTH_NORMAL_READERS != 0 {
             used_layouts.push(("depth_layout", f.depth_layout));
@@ -78,25 +101,6 @@ impl Context {
                 self.lights.len()
             )));
         }
-        let lowest = mask.trailing_zeros();
-        let highest = 31 - mask.leading_zeros();
-        let continues = match &self.progress.open {
-            Some(open) if open.index == f.frame_index && lowest > open.last_pass => {
-                if open.inputs != inputs {
-                    return Err(invalid(
-                        "the camera and lights must stay the same across the calls of one frame",
-                    ));
-                }
-                true
-            }
-            Some(open) if open.index == f.frame_index => {
-                return Err(invalid(format!(
-                    "frame {} is being recorded up to pass {}: a call of the same frame must go on after it",
-                    open.index, open.last_pass
-                )))
-            }
-            _ => false,
-        };
         if !continues {
             self.begin_frame(f.frame_index)?;
         }
@@ -237,6 +241,7 @@ impl Context {
                 index: frame_index,
                 inputs,
                 last_pass: highest,
+                deforms,
             });
         }
         if let Some(schedule) = schedule.filter(|_| !continues) {
@@ -246,7 +251,6 @@ impl Context {
     }
 
     pub(crate) fn record_readback(&mut self, r: &HrtsResourceReadback) -> ApiResult<()> {
-        check_size::<HrtsResourceReadback>(r.struct_size, "HrtsResourceReadback")?;
         if r.command_buffer == 0 || r.buffer == 0 {
             return Err(ApiError::new(
                 HrtsResult::ErrorNullPointer,

@@ -1,12 +1,32 @@
-//! The C-visible types. Input structs start with `struct_size` (the caller's `sizeof`), so a header of
-//! another version is rejected instead of misread. Enumerations passed *in* are `uint32_t` fields whose
+//! The C-visible types. Structs start with `struct_size` (the caller's `sizeof`), which says the version of
+//! the caller's header they were built with; arrays of structs without one come with a stride
+//! (`HRTS_API_VERSION` says how versions are read). Enumerations passed *in* are `uint32_t` fields whose
 //! values are listed by the matching enum; unknown values are rejected with `HRTS_RESULT_ERROR_INVALID_ENUM`.
 
 use std::ffi::c_char;
 
-/// Version of this header: `(major << 22) | (minor << 12) | patch`. A context refuses callers whose major
-/// version differs.
-pub const HRTS_API_VERSION: u32 = 5 << 22 | 8 << 12;
+/// Version of this header: `(major << 22) | (minor << 12) | patch`.
+///
+/// Versions. A minor version adds functions, enum values, and fields at the end of structs, never
+/// elsewhere, and a struct it extends grows (a new field never takes the trailing padding of an older
+/// version). A library reads the structs of every minor version of its major version from 5.1 on:
+/// - `struct_size` (the `sizeof` of the caller's header) says a struct's version. The library reads the
+///   fields that version has and gives the newer ones the defaults their documentation states ("API 5.x:
+///   ..."); a struct the library fills is written up to the caller's `struct_size` only, the fields of
+///   newer versions left out.
+/// - Arrays of structs without a `struct_size` (`HrtsDraw`, `HrtsLight`, `HrtsMeshVertices`) are read at
+///   the stride given beside them (`draw_stride`, `light_stride`, `deformed_stride`): the caller's `sizeof`
+///   of the element, which says its version. A stride of 0, as in the structs of callers before 5.8,
+///   reads the element as API 5.1 to 5.8 define it. An array of structs with a `struct_size`
+///   (`hrts_configure_lights`, `hrts_set_geometry_vulkan_meshes`) is read at its first element's, which
+///   every element must have.
+/// - A size or stride that is the size of no version this library reads, or of a newer version than
+///   the library's (the caller's header is newer), fails with `HRTS_RESULT_ERROR_STRUCT_SIZE` and a
+///   message listing the sizes it reads.
+/// - `hrts_context_create` refuses (`HRTS_RESULT_ERROR_VERSION`) another major version, a minor version
+///   newer than the library's, and 5.0, whose headers changed layouts without changing the version
+///   (`HrtsDraw` 72 then 76 bytes): its structs cannot be told apart.
+pub const HRTS_API_VERSION: u32 = 5 << 22 | 9 << 12;
 
 /// A flag in the C structs: 0 is false, any other value true. (A Rust `bool` would make any byte but 0
 /// and 1 undefined behaviour when the engine writes it.)
@@ -27,9 +47,11 @@ pub enum HrtsResult {
     Ok = 0,
     /// A required pointer argument was NULL.
     ErrorNullPointer = 1,
-    /// `struct_size` does not match this library's struct (header/library mismatch).
+    /// A `struct_size` or an array's element stride is the size of no version of the struct this library
+    /// reads (header/library mismatch, or a header newer than the library).
     ErrorStructSize = 2,
-    /// The caller's `api_version` has another major version.
+    /// The caller's `api_version` is of another major version, a newer minor version than the library's,
+    /// or 5.0.
     ErrorVersion = 3,
     /// An enumeration field holds an unknown value.
     ErrorInvalidEnum = 4,
@@ -216,8 +238,8 @@ pub enum HrtsResource {
     PrimListOffsets = 1,
     /// Primitive map list entries, a buffer of `uint32_t` triangle indices (`R32_UINT`, width = capacity).
     PrimListEntries = 2,
-    /// Occupancy view, `R8G8B8A8_UNORM`, N² (grey: list length on a log scale; red: traced exhaustively, past
-    /// the capacity or in an overflowed group of the packed offsets).
+    /// Occupancy view, `R8G8B8A8_UNORM`, N² (grey: list length on a log scale; red: no list kept, its pixels
+    /// walk the BVH: past the capacity or the list limit, or in an overflowed group of the packed offsets).
     Occupancy = 3,
     /// Ray-traced visibility, `R32_SFLOAT`, 1 = lit.
     RtVisibility = 4,
@@ -500,22 +522,25 @@ pub struct HrtsConfig {
     /// triangles). An engine that knows its scene can size them and avoid the frame of a growth.
     pub map_initial_entries: u32,
     /// (Triangle, face) pairs a point light's cube map starts with (default 0: two per triangle, at least
-    /// 1024; at most six per triangle). A frame that keeps more traces the light exhaustively (exact, slower; `bin_pairs` in the
-    /// frame report) and the pairs grow to fit from the next frame on.
+    /// 1024; at most six per triangle). A frame that keeps more walks every pixel of the light through the
+    /// BVH (exact; `bin_pairs` in the frame report) and the pairs grow to fit from the next frame on. API 5.4: 0 for a configuration of
+    /// 5.1 to 5.3.
     pub map_initial_pairs: u32,
-    /// Area shadows: light samples per pixel, 1..=128 (default 64).
+    /// Area shadows: light samples per pixel, 1..=128 (default 64). API 5.5: 64 for a configuration of 5.1
+    /// to 5.4.
     pub area_samples: u32,
     /// A texel whose list would hold more than this many entries keeps none: its pixels walk the BVH over
     /// the prim buffer instead, which then costs less (default 256; `0xFFFFFFFF`: no limit). It moves
-    /// cost, never exactness.
+    /// cost, never exactness. API 5.9: older callers get the default.
     pub map_list_limit: u32,
     /// Bin items (4x4-texel tiles of the triangles' footprints, widened by their penumbrae for area
     /// shadows) per pixel with a shadow ray past which a frame builds no list and every pixel walks the
-    /// BVH (default 8; infinity: always lists; 0: always the BVH). It moves cost, never exactness.
+    /// BVH (default 8; infinity: always lists; 0: always the BVH). It moves cost, never exactness. API
+    /// 5.9: older callers get the default.
     pub map_bin_budget: f32,
 }
 
-/// One draw of the geometry.
+/// One draw of the geometry: an element of `draws`, read at `draw_stride`.
 #[repr(C)]
 #[derive(Clone, Copy)]
 pub struct HrtsDraw {
@@ -549,6 +574,9 @@ pub struct HrtsCpuGeometry {
     pub draws: *const HrtsDraw,
     /// Number of draws.
     pub draw_count: u32,
+    /// Bytes from one draw to the next: `sizeof(HrtsDraw)` of the caller's header. API 5.8: 0 (as in the
+    /// struct of a caller of 5.1 to 5.7) reads the 76-byte `HrtsDraw` of API 5.1 to 5.8.
+    pub draw_stride: usize,
 }
 
 /// One mesh in the engine's Vulkan buffers (need `VK_BUFFER_USAGE_STORAGE_BUFFER_BIT`); read, never
@@ -598,6 +626,9 @@ pub struct HrtsVulkanGeometry {
     pub position_scale: [f32; 3],
     /// See `position_scale`.
     pub position_offset: [f32; 3],
+    /// Bytes from one draw to the next: `sizeof(HrtsDraw)` of the caller's header. API 5.8: 0 (as in the
+    /// struct of a caller of 5.1 to 5.7) reads the 76-byte `HrtsDraw` of API 5.1 to 5.8.
+    pub draw_stride: usize,
 }
 
 /// The engine's images the plugin reads and writes. All are 2D, one mip, one layer, same size.
@@ -653,7 +684,7 @@ pub struct HrtsTargets {
     pub output_format: u32,
 }
 
-/// One light of a frame.
+/// One light of a frame: an element of `HrtsFrame::lights`, read at `light_stride`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HrtsLight {
@@ -735,19 +766,27 @@ pub struct HrtsFrame {
     /// The meshes deformed this frame (`deformed_count` entries; may be NULL if the count is 0): each
     /// reads its positions from a vertex buffer of this frame instead of its own, and its triangles are
     /// rebuilt this frame (from its own vertex buffer again in the next frame that does not deform it).
-    /// Read by the call that begins the frame. A deformed mesh's bounds do not hold: give the frame's in
+    /// Read by the call that begins the frame alone (the frame's later calls deform the same meshes): the
+    /// array may be freed once that call returned. A deformed mesh's bounds do not hold: give the frame's in
     /// `bounds`, or the plugin culls by the view and the lights' ranges alone.
     pub deformed: *const HrtsMeshVertices,
     /// Number of entries in `deformed`.
     pub deformed_count: u32,
+    /// Bytes from one entry of `lights` to the next: `sizeof(HrtsLight)` of the caller's header. API 5.8: 0
+    /// (as in the struct of a caller of 5.1 to 5.7) reads the 100-byte `HrtsLight` of API 5.1 to 5.8.
+    pub light_stride: usize,
+    /// Bytes from one entry of `deformed` to the next: `sizeof(HrtsMeshVertices)` of the caller's header.
+    /// API 5.8: 0 (as in the struct of a caller of 5.1 to 5.7) reads the 32-byte `HrtsMeshVertices` of API
+    /// 5.1 to 5.8.
+    pub deformed_stride: usize,
 }
 
-/// Where one mesh's positions are in one frame (`HrtsFrame::deformed`): a vertex buffer of that frame,
-/// such as one of a ring of skinning outputs, one per frame in flight. It holds the mesh's vertex count in
-/// the mesh's `vertex_format` and `vertex_stride`, and must stay alive until the frame completed. The
-/// plugin keeps a descriptor per buffer for as long as frames in flight may use it (`frames_in_flight`
-/// frames after the last that gave it): a buffer destroyed sooner must not be replaced by one that may
-/// get the same handle within those frames.
+/// Where one mesh's positions are in one frame (an element of `HrtsFrame::deformed`, read at
+/// `deformed_stride`): a vertex buffer of that frame, such as one of a ring of skinning outputs, one per
+/// frame in flight. It holds the mesh's vertex count in the mesh's `vertex_format` and `vertex_stride`,
+/// and must stay alive until the frame completed. The plugin writes the buffer's descriptors anew in each
+/// frame that gives it and never reads them in another frame: once the frame completed, the engine may
+/// destroy the buffer, and a buffer created after it may get its handle.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct HrtsMeshVertices {
@@ -825,8 +864,8 @@ pub struct HrtsFrameReport {
     pub binning_path: u32,
     /// Conservative-raster tier used (0 for the compute and software paths).
     pub tier: u32,
-    /// Texels traced exhaustively (exact, slower): those whose list did not fit the entry capacity, and every
-    /// texel of a group of 16 whose lists' offsets did not fit the packed list offsets.
+    /// Texels whose pixels walked the BVH because their list did not fit the entry capacity, and every
+    /// texel of a group of 16 whose lists' offsets did not fit the packed list offsets (exact).
     pub texels_past_capacity: u32,
     /// Longest list of any texel.
     pub longest_list: u32,
@@ -889,15 +928,17 @@ pub struct HrtsFrameReport {
     /// Whether the light's last pass wrote its layer of the output image directly, with no copy: the
     /// output is `R32_SFLOAT` with STORAGE usage (the layer is then in the GENERAL layout between that
     /// pass and the output-copy call, which takes it to `output_layout_after`), and the configuration does
-    /// not read the final output back through `extra_outputs`.
+    /// not read the final output back through `extra_outputs`. API 5.3.
     pub output_direct: HrtsBool,
     /// A point light shadowed as one cube map: the (triangle, face) pairs its setup kept this frame (0
     /// for other lights). Past `bin_pair_capacity`, the frame traced every ray of the light against every
-    /// triangle (exact, slower) and the pairs grow to fit from the next frame on.
+    /// triangle (exact, slower) and the pairs grow to fit from the next frame on. API 5.4: not written into
+    /// the report of a caller of 5.1 to 5.3.
     pub bin_pairs: u32,
-    /// The (triangle, face) pairs the light's cube map held this frame.
+    /// The (triangle, face) pairs the light's cube map held this frame. API 5.4, as `bin_pairs`.
     pub bin_pair_capacity: u32,
-    /// Texels whose list passed `map_list_limit` and was not kept: their pixels walked the BVH.
+    /// Texels whose list passed `map_list_limit` and was not kept: their pixels walked the BVH. API 5.9:
+    /// this field and the ones after it are written for callers of 5.9 and later.
     pub texels_past_limit: u32,
     /// Bin items (4x4-texel tiles of the footprints) of the frame's lists (saturated at `0xFFFFFFFF`).
     pub bin_items: u32,

@@ -7,863 +7,9 @@
  * buffers and formats, a mesh deformed through per-frame vertex buffers, runs a table of misuse cases and
  * 100 create/destroy cycles. Prints "N passed, M failed" and exits non-zero on any failure. */
 #define _POSIX_C_SOURCE 200112L
-#include "hrts.h"
+#include "engine.h"
 
-#include <math.h>
-#include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
-#include <vulkan/vulkan.h>
-
-static int passed, failed;
-
-#define CHECK(cond, ...)                          \
-    do {                                          \
-        if (cond) {                               \
-            passed++;                             \
-        } else {                                  \
-            failed++;                             \
-            fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__); \
-            fprintf(stderr, __VA_ARGS__);         \
-            fprintf(stderr, "\n");                \
-        }                                         \
-    } while (0)
-
-#define VK(call)                                                        \
-    do {                                                                \
-        VkResult r_ = (call);                                           \
-        if (r_ != VK_SUCCESS) {                                         \
-            fprintf(stderr, "%s failed: %d\n", #call, (int)r_);         \
-            exit(2);                                                    \
-        }                                                               \
-    } while (0)
-
-/* ---------- scene: ground quad y = 0 (|x|,|z| <= 4) and a box [-0.5,0.5]x[0.6,1.6]x[-0.5,0.5] ---------- */
-static const double BOX_MIN[3] = {-0.5, 0.6, -0.5};
-static const double BOX_MAX[3] = {0.5, 1.6, 0.5};
-/* Where the engine has moved the box (its draw's translation; 0 unless a test moves it). */
-static double box_shift[3];
-static const double GROUND = 4.0;
-/* World-space bounds of the scene's triangles (min xyz, max xyz). */
-static const float SCENE_BOUNDS[6] = {-4.0f, 0.0f, -4.0f, 4.0f, 1.6f, 4.0f};
-
-static float positions[] = {
-    -4, 0, -4, 4, 0, -4, 4, 0, 4, -4, 0, 4, /* ground 0..3 */
-    -0.5f, 0.6f, -0.5f, 0.5f, 0.6f, -0.5f, 0.5f, 1.6f, -0.5f, -0.5f, 1.6f, -0.5f, /* box 4..11 */
-    -0.5f, 0.6f, 0.5f, 0.5f, 0.6f, 0.5f, 0.5f, 1.6f, 0.5f, -0.5f, 1.6f, 0.5f,
-};
-static uint32_t indices[] = {
-    0, 2, 1, 0, 3, 2, /* ground, facing +y */
-    4, 6, 5, 4, 7, 6, 8, 9, 10, 8, 10, 11, 4, 5, 9, 4, 9, 8, /* box back, front, bottom */
-    7, 10, 6, 7, 11, 10, 4, 8, 11, 4, 11, 7, 5, 6, 10, 5, 10, 9, /* top, left, right */
-};
-
-typedef struct {
-    double x, y, z;
-} V3;
-static V3 v3(double x, double y, double z) { V3 r = {x, y, z}; return r; }
-static V3 sub3(V3 a, V3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }
-static V3 add3(V3 a, V3 b) { return v3(a.x + b.x, a.y + b.y, a.z + b.z); }
-static V3 mul3(V3 a, double s) { return v3(a.x * s, a.y * s, a.z * s); }
-static double dot3(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static V3 cross3(V3 a, V3 b) { return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x); }
-static V3 norm3(V3 a) { return mul3(a, 1.0 / sqrt(dot3(a, a))); }
-
-/* Ray vs the box grown by `grow` (negative shrinks): entry distance and face normal, or -1. */
-static double ray_box(V3 o, V3 d, double grow, V3 *normal) {
-    double o_[3] = {o.x, o.y, o.z}, d_[3] = {d.x, d.y, d.z}, t0 = -1e300, t1 = 1e300;
-    int axis = -1;
-    double sign = 0;
-    for (int i = 0; i < 3; i++) {
-        double lo = BOX_MIN[i] + box_shift[i] - grow, hi = BOX_MAX[i] + box_shift[i] + grow;
-        if (d_[i] == 0.0) {
-            if (o_[i] < lo || o_[i] > hi) return -1;
-            continue;
-        }
-        double a = (lo - o_[i]) / d_[i], b = (hi - o_[i]) / d_[i];
-        double s = -1;
-        if (a > b) { double t = a; a = b; b = t; s = 1; }
-        if (a > t0) { t0 = a; axis = i; sign = d_[i] > 0 ? -1 : 1; (void)s; }
-        if (b < t1) t1 = b;
-    }
-    if (t0 > t1 || t1 < 0 || axis < 0) return -1;
-    if (normal) {
-        double n[3] = {0, 0, 0};
-        n[axis] = sign;
-        *normal = v3(n[0], n[1], n[2]);
-    }
-    return t0 > 0 ? t0 : 0;
-}
-
-/* ---------- camera and lights ---------- */
-enum { W = 160, H = 120, LAYERS = 8 };
-static const double FOV_Y = 0.8, NEAR = 0.05;
-static V3 cam_pos, cam_f, cam_r, cam_u;
-static float view[16], proj[16];
-
-/* The camera orbits the scene: angle 0 is the reference view from (3.2, 2.6, 3.9). */
-static void setup_camera(double angle) {
-    double radius = sqrt(3.2 * 3.2 + 3.9 * 3.9), a = atan2(3.2, 3.9) + angle;
-    cam_pos = v3(radius * sin(a), 2.6, radius * cos(a));
-    V3 target = v3(0, 0.5, 0);
-    cam_f = norm3(sub3(target, cam_pos));
-    cam_r = norm3(cross3(cam_f, v3(0, 1, 0)));
-    cam_u = cross3(cam_r, cam_f);
-    /* view = look_at_rh: rows r, u, -f */
-    float m[16] = {(float)cam_r.x, (float)cam_u.x, (float)-cam_f.x, 0, (float)cam_r.y, (float)cam_u.y, (float)-cam_f.y, 0,
-                   (float)cam_r.z, (float)cam_u.z, (float)-cam_f.z, 0, (float)-dot3(cam_r, cam_pos),
-                   (float)-dot3(cam_u, cam_pos), (float)dot3(cam_f, cam_pos), 1};
-    memcpy(view, m, sizeof m);
-    /* reversed-Z infinite perspective with clip y negated (Vulkan framebuffer y points down) */
-    double f = 1.0 / tan(FOV_Y / 2), aspect = (double)W / H;
-    float p[16] = {(float)(f / aspect), 0, 0, 0, 0, (float)-f, 0, 0, 0, 0, 0, -1, 0, 0, (float)NEAR, 0};
-    memcpy(proj, p, sizeof p);
-}
-
-/* A light as the engine knows it: its exact geometry and what it hands the plugin. */
-typedef struct {
-    int spot;
-    V3 dir; /* direction of travel (directional) or cone axis (spot), unit */
-    V3 pos; /* spot: emitter */
-    HrtsLight c;
-} Emitter;
-
-/* A directional light travelling along `dir`, with an orthographic view-projection enclosing the scene. */
-static Emitter directional(V3 dir) {
-    Emitter e;
-    memset(&e, 0, sizeof e);
-    e.dir = norm3(dir);
-    V3 lz = mul3(e.dir, -1.0), lx = norm3(cross3(fabs(lz.z) < 0.9 ? v3(0, 0, 1) : v3(1, 0, 0), lz)), ly = cross3(lz, lx);
-    double ext = 8.0, depth = 16.0;
-    /* x' = dot(lx,p)/ext, y' = dot(ly,p)/ext, z' = 0.5 - dot(lz,p)/depth maps the scene into [0,1] */
-    float l[16] = {(float)(lx.x / ext), (float)(ly.x / ext), (float)(-lz.x / depth), 0, (float)(lx.y / ext), (float)(ly.y / ext),
-                   (float)(-lz.y / depth), 0, (float)(lx.z / ext), (float)(ly.z / ext), (float)(-lz.z / depth), 0, 0, 0, 0.5f, 1};
-    e.c.light_type = HRTS_LIGHT_TYPE_DIRECTIONAL;
-    e.c.direction[0] = (float)e.dir.x;
-    e.c.direction[1] = (float)e.dir.y;
-    e.c.direction[2] = (float)e.dir.z;
-    memcpy(e.c.view_proj, l, sizeof l);
-    return e;
-}
-
-/* A directional light travelling along `dir` whose frustum the plugin fits to the scene's bounds every frame
- * (view_proj all zeros). */
-static Emitter fitted_sun(V3 dir) {
-    Emitter e = directional(dir);
-    memset(e.c.view_proj, 0, sizeof e.c.view_proj);
-    return e;
-}
-
-/* A spot light at `pos` aiming at `target`, with a perspective (standard depth) frustum of `fov` radians. */
-static Emitter spot(V3 pos, V3 target, double fov) {
-    Emitter e;
-    memset(&e, 0, sizeof e);
-    e.spot = 1;
-    e.pos = pos;
-    e.dir = norm3(sub3(target, pos));
-    V3 f = e.dir, r = norm3(cross3(f, fabs(f.y) < 0.9 ? v3(0, 1, 0) : v3(1, 0, 0))), u = cross3(r, f);
-    double n = 0.1, fa = 30.0, s = 1.0 / tan(fov / 2);
-    /* view rows r, u, -f; then x' = s x, y' = s y, z' = (fa z + n fa) / (n - fa), w = -z */
-    double vm[16] = {r.x, u.x, -f.x, 0, r.y, u.y, -f.y, 0, r.z, u.z, -f.z, 0, -dot3(r, pos), -dot3(u, pos), dot3(f, pos), 1};
-    double pm[16] = {s, 0, 0, 0, 0, s, 0, 0, 0, 0, fa / (n - fa), -1, 0, 0, n * fa / (n - fa), 0};
-    for (int c = 0; c < 4; c++)
-        for (int row = 0; row < 4; row++) {
-            double acc = 0;
-            for (int k = 0; k < 4; k++) acc += pm[k * 4 + row] * vm[c * 4 + k];
-            e.c.view_proj[c * 4 + row] = (float)acc;
-        }
-    e.c.light_type = HRTS_LIGHT_TYPE_SPOT;
-    e.c.position[0] = (float)pos.x;
-    e.c.position[1] = (float)pos.y;
-    e.c.position[2] = (float)pos.z;
-    e.c.direction[0] = (float)e.dir.x;
-    e.c.direction[1] = (float)e.dir.y;
-    e.c.direction[2] = (float)e.dir.z;
-    return e;
-}
-
-/* A point light at `pos`: the plugin fits its cube faces (no matrix). */
-static Emitter point(V3 pos) {
-    Emitter e;
-    memset(&e, 0, sizeof e);
-    e.spot = 1; /* shadow rays end at the emitter, as for a spot light */
-    e.pos = pos;
-    e.c.light_type = HRTS_LIGHT_TYPE_POINT;
-    e.c.position[0] = (float)pos.x;
-    e.c.position[1] = (float)pos.y;
-    e.c.position[2] = (float)pos.z;
-    return e;
-}
-
-/* A spot light at `pos` aiming at `target` with a cone of half-angle `cone`, its frusta fitted by the
- * plugin (view_proj all zeros). */
-static Emitter fitted_spot(V3 pos, V3 target, double cone) {
-    Emitter e = point(pos);
-    e.dir = norm3(sub3(target, pos));
-    e.c.light_type = HRTS_LIGHT_TYPE_SPOT;
-    e.c.direction[0] = (float)e.dir.x;
-    e.c.direction[1] = (float)e.dir.y;
-    e.c.direction[2] = (float)e.dir.z;
-    e.c.outer_cone = (float)cone;
-    return e;
-}
-
-/* Camera ray through pixel (x, y) centre. */
-static V3 pixel_ray(double x, double y) {
-    double f = 1.0 / tan(FOV_Y / 2), aspect = (double)W / H;
-    double nx = (x + 0.5) / W * 2 - 1, ny = (y + 0.5) / H * 2 - 1;
-    /* clip y is negated: NDC y down is view-space up */
-    return add3(add3(mul3(cam_r, nx * aspect / f), mul3(cam_u, -ny / f)), cam_f);
-}
-
-/* Nearest surface under a camera ray: 0 background, 1 ground, 2 box; t along `d` (|d| >= 1). */
-static int cast(V3 o, V3 d, double grow, double *t, V3 *n) {
-    double tb = ray_box(o, d, grow, n);
-    double tg = d.y < 0 ? -o.y / d.y : -1;
-    if (tg > 0) {
-        V3 p = add3(o, mul3(d, tg));
-        if (fabs(p.x) > GROUND || fabs(p.z) > GROUND) tg = -1;
-    }
-    if (tb > 0 && (tg < 0 || tb < tg)) { *t = tb; return 2; }
-    if (tg > 0) { *t = tg; *n = v3(0, 1, 0); return 1; }
-    return 0;
-}
-
-/* Whether the box grown by `grow` blocks the shadow ray from `p` toward the light. */
-static int blocked(V3 p, const Emitter *e, double grow) {
-    if (!e->spot) return ray_box(p, mul3(e->dir, -1.0), grow, NULL) >= 0;
-    double t = ray_box(p, sub3(e->pos, p), grow, NULL);
-    return t >= 0 && t < 1;
-}
-
-/* Exact classification under light `e`: 1 lit, 0 shadowed, -1 near an edge (within tol), -2 background. */
-static int exact(int x, int y, double tol, const Emitter *e) {
-    V3 d = pixel_ray(x, y), n;
-    double t;
-    int hit = cast(cam_pos, d, 0, &t, &n);
-    if (hit == 0) {
-        double t2;
-        V3 n2;
-        return cast(cam_pos, d, tol, &t2, &n2) ? -1 : -2;
-    }
-    /* camera near a box silhouette or edge: the grown and shrunk boxes disagree */
-    double t_in, t_out;
-    V3 na, nb;
-    int in = cast(cam_pos, d, -tol, &t_in, &na), out = cast(cam_pos, d, tol, &t_out, &nb);
-    if (in != out || in != hit || (na.x != nb.x || na.y != nb.y || na.z != nb.z)) return -1;
-    V3 p = add3(cam_pos, mul3(d, t));
-    V3 L = e->spot ? norm3(sub3(e->pos, p)) : mul3(e->dir, -1.0);
-    double c = dot3(n, L);
-    if (fabs(c) < 1e-6) return -1;
-    if (c < 0) return 0;
-    if (hit == 2) return 1; /* a convex box never shadows itself; the ground is below it */
-    if (blocked(p, e, -tol)) return 0;
-    if (!blocked(p, e, tol)) return 1;
-    return -1;
-}
-
-/* ---------- Vulkan helpers ---------- */
-static VkInstance instance;
-static VkPhysicalDevice phys;
-static VkDevice device;
-static VkQueue queue;
-static uint32_t family;
-static VkCommandPool pool;
-static VkDebugUtilsMessengerEXT messenger;
-static int validation_errors, validation_warnings;
-static const char *phase = "setup"; /* what the host is doing, for validation messages */
-
-static VKAPI_ATTR VkBool32 VKAPI_CALL on_validation(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                                    VkDebugUtilsMessageTypeFlagsEXT types,
-                                                    const VkDebugUtilsMessengerCallbackDataEXT *data, void *user) {
-    (void)types;
-    (void)user;
-    if (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) {
-        validation_errors++;
-        fprintf(stderr, "validation error (%s): %s\n", phase, data->pMessage);
-    } else if (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) {
-        validation_warnings++;
-        fprintf(stderr, "validation warning (%s): %s\n", phase, data->pMessage);
-    }
-    return VK_FALSE;
-}
-
-static uint32_t memory_type(uint32_t bits, VkMemoryPropertyFlags want) {
-    VkPhysicalDeviceMemoryProperties mp;
-    vkGetPhysicalDeviceMemoryProperties(phys, &mp);
-    for (uint32_t i = 0; i < mp.memoryTypeCount; i++)
-        if ((bits & (1u << i)) && (mp.memoryTypes[i].propertyFlags & want) == want) return i;
-    fprintf(stderr, "no memory type\n");
-    exit(2);
-}
-
-typedef struct {
-    VkImage image;
-    VkDeviceMemory memory;
-} Img;
-
-static Img make_image(VkFormat format, VkImageUsageFlags usage, uint32_t layers) {
-    Img r;
-    VkImageCreateInfo ci = {.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-    ci.imageType = VK_IMAGE_TYPE_2D;
-    ci.format = format;
-    ci.extent.width = W;
-    ci.extent.height = H;
-    ci.extent.depth = 1;
-    ci.mipLevels = 1;
-    ci.arrayLayers = layers;
-    ci.samples = VK_SAMPLE_COUNT_1_BIT;
-    ci.tiling = VK_IMAGE_TILING_OPTIMAL;
-    ci.usage = usage;
-    VK(vkCreateImage(device, &ci, NULL, &r.image));
-    VkMemoryRequirements req;
-    vkGetImageMemoryRequirements(device, r.image, &req);
-    VkMemoryAllocateInfo ai = {.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-    ai.allocationSize = req.size;
-    ai.memoryTypeIndex = memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    VK(vkAllocateMemory(device, &ai, NULL, &r.memory));
-    VK(vkBindImageMemory(device, r.image, r.memory, 0));
-    return r;
-}
-
-static void free_image(Img i) {
-    vkDestroyImage(device, i.image, NULL);
-    vkFreeMemory(device, i.memory, NULL);
-}
-
-typedef struct {
-    VkBuffer buffer;
-    VkDeviceMemory memory;
-    void *map;
-} Buf;
-
-static Buf make_host_buffer(VkDeviceSize size, VkBufferUsageFlags usage) {
-    Buf r;
-    VkBufferCreateInfo ci = {.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-    ci.size = size;
-    ci.usage = usage;
-    VK(vkCreateBuffer(device, &ci, NULL, &r.buffer));
-    VkMemoryRequirements req;
-    vkGetBufferMemoryRequirements(device, r.buffer, &req);
-    VkMemoryAllocateInfo ai = {.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-    ai.allocationSize = req.size;
-    ai.memoryTypeIndex =
-        memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
-    VK(vkAllocateMemory(device, &ai, NULL, &r.memory));
-    VK(vkBindBufferMemory(device, r.buffer, r.memory, 0));
-    VK(vkMapMemory(device, r.memory, 0, size, 0, &r.map));
-    return r;
-}
-
-static void free_buffer(Buf b) {
-    vkUnmapMemory(device, b.memory);
-    vkDestroyBuffer(device, b.buffer, NULL);
-    vkFreeMemory(device, b.memory, NULL);
-}
-
-static void barrier(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect, uint32_t layers, VkImageLayout from,
-                    VkImageLayout to) {
-    VkImageMemoryBarrier2 b = {.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-    b.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-    b.srcAccessMask = VK_ACCESS_2_MEMORY_WRITE_BIT;
-    b.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-    b.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT;
-    b.oldLayout = from;
-    b.newLayout = to;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = image;
-    b.subresourceRange.aspectMask = aspect;
-    b.subresourceRange.levelCount = 1;
-    b.subresourceRange.layerCount = layers;
-    VkDependencyInfo dep = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-    dep.imageMemoryBarrierCount = 1;
-    dep.pImageMemoryBarriers = &b;
-    vkCmdPipelineBarrier2(cmd, &dep);
-}
-
-/* Makes transfer writes visible to the host. */
-static void host_read_barrier(VkCommandBuffer cmd) {
-    VkMemoryBarrier2 b = {.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
-    b.srcStageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;
-    b.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-    b.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
-    b.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
-    VkDependencyInfo dep = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-    dep.memoryBarrierCount = 1;
-    dep.pMemoryBarriers = &b;
-    vkCmdPipelineBarrier2(cmd, &dep);
-}
-
-static VkCommandBuffer begin(void) {
-    VkCommandBufferAllocateInfo ai = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    ai.commandPool = pool;
-    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    ai.commandBufferCount = 1;
-    VkCommandBuffer cmd;
-    VK(vkAllocateCommandBuffers(device, &ai, &cmd));
-    VkCommandBufferBeginInfo bi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    VK(vkBeginCommandBuffer(cmd, &bi));
-    return cmd;
-}
-
-static void submit(VkCommandBuffer cmd, VkFence fence) {
-    VK(vkEndCommandBuffer(cmd));
-    VkSubmitInfo si = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO};
-    si.commandBufferCount = 1;
-    si.pCommandBuffers = &cmd;
-    VK(vkQueueSubmit(queue, 1, &si, fence));
-}
-
-static void submit_and_wait(VkCommandBuffer cmd) {
-    VkFenceCreateInfo fi = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    VkFence fence;
-    VK(vkCreateFence(device, &fi, NULL, &fence));
-    submit(cmd, fence);
-    VK(vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX));
-    vkDestroyFence(device, fence, NULL);
-    vkFreeCommandBuffers(device, pool, 1, &cmd);
-}
-
-/* Uploads `staging` (tightly packed texels of the copied aspect) into one-layer `img` and leaves it in
- * `layout`: `aspects` are the image's aspects (for the layout transitions), `copied` the one written. */
-/* `f` as an IEEE half, rounded to nearest even (values this small flush to zero: no view Z here is). */
-static uint16_t half_of(float f) {
-    uint32_t x;
-    memcpy(&x, &f, 4);
-    uint32_t sign = (x >> 16) & 0x8000;
-    int32_t e = (int32_t)((x >> 23) & 0xff) - 127 + 15;
-    uint32_t m = x & 0x7fffff;
-    if (e <= 0) return (uint16_t)sign;
-    if (e >= 31) return (uint16_t)(sign | 0x7c00);
-    uint32_t h = sign | (uint32_t)e << 10 | m >> 13, rest = m & 0x1fff;
-    if (rest > 0x1000 || (rest == 0x1000 && (h & 1))) h++;
-    return (uint16_t)h;
-}
-
-/* A copy region covering `layers` whole W x H layers of an image's `aspect`, from layer 0. */
-static VkBufferImageCopy frame_region(VkImageAspectFlags aspect, uint32_t layers) {
-    VkBufferImageCopy region;
-    memset(&region, 0, sizeof region);
-    region.imageSubresource.aspectMask = aspect;
-    region.imageSubresource.layerCount = layers;
-    region.imageExtent.width = W;
-    region.imageExtent.height = H;
-    region.imageExtent.depth = 1;
-    return region;
-}
-
-static void upload_image(Img img, VkImageAspectFlags aspects, VkImageAspectFlags copied, Buf staging, VkImageLayout layout) {
-    VkCommandBuffer cmd = begin();
-    barrier(cmd, img.image, aspects, 1, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
-    VkBufferImageCopy region = frame_region(copied, 1);
-    vkCmdCopyBufferToImage(cmd, staging.buffer, img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-    barrier(cmd, img.image, aspects, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, layout);
-    submit_and_wait(cmd);
-}
-
-/* `n` command buffers of the pool and `n` unsignalled fences: a ring of frames in flight. */
-static void frames_in_flight_ring(uint32_t n, VkCommandBuffer *cmds, VkFence *fences) {
-    VkCommandBufferAllocateInfo ai = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    ai.commandPool = pool;
-    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    ai.commandBufferCount = n;
-    VK(vkAllocateCommandBuffers(device, &ai, cmds));
-    for (uint32_t k = 0; k < n; k++) {
-        VkFenceCreateInfo fi = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-        VK(vkCreateFence(device, &fi, NULL, &fences[k]));
-    }
-}
-
-/* A timeline semaphore at 0 that submissions held by the test wait on (value 1). */
-static VkSemaphore held_semaphore(void) {
-    VkSemaphoreTypeCreateInfo sti = {.sType = VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
-    sti.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
-    VkSemaphoreCreateInfo sci = {.sType = VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-    sci.pNext = &sti;
-    VkSemaphore hold;
-    VK(vkCreateSemaphore(device, &sci, NULL, &hold));
-    return hold;
-}
-
-/* Submits `cmd` to run once the test releases `hold` (it stays pending until then), signalling `fence`. */
-static void submit_held(VkCommandBuffer cmd, VkSemaphore hold, VkFence fence) {
-    VK(vkEndCommandBuffer(cmd));
-    uint64_t wait_value = 1;
-    VkTimelineSemaphoreSubmitInfo ts = {.sType = VK_STRUCTURE_TYPE_TIMELINE_SEMAPHORE_SUBMIT_INFO};
-    ts.waitSemaphoreValueCount = 1;
-    ts.pWaitSemaphoreValues = &wait_value;
-    VkPipelineStageFlags stage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
-    VkSubmitInfo si = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO};
-    si.pNext = &ts;
-    si.waitSemaphoreCount = 1;
-    si.pWaitSemaphores = &hold;
-    si.pWaitDstStageMask = &stage;
-    si.commandBufferCount = 1;
-    si.pCommandBuffers = &cmd;
-    VK(vkQueueSubmit(queue, 1, &si, fence));
-}
-
-/* Lets the submissions waiting on `hold` run. */
-static void release_held(VkSemaphore hold) {
-    VkSemaphoreSignalInfo release = {.sType = VK_STRUCTURE_TYPE_SEMAPHORE_SIGNAL_INFO};
-    release.semaphore = hold;
-    release.value = 1;
-    VK(vkSignalSemaphore(device, &release));
-}
-
-static void create_device(void) {
-    const char *layers[] = {"VK_LAYER_KHRONOS_validation"};
-    const char *inst_ext[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME, VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME};
-    VkApplicationInfo app = {.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO};
-    app.pApplicationName = "hrts C host";
-    app.apiVersion = VK_API_VERSION_1_3;
-    /* Khronos synchronization validation: hazards between commands, command buffers and submissions */
-    VkValidationFeatureEnableEXT enables[] = {VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
-    VkValidationFeaturesEXT vf = {.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
-    vf.enabledValidationFeatureCount = 1;
-    vf.pEnabledValidationFeatures = enables;
-    VkDebugUtilsMessengerCreateInfoEXT mi = {.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-    vf.pNext = &mi;
-    mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
-    mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
-    mi.pfnUserCallback = on_validation;
-    VkInstanceCreateInfo ci = {.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
-    ci.pNext = &vf; /* the chained messenger also reports what vkCreateInstance and vkDestroyInstance find */
-    ci.pApplicationInfo = &app;
-    ci.enabledLayerCount = 1;
-    ci.ppEnabledLayerNames = layers;
-    ci.enabledExtensionCount = 2;
-    ci.ppEnabledExtensionNames = inst_ext;
-    VK(vkCreateInstance(&ci, NULL, &instance));
-    PFN_vkCreateDebugUtilsMessengerEXT create_messenger =
-        (PFN_vkCreateDebugUtilsMessengerEXT)vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT");
-    if (!create_messenger) { fprintf(stderr, "no vkCreateDebugUtilsMessengerEXT\n"); exit(2); }
-    VK(create_messenger(instance, &mi, NULL, &messenger));
-    uint32_t n = 8;
-    VkPhysicalDevice pds[8];
-    VK(vkEnumeratePhysicalDevices(instance, &n, pds));
-    const char *want = getenv("HRTS_DEVICE");
-    phys = VK_NULL_HANDLE;
-    for (uint32_t i = 0; i < n && !phys; i++) {
-        VkPhysicalDeviceProperties p;
-        vkGetPhysicalDeviceProperties(pds[i], &p);
-        if (p.apiVersion < VK_API_VERSION_1_3) continue;
-        if (want && !strstr(p.deviceName, want)) continue;
-        phys = pds[i];
-        printf("device: %s\n", p.deviceName);
-    }
-    if (!phys) { fprintf(stderr, "no Vulkan 1.3 device\n"); exit(2); }
-    uint32_t nf = 16;
-    VkQueueFamilyProperties qf[16];
-    vkGetPhysicalDeviceQueueFamilyProperties(phys, &nf, qf);
-    for (family = 0; family < nf; family++)
-        if ((qf[family].queueFlags & (VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT)) == (VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT)) break;
-    float prio = 1;
-    VkDeviceQueueCreateInfo qi = {.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-    qi.queueFamilyIndex = family;
-    qi.queueCount = 1;
-    qi.pQueuePriorities = &prio;
-    VkPhysicalDeviceVulkan13Features f13 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
-    f13.dynamicRendering = VK_TRUE;
-    f13.synchronization2 = VK_TRUE;
-    /* the engine's own: a timeline semaphore holds the first frame in flight (frames_in_flight) */
-    VkPhysicalDeviceVulkan12Features f12 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
-    f12.timelineSemaphore = VK_TRUE;
-    f12.pNext = &f13;
-    VkPhysicalDeviceFeatures feats;
-    memset(&feats, 0, sizeof feats);
-    feats.geometryShader = VK_TRUE;
-    feats.fragmentStoresAndAtomics = VK_TRUE;
-    feats.depthClamp = VK_TRUE;
-    VkDeviceCreateInfo di = {.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
-    di.pNext = &f12;
-    di.queueCreateInfoCount = 1;
-    di.pQueueCreateInfos = &qi;
-    di.pEnabledFeatures = &feats;
-    VK(vkCreateDevice(phys, &di, NULL, &device));
-    vkGetDeviceQueue(device, family, 0, &queue);
-    VkCommandPoolCreateInfo pi = {.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-    pi.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-    pi.queueFamilyIndex = family;
-    VK(vkCreateCommandPool(device, &pi, NULL, &pool));
-}
-
-static HrtsVulkanDevice adopt_info(void) {
-    HrtsVulkanDevice v;
-    memset(&v, 0, sizeof v);
-    v.struct_size = sizeof v;
-    v.get_instance_proc_addr = (HrtsGetInstanceProcAddr)vkGetInstanceProcAddr;
-    v.instance = (uint64_t)(uintptr_t)instance;
-    v.physical_device = (uint64_t)(uintptr_t)phys;
-    v.device = (uint64_t)(uintptr_t)device;
-    v.queue_family_index = family;
-    v.geometry_shader = true;
-    v.fragment_stores_and_atomics = true;
-    v.depth_clamp = true;
-    v.debug_utils = true;
-    return v;
-}
-
-static HrtsContext *create_context(const HrtsVulkanDevice *v, uint32_t frames_in_flight) {
-    HrtsContextCreateInfo ci;
-    memset(&ci, 0, sizeof ci);
-    ci.struct_size = sizeof ci;
-    ci.api_version = HRTS_API_VERSION;
-    ci.vulkan = v;
-    ci.frames_in_flight = frames_in_flight;
-    HrtsContext *ctx = NULL;
-    HrtsResult r = hrts_context_create(&ci, &ctx);
-    if (r != HRTS_RESULT_OK) {
-        fprintf(stderr, "hrts_context_create: %s: %s\n", hrts_result_name(r), hrts_last_error(NULL));
-        exit(2);
-    }
-    return ctx;
-}
-
-static HrtsDraw draws[2];
-static HrtsCpuGeometry cpu_geometry(void) {
-    static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    draws[0].first_index = 0;
-    draws[0].index_count = 6;
-    draws[1].first_index = 6;
-    draws[1].index_count = 36;
-    memcpy(draws[0].transform, identity, sizeof identity);
-    memcpy(draws[1].transform, identity, sizeof identity);
-    HrtsCpuGeometry g;
-    memset(&g, 0, sizeof g);
-    g.struct_size = sizeof g;
-    g.positions = positions;
-    g.vertex_count = 12;
-    g.vertex_stride = 12;
-    g.indices = indices;
-    g.index_count = 42;
-    g.draws = draws;
-    g.draw_count = 2;
-    return g;
-}
-
-/* The engine's images: depth, normals and a visibility array with one layer per light (up to LAYERS). */
-static Img depth_img, normal_img, out_img;
-
-static HrtsTargets targets(void) {
-    HrtsTargets t;
-    memset(&t, 0, sizeof t);
-    t.struct_size = sizeof t;
-    t.width = W;
-    t.height = H;
-    t.depth_image = (uint64_t)(uintptr_t)depth_img.image;
-    t.depth_usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-    t.normal_image = (uint64_t)(uintptr_t)normal_img.image;
-    t.normal_usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-    t.output_image = (uint64_t)(uintptr_t)out_img.image;
-    t.output_usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-    t.output_layers = LAYERS;
-    return t;
-}
-
-/* The lights of the frames recorded by `frame` (the engine's scene). */
-static Emitter scene_lights[HRTS_MAX_LIGHTS];
-static HrtsLight c_lights[HRTS_MAX_LIGHTS];
-static uint32_t light_count = 1;
-
-static void set_lights(const Emitter *lights, uint32_t count) {
-    light_count = count;
-    for (uint32_t i = 0; i < count; i++) {
-        scene_lights[i] = lights[i];
-        c_lights[i] = lights[i].c;
-    }
-}
-
-/* The engine's frame counter: every frame recorded gets the next index. */
-static uint64_t next_frame;
-
-static HrtsFrame frame(VkCommandBuffer cmd, uint64_t index) {
-    HrtsFrame f;
-    memset(&f, 0, sizeof f);
-    f.struct_size = sizeof f;
-    f.command_buffer = (uint64_t)(uintptr_t)cmd;
-    f.frame_index = index;
-    memcpy(f.view, view, sizeof view);
-    memcpy(f.proj, proj, sizeof proj);
-    f.camera_position[0] = (float)cam_pos.x;
-    f.camera_position[1] = (float)cam_pos.y;
-    f.camera_position[2] = (float)cam_pos.z;
-    f.lights = c_lights;
-    f.light_count = light_count;
-    f.depth_layout = VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL;
-    f.normal_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-    f.output_layout_before = VK_IMAGE_LAYOUT_UNDEFINED;
-    f.output_layout_after = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-    return f;
-}
-
-/* Draws depth and normals of the current camera on the CPU (the engine's own G-buffer pass) into host
- * buffers of W*H and 4*W*H floats. */
-static void draw_gbuffer(float *dp, float *np) {
-    for (int y = 0; y < H; y++)
-        for (int x = 0; x < W; x++) {
-            V3 d = pixel_ray(x, y), n;
-            double t;
-            int hit = cast(cam_pos, d, 0, &t, &n);
-            int i = y * W + x;
-            /* pixel_ray has unit length along the view axis, so view depth = t */
-            dp[i] = hit ? (float)(NEAR / t) : 0.0f;
-            if (hit && dot3(n, d) > 0) n = mul3(n, -1.0);
-            np[4 * i + 0] = hit ? (float)n.x : 0;
-            np[4 * i + 1] = hit ? (float)n.y : 0;
-            np[4 * i + 2] = hit ? (float)n.z : 0;
-            np[4 * i + 3] = hit ? 1.0f : 0.0f;
-        }
-}
-
-/* Records the upload of a drawn G-buffer into the depth and normal images; `first`: their contents are
- * undefined before (else they are in the layouts the frames leave them in). */
-static void record_gbuffer_upload(VkCommandBuffer cmd, Buf depth, Buf normal, int first) {
-    VkImageLayout depth_from = first ? VK_IMAGE_LAYOUT_UNDEFINED : VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL;
-    VkImageLayout normal_from = first ? VK_IMAGE_LAYOUT_UNDEFINED : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-    barrier(cmd, depth_img.image, VK_IMAGE_ASPECT_DEPTH_BIT, 1, depth_from, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
-    barrier(cmd, normal_img.image, VK_IMAGE_ASPECT_COLOR_BIT, 1, normal_from, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
-    VkBufferImageCopy region = frame_region(VK_IMAGE_ASPECT_DEPTH_BIT, 1);
-    vkCmdCopyBufferToImage(cmd, depth.buffer, depth_img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-    region.imageSubresource.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
-    vkCmdCopyBufferToImage(cmd, normal.buffer, normal_img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-    barrier(cmd, depth_img.image, VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL);
-    barrier(cmd, normal_img.image, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-}
-
-/* Draws and uploads the G-buffer of the current camera, waiting for it. */
-static int gbuffer_uploaded;
-static void upload_gbuffer(void) {
-    Buf depth = make_host_buffer(sizeof(float) * W * H, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
-    Buf normal = make_host_buffer(sizeof(float) * 4 * W * H, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
-    draw_gbuffer(depth.map, normal.map);
-    VkCommandBuffer cmd = begin();
-    record_gbuffer_upload(cmd, depth, normal, !gbuffer_uploaded);
-    gbuffer_uploaded = 1;
-    submit_and_wait(cmd);
-    free_buffer(depth);
-    free_buffer(normal);
-}
-
-/* Records the copy of the first `layers` output layers into `back` (tightly packed, layer after layer). */
-static void record_output_readback(VkCommandBuffer cmd, Buf back, uint32_t layers) {
-    VkBufferImageCopy region = frame_region(VK_IMAGE_ASPECT_COLOR_BIT, layers);
-    vkCmdCopyImageToBuffer(cmd, out_img.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, back.buffer, 1, &region);
-    host_read_barrier(cmd);
-}
-
-/* Copies the visibility of every light into `vis` (if the recording succeeded), submits `cmd` and waits. */
-static HrtsResult finish_frame(VkCommandBuffer cmd, HrtsResult r, float *vis) {
-    Buf back = make_host_buffer(sizeof(float) * W * H * light_count, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-    if (r == HRTS_RESULT_OK) record_output_readback(cmd, back, light_count);
-    submit_and_wait(cmd);
-    if (vis && r == HRTS_RESULT_OK) memcpy(vis, back.map, sizeof(float) * W * H * light_count);
-    free_buffer(back);
-    return r;
-}
-
-/* Records one plugin frame, submits it and reads the visibility of every light back into `vis`. */
-static HrtsResult run_frame(HrtsContext *ctx, float *vis) {
-    VkCommandBuffer cmd = begin();
-    HrtsFrame f = frame(cmd, next_frame++);
-    HrtsResult r = hrts_record_frame(ctx, &f);
-    return finish_frame(cmd, r, vis);
-}
-
-/* Records one frame pass by pass (one hrts_record_passes call per HrtsPass, into one command buffer), or
- * as an engine splits it: the light-space passes in a first submission, the screen-space passes and the
- * output copy in a second one. Reads the visibility back into `vis`. */
-static HrtsResult run_frame_in_parts(HrtsContext *ctx, float *vis, int one_by_one) {
-    VkCommandBuffer cmd = begin();
-    uint64_t index = next_frame++;
-    HrtsFrame f = frame(cmd, index);
-    HrtsResult r = HRTS_RESULT_OK;
-    if (one_by_one) {
-        for (uint32_t pass = 0; pass < HRTS_PASS_COUNT && r == HRTS_RESULT_OK; pass++)
-            r = hrts_record_passes(ctx, &f, 1u << pass);
-    } else {
-        r = hrts_record_passes(ctx, &f, HRTS_PASS_MASK_LIGHT_SPACE);
-        submit_and_wait(cmd);
-        cmd = begin();
-        f = frame(cmd, index);
-        if (r == HRTS_RESULT_OK) r = hrts_record_passes(ctx, &f, HRTS_PASS_MASK_SCREEN_SPACE);
-    }
-    return finish_frame(cmd, r, vis);
-}
-
-/* Records the copy of light `light`'s `resource` into `back` (`bytes` long) into `cmd`. */
-static HrtsResult record_resource_readback(HrtsContext *ctx, VkCommandBuffer cmd, uint32_t light, uint32_t resource,
-                                           Buf back, size_t bytes) {
-    HrtsResourceReadback rb;
-    memset(&rb, 0, sizeof rb);
-    rb.struct_size = sizeof rb;
-    rb.command_buffer = (uint64_t)(uintptr_t)cmd;
-    rb.resource = resource;
-    rb.light = light;
-    rb.buffer = (uint64_t)(uintptr_t)back.buffer;
-    rb.buffer_size = bytes;
-    return hrts_record_resource_readback(ctx, &rb);
-}
-
-/* Reads a plugin resource of the last complete frame back through hrts_record_resource_readback. */
-static HrtsResult read_resource(HrtsContext *ctx, uint32_t light, uint32_t resource, float *out, size_t bytes) {
-    Buf back = make_host_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-    VkCommandBuffer cmd = begin();
-    HrtsResult r = record_resource_readback(ctx, cmd, light, resource, back, bytes);
-    submit_and_wait(cmd);
-    if (r == HRTS_RESULT_OK) memcpy(out, back.map, bytes);
-    free_buffer(back);
-    return r;
-}
-
-static HrtsResult report(HrtsContext *ctx, uint64_t index, uint32_t light, HrtsFrameReport *rep) {
-    memset(rep, 0, sizeof *rep);
-    rep->struct_size = sizeof *rep;
-    return hrts_get_frame_report(ctx, index, light, rep);
-}
-
-static int differing(const float *a, const float *b, int n) {
-    int d = 0;
-    for (int i = 0; i < n; i++) d += memcmp(&a[i], &b[i], sizeof(float)) != 0;
-    return d;
-}
-
-/* Area shadows of `samples` samples: the pixels of `vis` strictly between 0 and 1 (`penumbra`), and those that
- * are no whole count k / samples in [0, 1], which it returns. */
-static int area_not_counts(const float *vis, float samples, int *penumbra) {
-    int not_counts = 0;
-    *penumbra = 0;
-    for (int i = 0; i < W * H; i++) {
-        float k = vis[i] * samples;
-        if (!(vis[i] >= 0.0f && vis[i] <= 1.0f) || k != floorf(k)) not_counts++;
-        if (vis[i] > 0.0f && vis[i] < 1.0f) (*penumbra)++;
-    }
-    return not_counts;
-}
-
-/* Pixels whose visibility differs from the exact shadow of light `e` (near-edge pixels counted apart). */
-static int count_mismatches(const float *vis, double tol, const Emitter *e, int *near_edge, int *shadowed, int *lit) {
-    int mismatches = 0;
-    *near_edge = *shadowed = *lit = 0;
-    for (int y = 0; y < H; y++)
-        for (int x = 0; x < W; x++) {
-            int ex = exact(x, y, tol, e);
-            float v = vis[y * W + x];
-            if (ex == -1) { (*near_edge)++; continue; }
-            float want = ex == 0 ? 0.0f : 1.0f;
-            if (ex == 0) (*shadowed)++;
-            if (ex == 1) (*lit)++;
-            if (v != want) {
-                if (mismatches < 8) fprintf(stderr, "pixel (%d,%d): exact %d, plugin %g\n", x, y, ex, v);
-                mismatches++;
-            }
-        }
-    return mismatches;
-}
-
-/* Tolerance of the exact classification: 1/16 of the pixel footprint at the farthest point. */
-static double edge_tolerance(void) { return 12.0 * (2 * tan(FOV_Y / 2) / H) / 16.0; }
 
 /* The engine's host allocator, handed to the plugin before anything else: it counts live bytes. */
 static size_t engine_live_bytes, engine_allocations;
@@ -893,21 +39,6 @@ static long rss_kib(void) {
         fclose(f);
     }
     return resident * 4;
-}
-
-static HrtsConfig config(uint32_t mode) {
-    HrtsConfig cfg;
-    memset(&cfg, 0, sizeof cfg);
-    cfg.struct_size = sizeof cfg;
-    if (hrts_config_defaults(&cfg) != HRTS_RESULT_OK) {
-        fprintf(stderr, "hrts_config_defaults: %s\n", hrts_last_error(NULL));
-        exit(2);
-    }
-    cfg.mode = mode;
-    cfg.antialiasing = false; /* compare the exact visibility, before FXAA */
-    cfg.map_size = 256;
-    cfg.shadow_map_size = 1024;
-    return cfg;
 }
 
 /* Engine geometry for misuse cases that fail before any buffer is touched: well-formed but for what the
@@ -1038,39 +169,6 @@ static void partial_record(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g)
     CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "partial record: destroy");
     setup_camera(0.0);
     upload_gbuffer();
-}
-
-/* The scene in the engine's own Vulkan buffers: float4 positions (stride 16) at byte offset 64, 16-bit
- * indices at byte offset 8; the buffers go to `vb` and `ib`. */
-static HrtsVulkanGeometry engine_geometry(Buf *vb, Buf *ib) {
-    *vb = make_host_buffer(64 + 12 * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    *ib = make_host_buffer(8 + 44 * 2, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    float *vp = (float *)((char *)vb->map + 64);
-    uint16_t *ip = (uint16_t *)((char *)ib->map + 8);
-    for (int v = 0; v < 12; v++) {
-        vp[4 * v + 0] = positions[3 * v + 0];
-        vp[4 * v + 1] = positions[3 * v + 1];
-        vp[4 * v + 2] = positions[3 * v + 2];
-        vp[4 * v + 3] = 1.0f;
-    }
-    for (int k = 0; k < 42; k++) ip[k] = (uint16_t)indices[k];
-    HrtsVulkanGeometry vg;
-    memset(&vg, 0, sizeof vg);
-    vg.struct_size = sizeof vg;
-    vg.vertex_buffer = (uint64_t)(uintptr_t)vb->buffer;
-    vg.vertex_buffer_size = 64 + 12 * 16;
-    vg.vertex_offset = 64;
-    vg.vertex_stride = 16;
-    vg.vertex_count = 12;
-    vg.index_buffer = (uint64_t)(uintptr_t)ib->buffer;
-    vg.index_buffer_size = 8 + 44 * 2;
-    vg.index_offset = 8;
-    vg.index_type = HRTS_INDEX_TYPE_UINT16;
-    vg.index_count = 42;
-    vg.draws = draws;
-    vg.draw_count = 2;
-    memcpy(vg.bounds, SCENE_BOUNDS, sizeof SCENE_BOUNDS);
-    return vg;
 }
 
 /* ---------- moving geometry: bounds per frame ---------- */
@@ -1851,6 +949,7 @@ static HrtsVulkanGeometry vulkan_mesh(Buf vb, VkDeviceSize vb_size, Buf ib, VkDe
     m.index_buffer_size = ib_size;
     m.draws = draw;
     m.draw_count = 1;
+    m.draw_stride = sizeof *draw;
     return m;
 }
 
@@ -2058,7 +1157,157 @@ static void engine_meshes(const HrtsVulkanDevice *vk) {
     free_buffer(one_ib);
 }
 
+/* ---------- draw transforms: all or nothing ---------- */
+/* A hrts_set_draw_transforms call that fails changes nothing. Transforms that are finite but overflow once
+ * the box mesh's dequantization (scale 0.5, offset (0, 1.1, 0)) is applied are refused; the bounds of the
+ * geometry call still hold, so the next frame, lit by a sun the plugin fits to them, records as before:
+ * the same visibility bit for bit, the exact shadow, and no triangle rebuilt. */
+static void draw_transforms_all_or_nothing(const HrtsVulkanDevice *vk) {
+    enum { PX = W * H };
+    setup_camera(0.0);
+    Emitter sun = fitted_sun(v3(0.45, -1.0, 0.2));
+    set_lights(&sun, 1);
+    upload_gbuffer();
+    SplitScene s;
+    split_scene(&s);
+    static float before[PX], after[PX];
+    HrtsContext *ctx = meshes_context(vk, 2, s.meshes, SPLIT_MESHES);
+    CHECK(run_frame(ctx, before) == HRTS_RESULT_OK, "all or nothing: first frame: %s", hrts_last_error(ctx));
+    float transforms[SPLIT_MESHES][16];
+    for (int i = 0; i < SPLIT_MESHES; i++) memcpy(transforms[i], s.draws[i].transform, sizeof transforms[i]);
+    /* the box's y axis and y translation 3e38: finite, but 1.1 * 3e38 + 3e38 once dequantized is not */
+    transforms[1][5] = 3.0e38f;
+    transforms[1][13] = 3.0e38f;
+    HrtsResult r = hrts_set_draw_transforms(ctx, SPLIT_MESHES, &transforms[0][0]);
+    char message[512];
+    snprintf(message, sizeof message, "%s", hrts_last_error(ctx));
+    HrtsResult next = run_frame(ctx, after);
+    char next_message[512];
+    snprintf(next_message, sizeof next_message, "%s", hrts_last_error(ctx));
+    HrtsFrameReport rep;
+    int rebuilt = next == HRTS_RESULT_OK && report(ctx, next_frame - 1, 0, &rep) == HRTS_RESULT_OK
+                      ? (int)rep.prim_triangles_rebuilt
+                      : -1;
+    int differ = next == HRTS_RESULT_OK ? differing(after, before, PX) : -1;
+    int near_edge, shadowed, lit;
+    int mismatches = count_mismatches(before, edge_tolerance(), &sun, &near_edge, &shadowed, &lit);
+    printf("draw transforms overflowing once dequantized: %s (%s); the next frame: %s, %d px differ from the frame "
+           "before, %d triangles rebuilt, %d mismatches with the exact shadow\n",
+           hrts_result_name(r), message, hrts_result_name(next), differ, rebuilt, mismatches);
+    CHECK(r == HRTS_RESULT_ERROR_INVALID_ARGUMENT && strstr(message, "transform 1"), "all or nothing: %s (%s)",
+          hrts_result_name(r), message);
+    CHECK(next == HRTS_RESULT_OK, "all or nothing: the next frame: %s", next_message);
+    CHECK(differ == 0 && rebuilt == 0, "all or nothing: %d px differ, %d triangles rebuilt", differ, rebuilt);
+    CHECK(mismatches == 0 && shadowed > 300, "all or nothing: %d mismatches, %d shadowed", mismatches, shadowed);
+    VK(vkDeviceWaitIdle(device));
+    CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
+    free_split_scene(&s);
+}
+
 /* ---------- a deforming mesh ---------- */
+/* HrtsFrame::deformed is read by the call that begins the frame alone: the engine may free the array once
+ * that call returned. A frame recorded in two calls (light space, then screen space) and one recorded pass by
+ * pass, the array poisoned after the first call (as freed memory may be), give `want` exactly. */
+static void deformed_read_once(HrtsContext *ctx, HrtsMeshVertices deformed, const float *want) {
+    enum { PX = W * H };
+    static float vis[PX];
+    int differ[2] = {-1, -1};
+    for (int one_by_one = 0; one_by_one < 2; one_by_one++) {
+        HrtsMeshVertices *list = malloc(sizeof *list);
+        *list = deformed;
+        VkCommandBuffer cmd = begin();
+        HrtsFrame f = frame(cmd, next_frame++);
+        f.deformed = list;
+        f.deformed_count = 1;
+        HrtsResult r = hrts_record_passes(ctx, &f, one_by_one ? 1u << HRTS_PASS_PRIM_BUFFER : HRTS_PASS_MASK_LIGHT_SPACE);
+        memset(list, 0xA5, sizeof *list);
+        if (one_by_one) {
+            for (uint32_t pass = HRTS_PASS_PRIM_BUFFER + 1; pass < HRTS_PASS_COUNT && r == HRTS_RESULT_OK; pass++)
+                r = hrts_record_passes(ctx, &f, 1u << pass);
+        } else if (r == HRTS_RESULT_OK) {
+            r = hrts_record_passes(ctx, &f, HRTS_PASS_MASK_SCREEN_SPACE);
+        }
+        char message[512];
+        snprintf(message, sizeof message, "%s", hrts_last_error(ctx));
+        r = finish_frame(cmd, r, vis);
+        free(list);
+        CHECK(r == HRTS_RESULT_OK, "deformed array poisoned after the first call (%s): %s: %s",
+              one_by_one ? "pass by pass" : "two calls", hrts_result_name(r), message);
+        if (r == HRTS_RESULT_OK) differ[one_by_one] = differing(vis, want, PX);
+    }
+    printf("deformed array poisoned after the frame's first call: %d px differ (light/screen space), %d px (pass by pass)\n",
+           differ[0], differ[1]);
+    CHECK(differ[0] == 0 && differ[1] == 0, "deformed read once: %d / %d px differ", differ[0], differ[1]);
+}
+
+/* A vertex buffer's handle reused: the engine destroys a skinned buffer once the frame that read it
+ * completed and creates one of the same size over other memory of its own block; the driver hands back the
+ * same VkBuffer handle. The next frame, within frames_in_flight of the first, must read the new buffer (the
+ * box deformed, B), not the destroyed one's memory (the box, A). `want` holds A's and B's visibility. */
+static void reused_vertex_handle(HrtsContext *ctx, const float *want_a, const float *want_b) {
+    enum { PX = W * H, TRIES = 64 };
+    const VkDeviceSize size = BOX_VERTICES * 8;
+    VkBufferCreateInfo ci = {.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    ci.size = size;
+    ci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    VkBuffer first;
+    VK(vkCreateBuffer(device, &ci, NULL, &first));
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(device, first, &req);
+    /* the engine's memory block: region 0 holds the box (A), region 1 the box deformed (B) */
+    VkDeviceSize region = (req.size + req.alignment - 1) / req.alignment * req.alignment;
+    VkMemoryAllocateInfo ai = {.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    ai.allocationSize = 2 * region;
+    ai.memoryTypeIndex =
+        memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    VkDeviceMemory block;
+    VK(vkAllocateMemory(device, &ai, NULL, &block));
+    void *map;
+    VK(vkMapMemory(device, block, 0, 2 * region, 0, &map));
+    box_snorm((uint16_t *)map, 0);
+    box_snorm((uint16_t *)((char *)map + region), 1);
+    VK(vkBindBufferMemory(device, first, block, 0));
+    static float vis[PX];
+    HrtsMeshVertices v = {1, (uint64_t)(uintptr_t)first, size, 0};
+    VkCommandBuffer cmd = begin();
+    HrtsFrame f = frame(cmd, next_frame++);
+    f.deformed = &v;
+    f.deformed_count = 1;
+    HrtsResult r = finish_frame(cmd, hrts_record_frame(ctx, &f), vis);
+    CHECK(r == HRTS_RESULT_OK, "reused handle: first frame: %s", hrts_last_error(ctx));
+    int differ_a = differing(vis, want_a, PX);
+    /* the frame completed (finish_frame waited for it): the buffer goes, others of its size come until one
+     * gets its handle */
+    const uint64_t handle = v.vertex_buffer;
+    vkDestroyBuffer(device, first, NULL);
+    VkBuffer tried[TRIES], again = VK_NULL_HANDLE;
+    int n = 0;
+    while (n < TRIES && again == VK_NULL_HANDLE) {
+        VK(vkCreateBuffer(device, &ci, NULL, &tried[n]));
+        if ((uint64_t)(uintptr_t)tried[n] == handle) again = tried[n];
+        n++;
+    }
+    int differ_b = -1;
+    if (again != VK_NULL_HANDLE) {
+        VK(vkBindBufferMemory(device, again, block, region));
+        cmd = begin();
+        f = frame(cmd, next_frame++);
+        f.deformed = &v;
+        f.deformed_count = 1;
+        r = finish_frame(cmd, hrts_record_frame(ctx, &f), vis);
+        CHECK(r == HRTS_RESULT_OK, "reused handle: second frame: %s", hrts_last_error(ctx));
+        differ_b = differing(vis, want_b, PX);
+    }
+    printf("reused vertex buffer handle: %s after %d buffers created; the frame before differs from the box in %d px, "
+           "the frame after from the box deformed in %d px\n",
+           again != VK_NULL_HANDLE ? "the handle came back" : "the handle did NOT come back", n, differ_a, differ_b);
+    CHECK(again != VK_NULL_HANDLE, "reused handle: the handle never came back: the case was not tested");
+    CHECK(differ_a == 0 && differ_b == 0, "reused handle: %d / %d px differ", differ_a, differ_b);
+    for (int k = 0; k < n; k++) vkDestroyBuffer(device, tried[k], NULL);
+    vkUnmapMemory(device, block);
+    vkFreeMemory(device, block, NULL);
+}
+
 /* The engine skins the box into one vertex buffer per frame in flight (2): buffer A holds the box, buffer B
  * the box deformed (its x < 0 half gone). Frames give them in turn through HrtsFrame::deformed, two frames
  * pending on the GPU at once, with frames that deform nothing between. Each frame's visibility equals, bit
@@ -2147,6 +1396,8 @@ static void deforming_mesh(const HrtsVulkanDevice *vk) {
         bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
         VK(vkBeginCommandBuffer(cmds[slot], &bi));
         HrtsFrame f = frame(cmds[slot], next_frame++);
+        f.light_stride = sizeof(HrtsLight);
+        f.deformed_stride = sizeof(HrtsMeshVertices);
         if (plan[i] != NONE) {
             f.deformed = &given[plan[i]];
             f.deformed_count = 1;
@@ -2216,6 +1467,8 @@ static void deforming_mesh(const HrtsVulkanDevice *vk) {
     printf("bad deformed lists: %d of 5 refused as they must; the frame after differs from the static geometry in %d px\n",
            refused, after_differ);
     CHECK(after_differ == 0, "deforming: the frame after the refused lists differs in %d px", after_differ);
+    deformed_read_once(ctx, given[B], expected[B]);
+    reused_vertex_handle(ctx, expected[A], expected[B]);
     VK(vkDeviceWaitIdle(device));
     CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
     vkDestroySemaphore(device, hold, NULL);
@@ -2235,15 +1488,18 @@ static void deforming_mesh(const HrtsVulkanDevice *vk) {
 enum {
     CREATE_NULL_INFO, CREATE_NULL_OUT, CREATE_STRUCT_SIZE, CREATE_VERSION, CREATE_NULL_DEVICE, CREATE_NULL_GIPA,
     CREATE_DEVICE_STRUCT_SIZE, CREATE_FRAMES_IN_FLIGHT, CREATE_UNSUPPORTED_EXTENSION, CREATE_NO_SUCH_QUEUE_FAMILY,
-    CREATE_NO_SUCH_QUEUE, CAPS_NULL_CONTEXT, CAPS_NULL_OUT, CAPS_STRUCT_SIZE, CONFIG_N_ZERO, CONFIG_N_ABSURD,
+    CREATE_NO_SUCH_QUEUE, CREATE_MISALIGNED_DEVICE, CREATE_MISALIGNED_EXTENSIONS, CREATE_NEWER_MINOR,
+    CREATE_VERSION_5_0, CAPS_NULL_CONTEXT, CAPS_NULL_OUT, CAPS_STRUCT_SIZE, CONFIG_N_ZERO, CONFIG_N_ABSURD,
     CONFIG_BUDGET_ZERO, CONFIG_BUDGET_SMALL, CONFIG_FACES, CONFIG_BINNING, CONFIG_STRUCT_SIZE, CONFIG_OLDER_SMALLER, CONFIG_MISALIGNED, CONFIG_MODE,
     CONFIG_NAN_LIGHT_SIZE, CONFIG_NEGATIVE_WSS, CONFIG_PCF_TAPS, CONFIG_SHADOW_MAP_ZERO, CONFIG_DEFAULTS_NULL,
     CONFIG_FILTER, CONFIG_EXTRA_OUTPUT, CONFIG_FILTER_RADII, CONFIG_SLOPE_BIAS, LIGHTS_ZERO, LIGHTS_TOO_MANY,
-    LIGHTS_NULL, LIGHTS_SECOND_INVALID, GEOMETRY_NULL_POSITIONS, GEOMETRY_STRIDE, GEOMETRY_NAN, GEOMETRY_INDEX,
-    GEOMETRY_NO_DRAWS, VULKAN_GEOMETRY_INDEX_TYPE, VULKAN_GEOMETRY_VERTEX_OFFSET_WRAP, VULKAN_GEOMETRY_INDEX_OFFSET_WRAP, MESHES_COUNT_ZERO,
+    LIGHTS_NULL, LIGHTS_SECOND_INVALID, LIGHTS_MIXED_VERSIONS, GEOMETRY_NULL_POSITIONS, GEOMETRY_STRIDE, GEOMETRY_NAN, GEOMETRY_INDEX,
+    GEOMETRY_NO_DRAWS, GEOMETRY_MISALIGNED_POSITIONS, GEOMETRY_MISALIGNED_INDICES, GEOMETRY_MISALIGNED_DRAWS,
+    GEOMETRY_DRAW_STRIDE, TRANSFORMS_MISALIGNED, TRANSFORMS_COUNT, VULKAN_GEOMETRY_INDEX_TYPE, VULKAN_GEOMETRY_VERTEX_OFFSET_WRAP, VULKAN_GEOMETRY_INDEX_OFFSET_WRAP, MESHES_COUNT_ZERO,
     MESHES_NULL, MESHES_BUFFER_TOO_SMALL, TARGETS_ZERO_WIDTH, TARGETS_DEPTH_USAGE, TARGETS_OUTPUT_USAGE,
     TARGETS_NULL_NORMAL, TARGETS_ZERO_LAYERS, FRAME_ZERO_DIRECTION, FRAME_NAN_PROJECTION, FRAME_LIGHT_TYPE,
     FRAME_NULL_COMMAND_BUFFER, FRAME_STRUCT_SIZE, FRAME_NULL_LIGHTS, FRAME_LIGHT_COUNT_ZERO, FRAME_LIGHT_COUNT_OTHER,
+    FRAME_MISALIGNED_LIGHTS, FRAME_NEWER_STRUCT_SIZE, FRAME_LIGHT_STRIDE, FRAME_DEFORMED_STRIDE,
     FRAME_DEFORMED_NULL, FRAME_DEFORMED_MESH,
     FRAME_INDEX_REPEATED, FRAME_INDEX_BACKWARDS, REPORT_STRUCT_SIZE, REPORT_OLD_FRAME, REPORT_NO_SUCH_LIGHT,
     REPORT_NOT_COMPLETED, PASSES_EMPTY_MASK, PASSES_UNKNOWN_BIT, PASSES_RAY_TRACE_FIRST, PASSES_CAMERA_MOVED,
@@ -2268,6 +1524,10 @@ static const struct {
     [CREATE_UNSUPPORTED_EXTENSION] = {"create(claims an extension the device lacks)", HRTS_RESULT_ERROR_UNSUPPORTED},
     [CREATE_NO_SUCH_QUEUE_FAMILY] = {"create(queue family 99)", HRTS_RESULT_ERROR_UNSUPPORTED},
     [CREATE_NO_SUCH_QUEUE] = {"create(queue 7 of a one-queue family)", HRTS_RESULT_ERROR_UNSUPPORTED},
+    [CREATE_MISALIGNED_DEVICE] = {"create(misaligned HrtsVulkanDevice)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [CREATE_MISALIGNED_EXTENSIONS] = {"create(misaligned extension names)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [CREATE_NEWER_MINOR] = {"create(a newer minor version than the library's)", HRTS_RESULT_ERROR_VERSION},
+    [CREATE_VERSION_5_0] = {"create(API 5.0)", HRTS_RESULT_ERROR_VERSION},
     [CAPS_NULL_CONTEXT] = {"capabilities(NULL context)", HRTS_RESULT_ERROR_NULL_POINTER},
     [CAPS_NULL_OUT] = {"capabilities(NULL out)", HRTS_RESULT_ERROR_NULL_POINTER},
     [CAPS_STRUCT_SIZE] = {"capabilities(wrong size)", HRTS_RESULT_ERROR_STRUCT_SIZE},
@@ -2294,11 +1554,18 @@ static const struct {
     [LIGHTS_TOO_MANY] = {"configure_lights(HRTS_MAX_LIGHTS + 1)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [LIGHTS_NULL] = {"configure_lights(NULL configs)", HRTS_RESULT_ERROR_NULL_POINTER},
     [LIGHTS_SECOND_INVALID] = {"configure_lights(second light's mode unknown)", HRTS_RESULT_ERROR_INVALID_ENUM},
+    [LIGHTS_MIXED_VERSIONS] = {"configure_lights(a 5.4 HrtsConfig after a current one)", HRTS_RESULT_ERROR_STRUCT_SIZE},
     [GEOMETRY_NULL_POSITIONS] = {"geometry(NULL positions)", HRTS_RESULT_ERROR_NULL_POINTER},
     [GEOMETRY_STRIDE] = {"geometry(stride 6)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [GEOMETRY_NAN] = {"geometry(NaN vertex)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [GEOMETRY_INDEX] = {"geometry(index out of range)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [GEOMETRY_NO_DRAWS] = {"geometry(no draws)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [GEOMETRY_MISALIGNED_POSITIONS] = {"geometry(misaligned positions)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [GEOMETRY_MISALIGNED_INDICES] = {"geometry(misaligned indices)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [GEOMETRY_MISALIGNED_DRAWS] = {"geometry(misaligned draws)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [GEOMETRY_DRAW_STRIDE] = {"geometry(draw_stride 72, the HrtsDraw of no version read)", HRTS_RESULT_ERROR_STRUCT_SIZE},
+    [TRANSFORMS_MISALIGNED] = {"draw transforms(misaligned)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [TRANSFORMS_COUNT] = {"draw transforms(3 for 2 draws)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [VULKAN_GEOMETRY_INDEX_TYPE] = {"vulkan geometry(unknown index type)", HRTS_RESULT_ERROR_INVALID_ENUM},
     [VULKAN_GEOMETRY_VERTEX_OFFSET_WRAP] = {"vulkan geometry(vertex offset UINT64_MAX - 3)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [VULKAN_GEOMETRY_INDEX_OFFSET_WRAP] = {"vulkan geometry(index offset UINT64_MAX - 3)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
@@ -2318,6 +1585,10 @@ static const struct {
     [FRAME_NULL_LIGHTS] = {"frame(NULL lights)", HRTS_RESULT_ERROR_NULL_POINTER},
     [FRAME_LIGHT_COUNT_ZERO] = {"frame(0 lights)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [FRAME_LIGHT_COUNT_OTHER] = {"frame(2 lights, 1 configured)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [FRAME_MISALIGNED_LIGHTS] = {"frame(misaligned lights)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [FRAME_NEWER_STRUCT_SIZE] = {"frame(a newer, larger HrtsFrame)", HRTS_RESULT_ERROR_STRUCT_SIZE},
+    [FRAME_LIGHT_STRIDE] = {"frame(light_stride 104)", HRTS_RESULT_ERROR_STRUCT_SIZE},
+    [FRAME_DEFORMED_STRIDE] = {"frame(deformed_stride 40)", HRTS_RESULT_ERROR_STRUCT_SIZE},
     [FRAME_DEFORMED_NULL] = {"frame(deformed NULL, deformed_count 1)", HRTS_RESULT_ERROR_NULL_POINTER},
     [FRAME_DEFORMED_MESH] = {"frame(deformed mesh 1 of 1)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [FRAME_INDEX_REPEATED] = {"frame(index of the last frame again)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
@@ -2359,6 +1630,15 @@ typedef struct {
     HrtsContext *fresh;  /* a context created after `gone` was destroyed */
 } Misuse;
 
+/* A copy of `bytes` bytes at `from` in `storage` (of `bytes` + 16 bytes), at an address that is no multiple of
+ * `alignment`: what a caller's misaligned pointer points at. */
+static const void *misaligned_copy(unsigned char *storage, const void *from, size_t bytes, size_t alignment) {
+    unsigned char *at = storage + 1;
+    while ((uintptr_t)at % alignment == 0) at++;
+    memcpy(at, from, bytes);
+    return at;
+}
+
 static HrtsResult misuse_call(int id, Misuse *m) {
     static float scratch[W * H];
     HrtsContext *ctx = m->ctx;
@@ -2388,6 +1668,8 @@ static HrtsResult misuse_call(int id, Misuse *m) {
     case CREATE_NULL_OUT: return hrts_context_create(&ci, NULL);
     case CREATE_STRUCT_SIZE: ci.struct_size -= 4; return hrts_context_create(&ci, &none);
     case CREATE_VERSION: ci.api_version += 1u << 22; return hrts_context_create(&ci, &none);
+    case CREATE_NEWER_MINOR: ci.api_version += 1u << 12; return hrts_context_create(&ci, &none);
+    case CREATE_VERSION_5_0: ci.api_version = 5u << 22; return hrts_context_create(&ci, &none);
     case CREATE_NULL_DEVICE: bad.device = 0; ci.vulkan = &bad; return hrts_context_create(&ci, &none);
     case CREATE_NULL_GIPA: bad.get_instance_proc_addr = NULL; ci.vulkan = &bad; return hrts_context_create(&ci, &none);
     case CREATE_DEVICE_STRUCT_SIZE: bad.struct_size = 8; ci.vulkan = &bad; return hrts_context_create(&ci, &none);
@@ -2399,6 +1681,18 @@ static HrtsResult misuse_call(int id, Misuse *m) {
         return hrts_context_create(&ci, &none);
     case CREATE_NO_SUCH_QUEUE_FAMILY: bad.queue_family_index = 99; ci.vulkan = &bad; return hrts_context_create(&ci, &none);
     case CREATE_NO_SUCH_QUEUE: bad.queue_index = 7; ci.vulkan = &bad; return hrts_context_create(&ci, &none);
+    case CREATE_MISALIGNED_DEVICE: {
+        static unsigned char storage[sizeof(HrtsVulkanDevice) + 16];
+        ci.vulkan = misaligned_copy(storage, m->vk, sizeof *m->vk, sizeof(void *));
+        return hrts_context_create(&ci, &none);
+    }
+    case CREATE_MISALIGNED_EXTENSIONS: {
+        static unsigned char storage[sizeof(char *) + 16];
+        bad.enabled_extensions = misaligned_copy(storage, fake_extension, sizeof(char *), sizeof(char *));
+        bad.enabled_extension_count = 1;
+        ci.vulkan = &bad;
+        return hrts_context_create(&ci, &none);
+    }
     case CAPS_NULL_CONTEXT: return hrts_get_capabilities(NULL, &caps);
     case CAPS_NULL_OUT: return hrts_get_capabilities(ctx, NULL);
     case CAPS_STRUCT_SIZE: caps.struct_size = 4; return hrts_get_capabilities(ctx, &caps);
@@ -2419,11 +1713,8 @@ static HrtsResult misuse_call(int id, Misuse *m) {
         return r;
     }
     case CONFIG_MISALIGNED: {
-        static unsigned char bytes[sizeof(HrtsConfig) + 16];
-        unsigned char *at = bytes + 1;
-        while (((uintptr_t)at % sizeof(uint32_t)) == 0) at++; /* HrtsConfig holds 4-byte fields */
-        memcpy(at, &c, sizeof c);
-        return hrts_configure(ctx, (const HrtsConfig *)(void *)at);
+        static unsigned char storage[sizeof(HrtsConfig) + 16];
+        return hrts_configure(ctx, misaligned_copy(storage, &c, sizeof c, sizeof(uint32_t))); /* 4-byte fields */
     }
     case CONFIG_MODE: c.mode = 9; return hrts_configure(ctx, &c);
     case CONFIG_NAN_LIGHT_SIZE: c.pcss_angular_radius = NAN; return hrts_configure(ctx, &c);
@@ -2439,6 +1730,7 @@ static HrtsResult misuse_call(int id, Misuse *m) {
     case LIGHTS_TOO_MANY: return hrts_configure_lights(ctx, HRTS_MAX_LIGHTS + 1, two);
     case LIGHTS_NULL: return hrts_configure_lights(ctx, 2, NULL);
     case LIGHTS_SECOND_INVALID: two[1].mode = 9; return hrts_configure_lights(ctx, 2, two);
+    case LIGHTS_MIXED_VERSIONS: two[1].struct_size = 108; return hrts_configure_lights(ctx, 2, two);
     case GEOMETRY_NULL_POSITIONS: g.positions = NULL; return hrts_set_geometry_cpu(ctx, &g);
     case GEOMETRY_STRIDE: g.vertex_stride = 6; return hrts_set_geometry_cpu(ctx, &g);
     case GEOMETRY_NAN: {
@@ -2456,6 +1748,30 @@ static HrtsResult misuse_call(int id, Misuse *m) {
         return hrts_set_geometry_cpu(ctx, &g);
     }
     case GEOMETRY_NO_DRAWS: g.draw_count = 0; return hrts_set_geometry_cpu(ctx, &g);
+    case GEOMETRY_MISALIGNED_POSITIONS: {
+        static unsigned char storage[sizeof positions + 16];
+        g.positions = misaligned_copy(storage, positions, sizeof positions, sizeof(float));
+        return hrts_set_geometry_cpu(ctx, &g);
+    }
+    case GEOMETRY_MISALIGNED_INDICES: {
+        static unsigned char storage[sizeof indices + 16];
+        g.indices = misaligned_copy(storage, indices, sizeof indices, sizeof(uint32_t));
+        return hrts_set_geometry_cpu(ctx, &g);
+    }
+    case GEOMETRY_MISALIGNED_DRAWS: {
+        static unsigned char storage[sizeof draws + 16];
+        g.draws = misaligned_copy(storage, draws, sizeof draws, sizeof(float));
+        return hrts_set_geometry_cpu(ctx, &g);
+    }
+    case GEOMETRY_DRAW_STRIDE: g.draw_stride = 72; return hrts_set_geometry_cpu(ctx, &g);
+    case TRANSFORMS_MISALIGNED:
+    case TRANSFORMS_COUNT: {
+        static float transforms[3][16];
+        static unsigned char storage[sizeof transforms + 16];
+        for (int i = 0; i < 3; i++) memcpy(transforms[i], draws[0].transform, sizeof transforms[i]);
+        if (id == TRANSFORMS_COUNT) return hrts_set_draw_transforms(ctx, 3, &transforms[0][0]);
+        return hrts_set_draw_transforms(ctx, 2, misaligned_copy(storage, transforms, sizeof transforms, sizeof(float)));
+    }
     case VULKAN_GEOMETRY_INDEX_TYPE: {
         HrtsVulkanGeometry vg = fake_vulkan_geometry(&g);
         vg.index_type = 5;
@@ -2496,6 +1812,20 @@ static HrtsResult misuse_call(int id, Misuse *m) {
     case FRAME_NULL_LIGHTS: f.lights = NULL; return hrts_record_frame(ctx, &f);
     case FRAME_LIGHT_COUNT_ZERO: f.light_count = 0; return hrts_record_frame(ctx, &f);
     case FRAME_LIGHT_COUNT_OTHER: f.lights = lights; f.light_count = 2; return hrts_record_frame(ctx, &f);
+    case FRAME_NEWER_STRUCT_SIZE: f.struct_size = sizeof f + 8; return hrts_record_frame(ctx, &f);
+    case FRAME_LIGHT_STRIDE: f.light_stride = sizeof(HrtsLight) + 4; return hrts_record_frame(ctx, &f);
+    case FRAME_DEFORMED_STRIDE: {
+        HrtsMeshVertices v = {0, 1, 1024, 0};
+        f.deformed = &v;
+        f.deformed_count = 1;
+        f.deformed_stride = 40;
+        return hrts_record_frame(ctx, &f);
+    }
+    case FRAME_MISALIGNED_LIGHTS: {
+        static unsigned char storage[sizeof(HrtsLight) + 16];
+        f.lights = misaligned_copy(storage, &c_lights[0], sizeof(HrtsLight), sizeof(float));
+        return hrts_record_frame(ctx, &f);
+    }
     case FRAME_DEFORMED_NULL: f.deformed_count = 1; return hrts_record_frame(ctx, &f);
     case FRAME_DEFORMED_MESH: {
         HrtsMeshVertices v = {1, 1, 1024, 0};
@@ -2603,8 +1933,10 @@ static void misuse(HrtsContext *ctx, const HrtsVulkanDevice *vk) {
         phase = MISUSE[id].name;
         HrtsResult got = misuse_call(id, &m);
         char message[512];
-        snprintf(message, sizeof message, "%s", hrts_last_error(NULL));
-        int ok = got == MISUSE[id].want && message[0] != '\0';
+        /* the copy, and the size of the whole message: the same string hrts_last_error gives */
+        size_t needed = hrts_get_last_error(NULL, message, sizeof message);
+        int ok = got == MISUSE[id].want && message[0] != '\0' && needed == strlen(message) + 1 &&
+                 strcmp(message, hrts_last_error(NULL)) == 0;
         if (!ok)
             fprintf(stderr, "misuse case '%s': got %s, want %s, message \"%s\"\n", MISUSE[id].name, hrts_result_name(got),
                     hrts_result_name(MISUSE[id].want), message);
@@ -3167,6 +2499,8 @@ int main(void) {
     quantized_positions(&vk, &g);
     phase = "engine meshes";
     engine_meshes(&vk);
+    phase = "draw transforms: all or nothing";
+    draw_transforms_all_or_nothing(&vk);
     phase = "deforming mesh";
     deforming_mesh(&vk);
     phase = "moving geometry";
@@ -3235,12 +2569,7 @@ int main(void) {
     free_image(depth_img);
     free_image(normal_img);
     free_image(out_img);
-    vkDestroyCommandPool(device, pool, NULL);
-    vkDestroyDevice(device, NULL); /* the object tracker reports any object the plugin leaked here */
-    PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger =
-        (PFN_vkDestroyDebugUtilsMessengerEXT)vkGetInstanceProcAddr(instance, "vkDestroyDebugUtilsMessengerEXT");
-    destroy_messenger(instance, messenger, NULL);
-    vkDestroyInstance(instance, NULL);
+    destroy_device();
     printf("validation: %d errors, %d warnings (synchronization validation on)\n", validation_errors, validation_warnings);
     CHECK(validation_errors == 0, "%d validation errors", validation_errors);
     printf("%d passed, %d failed\n", passed, failed);

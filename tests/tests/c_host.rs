@@ -1,11 +1,13 @@
-//! The C ABI as an engine uses it: a plain C program (tests/c_host/c_host.c), built here with the system
-//! compiler against the generated header and the plugin's shared library, creates its own Vulkan device,
-//! fills depth and normal images itself, records the plugin into its command buffer and checks the
-//! visibility against the exact shadow, then runs the misuse cases and 100 create/destroy cycles.
+//! The C ABI as an engine uses it: a plain C program (tests/c_host/c_host.c, with the engine it shares
+//! with the other C tests, engine.c), built here with the system compiler against the generated header
+//! and the plugin's shared library, creates its own Vulkan device, fills depth and normal images itself,
+//! records the plugin into its command buffer and checks the visibility against the exact shadow, then
+//! runs the misuse cases and 100 create/destroy cycles.
 
 mod native;
 
 use native::{compiler, library_dir, run, workspace};
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 #[test]
@@ -30,25 +32,56 @@ fn header_compiles_as_c99_and_cxx() {
         .arg(&src));
 }
 
-#[test]
-fn c_host_matches_the_exact_shadow_and_survives_misuse() {
+/// Builds the C program of `sources` (in tests/c_host) against the `hrts.h` in `include` and the plugin's
+/// shared library; returns the executable.
+fn build_c_program(name: &str, include: &Path, sources: &[&str]) -> PathBuf {
     let root = workspace();
     let lib = library_dir();
-    let exe = std::env::temp_dir().join(format!("hrts-c-host-{}", std::process::id()));
+    let exe = std::env::temp_dir().join(format!("hrts-{name}-{}", std::process::id()));
     run(Command::new(compiler("cc"))
         .args(["-std=c99", "-O1", "-Wall", "-Wextra", "-Werror"])
         .arg("-I")
-        .arg(root.join("plugin_api/include"))
-        .arg(root.join("tests/c_host/c_host.c"))
+        .arg(include)
+        .args(sources.iter().map(|s| root.join("tests/c_host").join(s)))
         .arg("-o")
         .arg(&exe)
         .arg("-L")
         .arg(&lib)
         .arg(format!("-Wl,-rpath,{}", lib.display()))
         .args(["-lhrts", "-lvulkan", "-lm"]));
+    exe
+}
+
+#[test]
+fn c_host_matches_the_exact_shadow_and_survives_misuse() {
+    let include = workspace().join("plugin_api/include");
+    let exe = build_c_program("c-host", &include, &["c_host.c", "engine.c"]);
     let out = run(&mut Command::new(&exe));
     let stdout = String::from_utf8_lossy(&out.stdout);
     println!("{stdout}");
     assert!(stdout.contains(" 0 failed"), "{stdout}");
     assert!(stdout.contains(", 0 mismatches"), "{stdout}");
+}
+
+/// Callers built against older headers (tests/c_host/headers/<version>/hrts.h, as published: 5.1, the
+/// oldest this library reads, and 5.7, the last before the element strides) get the exact shadow from the
+/// current library, which writes nothing past their structs (old_caller.c).
+#[test]
+fn callers_of_older_headers_get_the_exact_shadow() {
+    for version in ["5.1", "5.7"] {
+        let include = workspace().join("tests/c_host/headers").join(version);
+        let exe = build_c_program(
+            &format!("old-caller-{version}"),
+            &include,
+            &["old_caller.c", "engine.c"],
+        );
+        let out = run(&mut Command::new(&exe));
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        println!("{stdout}");
+        assert!(
+            stdout.contains(&format!("caller's header: API {version}")),
+            "{stdout}"
+        );
+        assert!(stdout.contains(" 0 failed"), "{stdout}");
+    }
 }

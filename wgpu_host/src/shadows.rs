@@ -310,6 +310,7 @@ impl Shadows {
                     vertex_format: vk::Format::R32G32B32_SFLOAT.as_raw() as u32,
                     position_scale: [0.0; 3],
                     position_offset: [0.0; 3],
+                    draw_stride: size_of::<HrtsDraw>(),
                 }
             })
             .collect();
@@ -431,6 +432,8 @@ impl Shadows {
                     has_bounds: 1,
                     deformed: std::ptr::null(),
                     deformed_count: 0,
+                    light_stride: size_of::<HrtsLight>(),
+                    deformed_stride: size_of::<HrtsMeshVertices>(),
                 };
                 anyhow::Ok(hrts_record_frame(self.context, &f))
             })

@@ -34,21 +34,20 @@ pub struct MeshVertices {
     pub offset: u64,
 }
 
-/// A vertex buffer some frame read instead of a mesh's own, with the bind group that reads it: kept
-/// while a frame in flight may use it.
-struct CachedVertices {
-    mesh: usize,
-    buffer: Buffer,
+/// The bind group of a vertex buffer a frame reads instead of a mesh's own, written for that frame: kept
+/// while the frame may be in flight, never reused by another frame (the engine may destroy the buffer
+/// once the frame completed, and its handle may then name another buffer).
+struct FrameVertices {
     group: BindGroup,
-    /// The last frame that read it.
-    last_used: u64,
+    /// The frame that reads it.
+    frame: u64,
 }
 
 /// A mesh that reads a vertex buffer of the frame.
 struct FrameMesh {
     mesh: usize,
     vertex: VertexLayout,
-    /// Its [`CachedVertices`] entry.
+    /// Its [`FrameVertices`] entry.
     entry: usize,
 }
 
@@ -75,8 +74,8 @@ struct PrimBufferState {
     built_with: Vec<Option<Mat4>>,
     /// The frame whose per-frame vertex buffers were set last, and the meshes reading them.
     frame_meshes: Option<(u64, Vec<FrameMesh>)>,
-    /// The vertex buffers frames read instead of their meshes' own.
-    frame_vertices: Vec<CachedVertices>,
+    /// The vertex buffers the frames in flight read instead of their meshes' own.
+    frame_vertices: Vec<FrameVertices>,
     /// The triangles each recent frame's build rewrote.
     rebuilt: VecDeque<(u64, u32)>,
 }
@@ -279,9 +278,11 @@ impl SharedGeometry {
 
     /// Sets the vertex buffers frame `frame` reads instead of its meshes' own (none: every mesh reads its
     /// own); those meshes' draws are rebuilt in that frame, and again from their own vertices in the next
-    /// frame that does not deform them. Bind groups are kept per buffer and dropped once no frame in
-    /// flight uses them: `completed` is the last frame known to have completed on the GPU (everything up
-    /// to `frame - frames_in_flight`). Checks every entry before it changes anything.
+    /// frame that does not deform them. Each buffer gets a bind group written for this frame, dropped once
+    /// the frame completed: `completed` is the last frame known to have completed on the GPU (everything
+    /// up to `frame - frames_in_flight`). A frame never reuses an earlier frame's bind group, even for the
+    /// same handle: the engine may have destroyed that buffer and created another at the same handle.
+    /// Checks every entry before it changes anything.
     pub fn set_frame_vertices(
         &self,
         device: &Device,
@@ -315,36 +316,19 @@ impl SharedGeometry {
             layouts.push(vertex);
         }
         let mut s = self.lock();
-        // The entries of the last frame's meshes move when unused buffers go.
+        // The entries of the last frame's meshes move when those of completed frames go.
         s.frame_meshes = None;
         if let Some(done) = completed {
-            s.frame_vertices.retain(|c| c.last_used > done);
+            s.frame_vertices.retain(|v| v.frame > done);
         }
         let mut frame_meshes = Vec::with_capacity(vertices.len());
         for (v, vertex) in vertices.into_iter().zip(layouts) {
-            let key = (v.mesh, v.buffer.raw_handle(), v.buffer.size());
-            let cached = s
-                .frame_vertices
-                .iter()
-                .position(|c| (c.mesh, c.buffer.raw_handle(), c.buffer.size()) == key);
-            let entry = match cached {
-                Some(entry) => entry,
-                None => {
-                    let group = self.pass.bind(device, &meshes[v.mesh], &v.buffer)?;
-                    s.frame_vertices.push(CachedVertices {
-                        mesh: v.mesh,
-                        buffer: v.buffer,
-                        group,
-                        last_used: frame,
-                    });
-                    s.frame_vertices.len() - 1
-                }
-            };
-            s.frame_vertices[entry].last_used = frame;
+            let group = self.pass.bind(device, &meshes[v.mesh], &v.buffer)?;
+            s.frame_vertices.push(FrameVertices { group, frame });
             frame_meshes.push(FrameMesh {
-                mesh: key.0,
+                mesh: v.mesh,
                 vertex,
-                entry,
+                entry: s.frame_vertices.len() - 1,
             });
         }
         s.frame_meshes = Some((frame, frame_meshes));
