@@ -75,7 +75,7 @@ fn run(
 
 fn area_ms(r: &Run) -> (f64, f64) {
     (
-        median_of(&r.times, &["primitive map", "occupancy"]).unwrap_or(f64::NAN),
+        median_of(&r.times, &["primitive map"]).unwrap_or(f64::NAN),
         median_of(&r.times, &["ray trace"]).unwrap_or(f64::NAN),
     )
 }

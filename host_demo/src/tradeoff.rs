@@ -80,11 +80,10 @@ const FAMILIES: [&str; 6] = ["shadow map", "PCF", "PCSS", "ray traced", "hybrid"
 
 const SHADOW_MAP_PASSES: &[&str] = &["shadow map"];
 const SOFT_PASSES: &[&str] = &["shadow map", "PCSS"];
-const TRACED_PASSES: &[&str] = &["primitive map", "occupancy", "ray trace", "FXAA"];
+const TRACED_PASSES: &[&str] = &["primitive map", "ray trace", "FXAA"];
 const HYBRID_PASSES: &[&str] = &[
     "shadow map",
     "primitive map",
-    "occupancy",
     "ray trace",
     "PCSS",
     "FXAA",

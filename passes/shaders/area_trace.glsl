@@ -280,10 +280,11 @@ uint band_index(uint i0, uint i1) {
 // (the projection of a convex set in front of the origin is the convex hull of its corners', and a segment
 // or ray from o through a point of the box reaches the plane at its sample's point), found in the sample
 // bands of the columns and rows the rectangle spans. A box with a corner not in front of the origin keeps
-// them all.
-uvec4 bvh_box_samples(vec3 lo, vec3 hi, uvec4 reach) {
+// them all, as does a triangle's (a `leaf`): its own test narrows its samples better, through the edge
+// table.
+uvec4 bvh_box_samples(vec3 lo, vec3 hi, uvec4 reach, bool leaf) {
     uvec4 open = reach & ~blocked;
-    if (all(equal(open, uvec4(0u))) || !(plane_depth > 0.0)) {
+    if (leaf || all(equal(open, uvec4(0u))) || !(plane_depth > 0.0)) {
         return open;
     }
     vec2 rect_lo = vec2(1.0 / 0.0), rect_hi = vec2(-1.0 / 0.0);
@@ -312,6 +313,37 @@ uvec4 bvh_box_samples(vec3 lo, vec3 hi, uvec4 reach) {
         & sample_bands[bands_base + 1u + BAND_COUNT + band_index(c0.y, c1.y)];
 }
 
+
+// The pixel's walk of the BVH with its bundle: the segments from the origin to the emitter's disc (whose
+// axes' combined reach bounds u U + v V over the unit disc), or the rays within the light's cone. (Walking
+// each sample's segment on its own once the bundle met many nodes was measured slower on an H100 at every
+// light size: a node's test costs less, but the samples' walks meet the nodes near the origin again and
+// again.)
+void walk_bvh() {
+    if (local) {
+        float reach = max(dot(disc_u, disc_u), dot(disc_v, disc_v)) + abs(dot(disc_u, disc_v));
+        bvh_set_cone(origin, disc_c, sqrt(reach) * (1.0 + 1e-4), 1.0);
+        // The disc's plane, spanned by its axes U and V, in the dual basis of (U, V): a point P + u U + v V
+        // of it gets (u, v) however far from orthogonal the axes' rounding leaves them.
+        vec3 n = cross(disc_u, disc_v);
+        plane_normal = dot(disc_c, n) < 0.0 ? -n : n;
+        vec3 du = cross(disc_v, n), dv = cross(n, disc_u);
+        plane_u = du / dot(disc_u, du);
+        plane_v = dv / dot(disc_v, dv);
+        plane_depth = dot(disc_c, plane_normal);
+        plane_offset = vec2(dot(disc_c, plane_u), dot(disc_c, plane_v));
+        plane_margin = 1e-4;
+    } else {
+        bvh_set_cone(origin, samples.center.xyz, samples.center.w * (1.0 + 1e-4) + 1e-6, 1.0 / 0.0);
+        plane_normal = samples.center.xyz;
+        plane_u = samples.axis_u.xyz;
+        plane_v = samples.axis_v.xyz;
+        plane_depth = 1.0;
+        plane_offset = vec2(0.0);
+        plane_margin = 1e-4 * samples.center.w;
+    }
+    count_walk(bvh_walk(k.misc.y, all_samples));
+}
 
 void main() {
     sample_count = k.misc.w;
@@ -360,36 +392,7 @@ void main() {
             consider(entries[i], all_samples);
         }
     } else if (!all_blocked()) {
-        // The bundle: the segments from the origin to the emitter's disc (its axes' combined reach bounds
-        // u U + v V over the unit disc), or the rays within the light's cone.
-        bvh_cone_o = origin;
-        if (local) {
-            bvh_cone_d = disc_c;
-            float reach = max(dot(disc_u, disc_u), dot(disc_v, disc_v)) + abs(dot(disc_u, disc_v));
-            bvh_cone_spread = sqrt(reach) * (1.0 + 1e-4);
-            bvh_cone_t_end = 1.0;
-            // The disc's plane, spanned by its axes U and V, in the dual basis of (U, V): a point P + u U
-            // + v V of it gets (u, v) however far from orthogonal the axes' rounding leaves them.
-            vec3 n = cross(disc_u, disc_v);
-            plane_normal = dot(disc_c, n) < 0.0 ? -n : n;
-            vec3 du = cross(disc_v, n), dv = cross(n, disc_u);
-            plane_u = du / dot(disc_u, du);
-            plane_v = dv / dot(disc_v, dv);
-            plane_depth = dot(disc_c, plane_normal);
-            plane_offset = vec2(dot(disc_c, plane_u), dot(disc_c, plane_v));
-            plane_margin = 1e-4;
-        } else {
-            bvh_cone_d = samples.center.xyz;
-            bvh_cone_spread = samples.center.w * (1.0 + 1e-4) + 1e-6;
-            bvh_cone_t_end = 1.0 / 0.0;
-            plane_normal = samples.center.xyz;
-            plane_u = samples.axis_u.xyz;
-            plane_v = samples.axis_v.xyz;
-            plane_depth = 1.0;
-            plane_offset = vec2(0.0);
-            plane_margin = 1e-4 * samples.center.w;
-        }
-        count_walk(bvh_walk(k.misc.y, all_samples));
+        walk_bvh();
     }
     uvec4 seen = blocked & all_samples;
     uint hidden = bitCount(seen.x) + bitCount(seen.y) + bitCount(seen.z) + bitCount(seen.w);

@@ -15,19 +15,35 @@
 // the exact bundle meets is always walked.
 //
 // With BVH_MASKED defined (the area trace), each node of the walk carries the samples whose segment or ray
-// may meet it: the includer's `uvec4 bvh_box_samples(vec3 lo, vec3 hi, uvec4 samples)` narrows its
-// parent's to those of a child's box, and a child none of whose samples is still open is not walked. A wide
-// bundle then costs what its samples can meet, not what its cone holds.
+// may meet it: the includer's `uvec4 bvh_box_samples(vec3 lo, vec3 hi, uvec4 samples, bool leaf)` narrows
+// its parent's to those of a child's box (a triangle's own test decides its samples better than its box
+// can: for a leaf it need only drop those already decided), and a child none of whose samples is still
+// open is not walked. A wide bundle then costs what its samples can meet, not what its cone holds.
 
 vec3 bvh_cone_o;
 vec3 bvh_cone_d;
 float bvh_cone_spread;
 float bvh_cone_t_end;
+// Per axis, the reciprocals of the rates at which the cone's section's ends move (0 where one stands still).
+vec3 bvh_inv_up, bvh_inv_down;
+
+// Sets the bundle of the next walk: the cone from o along d, spreading by `spread` per unit of t, to t_end.
+void bvh_set_cone(vec3 o, vec3 d, float spread, float t_end) {
+    bvh_cone_o = o;
+    bvh_cone_d = d;
+    bvh_cone_spread = spread;
+    bvh_cone_t_end = t_end;
+    vec3 up = d + spread, down = d - spread;
+    bvh_inv_up = vec3(up.x != 0.0 ? 1.0 / up.x : 0.0, up.y != 0.0 ? 1.0 / up.y : 0.0,
+                      up.z != 0.0 ? 1.0 / up.z : 0.0);
+    bvh_inv_down = vec3(down.x != 0.0 ? 1.0 / down.x : 0.0, down.y != 0.0 ? 1.0 / down.y : 0.0,
+                        down.z != 0.0 ? 1.0 / down.z : 0.0);
+}
 
 void bvh_visit(uint triangle, uvec4 samples);
 bool bvh_done();
 #ifdef BVH_MASKED
-uvec4 bvh_box_samples(vec3 lo, vec3 hi, uvec4 samples);
+uvec4 bvh_box_samples(vec3 lo, vec3 hi, uvec4 samples, bool leaf);
 #endif
 
 // Whether the bundle meets the box [lo, hi]; `t_enter`, the first t at which it may.
@@ -47,17 +63,17 @@ bool bvh_cone_meets(vec3 lo, vec3 hi, out float t_enter) {
         float down = bvh_cone_d[a] - bvh_cone_spread;
         // The section's upper end reaches the box's minimum: o + t up >= lo.
         if (up > 0.0) {
-            t0 = max(t0, (lo[a] - o) / up);
+            t0 = max(t0, (lo[a] - o) * bvh_inv_up[a]);
         } else if (up < 0.0) {
-            t1 = min(t1, (lo[a] - o) / up);
+            t1 = min(t1, (lo[a] - o) * bvh_inv_up[a]);
         } else if (o < lo[a]) {
             return false;
         }
         // The section's lower end stays below the box's maximum: o + t down <= hi.
         if (down < 0.0) {
-            t0 = max(t0, (hi[a] - o) / down);
+            t0 = max(t0, (hi[a] - o) * bvh_inv_down[a]);
         } else if (down > 0.0) {
-            t1 = min(t1, (hi[a] - o) / down);
+            t1 = min(t1, (hi[a] - o) * bvh_inv_down[a]);
         } else if (o > hi[a]) {
             return false;
         }
@@ -66,14 +82,14 @@ bool bvh_cone_meets(vec3 lo, vec3 hi, out float t_enter) {
     return t0 <= t1;
 }
 
-// The samples of `samples` whose segment or ray may meet the box [lo, hi], and where the bundle may enter
-// it: none when the bundle misses it.
-uvec4 bvh_child(vec3 lo, vec3 hi, uvec4 samples, out float t_enter) {
+// The samples of `samples` whose segment or ray may meet the box [lo, hi] of a node or a `leaf`, and where
+// the bundle may enter it: none when the bundle misses it.
+uvec4 bvh_child(vec3 lo, vec3 hi, uvec4 samples, bool leaf, out float t_enter) {
     if (!bvh_cone_meets(lo, hi, t_enter)) {
         return uvec4(0u);
     }
 #ifdef BVH_MASKED
-    return bvh_box_samples(lo, hi, samples);
+    return bvh_box_samples(lo, hi, samples, leaf);
 #else
     return samples;
 #endif
@@ -102,11 +118,13 @@ bool bvh_walk(uint triangles, uvec4 samples) {
     for (uint round = 0u; round < 65535u && walking; ++round) {
         for (uint step = 0u; step < 64u && walking; ++step) {
             BvhNode nd = bvh_nodes[node];
-            float t_left, t_right;
-            uvec4 left = bvh_child(nd.left_lo.xyz, nd.left_hi.xyz, node_samples, t_left);
-            uvec4 right = bvh_child(nd.right_lo.xyz, nd.right_hi.xyz, node_samples, t_right);
             uint left_child = floatBitsToUint(nd.left_lo.w);
             uint right_child = floatBitsToUint(nd.right_lo.w);
+            float t_left, t_right;
+            uvec4 left = bvh_child(nd.left_lo.xyz, nd.left_hi.xyz, node_samples, left_child >= BVH_LEAF,
+                                   t_left);
+            uvec4 right = bvh_child(nd.right_lo.xyz, nd.right_hi.xyz, node_samples,
+                                    right_child >= BVH_LEAF, t_right);
             uint leaves[2];
             uvec4 leaf_samples[2];
             uint count = 0u;

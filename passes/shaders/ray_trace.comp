@@ -184,10 +184,7 @@ void main() {
         walk_nearest = nearest;
         walk_first_hit = first_hit;
         walk_t_max = t_max;
-        bvh_cone_o = o;
-        bvh_cone_d = dir;
-        bvh_cone_spread = 0.0;
-        bvh_cone_t_end = t_max;
+        bvh_set_cone(o, dir, 0.0, t_max);
         count_walk(bvh_walk(k.misc.y, uvec4(1u, 0u, 0u, 0u)));
         nearest = walk_nearest;
     }

@@ -295,7 +295,7 @@ fn io(pass: PassId, request: &PlanRequest, hard_edge: HardEdge) -> (ResourceSet,
             [&screen[..], &[R::PrimBuffer, R::Light]].concat(),
             vec![R::PrimListOffsets, R::PrimListEntries],
         ),
-        // The statistics always (the frame report), the view only when asked for.
+        // The view, when asked for (the statistics are read back after the ray trace).
         PassId::Occupancy => (
             vec![R::PrimListOffsets],
             if outputs(request).contains(R::Occupancy) {
@@ -374,15 +374,7 @@ impl FramePlan {
         } else {
             HardEdge::ShadowMap
         };
-        let mut live = cull(&request, hard_edge, outputs);
-        // The frame report carries the statistics of every primitive map the frame builds.
-        if live.contains(&PassId::PrimitiveMap) && !live.contains(&PassId::Occupancy) {
-            let at = live
-                .iter()
-                .position(|&p| p == PassId::PrimitiveMap)
-                .map_or(live.len(), |i| i + 1);
-            live.insert(at, PassId::Occupancy);
-        }
+        let live = cull(&request, hard_edge, outputs);
         let resources = live
             .iter()
             .map(|&p| io(p, &request, hard_edge).1)
@@ -519,10 +511,7 @@ mod tests {
     fn area_runs_the_map_and_its_ray_trace_alone_and_ignores_antialiasing() {
         for aa in [false, true] {
             let p = plan(ShadowMode::Area, aa);
-            assert_eq!(
-                p.passes(),
-                &[P::PrimBuffer, P::PrimitiveMap, P::Occupancy, P::RayTrace]
-            );
+            assert_eq!(p.passes(), &[P::PrimBuffer, P::PrimitiveMap, P::RayTrace]);
             assert_eq!(p.final_output(), R::RtVisibility);
             assert!(!p.resources().contains(R::BlockerDistance));
             assert!(!p.resources().contains(R::ShadowMap));
@@ -553,7 +542,6 @@ mod tests {
                 P::PrimBuffer,
                 P::ShadowMap,
                 P::PrimitiveMap,
-                P::Occupancy,
                 P::RayTrace,
                 P::Pcss,
                 P::Fxaa,
@@ -580,10 +568,7 @@ mod tests {
     #[test]
     fn hard_never_allocates_a_shadow_map() {
         let p = plan(ShadowMode::Hard, false);
-        assert_eq!(
-            p.passes(),
-            &[P::PrimBuffer, P::PrimitiveMap, P::Occupancy, P::RayTrace]
-        );
+        assert_eq!(p.passes(), &[P::PrimBuffer, P::PrimitiveMap, P::RayTrace]);
         assert!(!p.resources().contains(R::ShadowMap));
         assert_eq!(p.final_output(), R::RtVisibility);
         let aa = plan(ShadowMode::Hard, true);
@@ -610,13 +595,13 @@ mod tests {
     #[test]
     fn the_occupancy_view_exists_only_when_asked_for() {
         let stats_only = plan(ShadowMode::Hard, false);
-        assert!(stats_only.runs(P::Occupancy));
+        assert!(!stats_only.runs(P::Occupancy));
         assert!(!stats_only.resources().contains(R::Occupancy));
         let with_view = FramePlan::derive(PlanRequest {
             extra_outputs: ResourceSet::of(&[R::Occupancy]),
             ..stats_only.request
         });
-        assert_eq!(with_view.passes(), stats_only.passes());
+        assert!(with_view.runs(P::Occupancy));
         assert!(with_view.resources().contains(R::Occupancy));
     }
 
@@ -719,7 +704,6 @@ mod tests {
             ran(&s),
             &[
                 P::PrimitiveMap,
-                P::Occupancy,
                 P::RayTrace,
                 P::Pcss,
                 P::Fxaa,
@@ -732,7 +716,7 @@ mod tests {
         }
         // A moving light re-renders the shadow map but not the prim buffer.
         let s = p.schedule(screen_only.with(R::Light), valid);
-        assert_eq!(ran(&s)[..3], [P::ShadowMap, P::PrimitiveMap, P::Occupancy]);
+        assert_eq!(ran(&s)[..3], [P::ShadowMap, P::PrimitiveMap, P::RayTrace]);
         // Dynamic geometry rebuilds everything downstream of the prim buffer.
         let s = p.schedule(screen_only.with(R::SceneGeometry), valid);
         assert_eq!(ran(&s), p.passes());

@@ -229,7 +229,7 @@ fn plan_culls_by_mode_and_caches_static_light_space_passes() {
     assert!(reports[2].ran(PassId::ShadowMap), "after the light moved");
     // The primitive map is fitted to the receivers the depth buffer shows: rebuilt every frame.
     for r in &reports {
-        assert!(r.ran(PassId::PrimitiveMap) && r.ran(PassId::Occupancy));
+        assert!(r.ran(PassId::PrimitiveMap) && r.ran(PassId::RayTrace));
     }
     assert_eq!(reports[1].status(PassId::PrimBuffer), up_to_date);
     assert_eq!(reports[2].status(PassId::PrimBuffer), up_to_date);

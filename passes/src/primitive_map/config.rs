@@ -174,7 +174,7 @@ pub struct PrimitiveMapConfig {
 }
 
 /// Default [`PrimitiveMapConfig::list_limit`].
-pub const DEFAULT_LIST_LIMIT: u32 = 256;
+pub const DEFAULT_LIST_LIMIT: u32 = 1024;
 
 /// Default [`PrimitiveMapConfig::bin_budget`].
 pub const DEFAULT_BIN_BUDGET: f32 = 8.0;
