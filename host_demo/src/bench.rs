@@ -77,7 +77,8 @@ pub struct BenchArgs {
     /// Default: hard shadows alone.
     #[arg(long, value_delimiter = ',', requires = "lights")]
     pub emitter_size: Vec<f32>,
-    /// A texel whose list would pass this many entries keeps none: its pixels walk the BVH.
+    /// A texel whose list would pass this many entries keeps none: its pixels walk the BVH (0: the
+    /// plugin's choice by mode).
     #[arg(long, default_value_t = passes::primitive_map::DEFAULT_LIST_LIMIT)]
     pub list_limit: u32,
     /// Bin items per pixel with a ray past which a frame builds no list and every pixel walks the BVH

@@ -127,8 +127,8 @@ struct RenderArgs {
     /// sw (geometry-shader conservative raster).
     #[arg(long, default_value = "auto", value_parser = parse_binning)]
     binning: BinningRequest,
-    /// A texel whose list would pass this many entries keeps none: its pixels walk the BVH (moves cost,
-    /// never exactness).
+    /// A texel whose list would pass this many entries keeps none: its pixels walk the BVH (0: the
+    /// plugin's choice by mode; moves cost, never exactness).
     #[arg(long, default_value_t = passes::primitive_map::DEFAULT_LIST_LIMIT)]
     list_limit: u32,
     /// Bin items per pixel with a ray past which a frame builds no list and every pixel walks the BVH

@@ -57,8 +57,6 @@ pub struct PrefixScan {
     levels: Vec<(BindGroup, u32)>,
     /// Whether the scan takes two dispatches over one level ([`FLAT_BLOCKS`]; one block takes one).
     flat: bool,
-    /// Input values above this are read as 0 ([`PrefixScan::with_input_cap`]).
-    cap: u32,
     _sums: Vec<Buffer>,
 }
 
@@ -110,19 +108,23 @@ impl PrefixScan {
         Ok(Self {
             levels,
             flat,
-            cap: u32::MAX,
             _sums: sums,
         })
-    }
-
-    /// The same scan, reading every input value above `cap` as 0.
-    pub fn with_input_cap(self, cap: u32) -> Self {
-        Self { cap, ..self }
     }
 
     /// Records the scan; the data buffer's earlier writes must be visible (UAV barrier) and its scanned
     /// values are visible to later storage accesses after the UAV barrier this records last.
     pub fn record(&self, enc: &mut Encoder<'_>, pipeline: &ScanPipeline) -> Result<(), PassError> {
+        self.record_capped(enc, pipeline, u32::MAX)
+    }
+
+    /// [`PrefixScan::record`], reading every input value above `cap` as 0.
+    pub fn record_capped(
+        &self,
+        enc: &mut Encoder<'_>,
+        pipeline: &ScanPipeline,
+        cap: u32,
+    ) -> Result<(), PassError> {
         let blocks = |n: u32| u64::from(n).div_ceil(BLOCK).max(1) as u32;
         let levels = self.levels.iter().enumerate();
         let passes: Vec<(usize, &(BindGroup, u32), u32)> = if self.flat {
@@ -141,7 +143,7 @@ impl PrefixScan {
                 n: *n,
                 mode,
                 // Only the input's values are capped (the levels above hold block totals).
-                cap: if level == 0 { self.cap } else { u32::MAX },
+                cap: if level == 0 { cap } else { u32::MAX },
                 pad: 0,
             };
             enc.dispatch(

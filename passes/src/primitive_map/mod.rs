@@ -212,7 +212,6 @@ impl PrimitiveMap {
             entries: &entries,
             pool: inputs.scratch,
             entry_capacity: capacity,
-            list_limit: config.list_limit,
         };
         let bound = ScratchBindings::new(device, &pipes, scratch, &targets, (texels, bins))?;
         Ok(Self {
@@ -428,7 +427,6 @@ impl PrimitiveMap {
             entries: &self.entries,
             pool,
             entry_capacity: self.capacity,
-            list_limit: self.config.list_limit,
         };
         let sizes = (self.config.texels(), self.bins);
         let bound = ScratchBindings::new(device, &self.pipes, scratch, &targets, sizes)?;
@@ -495,7 +493,9 @@ impl PrimitiveMap {
             list_capacity: self.bound.pair_list.as_ref().map_or(0, |l| {
                 (l.size() / PAIR_BYTES).min(u64::from(u32::MAX)) as u32
             }),
-            list_limit: self.config.list_limit,
+            list_limit: self
+                .config
+                .list_limit_for(push.penumbra > 0.0 || push.emitter_radius > 0.0),
             bin_budget: self.config.bin_budget,
             count_scale: self.config.debug_count_scale,
             ..*push
@@ -575,7 +575,9 @@ impl PrimitiveMap {
         enc.end_pass();
 
         enc.begin_pass("primitive map: scan");
-        self.bound.offset_scan.record(enc, &self.pipes.scan)?;
+        self.bound
+            .offset_scan
+            .record_capped(enc, &self.pipes.scan, push.list_limit)?;
         let groups = self.config.texels().div_ceil(OFFSET_GROUP as u64) + 1;
         // The offsets and statistics, then the cursors of the lists not kept.
         for mode in 0..2u32 {

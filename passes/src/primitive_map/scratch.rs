@@ -282,8 +282,6 @@ pub(super) struct BindTargets<'a> {
     /// The pool the pair list comes from, and the pairs it must hold (the entry capacity).
     pub(super) pool: &'a MapScratchPool,
     pub(super) entry_capacity: u32,
-    /// The map's list limit: the scan reads longer counts as 0.
-    pub(super) list_limit: u32,
 }
 
 impl ScratchBindings {
@@ -354,8 +352,7 @@ impl ScratchBindings {
             &s.counts,
             &s.counts,
             (texels + 1) as u32,
-        )?
-        .with_input_cap(t.list_limit);
+        )?;
         let index_group = device.create_bind_group(
             pipes.index.layout(),
             &[
