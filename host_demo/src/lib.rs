@@ -305,7 +305,9 @@ pub fn check_validation(device: &Device) -> anyhow::Result<()> {
 pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     let [x, y, z] = parts.as_slice() else {
-        return Err(format!("expected x,y,z but got '{s}'"));
+        return Err(format!(
+            "expected x,y,z (three numbers, such as -5,2,3) but got '{s}'"
+        ));
     };
     let f = |v: &str| {
         v.parse::<f32>()
@@ -323,6 +325,10 @@ mod tests {
     #[test]
     fn parses_vectors() {
         assert_eq!(parse_vec3("1, 2,3").unwrap(), Vec3::new(1.0, 2.0, 3.0));
+        assert_eq!(
+            parse_vec3("-5,-0.5,-1e2").unwrap(),
+            Vec3::new(-5.0, -0.5, -100.0)
+        );
         assert!(parse_vec3("1,2").is_err());
         assert!(parse_vec3("1,nan,2").is_err());
         assert!(parse_vec3("a,b,c").is_err());

@@ -400,6 +400,8 @@ fn out_of_range_options_name_the_flag_and_the_range() {
             "1..=65535",
         ),
         (&["render", "--width", "0"][..], "--width", "1..=16384"),
+        (&["render", "--width", "-5"][..], "--width", "1..=16384"),
+        (&["tradeoff", "--strata", "-2"][..], "--strata", "1.."),
         (&["bench", "--frames", "0"][..], "--frames", "1.."),
         (
             &["tradeoff", "--height", "99999"][..],
@@ -415,6 +417,111 @@ fn out_of_range_options_name_the_flag_and_the_range() {
             stderr.contains(flag) && stderr.contains(range),
             "{args:?}: {stderr}"
         );
+    }
+}
+
+/// Vector options take negative numbers as people type them (`--camera-pos -5,2,3`, not only
+/// `--camera-pos=-5,2,3`), each value reaching the view.
+#[test]
+fn vector_options_take_negative_numbers() {
+    let dir = temp_dir("negative");
+    let out = dir.join("render");
+    let output = host_demo(&[
+        "render",
+        "--out",
+        out.to_str().unwrap(),
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--frames",
+        "1",
+        "--map-size",
+        "64",
+        "--shadow-map-size",
+        "64",
+        "--camera-pos",
+        "-5,2,3",
+        "--camera-target",
+        "0,-0.5,0",
+        "--light-dir",
+        "-0.3,-1,-0.2",
+    ]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("frame.json")).unwrap()).unwrap();
+    let floats = |v: &serde_json::Value| -> Vec<f64> {
+        v.as_array()
+            .unwrap_or_else(|| panic!("not an array: {v}"))
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    assert_eq!(floats(&json["camera"]["position"]), [-5.0, 2.0, 3.0]);
+    // The target lies on the view's axis: x and y of the view-space target are 0.
+    let view = floats(&json["camera"]["view"]);
+    let target = [0.0, -0.5, 0.0, 1.0];
+    for row in 0..2 {
+        let v: f64 = (0..4).map(|col| view[col * 4 + row] * target[col]).sum();
+        assert!(v.abs() < 1e-4, "target off the view axis: {view:?}");
+    }
+    let light = floats(&json["light"]["direction"]);
+    let given = [-0.3f64, -1.0, -0.2];
+    let norm = given.iter().map(|c| c * c).sum::<f64>().sqrt();
+    for (l, g) in light.iter().zip(given) {
+        assert!((l - g / norm).abs() < 1e-5, "light direction {light:?}");
+    }
+
+    let example = example_scene(&dir);
+    let output = host_demo(&[
+        "plan",
+        "--scene",
+        example.to_str().unwrap(),
+        "--camera-pos",
+        "-5,2,3",
+        "--camera-target",
+        "-1,0,-0.5",
+    ]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert!(stdout.contains("camera from the command line"), "{stdout}");
+
+    let out = dir.join("compare");
+    let output = host_demo(&[
+        "compare",
+        "--out",
+        out.to_str().unwrap(),
+        "--width",
+        "32",
+        "--height",
+        "18",
+        "--frames",
+        "1",
+        "--camera-pos",
+        "-1,1.5,3.3",
+        "--camera-target",
+        "0.8,-0.35,0.5",
+        "--close-up-pos",
+        "-2.3,0.9,2.4",
+        "--close-up-target",
+        "1.9,-0.1,1.3",
+    ]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let caption = std::fs::read_to_string(out.join("caption.txt")).expect("caption.txt");
+    for said in [
+        "overview camera [-1.0, 1.5, 3.3] -> [0.8, -0.35, 0.5]",
+        "close-up [-2.3, 0.9, 2.4] -> [1.9, -0.1, 1.3]",
+    ] {
+        assert!(caption.contains(said), "'{said}' missing from: {caption}");
     }
 }
 
