@@ -30,6 +30,7 @@ pub mod load_report;
 pub mod output;
 pub mod peer;
 pub mod plugin;
+pub mod progress;
 pub mod ray_dump;
 pub mod render;
 pub mod renderer;
@@ -45,6 +46,7 @@ use passes::{Draw, FrameInputs, Geometry, Light, PassError};
 use rhi::Device;
 use scene::{Aabb, Camera, DirectionalLight, Scene};
 
+pub use progress::progress;
 pub use renderer::{read_images, FrameImages, FrameOutput, ShadowRenderer};
 
 mod shaders {
@@ -168,94 +170,6 @@ impl CameraMatrices {
             proj: inputs.proj,
             position: inputs.camera_position,
         }
-    }
-}
-
-/// Progress of a long run of `len` steps on stderr: a bar on a terminal; elsewhere (a pipe, a CI log,
-/// `nohup`) one plain line per step, so that a run never looks hung.
-pub fn progress(len: u64, what: &str) -> Progress {
-    let bar = std::io::IsTerminal::is_terminal(&std::io::stderr()).then(|| {
-        let style =
-            indicatif::ProgressStyle::with_template("{msg} {bar:30} {pos}/{len} ({elapsed})")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
-        indicatif::ProgressBar::new(len)
-            .with_style(style)
-            .with_message(what.to_owned())
-    });
-    Progress {
-        bar,
-        what: what.to_owned(),
-        len,
-        done: std::cell::Cell::new(0),
-        announced: std::cell::Cell::new(false),
-        start: std::time::Instant::now(),
-    }
-}
-
-/// See [`progress`].
-pub struct Progress {
-    bar: Option<indicatif::ProgressBar>,
-    what: String,
-    len: u64,
-    done: std::cell::Cell<u64>,
-    /// Whether the current step's line was printed.
-    announced: std::cell::Cell<bool>,
-    start: std::time::Instant,
-}
-
-impl Progress {
-    /// Names the step that starts now (off a terminal: prints its line).
-    pub fn set_message(&self, message: impl Into<String>) {
-        let message = message.into();
-        match &self.bar {
-            Some(bar) => bar.set_message(message),
-            None => {
-                self.announced.set(true);
-                eprintln!(
-                    "{}",
-                    self.line((self.done.get() + 1).min(self.len), &message)
-                );
-            }
-        }
-    }
-
-    /// Marks `n` steps done (off a terminal: prints a line for a step that was not named).
-    pub fn inc(&self, n: u64) {
-        self.done.set(self.done.get() + n);
-        match &self.bar {
-            Some(bar) => bar.inc(n),
-            None => {
-                if !self.announced.replace(false) {
-                    eprintln!("{}", self.line(self.done.get(), "done"));
-                }
-            }
-        }
-    }
-
-    /// Ends the run (clears the bar).
-    pub fn finish_and_clear(&self) {
-        if let Some(bar) = &self.bar {
-            bar.finish_and_clear();
-        }
-    }
-
-    /// "what [step/len] message (elapsed, about how long is left)", `step` counted from 1.
-    fn line(&self, step: u64, message: &str) -> String {
-        let done = self.done.get();
-        let elapsed = self.start.elapsed().as_secs_f64();
-        let remaining = self.len.saturating_sub(done);
-        let left = if done == 0 || remaining == 0 {
-            String::new()
-        } else {
-            format!(
-                ", about {:.0} s left",
-                elapsed / done as f64 * remaining as f64
-            )
-        };
-        format!(
-            "{} [{}/{}] {message} ({elapsed:.0} s elapsed{left})",
-            self.what, step, self.len
-        )
     }
 }
 

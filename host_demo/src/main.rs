@@ -400,7 +400,10 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
     };
     render_to_folder(&device, &view, &options, &args.out)?;
     if args.dump_rays {
+        let bar = host_demo::progress(1, "ray dump");
+        bar.set_message("the frame's shadow rays");
         let dump = host_demo::ray_dump::write_ray_dump(&view, &view.frame_inputs(), &args.out)?;
+        drop(bar);
         println!("ray dump: {dump:?}");
     }
     host_demo::check_validation(&device)
