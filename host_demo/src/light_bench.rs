@@ -9,13 +9,13 @@
 //! `--emitter-size` runs every light at each size given, sized lights with exact soft shadows, each also
 //! traced by the ray-tracing-pipeline peer at equal samples (trace only).
 
-use crate::bench::BenchArgs;
+use crate::bench::{keep_only, models_folder, BenchArgs};
 use crate::gbuffer::GBufferLayout;
 use crate::plugin::{c_point_light, LightsFrame, PluginRenderer};
 use crate::scene_plan::{plan_scene, PlanSettings};
 use crate::scene_render::SceneRenderer;
 use crate::CameraMatrices;
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use glam::Vec3;
 use passes::{
     directional_light_frustum, spot_light_frusta, AreaConfig, FrameInputs, Light, MapStats,
@@ -24,7 +24,7 @@ use passes::{
 use rhi::Device;
 use scene::{Aabb, Camera, LightKind, LightSize, SceneFile, SceneLight};
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::PathBuf;
 
 /// A scene of the benchmark: a model of the models folder and, as fractions of its bounds, the camera's
 /// position and target and the positions of the lights inside.
@@ -57,6 +57,42 @@ const SCENES: [LightScene; 2] = [
         spot: Vec3::new(0.5, 0.9, 0.5),
     },
 ];
+
+/// The scenes `--lights` measures (those `--only` keeps) and the folder that holds them.
+pub struct LightScenes {
+    folder: PathBuf,
+    scenes: Vec<&'static LightScene>,
+}
+
+/// The scenes of `--lights` that `--only` keeps, in the models folder of `args`. Fails, naming the
+/// shared models it needs and where it looked, when the folder lacks one of them, and when an `--only`
+/// matches none of the scenes.
+pub fn chosen_scenes(args: &BenchArgs) -> Result<LightScenes> {
+    let scenes = keep_only(
+        SCENES.iter().collect(),
+        |s| s.file,
+        &args.only,
+        "scenes of --lights",
+    )?;
+    let (folder, how) = models_folder(args);
+    let missing: Vec<&str> = scenes
+        .iter()
+        .map(|s| s.file)
+        .filter(|file| !folder.join(file).is_file())
+        .collect();
+    if !missing.is_empty() {
+        let needed: Vec<&str> = SCENES.iter().map(|s| s.file).collect();
+        bail!(
+            "bench --lights measures lights inside the shared models {}, framed for them; the models \
+             folder {} ({how}) has no {}: name the project's shared models folder with --models DIR (or \
+             HRTS_MODELS), or keep the scenes it has with --only",
+            needed.join(" and "),
+            folder.display(),
+            missing.join(" nor ")
+        );
+    }
+    Ok(LightScenes { folder, scenes })
+}
 
 /// The point `f` (fractions of each axis) of `bounds`.
 fn at(bounds: &Aabb, f: Vec3) -> Vec3 {
@@ -448,8 +484,8 @@ fn measure_native_points(
     })
 }
 
-/// Runs the light benchmark and returns its Markdown table.
-pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Result<String> {
+/// Runs the light benchmark on `scenes` ([`chosen_scenes`]) and returns its Markdown table.
+pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) -> Result<String> {
     let caps = device.capabilities();
     if let Some(bad) = args
         .emitter_size
@@ -490,11 +526,8 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
         args.map_size,
         args.frames.max(2) - 1
     );
-    let chosen: Vec<&LightScene> = SCENES
-        .iter()
-        .filter(|s| args.only.is_empty() || args.only.iter().any(|o| s.file.contains(o.as_str())))
-        .collect();
-    let total: usize = chosen
+    let total: usize = scenes
+        .scenes
         .iter()
         .map(|s| (2 + s.points.len() + usize::from(args.point_lights > 0)) * sizes.len())
         .sum();
@@ -503,8 +536,8 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
     let mut per_pass = String::from(
         "\nPer pass (median ms over the same frames, summed over the light's frusta):\n\n",
     );
-    for scene_case in chosen {
-        let path = models.join(scene_case.file);
+    for &scene_case in &scenes.scenes {
+        let path = scenes.folder.join(scene_case.file);
         let scene =
             scene::load_obj(&path).with_context(|| format!("loading {}", path.display()))?;
         let bounds = scene.bounds();

@@ -570,7 +570,7 @@ fn main() -> ExitCode {
             host_demo::compare::run_cli(cli.device.clone(), cli.validation, args)
         }
         Command::Bench { args, out } => {
-            device(&cli).and_then(|d| host_demo::bench::run_cli(&d, args, out.as_deref()))
+            host_demo::bench::run_cli(cli.device.clone(), cli.validation, args, out.as_deref())
         }
         Command::Tradeoff(args) => {
             device(&cli).and_then(|d| host_demo::tradeoff::run_cli(&d, args))

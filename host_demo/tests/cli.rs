@@ -569,6 +569,127 @@ fn long_runs_print_a_line_per_step_off_a_terminal() {
     assert!(lines[1].contains("s elapsed, about"), "{stderr}");
 }
 
+/// The cells of the Markdown table row of `model` in `tables`.
+fn table_row<'a>(tables: &'a str, model: &str) -> Vec<&'a str> {
+    let row = tables
+        .lines()
+        .find(|l| l.starts_with(&format!("| {model} |")))
+        .unwrap_or_else(|| panic!("no row of {model} in:\n{tables}"));
+    row.trim_matches('|').split('|').map(str::trim).collect()
+}
+
+/// `bench` measures a folder of any OBJ files (every .obj in it and its subfolders, in sorted order; a
+/// shared model's file name keeps its framing) or the files given to `--obj`, each with the RT-pipeline
+/// peer's cells; a folder without .obj files, a missing file and an `--only` that matches nothing are
+/// errors that say what was expected, before any GPU work.
+#[test]
+fn bench_takes_the_users_own_models() {
+    let dir = temp_dir("own-models");
+    let models = dir.join("models");
+    std::fs::create_dir_all(models.join("sub")).unwrap();
+    room_obj(&models);
+    std::fs::write(
+        models.join("zeta.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    std::fs::write(models.join("notes.txt"), "not a model").unwrap();
+    let shared = scene::models_dir().unwrap_or_else(|e| panic!("{e}"));
+    std::fs::copy(
+        shared.join("06_cornell_box/cornell_box.obj"),
+        models.join("sub/cornell_box.obj"),
+    )
+    .unwrap();
+    let small = ["--width", "32", "--height", "24", "--frames", "2"];
+    let bench = |extra: &[&str]| {
+        let mut args = vec!["bench"];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&small);
+        host_demo(&args)
+    };
+
+    let output = bench(&["--models", models.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let order: Vec<usize> = ["room.obj", "sub/cornell_box.obj", "zeta.obj"]
+        .iter()
+        .map(|m| {
+            stdout
+                .find(&format!("| {m} |"))
+                .unwrap_or_else(|| panic!("no row of {m}:\n{stdout}"))
+        })
+        .collect();
+    assert!(order.windows(2).all(|w| w[0] < w[1]), "{stdout}");
+    let cornell = table_row(&stdout, "sub/cornell_box.obj");
+    let zeta = table_row(&stdout, "zeta.obj");
+    // The shared Cornell box keeps its framing (no ground plane); another file gets a ground plane.
+    assert_eq!(cornell[1], "36", "{stdout}");
+    assert_eq!(zeta[1], "3", "{stdout}");
+    // Every model has the RT-pipeline peer's cells (numbers where the device traces rays).
+    assert_eq!(zeta.len(), 16, "{stdout}");
+    assert_eq!(zeta[11] == "—", cornell[11] == "—", "{stdout}");
+
+    let zeta_path = models.join("zeta.obj");
+    let room_path = models.join("room.obj");
+    let output = bench(&[
+        "--obj",
+        zeta_path.to_str().unwrap(),
+        room_path.to_str().unwrap(),
+        "--no-reference",
+    ]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert_eq!(table_row(&stdout, zeta_path.to_str().unwrap()).len(), 16);
+    assert_eq!(table_row(&stdout, room_path.to_str().unwrap())[1], "26");
+
+    let empty = dir.join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let missing = dir.join("missing.obj");
+    for (args, expect) in [
+        (
+            vec!["bench", "--models", empty.to_str().unwrap()],
+            "no .obj file in",
+        ),
+        (
+            vec!["bench", "--models", models.to_str().unwrap(), "--only", "bunny"],
+            "(named by --models): room.obj, sub/cornell_box.obj, zeta.obj",
+        ),
+        (
+            vec!["bench", "--obj", missing.to_str().unwrap()],
+            "missing.obj: no such file",
+        ),
+        (
+            vec!["bench", "--lights", "--models", models.to_str().unwrap()],
+            "has no 04_dabrovic_sponza_66k.obj nor 05_conference_clean_277k.obj",
+        ),
+        (
+            vec!["bench", "--lights", "--only", "bunny"],
+            "matches none of the scenes of --lights: 04_dabrovic_sponza_66k.obj, 05_conference_clean_277k.obj",
+        ),
+    ] {
+        // No device: the error comes before any GPU work.
+        let mut args_with_device = vec!["--device", "no such device"];
+        args_with_device.extend(args.iter());
+        let output = host_demo(&args_with_device);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_clean_failure(&output, &stderr, expect);
+        if args.contains(&"--only") {
+            assert!(stderr.contains("--only bunny matches none of the "), "{stderr}");
+        }
+    }
+    let output = host_demo(&["bench", "--models", empty.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("--obj FILE"), "{stderr}");
+}
+
 /// Reads an 8-bit PNG (grey or RGBA) into its first channel per pixel.
 fn png_first_channel(path: &Path) -> Vec<u8> {
     let decoder = png::Decoder::new(std::fs::File::open(path).expect("png exists"));
