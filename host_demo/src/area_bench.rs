@@ -131,15 +131,15 @@ pub(crate) fn run_area_bench(
         "bench --area",
     );
     for model in models {
-        let view = view_of(model, args)?;
         bar.set_message(format!("{} area", model.name));
+        let view = view_of(model, args)?;
         let (renderer, area) = run(device, &view, area_config(args, r, n), args.frames)?;
-        bar.set_message(format!("{} RT peer", model.name));
         let peer = peer_trace_ms(device, &renderer, &view, r, n, args.frames)?;
         bar.inc(1);
         let wrong = if args.no_reference {
             "—".to_owned()
         } else {
+            bar.set_message(format!("{} CPU reference", model.name));
             let images = renderer.read_back(device, false)?;
             let rs = RefScene::new(&view.scene);
             let c = compare_area(&rs, &view, r, n, &images.output);

@@ -9,10 +9,11 @@
 //!
 //! GPU timestamps around every pass; medians over the frames after the first.
 
-use crate::accuracy::compare_visibility;
+use crate::accuracy::{compare_visibility_to, view_reference};
 use crate::gbuffer::GBufferLayout;
 use crate::peer::run_peer;
 use crate::plugin::PluginRenderer;
+use crate::progress::phase;
 use crate::render::{map_bytes, median_timings};
 use crate::View;
 use anyhow::{bail, Context, Result};
@@ -403,10 +404,16 @@ fn frames_with_layout(
     frames: u32,
     layout: GBufferLayout,
 ) -> Result<(PluginRenderer, Vec<FrameReport>)> {
+    let frames = frames.max(2);
+    let progress = phase("frames", u64::from(frames));
     let mut renderer = PluginRenderer::with_layout(device, view, config, layout)?;
     let inputs = view.frame_inputs();
-    let reports = (0..frames.max(2))
-        .map(|_| renderer.render(device, &inputs))
+    let reports = (0..frames)
+        .map(|_| {
+            let report = renderer.render(device, &inputs);
+            progress.inc(1);
+            report
+        })
         .collect::<Result<Vec<_>>>()?;
     Ok((renderer, reports))
 }
@@ -421,11 +428,13 @@ fn measure(device: &Device, model: &BenchModel, args: &BenchArgs) -> Result<Meas
     let times = median_timings(&reports);
     let report = reports.last().cloned().context("no frame")?;
     let inputs = view.frame_inputs();
-    let reference = (!args.no_reference).then(|| RefScene::new(&view.scene));
+    // One reference for our frame and the peer's.
+    let reference =
+        (!args.no_reference).then(|| view_reference(&RefScene::new(&view.scene), &view));
     let wrong = match &reference {
-        Some(rs) => {
+        Some(r) => {
             let images = renderer.read_back(device, false)?;
-            let c = compare_visibility(rs, &view, &images);
+            let c = compare_visibility_to(r, &view, &images);
             Some((c.mismatches, c.near_edge))
         }
         None => None,
@@ -433,12 +442,12 @@ fn measure(device: &Device, model: &BenchModel, args: &BenchArgs) -> Result<Meas
     let peer = if device.capabilities().ray_tracing_pipeline {
         let run = run_peer(device, &renderer, &inputs, args.frames)?;
         let wrong = match &reference {
-            Some(rs) => {
+            Some(r) => {
                 let images = crate::FrameImages {
                     visibility: run.visibility,
                     ..renderer.read_back(device, false)?
                 };
-                Some(compare_visibility(rs, &view, &images).mismatches)
+                Some(compare_visibility_to(r, &view, &images).mismatches)
             }
             None => None,
         };
@@ -452,9 +461,10 @@ fn measure(device: &Device, model: &BenchModel, args: &BenchArgs) -> Result<Meas
     };
     let mut raster_build = [None, None];
     if model.framing.gtx980.is_some() {
-        for (slot, request) in raster_build
+        for ((slot, request), path) in raster_build
             .iter_mut()
             .zip([BinningRequest::Hardware, BinningRequest::Software])
+            .zip(["hardware", "software"])
         {
             if passes::choose_binning_path(device.capabilities(), request).is_err() {
                 continue;
@@ -466,6 +476,7 @@ fn measure(device: &Device, model: &BenchModel, args: &BenchArgs) -> Result<Meas
                 },
                 ..ShadowConfig::default()
             };
+            let _binning = phase(format!("{path} conservative raster binning"), 1);
             let (_, reports) = frames_of(device, &view, config, args.frames)?;
             *slot = median_of(&median_timings(&reports), &["primitive map"]);
         }
@@ -606,6 +617,7 @@ fn run_gbuffer_bench(device: &Device, args: &BenchArgs, models: &[BenchModel]) -
     );
     let bar = crate::progress(models.len() as u64 * 2, "bench --gbuffer");
     for model in models {
+        bar.set_message(&model.name);
         let view = view_of(model, args)?;
         for (name, layout) in [
             ("as first required", GBufferLayout::ANALYSIS),
@@ -651,6 +663,11 @@ fn run_gbuffer_bench(device: &Device, args: &BenchArgs, models: &[BenchModel]) -
 /// configuration measured does not pay for a GPU still clocking up (seen on an H100: the first light 4x
 /// slower than the same light measured later).
 fn warm_up(device: &Device, args: &BenchArgs) -> Result<()> {
+    let bar = crate::progress(1, "bench warm-up");
+    bar.set_message(format!(
+        "the built-in scene at {}×{}",
+        args.width, args.height
+    ));
     let view = View::framed(scene::procedural_default(), args.width, args.height);
     let started = std::time::Instant::now();
     let (mut renderer, _) = frames_of(device, &view, ShadowConfig::default(), 2)?;

@@ -336,12 +336,15 @@ fn measure_light(
         height: args.height,
     };
     let plan = plan_scene(file, camera, &settings)?;
+    let progress = crate::progress::phase("frames", u64::from(args.frames.max(2)));
     let mut renderer = SceneRenderer::new(device, file, args.width, args.height)?;
     renderer.write_outputs_directly();
     let mut frames = Vec::new();
     for _ in 0..args.frames.max(2) {
         frames.push(renderer.render(device, camera, &plan)?);
+        progress.inc(1);
     }
+    drop(progress);
     let (gpu_ms, map_ms, trace_ms) = medians(&frames[1..]);
     let max_ms = slowest(&frames);
     let last = frames.last().context("no frame rendered")?;
@@ -421,6 +424,7 @@ fn measure_native_points(
     args: &BenchArgs,
     emitter_radius: Option<f32>,
 ) -> Result<LightCost> {
+    let progress = crate::progress::phase("frames", u64::from(args.frames.max(2)));
     let mut plugin = PluginRenderer::for_scene_casters(
         device,
         &file.scene,
@@ -451,7 +455,9 @@ fn measure_native_points(
     let mut frames = Vec::new();
     for _ in 0..args.frames.max(2) {
         frames.push(plugin.render_c_lights(device, &matrices, lights.clone())?);
+        progress.inc(1);
     }
+    drop(progress);
     let (_, map_ms, trace_ms) = medians(&frames[1..]);
     let frame_ms = |f: &LightsFrame| f.lights.iter().map(|l| l.gpu_ms).sum::<f64>();
     let gpu_ms = median(frames[1..].iter().map(frame_ms).collect());
@@ -538,6 +544,7 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
     );
     for &scene_case in &scenes.scenes {
         let path = scenes.folder.join(scene_case.file);
+        bar.set_message(format!("{} loading", scene_case.file));
         let scene =
             scene::load_obj(&path).with_context(|| format!("loading {}", path.display()))?;
         let bounds = scene.bounds();

@@ -559,14 +559,92 @@ fn long_runs_print_a_line_per_step_off_a_terminal() {
     ]);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(output.status.success(), "{stderr}");
-    let lines: Vec<&str> = stderr
+    // A step's line is "bench [i/n] <model> (<times>)"; its phases' lines follow the model with ": ".
+    let steps: Vec<&str> = stderr
         .lines()
-        .filter(|l| l.starts_with("bench ["))
+        .filter(|l| {
+            l.starts_with("bench [") && l.split(" (").next().is_some_and(|s| !s.contains(": "))
+        })
         .collect();
-    assert_eq!(lines.len(), 2, "{stderr}");
-    assert!(lines[0].starts_with("bench [1/2] 01_scorpion"), "{stderr}");
-    assert!(lines[1].starts_with("bench [2/2] 07_veach"), "{stderr}");
-    assert!(lines[1].contains("s elapsed, about"), "{stderr}");
+    assert_eq!(steps.len(), 2, "{stderr}");
+    assert!(steps[0].starts_with("bench [1/2] 01_scorpion"), "{stderr}");
+    assert!(steps[1].starts_with("bench [2/2] 07_veach"), "{stderr}");
+    assert!(steps[1].contains("s elapsed, about"), "{stderr}");
+    assert!(
+        stderr.contains("bench [1/2] 01_scorpion_low_12k.obj: frames 0/2 ("),
+        "{stderr}"
+    );
+}
+
+/// Off a terminal, no long phase is silent: a bench of one model at a low resolution, with the CPU
+/// reference, prints its lines (steps, phases, and the state again whenever the interval passes without
+/// a line) at most a few intervals apart — the interval shortened to 1 s by `HRTS_PROGRESS_SECONDS` so
+/// that a short run shows it (by default 10 s, against the 15 s). Progress per model alone
+/// printed one line for the whole model.
+#[test]
+fn piped_runs_print_a_line_every_interval() {
+    use std::io::{BufRead, BufReader, Read};
+    use std::time::{Duration, Instant};
+    let started = Instant::now();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_host_demo"))
+        .args([
+            "bench",
+            "--only",
+            "02_stanford",
+            "--frames",
+            "3",
+            "--width",
+            "160",
+            "--height",
+            "90",
+        ])
+        .env("HRTS_PROGRESS_SECONDS", "1")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("host_demo runs");
+    let mut stdout = child.stdout.take().expect("stdout");
+    let tables = std::thread::spawn(move || {
+        let mut text = String::new();
+        stdout.read_to_string(&mut text).map(|_| text)
+    });
+    let mut lines = Vec::new();
+    for line in BufReader::new(child.stderr.take().expect("stderr")).lines() {
+        lines.push((started.elapsed(), line.expect("a line of stderr")));
+    }
+    let status = child.wait().expect("host_demo ends");
+    let ended = started.elapsed();
+    let tables = tables.join().expect("stdout read").expect("stdout");
+    let log: String = lines
+        .iter()
+        .map(|(t, l)| format!("{:6.2} s | {l}\n", t.as_secs_f64()))
+        .collect();
+    assert!(status.success(), "{log}");
+    assert!(tables.contains("| 02_stanford_bunny_69k.obj |"), "{tables}");
+    let first = lines.first().map_or(ended, |(t, _)| *t);
+    assert!(
+        first < Duration::from_secs(15),
+        "first line after {first:?}:\n{log}"
+    );
+    let mut times: Vec<Duration> = lines.iter().map(|(t, _)| *t).collect();
+    times.push(ended);
+    let longest = times
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .max()
+        .unwrap_or_default();
+    assert!(
+        longest <= Duration::from_secs(4),
+        "{longest:?} without a line (interval 1 s):\n{log}"
+    );
+    for phase in [": frames 0/3 (", ": CPU reference 0/90 ("] {
+        assert!(log.contains(phase), "no line of '{phase}':\n{log}");
+    }
+    assert!(
+        lines.len() as f64 >= ended.as_secs_f64() / 2.0,
+        "{} lines in {ended:?}:\n{log}",
+        lines.len()
+    );
 }
 
 /// The cells of the Markdown table row of `model` in `tables`.
