@@ -5,8 +5,8 @@ use crate::{CameraMatrices, FrameImages, View};
 use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
 use passes::{PrimitiveMapConfig, GUARD_WORDS};
 use reference::{
-    conservative_texel_sets, overlaps_texel_with_margin, reference_visibility, FaceSelection,
-    Light, PixelClass, RefScene, VisibilityParams, VisibilityReference,
+    conservative_texel_sets, overlaps_texel_with_margin, reference_visibility_with_progress,
+    FaceSelection, Light, PixelClass, RefScene, VisibilityParams, VisibilityReference,
 };
 use scene::{Camera, Scene};
 
@@ -194,19 +194,35 @@ pub fn scene_visibility_params(
     }
 }
 
-/// Compares GPU visibility and blocker distance with the exact reference.
+/// Compares GPU visibility and blocker distance with the exact reference ([`view_reference`]).
 pub fn compare_visibility(
     rs: &RefScene,
     view: &View,
     images: &FrameImages,
 ) -> VisibilityComparison {
+    compare_visibility_to(&view_reference(rs, view), view, images)
+}
+
+/// The exact reference of `view` ([`visibility_params`]); its rows are counted as the phase "CPU
+/// reference" of the run's progress ([`crate::progress::phase`]).
+pub fn view_reference(rs: &RefScene, view: &View) -> VisibilityReference {
+    let rows = crate::progress::phase("CPU reference", u64::from(view.height));
+    reference_visibility_with_progress(rs, &visibility_params(view), &|| rows.inc(1))
+}
+
+/// Compares GPU visibility and blocker distance with `r`, the exact reference of `view`
+/// ([`view_reference`]).
+pub fn compare_visibility_to(
+    r: &VisibilityReference,
+    view: &View,
+    images: &FrameImages,
+) -> VisibilityComparison {
     let params = visibility_params(view);
-    let r = reference_visibility(rs, &params);
     let far = (view.camera.position - view.scene.bounds().center()).length() as f64
         + view.scene.bounds().radius() as f64;
     let bd_bound = 4.0 * (params.tolerance + far * params.tolerance_per_distance);
     compare_with_reference(
-        &r,
+        r,
         &images.visibility,
         Some((&images.blocker_distance, bd_bound)),
         None,
@@ -301,7 +317,8 @@ pub struct AreaComparison {
 
 /// Compares GPU area-shadow visibility (`visibility`, row-major, the visible fraction of `samples`) with
 /// the exact reference of the same sample directions: the light of `view` of angular radius
-/// `angular_radius`, sampled by [`passes::area::area_sample_directions`].
+/// `angular_radius`, sampled by [`passes::area::area_sample_directions`]. The reference's rows (of every
+/// sample) are counted as the phase "CPU reference" of the run's progress.
 pub fn compare_area(
     rs: &RefScene,
     view: &View,
@@ -314,7 +331,14 @@ pub fn compare_area(
             .iter()
             .map(|w| w.as_dvec3())
             .collect();
-    let r = reference::area_reference(rs, &visibility_params(view), &directions);
+    let rows = crate::progress::phase(
+        format!("CPU reference ({samples} samples)"),
+        u64::from(view.height) * directions.len() as u64,
+    );
+    let r =
+        reference::area_reference_with_progress(rs, &visibility_params(view), &directions, &|| {
+            rows.inc(1)
+        });
     compare_area_counts(&r, visibility, None)
 }
 

@@ -6,7 +6,7 @@
 //! GPU timestamps around every pass; medians over the frames after the first.
 
 use crate::accuracy::compare_area;
-use crate::bench::{chosen_models, frames_of, median_of, models_folder, view_of, BenchArgs};
+use crate::bench::{frames_of, median_of, view_of, BenchArgs, BenchModel};
 use crate::render::{map_bytes, median_timings};
 use crate::View;
 use anyhow::{Context, Result};
@@ -99,11 +99,13 @@ fn peer_trace_ms(
     Ok(Some(run.trace_ms))
 }
 
-/// Runs the area benchmark over the chosen models and returns its Markdown tables.
-pub fn run_area_bench(device: &Device, args: &BenchArgs) -> Result<String> {
-    let models = models_folder(args)?;
+/// Runs the area benchmark over `models` and returns its Markdown tables.
+pub(crate) fn run_area_bench(
+    device: &Device,
+    args: &BenchArgs,
+    models: &[BenchModel],
+) -> Result<String> {
     let caps = device.capabilities();
-    let chosen = chosen_models(args);
     let (r, n) = (args.angular_radius, args.area_samples);
     let mut main = format!(
         "Device: {} ({}); {}×{}; directional light of angular radius {r}; medians of {} frames after the \
@@ -125,26 +127,26 @@ pub fn run_area_bench(device: &Device, args: &BenchArgs) -> Result<String> {
         RADII[0], RADII[1], RADII[2], SAMPLES[0], SAMPLES[1], SAMPLES[2], SAMPLES[3]
     );
     let bar = crate::progress(
-        chosen.len() as u64 * (2 + (RADII.len() + SAMPLES.len()) as u64),
+        models.len() as u64 * (2 + (RADII.len() + SAMPLES.len()) as u64),
         "bench --area",
     );
-    for model in chosen {
-        let view = view_of(model, &models, args)?;
-        bar.set_message(format!("{} area", model.file));
+    for model in models {
+        bar.set_message(format!("{} area", model.name));
+        let view = view_of(model, args)?;
         let (renderer, area) = run(device, &view, area_config(args, r, n), args.frames)?;
-        bar.set_message(format!("{} RT peer", model.file));
         let peer = peer_trace_ms(device, &renderer, &view, r, n, args.frames)?;
         bar.inc(1);
         let wrong = if args.no_reference {
             "—".to_owned()
         } else {
+            bar.set_message(format!("{} CPU reference", model.name));
             let images = renderer.read_back(device, false)?;
             let rs = RefScene::new(&view.scene);
             let c = compare_area(&rs, &view, r, n, &images.output);
             format!("{} ({})", c.mismatches + c.non_finite, c.unstable)
         };
         drop(renderer);
-        bar.set_message(format!("{} PCSS", model.file));
+        bar.set_message(format!("{} PCSS", model.name));
         let (_, pcss) = run(device, &view, pcss_config(r), args.frames)?;
         bar.inc(1);
         let (build, trace) = area_ms(&area);
@@ -156,7 +158,7 @@ pub fn run_area_bench(device: &Device, args: &BenchArgs) -> Result<String> {
         };
         main.push_str(&format!(
             "| {} | {} | {build:.3} | {trace:.3} | {:.3} | {pcss_ms:.3} | {:.2} | {peer_cell} | {ratio_cell} | {} | {:.1} | {} | {} | {} | {:.1} | {wrong} |\n",
-            model.file,
+            model.name,
             view.scene.triangle_count(),
             build + trace,
             (build + trace) / pcss_ms,
@@ -173,7 +175,7 @@ pub fn run_area_bench(device: &Device, args: &BenchArgs) -> Result<String> {
             .map(|&radius| (radius, n))
             .chain(SAMPLES.iter().map(|&samples| (r, samples)))
         {
-            bar.set_message(format!("{} r {radius}, {samples} samples", model.file));
+            bar.set_message(format!("{} r {radius}, {samples} samples", model.name));
             let (_, point) = run(
                 device,
                 &view,
@@ -188,7 +190,7 @@ pub fn run_area_bench(device: &Device, args: &BenchArgs) -> Result<String> {
             ));
             bar.inc(1);
         }
-        sweep.push_str(&format!("| {} | {} |\n", model.file, cells.join(" | ")));
+        sweep.push_str(&format!("| {} | {} |\n", model.name, cells.join(" | ")));
     }
     bar.finish_and_clear();
     main.push_str(&format!(

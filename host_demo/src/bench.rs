@@ -9,13 +9,14 @@
 //!
 //! GPU timestamps around every pass; medians over the frames after the first.
 
-use crate::accuracy::compare_visibility;
+use crate::accuracy::{compare_visibility_to, view_reference};
 use crate::gbuffer::GBufferLayout;
 use crate::peer::run_peer;
 use crate::plugin::PluginRenderer;
+use crate::progress::phase;
 use crate::render::{map_bytes, median_timings};
 use crate::View;
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use glam::Vec3;
 use passes::{
     BinningRequest, FrameReport, PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig,
@@ -29,9 +30,14 @@ use std::path::{Path, PathBuf};
 /// Options of the benchmark.
 #[derive(Debug, Clone, clap::Args)]
 pub struct BenchArgs {
-    /// Folder with the test models (default: `HRTS_MODELS`, else `../shared/models` beside the checkout).
-    #[arg(long)]
+    /// Folder of the models: every .obj file in it and its subfolders, in sorted order (default:
+    /// `HRTS_MODELS`, else `../shared/models` beside the checkout). A file named as a shared model keeps
+    /// that model's framing; any other is framed automatically on a ground plane, lit by the demo's sun.
+    #[arg(long, value_name = "DIR")]
     pub models: Option<PathBuf>,
+    /// These OBJ files instead of a folder's, each measured as a model (framed as in --models).
+    #[arg(long, value_name = "FILE", num_args = 1.., conflicts_with_all = ["models", "lights"])]
+    pub obj: Vec<PathBuf>,
     /// Frames per configuration; medians over all but the first.
     #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..))]
     pub frames: u32,
@@ -41,7 +47,9 @@ pub struct BenchArgs {
     /// Frame height.
     #[arg(long, default_value_t = 1080, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
     pub height: u32,
-    /// Only the models whose file name contains one of these (comma-separated; default all).
+    /// Only the models whose name (the path in the models folder, or the file as given to --obj; with
+    /// --lights, the scene's file) contains one of these (comma-separated; default all). One that matches
+    /// none is an error that lists the names.
     #[arg(long, value_delimiter = ',')]
     pub only: Vec<String>,
     /// Skip the exact CPU reference (wrong-pixel counts): minutes on two cores at 1080p.
@@ -102,10 +110,12 @@ impl BenchArgs {
     }
 }
 
-/// One benchmark model: a file of `../shared/models`, how it is shown, and the talk's GTX 980 times (ms)
-/// for its three models.
-pub(crate) struct Model {
-    pub(crate) file: &'static str,
+/// How a model of the benchmark is shown: the own framing of a shared model (matched by file name), or
+/// [`DEFAULT_FRAMING`] for any other file; with the talk's GTX 980 times (ms) for its three models.
+pub(crate) struct Framing {
+    /// File name of the shared model ("" for the default).
+    file: &'static str,
+    /// Whether a ground plane is added under the model.
     ground: bool,
     /// Camera position and target (default: framed).
     camera: Option<(Vec3, Vec3)>,
@@ -123,36 +133,47 @@ const TALK_ROWS: [&str; 6] = [
     "FXAA",
 ];
 
-const MODELS: [Model; 8] = [
-    Model {
+/// The framing of a file that is none of the shared models: on a ground plane, the camera framing it, the
+/// demo's slanted sun.
+const DEFAULT_FRAMING: Framing = Framing {
+    file: "",
+    ground: true,
+    camera: None,
+    light: None,
+    gtx980: None,
+};
+
+/// The shared models' framings.
+const SHARED_MODELS: [Framing; 8] = [
+    Framing {
         file: "01_scorpion_low_12k.obj",
         ground: true,
         camera: None,
         light: None,
         gtx980: Some([0.4, 0.5, 0.4, 1.3, 1.8, 0.2]),
     },
-    Model {
+    Framing {
         file: "02_stanford_bunny_69k.obj",
         ground: true,
         camera: None,
         light: None,
         gtx980: Some([0.5, 0.7, 0.7, 1.3, 2.8, 0.2]),
     },
-    Model {
+    Framing {
         file: "03_bunny_hr_x4_239k.obj",
         ground: true,
         camera: None,
         light: None,
         gtx980: Some([3.4, 4.1, 1.0, 1.3, 3.4, 0.2]),
     },
-    Model {
+    Framing {
         file: "04_dabrovic_sponza_66k.obj",
         ground: false,
         camera: Some((Vec3::new(-12.0, 2.5, 0.5), Vec3::new(4.0, 4.0, -1.0))),
         light: Some(Vec3::new(0.3, -1.0, 0.12)),
         gtx980: None,
     },
-    Model {
+    Framing {
         file: "05_conference_clean_277k.obj",
         ground: false,
         camera: Some((
@@ -162,8 +183,8 @@ const MODELS: [Model; 8] = [
         light: Some(Vec3::new(0.35, -1.0, 0.25)),
         gtx980: None,
     },
-    Model {
-        file: "06_cornell_box/cornell_box.obj",
+    Framing {
+        file: "cornell_box.obj",
         ground: false,
         camera: Some((
             Vec3::new(278.0, 273.0, -800.0),
@@ -172,14 +193,14 @@ const MODELS: [Model; 8] = [
         light: Some(Vec3::new(0.35, -0.45, 1.0)),
         gtx980: None,
     },
-    Model {
+    Framing {
         file: "07_veach_mi_plates.obj",
         ground: false,
         camera: None,
         light: None,
         gtx980: None,
     },
-    Model {
+    Framing {
         file: "08_smallpine_1650.obj",
         ground: true,
         camera: None,
@@ -188,9 +209,37 @@ const MODELS: [Model; 8] = [
     },
 ];
 
+/// A model of the benchmark: an OBJ file, its name (in the tables, and for `--only`) and how it is
+/// shown.
+pub(crate) struct BenchModel {
+    path: PathBuf,
+    /// The path in the models folder (with `/`), or the file as given to `--obj`.
+    pub(crate) name: String,
+    framing: &'static Framing,
+}
+
+impl BenchModel {
+    /// The model of the file at `path`, named `name`, framed as the shared model of its file name if any.
+    fn new(path: PathBuf, name: String) -> Self {
+        let file = path
+            .file_name()
+            .and_then(|f| f.to_str())
+            .unwrap_or_default();
+        let framing = SHARED_MODELS
+            .iter()
+            .find(|f| f.file == file)
+            .unwrap_or(&DEFAULT_FRAMING);
+        Self {
+            path,
+            name,
+            framing,
+        }
+    }
+}
+
 /// What one model measured with default settings.
 struct Measured {
-    file: &'static str,
+    name: String,
     triangles: usize,
     report: FrameReport,
     times: BTreeMap<String, f64>,
@@ -219,31 +268,113 @@ pub fn median_of(t: &BTreeMap<String, f64>, prefixes: &[&str]) -> Option<f64> {
         .sum()
 }
 
-/// The models folder of `args` (`--models`, else the shared one).
-pub(crate) fn models_folder(args: &BenchArgs) -> Result<PathBuf> {
+/// The models folder of `args` and how it was chosen, for messages: `--models`, else `HRTS_MODELS`, else
+/// the shared folder beside the checkout ([`scene::models_folder`]).
+pub(crate) fn models_folder(args: &BenchArgs) -> (PathBuf, String) {
     match &args.models {
-        Some(dir) => Ok(dir.clone()),
-        None => scene::models_dir().map_err(anyhow::Error::msg),
+        Some(dir) => (dir.clone(), "named by --models".to_owned()),
+        None => scene::models_folder(),
     }
 }
 
-/// The benchmark models `--only` keeps.
-pub(crate) fn chosen_models(args: &BenchArgs) -> Vec<&'static Model> {
-    MODELS
-        .iter()
-        .filter(|m| args.only.is_empty() || args.only.iter().any(|o| m.file.contains(o.as_str())))
-        .collect()
+/// The models to measure: the `--obj` files, else every .obj file of the models folder in sorted order;
+/// those `--only` keeps. Fails, saying what it expected, on a missing file or folder, a folder without
+/// .obj files, or an `--only` that matches none of them.
+pub(crate) fn chosen_models(args: &BenchArgs) -> Result<Vec<BenchModel>> {
+    let (models, what) = if args.obj.is_empty() {
+        let (dir, how) = models_folder(args);
+        let to_do =
+            "bench measures every .obj file of the models folder and its subfolders; name a \
+                     folder of OBJ files with --models DIR, or the files with --obj FILE…";
+        if !dir.is_dir() {
+            bail!(
+                "the models folder {} ({how}) is not a folder: {to_do}",
+                dir.display()
+            );
+        }
+        let files = obj_files(&dir)?;
+        if files.is_empty() {
+            bail!("no .obj file in {} ({how}): {to_do}", dir.display());
+        }
+        let models = files
+            .into_iter()
+            .map(|name| BenchModel::new(dir.join(&name), name))
+            .collect();
+        (models, format!("models in {} ({how})", dir.display()))
+    } else {
+        let mut models = Vec::new();
+        for path in &args.obj {
+            if !path.is_file() {
+                bail!("--obj {}: no such file", path.display());
+            }
+            models.push(BenchModel::new(path.clone(), path.display().to_string()));
+        }
+        (models, "files of --obj".to_owned())
+    };
+    keep_only(models, |m| &m.name, &args.only, &what)
 }
 
-pub(crate) fn view_of(model: &Model, models: &Path, args: &BenchArgs) -> Result<View> {
-    let path = models.join(model.file);
-    let mut scene =
-        scene::load_obj(&path).with_context(|| format!("loading {}", path.display()))?;
-    if model.ground {
+/// The .obj files (of any case) in `dir` and its subfolders (links to folders are not followed), as
+/// paths relative to `dir` with `/` between folders, sorted.
+fn obj_files(dir: &Path) -> Result<Vec<String>> {
+    let mut files = Vec::new();
+    let mut folders = vec![(dir.to_path_buf(), String::new())];
+    while let Some((folder, prefix)) = folders.pop() {
+        let entries =
+            std::fs::read_dir(&folder).with_context(|| format!("listing {}", folder.display()))?;
+        for entry in entries {
+            let entry = entry.with_context(|| format!("listing {}", folder.display()))?;
+            let name = format!("{prefix}{}", entry.file_name().to_string_lossy());
+            let path = entry.path();
+            if entry.file_type().is_ok_and(|t| t.is_dir()) {
+                folders.push((path, format!("{name}/")));
+            } else if path.is_file()
+                && path
+                    .extension()
+                    .is_some_and(|e| e.eq_ignore_ascii_case("obj"))
+            {
+                files.push(name);
+            }
+        }
+    }
+    files.sort();
+    Ok(files)
+}
+
+/// The `items` whose name contains one of `only` (all of them when it is empty). An entry of `only` that
+/// matches none is an error that lists the names of the `what`.
+pub(crate) fn keep_only<T>(
+    items: Vec<T>,
+    name: impl Fn(&T) -> &str,
+    only: &[String],
+    what: &str,
+) -> Result<Vec<T>> {
+    if let Some(unmatched) = only
+        .iter()
+        .find(|o| !items.iter().any(|i| name(i).contains(o.as_str())))
+    {
+        let names: Vec<&str> = items.iter().map(&name).collect();
+        bail!(
+            "--only {unmatched} matches none of the {what}: {}",
+            names.join(", ")
+        );
+    }
+    Ok(items
+        .into_iter()
+        .filter(|i| only.is_empty() || only.iter().any(|o| name(i).contains(o.as_str())))
+        .collect())
+}
+
+/// The view of `model` at the benchmark's size, as its framing shows it.
+pub(crate) fn view_of(model: &BenchModel, args: &BenchArgs) -> Result<View> {
+    let framing = model.framing;
+    let mut scene = scene::load_obj(&model.path)
+        .with_context(|| format!("loading {}", model.path.display()))?;
+    if framing.ground {
         scene = scene.with_ground_plane();
     }
     let mut view = View::framed(scene, args.width, args.height);
-    if let Some((position, target)) = model.camera {
+    if let Some((position, target)) = framing.camera {
         view.camera = Camera {
             position,
             target,
@@ -252,7 +383,7 @@ pub(crate) fn view_of(model: &Model, models: &Path, args: &BenchArgs) -> Result<
             near: 0.01 * (target - position).length(),
         };
     }
-    if let Some(direction) = model.light {
+    if let Some(direction) = framing.light {
         view.light = DirectionalLight::new(direction).context("unusable light direction")?;
     }
     Ok(view)
@@ -274,16 +405,22 @@ fn frames_with_layout(
     frames: u32,
     layout: GBufferLayout,
 ) -> Result<(PluginRenderer, Vec<FrameReport>)> {
+    let frames = frames.max(2);
+    let progress = phase("frames", u64::from(frames));
     let mut renderer = PluginRenderer::with_layout(device, view, config, layout)?;
     let inputs = view.frame_inputs();
-    let reports = (0..frames.max(2))
-        .map(|_| renderer.render(device, &inputs))
+    let reports = (0..frames)
+        .map(|_| {
+            let report = renderer.render(device, &inputs);
+            progress.inc(1);
+            report
+        })
         .collect::<Result<Vec<_>>>()?;
     Ok((renderer, reports))
 }
 
-fn measure(device: &Device, model: &Model, models: &Path, args: &BenchArgs) -> Result<Measured> {
-    let view = view_of(model, models, args)?;
+fn measure(device: &Device, model: &BenchModel, args: &BenchArgs) -> Result<Measured> {
+    let view = view_of(model, args)?;
     let config = ShadowConfig {
         extra_outputs: ResourceSet::of(&[ResourceId::RtVisibility]),
         ..ShadowConfig::default()
@@ -292,11 +429,13 @@ fn measure(device: &Device, model: &Model, models: &Path, args: &BenchArgs) -> R
     let times = median_timings(&reports);
     let report = reports.last().cloned().context("no frame")?;
     let inputs = view.frame_inputs();
-    let reference = (!args.no_reference).then(|| RefScene::new(&view.scene));
+    // One reference for our frame and the peer's.
+    let reference =
+        (!args.no_reference).then(|| view_reference(&RefScene::new(&view.scene), &view));
     let wrong = match &reference {
-        Some(rs) => {
+        Some(r) => {
             let images = renderer.read_back(device, false)?;
-            let c = compare_visibility(rs, &view, &images);
+            let c = compare_visibility_to(r, &view, &images);
             Some((c.mismatches, c.near_edge))
         }
         None => None,
@@ -304,12 +443,12 @@ fn measure(device: &Device, model: &Model, models: &Path, args: &BenchArgs) -> R
     let peer = if device.capabilities().ray_tracing_pipeline {
         let run = run_peer(device, &renderer, &inputs, args.frames)?;
         let wrong = match &reference {
-            Some(rs) => {
+            Some(r) => {
                 let images = crate::FrameImages {
                     visibility: run.visibility,
                     ..renderer.read_back(device, false)?
                 };
-                Some(compare_visibility(rs, &view, &images).mismatches)
+                Some(compare_visibility_to(r, &view, &images).mismatches)
             }
             None => None,
         };
@@ -322,10 +461,11 @@ fn measure(device: &Device, model: &Model, models: &Path, args: &BenchArgs) -> R
         None
     };
     let mut raster_build = [None, None];
-    if model.gtx980.is_some() {
-        for (slot, request) in raster_build
+    if model.framing.gtx980.is_some() {
+        for ((slot, request), path) in raster_build
             .iter_mut()
             .zip([BinningRequest::Hardware, BinningRequest::Software])
+            .zip(["hardware", "software"])
         {
             if passes::choose_binning_path(device.capabilities(), request).is_err() {
                 continue;
@@ -337,12 +477,13 @@ fn measure(device: &Device, model: &Model, models: &Path, args: &BenchArgs) -> R
                 },
                 ..ShadowConfig::default()
             };
+            let _binning = phase(format!("{path} conservative raster binning"), 1);
             let (_, reports) = frames_of(device, &view, config, args.frames)?;
             *slot = median_of(&median_timings(&reports), &["primitive map"]);
         }
     }
     Ok(Measured {
-        file: model.file,
+        name: model.name.clone(),
         triangles: view.scene.triangle_count(),
         report,
         times,
@@ -368,7 +509,7 @@ fn talk_table(m: &Measured, gtx980: &[f64; 6], device: &str) -> String {
     ];
     let mut s = format!(
         "\n**{}** ({} triangles with the ground plane)\n\n| | NV GTX 980 (talk) | {device} |\n|---|---:|---:|\n| Primitive Map + compute (default) | — | {} |\n",
-        m.file,
+        m.name,
         m.triangles,
         fmt(median_of(t, &["primitive map"]))
     );
@@ -392,7 +533,7 @@ fn scene_row(m: &Measured) -> String {
     let ratio = |ours: f64, theirs: f64| format!("{:.2}", ours / theirs);
     format!(
         "| {} | {} | {} | {:.3} | {:.3} | {:.1} | {} | {:.1} | {} | {} | {} ({near}) | {} | {} | {} | {} | {} |\n",
-        m.file,
+        m.name,
         m.triangles,
         st.triangles_binned,
         build,
@@ -411,16 +552,14 @@ fn scene_row(m: &Measured) -> String {
     )
 }
 
-/// Runs every model and returns the Markdown tables.
-pub fn run_bench(device: &Device, args: &BenchArgs) -> Result<String> {
-    let models = models_folder(args)?;
+/// Measures `models` and returns the Markdown tables.
+fn run_bench(device: &Device, args: &BenchArgs, models: &[BenchModel]) -> Result<String> {
     let caps = device.capabilities();
-    let chosen = chosen_models(args);
-    let bar = crate::progress(chosen.len() as u64, "bench");
+    let bar = crate::progress(models.len() as u64, "bench");
     let mut measured = Vec::new();
-    for model in chosen {
-        bar.set_message(model.file);
-        measured.push((model, measure(device, model, &models, args)?));
+    for model in models {
+        bar.set_message(&model.name);
+        measured.push((model, measure(device, model, args)?));
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -450,7 +589,7 @@ pub fn run_bench(device: &Device, args: &BenchArgs) -> Result<String> {
          structures (any-hit, terminate on first hit), \"—\" where the device has none.\n",
     );
     for (model, m) in &measured {
-        if let Some(gtx980) = &model.gtx980 {
+        if let Some(gtx980) = &model.framing.gtx980 {
             out.push_str(&talk_table(m, gtx980, &caps.device_name));
         }
     }
@@ -458,13 +597,11 @@ pub fn run_bench(device: &Device, args: &BenchArgs) -> Result<String> {
     Ok(out)
 }
 
-/// The G-buffer table: per model, the demo's G-buffer pass and the plugin's passes (medians, ms) with the
-/// analysis G-buffer and with a compact one.
-pub fn run_gbuffer_bench(device: &Device, args: &BenchArgs) -> Result<String> {
-    let models = models_folder(args)?;
+/// The G-buffer table: per model of `models`, the demo's G-buffer pass and the plugin's passes (medians,
+/// ms) with the analysis G-buffer and with a compact one.
+fn run_gbuffer_bench(device: &Device, args: &BenchArgs, models: &[BenchModel]) -> Result<String> {
     let caps = device.capabilities();
     let compact = GBufferLayout::compact(device);
-    let chosen = chosen_models(args);
     let mut out = format!(
         "Device: {} ({}); {}×{}, default settings (hybrid); medians of {} frames after the first (GPU \
          timestamps, ms). G-buffer as first required: position and world normal RGBA32F, D32 depth (32 bytes \
@@ -479,14 +616,15 @@ pub fn run_gbuffer_bench(device: &Device, args: &BenchArgs) -> Result<String> {
         compact.depth,
         compact.normal,
     );
-    let bar = crate::progress(chosen.len() as u64 * 2, "bench --gbuffer");
-    for model in chosen {
-        let view = view_of(model, &models, args)?;
+    let bar = crate::progress(models.len() as u64 * 2, "bench --gbuffer");
+    for model in models {
+        bar.set_message(&model.name);
+        let view = view_of(model, args)?;
         for (name, layout) in [
             ("as first required", GBufferLayout::ANALYSIS),
             ("compact", compact),
         ] {
-            bar.set_message(format!("{} ({name})", model.file));
+            bar.set_message(format!("{} ({name})", model.name));
             let (_, reports) =
                 frames_with_layout(device, &view, ShadowConfig::default(), args.frames, layout)?;
             let times = median_timings(&reports);
@@ -504,7 +642,7 @@ pub fn run_gbuffer_bench(device: &Device, args: &BenchArgs) -> Result<String> {
                 .fold(0.0, |total, (_, v)| total + v);
             out.push_str(&format!(
                 "| {} | {name} | {:.3} | {plugin:.3} | {:.3} | {:.3} | {:.3} | {:.3} |\n",
-                model.file,
+                model.name,
                 sum("gbuffer"),
                 sum("primitive map"),
                 sum("ray trace"),
@@ -526,6 +664,11 @@ pub fn run_gbuffer_bench(device: &Device, args: &BenchArgs) -> Result<String> {
 /// configuration measured does not pay for a GPU still clocking up (seen on an H100: the first light 4x
 /// slower than the same light measured later).
 fn warm_up(device: &Device, args: &BenchArgs) -> Result<()> {
+    let bar = crate::progress(1, "bench warm-up");
+    bar.set_message(format!(
+        "the built-in scene at {}×{}",
+        args.width, args.height
+    ));
     let view = View::framed(scene::procedural_default(), args.width, args.height);
     let started = std::time::Instant::now();
     let (mut renderer, _) = frames_of(device, &view, ShadowConfig::default(), 2)?;
@@ -536,22 +679,41 @@ fn warm_up(device: &Device, args: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
-/// Entry point of the subcommand: prints the tables and writes them to `out` if given.
-pub fn run_cli(device: &Device, args: &BenchArgs, out: Option<&Path>) -> Result<()> {
-    warm_up(device, args)?;
-    let tables = if args.lights {
-        let models = models_folder(args)?;
-        crate::light_bench::run_light_bench(device, args, &models)?
-    } else if args.gbuffer {
-        run_gbuffer_bench(device, args)?
-    } else if args.area {
-        crate::area_bench::run_area_bench(device, args)?
+/// Entry point of the subcommand on the device the command line names (a name filter, validation
+/// layers): prints the tables and writes them to `out` if given. What to measure is settled first, so
+/// that a wrong folder, file or `--only` fails before any GPU work.
+pub fn run_cli(
+    device_filter: Option<String>,
+    validation: bool,
+    args: &BenchArgs,
+    out: Option<&Path>,
+) -> Result<()> {
+    let work = if args.lights {
+        Work::Lights(crate::light_bench::chosen_scenes(args)?)
     } else {
-        run_bench(device, args)?
+        Work::Models(chosen_models(args)?)
+    };
+    let device = crate::open_device(device_filter, validation)?;
+    warm_up(&device, args)?;
+    let tables = match &work {
+        Work::Lights(scenes) => crate::light_bench::run_light_bench(&device, args, scenes)?,
+        Work::Models(models) if args.gbuffer => run_gbuffer_bench(&device, args, models)?,
+        Work::Models(models) if args.area => {
+            crate::area_bench::run_area_bench(&device, args, models)?
+        }
+        Work::Models(models) => run_bench(&device, args, models)?,
     };
     println!("{tables}");
     if let Some(path) = out {
         std::fs::write(path, &tables).with_context(|| format!("writing {}", path.display()))?;
     }
-    Ok(())
+    crate::check_validation(&device)
+}
+
+/// What `bench` measures.
+enum Work {
+    /// `--lights`: the light scenes.
+    Lights(crate::light_bench::LightScenes),
+    /// The models (the shadow table, `--gbuffer` or `--area`).
+    Models(Vec<BenchModel>),
 }

@@ -30,6 +30,7 @@ pub mod load_report;
 pub mod output;
 pub mod peer;
 pub mod plugin;
+pub mod progress;
 pub mod ray_dump;
 pub mod render;
 pub mod renderer;
@@ -45,6 +46,7 @@ use passes::{Draw, FrameInputs, Geometry, Light, PassError};
 use rhi::Device;
 use scene::{Aabb, Camera, DirectionalLight, Scene};
 
+pub use progress::progress;
 pub use renderer::{read_images, FrameImages, FrameOutput, ShadowRenderer};
 
 mod shaders {
@@ -171,94 +173,6 @@ impl CameraMatrices {
     }
 }
 
-/// Progress of a long run of `len` steps on stderr: a bar on a terminal; elsewhere (a pipe, a CI log,
-/// `nohup`) one plain line per step, so that a run never looks hung.
-pub fn progress(len: u64, what: &str) -> Progress {
-    let bar = std::io::IsTerminal::is_terminal(&std::io::stderr()).then(|| {
-        let style =
-            indicatif::ProgressStyle::with_template("{msg} {bar:30} {pos}/{len} ({elapsed})")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
-        indicatif::ProgressBar::new(len)
-            .with_style(style)
-            .with_message(what.to_owned())
-    });
-    Progress {
-        bar,
-        what: what.to_owned(),
-        len,
-        done: std::cell::Cell::new(0),
-        announced: std::cell::Cell::new(false),
-        start: std::time::Instant::now(),
-    }
-}
-
-/// See [`progress`].
-pub struct Progress {
-    bar: Option<indicatif::ProgressBar>,
-    what: String,
-    len: u64,
-    done: std::cell::Cell<u64>,
-    /// Whether the current step's line was printed.
-    announced: std::cell::Cell<bool>,
-    start: std::time::Instant,
-}
-
-impl Progress {
-    /// Names the step that starts now (off a terminal: prints its line).
-    pub fn set_message(&self, message: impl Into<String>) {
-        let message = message.into();
-        match &self.bar {
-            Some(bar) => bar.set_message(message),
-            None => {
-                self.announced.set(true);
-                eprintln!(
-                    "{}",
-                    self.line((self.done.get() + 1).min(self.len), &message)
-                );
-            }
-        }
-    }
-
-    /// Marks `n` steps done (off a terminal: prints a line for a step that was not named).
-    pub fn inc(&self, n: u64) {
-        self.done.set(self.done.get() + n);
-        match &self.bar {
-            Some(bar) => bar.inc(n),
-            None => {
-                if !self.announced.replace(false) {
-                    eprintln!("{}", self.line(self.done.get(), "done"));
-                }
-            }
-        }
-    }
-
-    /// Ends the run (clears the bar).
-    pub fn finish_and_clear(&self) {
-        if let Some(bar) = &self.bar {
-            bar.finish_and_clear();
-        }
-    }
-
-    /// "what [step/len] message (elapsed, about how long is left)", `step` counted from 1.
-    fn line(&self, step: u64, message: &str) -> String {
-        let done = self.done.get();
-        let elapsed = self.start.elapsed().as_secs_f64();
-        let remaining = self.len.saturating_sub(done);
-        let left = if done == 0 || remaining == 0 {
-            String::new()
-        } else {
-            format!(
-                ", about {:.0} s left",
-                elapsed / done as f64 * remaining as f64
-            )
-        };
-        format!(
-            "{} [{}/{}] {message} ({elapsed:.0} s elapsed{left})",
-            self.what, step, self.len
-        )
-    }
-}
-
 /// Bounds of every object but one named "ground" (all of the scene if that is all there is).
 pub fn focus_bounds(scene: &Scene) -> Aabb {
     let mut b = Aabb::empty();
@@ -305,7 +219,9 @@ pub fn check_validation(device: &Device) -> anyhow::Result<()> {
 pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     let [x, y, z] = parts.as_slice() else {
-        return Err(format!("expected x,y,z but got '{s}'"));
+        return Err(format!(
+            "expected x,y,z (three numbers, such as -5,2,3) but got '{s}'"
+        ));
     };
     let f = |v: &str| {
         v.parse::<f32>()
@@ -323,6 +239,10 @@ mod tests {
     #[test]
     fn parses_vectors() {
         assert_eq!(parse_vec3("1, 2,3").unwrap(), Vec3::new(1.0, 2.0, 3.0));
+        assert_eq!(
+            parse_vec3("-5,-0.5,-1e2").unwrap(),
+            Vec3::new(-5.0, -0.5, -100.0)
+        );
         assert!(parse_vec3("1,2").is_err());
         assert!(parse_vec3("1,nan,2").is_err());
         assert!(parse_vec3("a,b,c").is_err());

@@ -9,13 +9,13 @@
 //! `--emitter-size` runs every light at each size given, sized lights with exact soft shadows, each also
 //! traced by the ray-tracing-pipeline peer at equal samples (trace only).
 
-use crate::bench::BenchArgs;
+use crate::bench::{keep_only, models_folder, BenchArgs};
 use crate::gbuffer::GBufferLayout;
 use crate::plugin::{c_point_light, LightsFrame, PluginRenderer};
 use crate::scene_plan::{plan_scene, PlanSettings};
 use crate::scene_render::SceneRenderer;
 use crate::CameraMatrices;
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use glam::Vec3;
 use passes::{
     directional_light_frustum, spot_light_frusta, AreaConfig, FrameInputs, Light, MapStats,
@@ -24,7 +24,7 @@ use passes::{
 use rhi::Device;
 use scene::{Aabb, Camera, LightKind, LightSize, SceneFile, SceneLight};
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::PathBuf;
 
 /// A scene of the benchmark: a model of the models folder and, as fractions of its bounds, the camera's
 /// position and target and the positions of the lights inside.
@@ -57,6 +57,42 @@ const SCENES: [LightScene; 2] = [
         spot: Vec3::new(0.5, 0.9, 0.5),
     },
 ];
+
+/// The scenes `--lights` measures (those `--only` keeps) and the folder that holds them.
+pub struct LightScenes {
+    folder: PathBuf,
+    scenes: Vec<&'static LightScene>,
+}
+
+/// The scenes of `--lights` that `--only` keeps, in the models folder of `args`. Fails, naming the
+/// shared models it needs and where it looked, when the folder lacks one of them, and when an `--only`
+/// matches none of the scenes.
+pub fn chosen_scenes(args: &BenchArgs) -> Result<LightScenes> {
+    let scenes = keep_only(
+        SCENES.iter().collect(),
+        |s| s.file,
+        &args.only,
+        "scenes of --lights",
+    )?;
+    let (folder, how) = models_folder(args);
+    let missing: Vec<&str> = scenes
+        .iter()
+        .map(|s| s.file)
+        .filter(|file| !folder.join(file).is_file())
+        .collect();
+    if !missing.is_empty() {
+        let needed: Vec<&str> = SCENES.iter().map(|s| s.file).collect();
+        bail!(
+            "bench --lights measures lights inside the shared models {}, framed for them; the models \
+             folder {} ({how}) has no {}: name the project's shared models folder with --models DIR (or \
+             HRTS_MODELS), or keep the scenes it has with --only",
+            needed.join(" and "),
+            folder.display(),
+            missing.join(" nor ")
+        );
+    }
+    Ok(LightScenes { folder, scenes })
+}
 
 /// The point `f` (fractions of each axis) of `bounds`.
 fn at(bounds: &Aabb, f: Vec3) -> Vec3 {
@@ -300,12 +336,15 @@ fn measure_light(
         height: args.height,
     };
     let plan = plan_scene(file, camera, &settings)?;
+    let progress = crate::progress::phase("frames", u64::from(args.frames.max(2)));
     let mut renderer = SceneRenderer::new(device, file, args.width, args.height)?;
     renderer.write_outputs_directly();
     let mut frames = Vec::new();
     for _ in 0..args.frames.max(2) {
         frames.push(renderer.render(device, camera, &plan)?);
+        progress.inc(1);
     }
+    drop(progress);
     let (gpu_ms, map_ms, trace_ms) = medians(&frames[1..]);
     let max_ms = slowest(&frames);
     let last = frames.last().context("no frame rendered")?;
@@ -385,6 +424,7 @@ fn measure_native_points(
     args: &BenchArgs,
     emitter_radius: Option<f32>,
 ) -> Result<LightCost> {
+    let progress = crate::progress::phase("frames", u64::from(args.frames.max(2)));
     let mut plugin = PluginRenderer::for_scene_casters(
         device,
         &file.scene,
@@ -415,7 +455,9 @@ fn measure_native_points(
     let mut frames = Vec::new();
     for _ in 0..args.frames.max(2) {
         frames.push(plugin.render_c_lights(device, &matrices, lights.clone())?);
+        progress.inc(1);
     }
+    drop(progress);
     let (_, map_ms, trace_ms) = medians(&frames[1..]);
     let frame_ms = |f: &LightsFrame| f.lights.iter().map(|l| l.gpu_ms).sum::<f64>();
     let gpu_ms = median(frames[1..].iter().map(frame_ms).collect());
@@ -448,8 +490,8 @@ fn measure_native_points(
     })
 }
 
-/// Runs the light benchmark and returns its Markdown table.
-pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Result<String> {
+/// Runs the light benchmark on `scenes` ([`chosen_scenes`]) and returns its Markdown table.
+pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) -> Result<String> {
     let caps = device.capabilities();
     if let Some(bad) = args
         .emitter_size
@@ -490,11 +532,8 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
         args.map_size,
         args.frames.max(2) - 1
     );
-    let chosen: Vec<&LightScene> = SCENES
-        .iter()
-        .filter(|s| args.only.is_empty() || args.only.iter().any(|o| s.file.contains(o.as_str())))
-        .collect();
-    let total: usize = chosen
+    let total: usize = scenes
+        .scenes
         .iter()
         .map(|s| (2 + s.points.len() + usize::from(args.point_lights > 0)) * sizes.len())
         .sum();
@@ -503,8 +542,9 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
     let mut per_pass = String::from(
         "\nPer pass (median ms over the same frames, summed over the light's frusta):\n\n",
     );
-    for scene_case in chosen {
-        let path = models.join(scene_case.file);
+    for &scene_case in &scenes.scenes {
+        let path = scenes.folder.join(scene_case.file);
+        bar.set_message(format!("{} loading", scene_case.file));
         let scene =
             scene::load_obj(&path).with_context(|| format!("loading {}", path.display()))?;
         let bounds = scene.bounds();
@@ -526,7 +566,7 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
         let extent = (bounds.max - bounds.min).length();
         let mut sun = None;
         for &fraction in &sizes {
-            let emitter_radius = (fraction > 0.0).then(|| fraction * extent);
+            let emitter_radius = (fraction > 0.0).then_some(fraction * extent);
             let size_cell =
                 emitter_radius.map_or("0".to_owned(), |_| format!("{:.1} %", fraction * 100.0));
             if let Some(r) = emitter_radius {

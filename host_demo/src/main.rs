@@ -1,7 +1,7 @@
 //! `host_demo`: the standalone demo of hybrid ray-traced shadows.
 
 use anyhow::{bail, Context, Result};
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use glam::Vec3;
 use host_demo::interior::Enclosure;
 use host_demo::render::{
@@ -15,6 +15,7 @@ use passes::{BinningRequest, FaceMode, PrimitiveMapConfig, ShadowMode};
 use reference::RefScene;
 use rhi::Device;
 use scene::{Aabb, Camera, DirectionalLight, LightSize, Scene, SceneFile, SceneLight};
+use std::any::TypeId;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -399,7 +400,10 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
     };
     render_to_folder(&device, &view, &options, &args.out)?;
     if args.dump_rays {
+        let bar = host_demo::progress(1, "ray dump");
+        bar.set_message("the frame's shadow rays");
         let dump = host_demo::ray_dump::write_ray_dump(&view, &view.frame_inputs(), &args.out)?;
+        drop(bar);
         println!("ray dump: {dump:?}");
     }
     host_demo::check_validation(&device)
@@ -512,9 +516,46 @@ fn device(cli: &Cli) -> Result<Device> {
     host_demo::open_device(cli.device.clone(), cli.validation)
 }
 
+/// The command line of [`Cli`], where every option of numbers takes negative ones as people type them
+/// (`--camera-pos -5,2,3`, not only `--camera-pos=-5,2,3`).
+fn command() -> clap::Command {
+    negative_numbers(Cli::command())
+}
+
+/// `command` and its subcommands with negative values allowed on the options of numbers: an option of
+/// one number takes a negative number (`allow_negative_numbers`); a vector or a list of numbers, whose
+/// value is no number as a whole, takes a value that begins with a hyphen (`allow_hyphen_values`), so
+/// that such an option followed by another flag takes the flag as its value and fails to parse it.
+fn negative_numbers(command: clap::Command) -> clap::Command {
+    command
+        .mut_args(|arg| {
+            let value = arg.get_value_parser().type_id();
+            let number = [
+                TypeId::of::<u32>(),
+                TypeId::of::<u64>(),
+                TypeId::of::<i32>(),
+                TypeId::of::<i64>(),
+                TypeId::of::<usize>(),
+                TypeId::of::<f32>(),
+                TypeId::of::<f64>(),
+            ]
+            .into_iter()
+            .any(|t| value == t);
+            if value == TypeId::of::<Vec3>() || (number && arg.get_value_delimiter().is_some()) {
+                arg.allow_hyphen_values(true)
+            } else if number {
+                arg.allow_negative_numbers(true)
+            } else {
+                arg
+            }
+        })
+        .mut_subcommands(negative_numbers)
+}
+
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    let cli = Cli::parse();
+    let cli = Cli::from_arg_matches(&command().get_matches())
+        .unwrap_or_else(|e| e.format(&mut command()).exit());
     let result = match &cli.command {
         Command::Render(args) => render(&cli, args),
         Command::Plan(args) => plan(args),
@@ -529,7 +570,7 @@ fn main() -> ExitCode {
             host_demo::compare::run_cli(cli.device.clone(), cli.validation, args)
         }
         Command::Bench { args, out } => {
-            device(&cli).and_then(|d| host_demo::bench::run_cli(&d, args, out.as_deref()))
+            host_demo::bench::run_cli(cli.device.clone(), cli.validation, args, out.as_deref())
         }
         Command::Tradeoff(args) => {
             device(&cli).and_then(|d| host_demo::tradeoff::run_cli(&d, args))
@@ -561,6 +602,102 @@ fn main() -> ExitCode {
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::error::ErrorKind;
+
+    /// Every option of numbers of every subcommand takes a negative value as a separate argument
+    /// (`--flag -1`, a vector `-1,-2,-3`, a list `-1,2`): it is parsed as the option's value (and then
+    /// accepted, or refused by the option's own check), never as an unknown argument.
+    #[test]
+    fn every_option_of_numbers_takes_negative_values() {
+        let root = command();
+        let mut checked = Vec::new();
+        for sub in root.get_subcommands() {
+            for arg in sub.get_arguments() {
+                let Some(long) = arg.get_long() else { continue };
+                let value = if !arg.is_allow_hyphen_values_set() {
+                    if !arg.is_allow_negative_numbers_set() {
+                        continue;
+                    }
+                    "-1"
+                } else if arg.get_value_parser().type_id() == TypeId::of::<Vec3>() {
+                    "-1,-2,-3"
+                } else {
+                    "-1,2"
+                };
+                let flag = format!("--{long}");
+                let parsed =
+                    command().try_get_matches_from(["host_demo", sub.get_name(), &flag, value]);
+                match parsed {
+                    Ok(m) => {
+                        let raw: Vec<_> = m
+                            .subcommand_matches(sub.get_name())
+                            .and_then(|m| m.get_raw(arg.get_id().as_str()))
+                            .map(|r| r.map(|v| v.to_string_lossy().into_owned()).collect())
+                            .unwrap_or_default();
+                        assert_eq!(raw.join(","), value, "{} {flag} {value}", sub.get_name());
+                    }
+                    Err(e) => assert!(
+                        matches!(
+                            e.kind(),
+                            ErrorKind::ValueValidation
+                                | ErrorKind::MissingRequiredArgument
+                                | ErrorKind::InvalidValue
+                        ) && !e.to_string().contains("unexpected argument"),
+                        "{} {flag} {value}: {e}",
+                        sub.get_name()
+                    ),
+                }
+                checked.push(format!("{} {flag}", sub.get_name()));
+            }
+        }
+        for expected in [
+            "render --camera-pos",
+            "render --camera-target",
+            "render --light-dir",
+            "render --bin-budget",
+            "render --angular-radius",
+            "render --width",
+            "plan --camera-pos",
+            "plan --camera-target",
+            "compare --camera-pos",
+            "compare --camera-target",
+            "compare --close-up-pos",
+            "compare --close-up-target",
+            "bench --emitter-size",
+            "bench --angular-radius",
+            "tradeoff --angular-radius",
+        ] {
+            assert!(
+                checked.iter().any(|c| c == expected),
+                "{expected} not checked: {checked:?}"
+            );
+        }
+    }
+
+    /// Options of other values still refuse a value that looks like a flag; a vector option followed by a
+    /// flag instead of its value is still refused (with the flag as its value, and what follows
+    /// unexpected).
+    #[test]
+    fn other_options_keep_refusing_hyphen_values() {
+        let e = command()
+            .try_get_matches_from(["host_demo", "render", "--out", "-x"])
+            .expect_err("--out -x is refused");
+        assert_eq!(e.kind(), ErrorKind::UnknownArgument, "{e}");
+        for args in [
+            &["--camera-pos", "--camera-target", "0,0,0"][..],
+            &["--camera-pos", "--camera-target=0,0,0"][..],
+        ] {
+            let parsed = command()
+                .try_get_matches_from(["host_demo", "render"].iter().chain(args))
+                .and_then(|m| Cli::from_arg_matches(&m));
+            assert!(parsed.is_err(), "{args:?} accepted");
         }
     }
 }

@@ -77,6 +77,8 @@ fn run(
     let normal = targets
         .world_normal()
         .context("the ray-tracing peer reads the analysis G-buffer's world normals")?;
+    let frames = frames.max(2);
+    let progress = crate::progress::phase("RT peer frames", u64::from(frames));
     let new = if area.is_some() {
         RtPeerPass::new_area
     } else {
@@ -93,7 +95,7 @@ fn run(
     )?;
     let timer = device.create_timer(2)?;
     let (mut build, mut trace) = (Vec::new(), Vec::new());
-    for _ in 0..frames.max(2) {
+    for _ in 0..frames {
         device.submit_and_wait(|enc| {
             enc.attach_timer(&timer);
             peer.record_build(enc).map_err(into_rhi)?;
@@ -110,6 +112,7 @@ fn run(
                 _ => {}
             }
         }
+        progress.inc(1);
     }
     let mut images = FrameImages::default();
     for bytes in read_images(device, &[(&peer.visibility, S::UnorderedAccess)])? {

@@ -27,7 +27,7 @@ use anyhow::{bail, Context, Result};
 use glam::{DVec3, DVec4};
 use passes::ray_trace::{RAY_OFFSET_FLOAT_BOUND, RAY_OFFSET_PIXELS};
 use passes::FrameInputs;
-use reference::{reference_visibility, PixelClass, RefScene, VisibilityParams};
+use reference::{reference_visibility_with_progress, PixelClass, RefScene, VisibilityParams};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -206,7 +206,9 @@ fn shadow_rays(rs: &RefScene, view: &View, inputs: &FrameInputs, origin: DVec3) 
         tolerance_per_distance: tolerance_per_distance(view),
         pixel_tolerance: 1.0 / 128.0,
     };
-    let reference = reference_visibility(rs, &params);
+    let rows = crate::progress::phase("CPU reference", u64::from(view.height));
+    let reference = reference_visibility_with_progress(rs, &params, &|| rows.inc(1));
+    drop(rows);
     let camera = inputs.camera_position.as_dvec3() - origin;
     let light_view_proj = inputs.light.view_proj().as_dmat4();
     let light_position = inputs.light.position().map(|p| p.as_dvec3() - origin);
@@ -378,7 +380,7 @@ mod tests {
             tolerance_per_distance: tolerance_per_distance(&view),
             pixel_tolerance: 1.0 / 128.0,
         };
-        let r = reference_visibility(&rs, &params);
+        let r = reference::reference_visibility(&rs, &params);
         let pixels: Vec<usize> = rays
             .chunks_exact(RAY_FLOATS)
             .map(|ray| ray[7] as usize)

@@ -332,16 +332,21 @@ pub fn render_to_folder(
     // The demo's G-buffer as engines keep one (D24S8 depth, octahedral RG16F normals); its read-back
     // rebuilds positions and world normals for the outputs below.
     let layout = GBufferLayout::compact(device);
+    let frames = options.frames.max(1);
+    // Steps: the passes' creation, each frame, the outputs.
+    let bar = crate::progress(u64::from(frames) + 2, "render");
+    bar.set_message("creating the shadow passes");
     let mut renderer = PluginRenderer::with_layout(device, view, config, layout)
         .context("creating the shadow passes")?;
+    bar.inc(1);
     let inputs = view.frame_inputs();
     let mut reports = Vec::new();
-    let bar = crate::progress(u64::from(options.frames.max(1)), "frames");
-    for _ in 0..options.frames.max(1) {
+    for frame in 1..=frames {
+        bar.set_message(format!("frame {frame} of {frames}"));
         reports.push(renderer.render(device, &inputs).context("rendering")?);
         bar.inc(1);
     }
-    bar.finish_and_clear();
+    bar.set_message("reading back and writing the outputs");
     let images = renderer.read_back(device, false).context("reading back")?;
     let (w, h, n) = (view.width, view.height, options.map.size);
     write_exr_rgba(&out.join("position.exr"), w, h, &images.position)?;
@@ -450,6 +455,8 @@ pub fn render_to_folder(
     let text = serde_json::to_string_pretty(&json)?;
     std::fs::write(out.join("frame.json"), text)
         .with_context(|| format!("writing {}/frame.json", out.display()))?;
+    bar.inc(1);
+    bar.finish_and_clear();
 
     println!("{}", crate::plugin::device_banner(caps));
     if report.status(PassId::PrimitiveMap) == Some(PassStatus::Skipped(SkipReason::NotRequested)) {

@@ -2,7 +2,7 @@
 //! sizes and the ray-traced primitive map at growing N, each with its GPU time, memory, and
 //! the pixels it gets wrong against the exact f64 reference (near-edge pixels counted apart).
 
-use crate::accuracy::compare_visibility;
+use crate::accuracy::{compare_visibility_to, view_reference};
 use crate::bench::median_of;
 use crate::plugin::PluginRenderer;
 use crate::render::{map_bytes, median_timings};
@@ -63,11 +63,13 @@ pub fn render_frames(
     config: ShadowConfig,
     frames: u32,
 ) -> Result<(crate::FrameImages, Vec<passes::FrameReport>)> {
+    let progress = crate::progress::phase("frames", u64::from(frames.max(2)));
     let mut r = PluginRenderer::new(device, view, config)?;
     let inputs = view.frame_inputs();
     let mut reports = Vec::new();
     for _ in 0..frames.max(2) {
         reports.push(r.render(device, &inputs)?);
+        progress.inc(1);
     }
     Ok((r.read_back(device, false)?, reports))
 }
@@ -96,14 +98,18 @@ pub fn model_view(
 
 /// Builds the report as Markdown.
 pub fn run_report(device: &Device, args: &AccuracyArgs) -> Result<String> {
+    let bar = crate::progress(8, "accuracy");
+    bar.set_message("the exact reference");
     let (view, label) = model_view(args.obj.as_deref(), args.width, args.height)?;
-    let rs = RefScene::new(&view.scene);
+    // One reference for every configuration: the same view.
+    let reference = view_reference(&RefScene::new(&view.scene), &view);
+    bar.inc(1);
     let sum = |t: &std::collections::BTreeMap<String, f64>, names: &[&str]| {
         median_of(t, names).unwrap_or(f64::NAN)
     };
     let mut rows = Vec::new();
-    let bar = crate::progress(7, "accuracy");
     for size in [1024u32, 3072, 8192] {
+        bar.set_message(format!("shadow map {size}²"));
         let config = ShadowConfig {
             mode: ShadowMode::Hard,
             antialiasing: false,
@@ -120,7 +126,7 @@ pub fn run_report(device: &Device, args: &AccuracyArgs) -> Result<String> {
         };
         let (mut images, t, _) = render(device, &view, config, args.frames)?;
         images.visibility = std::mem::take(&mut images.shadow_map_visibility);
-        let c = compare_visibility(&rs, &view, &images);
+        let c = compare_visibility_to(&reference, &view, &images);
         rows.push(Row {
             method: format!("shadow map {size}² (classic test, constant + slope bias)"),
             memory: u64::from(size) * u64::from(size) * 4,
@@ -131,12 +137,13 @@ pub fn run_report(device: &Device, args: &AccuracyArgs) -> Result<String> {
         bar.inc(1);
     }
     for size in [256u32, 512, 1024, 2048] {
+        bar.set_message(format!("primitive map {size}²"));
         let map = PrimitiveMapConfig {
             size,
             ..PrimitiveMapConfig::default()
         };
         let (images, t, memory) = render(device, &view, ShadowConfig::from(map), args.frames)?;
-        let c = compare_visibility(&rs, &view, &images);
+        let c = compare_visibility_to(&reference, &view, &images);
         rows.push(Row {
             method: format!("ray traced, primitive map {size}² (fitted, exact lists)"),
             memory,

@@ -469,16 +469,23 @@ pub fn render_scene_to_folder(
         settings.height
     );
     print!("{}", plan.describe());
+    // Steps: the renderer's creation, each frame, the outputs.
+    let bar = crate::progress(u64::from(frames) + 2, "render");
+    bar.set_message("creating the renderer");
     let mut renderer = SceneRenderer::new(device, file, settings.width, settings.height)
         .context("creating the renderer")?;
+    bar.inc(1);
     let mut reports: Vec<LightsFrame> = Vec::new();
-    for _ in 0..frames {
+    for index in 1..=frames {
+        bar.set_message(format!("frame {index} of {frames}"));
         let frame = renderer
             .render(device, camera, &plan)
             .context("rendering")?;
-        print!("{}", describe_frame(&plan, &frame, reports.last()));
+        bar.inc(1);
+        bar.suspend(|| print!("{}", describe_frame(&plan, &frame, reports.last())));
         reports.push(frame);
     }
+    bar.set_message("reading back and writing the outputs");
     let images = renderer.read_back(device, &plan).context("reading back")?;
     let (w, h) = (settings.width, settings.height);
     let radiance = shade(
@@ -566,6 +573,8 @@ pub fn render_scene_to_folder(
     let text = serde_json::to_string_pretty(&json)?;
     std::fs::write(out.join("scene_report.json"), text)
         .with_context(|| format!("writing {}/scene_report.json", out.display()))?;
+    bar.inc(1);
+    bar.finish_and_clear();
     println!(
         "outputs in {}: shaded.png, shaded.exr, scene_report.json, visibility_<light>_<name>.png/.exr",
         out.display()

@@ -5,7 +5,7 @@
 //! (`reference::soft_visibility`). The sweep reports error metrics users know, GPU time and memory, and
 //! writes CSV, JSON, an error-against-time plot with the Pareto front marked, and a strip of error maps.
 
-use crate::accuracy::visibility_params;
+use crate::accuracy::{view_reference, visibility_params};
 use crate::images::{write_png_compact, Canvas};
 use crate::output::shade_preview;
 use crate::render::median_timings;
@@ -17,7 +17,7 @@ use passes::{
     ResourceSet, ShadowConfig, ShadowMapConfig, ShadowMode,
 };
 use plotters::prelude::*;
-use reference::{reference_visibility, soft_visibility, AreaLight, RefScene, SoftParams};
+use reference::{soft_visibility_with_progress, AreaLight, RefScene, SoftParams};
 use rhi::Device;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -317,15 +317,21 @@ pub struct Sweep {
 pub fn run_sweep(device: &Device, view: &View, scene: &str, args: &TradeoffArgs) -> Result<Sweep> {
     let wss = crate::render::default_world_space_scale(view);
     let methods = methods(args.angular_radius, wss);
+    let bar = crate::progress(methods.len() as u64 + 1, "tradeoff");
+    bar.set_message("ground truth");
     let rs = RefScene::new(&view.scene);
     let params = visibility_params(view);
     let started = Instant::now();
-    let hard = reference_visibility(&rs, &params);
+    let hard = view_reference(&rs, view);
     let light = AreaLight::Directional {
         direction: view.frame_inputs().light.direction().as_dvec3(),
         angular_radius: f64::from(args.angular_radius),
     };
-    let soft = soft_visibility(
+    let rows = crate::progress::phase(
+        format!("soft shadows, {}² samples", args.strata),
+        u64::from(view.height),
+    );
+    let soft = soft_visibility_with_progress(
         &rs,
         &hard,
         &light,
@@ -334,8 +340,11 @@ pub fn run_sweep(device: &Device, view: &View, scene: &str, args: &TradeoffArgs)
             seed: 0x5eed,
             camera_position: params.camera_position,
         },
+        &|| rows.inc(1),
     )
     .map_err(anyhow::Error::msg)?;
+    drop(rows);
+    bar.inc(1);
     let ground_truth_seconds = started.elapsed().as_secs_f64();
     let contact_distance = 0.05 * f64::from(wss);
     let contact: Vec<bool> = hard
@@ -343,11 +352,10 @@ pub fn run_sweep(device: &Device, view: &View, scene: &str, args: &TradeoffArgs)
         .iter()
         .map(|&d| d < contact_distance)
         .collect();
-    let bar = crate::progress(methods.len() as u64, "tradeoff");
     let mut rows = Vec::new();
     let mut error_maps = Vec::new();
     for m in &methods {
-        bar.set_message(format!("tradeoff: {} {}", m.family, m.name));
+        bar.set_message(format!("{} {}", m.family, m.name));
         let (images, reports) = render_frames(device, view, m.config, args.frames)
             .with_context(|| format!("{} {}", m.family, m.name))?;
         let visibility = match m.output {

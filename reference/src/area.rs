@@ -1,10 +1,12 @@
 //! The exact reference of area shadows with a fixed set of light samples: per pixel, how many of the sample
 //! directions reach the light, each decided by [`reference_visibility`] as a hard shadow ray of its own, and
 //! whether every one of them is decided beyond the tolerance (a stable pixel).
+//!
+//! [`reference_visibility`]: crate::reference_visibility
 
 use glam::{DVec2, DVec3};
 
-use crate::{reference_visibility, Light, PixelClass, RefScene, VisibilityParams};
+use crate::{reference_visibility_with_progress, Light, PixelClass, RefScene, VisibilityParams};
 
 /// Visible sample counts of every pixel; row-major with `y = 0` the top row, like
 /// [`crate::VisibilityReference`].
@@ -26,12 +28,23 @@ pub struct AreaReference {
 
 /// The visible count of each pixel of `params`' view over the sample directions `towards_light` (each the
 /// direction from a receiver *towards* the light, as the area trace holds them; `params.light` is
-/// replaced). A sample is visible where [`reference_visibility`] calls the pixel lit for a directional light
-/// travelling along its opposite.
+/// replaced). A sample is visible where [`reference_visibility`](crate::reference_visibility) calls the
+/// pixel lit for a directional light travelling along its opposite.
 pub fn area_reference(
     scene: &RefScene,
     params: &VisibilityParams,
     towards_light: &[DVec3],
+) -> AreaReference {
+    area_reference_with_progress(scene, params, towards_light, &|| {})
+}
+
+/// [`area_reference`], calling `row_done` once per row of each sample it finishes (from any thread of its
+/// pool), for a caller's progress display: `params.height * towards_light.len()` calls in all.
+pub fn area_reference_with_progress(
+    scene: &RefScene,
+    params: &VisibilityParams,
+    towards_light: &[DVec3],
+    row_done: &(dyn Fn() + Sync),
 ) -> AreaReference {
     count_samples(
         scene,
@@ -39,6 +52,7 @@ pub fn area_reference(
         towards_light
             .iter()
             .map(|&w| Light::Directional { direction: -w }),
+        row_done,
     )
 }
 
@@ -60,14 +74,16 @@ pub fn local_area_reference(
             radius,
             offset,
         }),
+        &|| {},
     )
 }
 
-/// Counts, per pixel, the `lights` (one per sample) that reach it.
+/// Counts, per pixel, the `lights` (one per sample) that reach it, calling `row_done` per row of each.
 fn count_samples(
     scene: &RefScene,
     params: &VisibilityParams,
     lights: impl ExactSizeIterator<Item = Light>,
+    row_done: &(dyn Fn() + Sync),
 ) -> AreaReference {
     let pixels = params.width as usize * params.height as usize;
     let mut out = AreaReference {
@@ -80,7 +96,7 @@ fn count_samples(
     };
     for light in lights {
         let per_sample = VisibilityParams { light, ..*params };
-        let r = reference_visibility(scene, &per_sample);
+        let r = reference_visibility_with_progress(scene, &per_sample, row_done);
         for (i, class) in r.class.iter().enumerate() {
             match class {
                 PixelClass::Background => {

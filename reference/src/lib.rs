@@ -44,13 +44,16 @@ mod visibility;
 #[cfg(test)]
 mod tests;
 
-pub use area::{area_reference, local_area_reference, AreaReference};
+pub use area::{area_reference, area_reference_with_progress, local_area_reference, AreaReference};
 pub use geometry::{intersect_watertight, line_segment_distance};
 pub use predicates::{certainly_blocked, contact_shadow_start};
 pub use ref_scene::RefScene;
-pub use soft::{soft_visibility, AreaLight, SoftParams, SoftReference, RELATIVE_RAY_OFFSET};
+pub use soft::{
+    soft_visibility, soft_visibility_with_progress, AreaLight, SoftParams, SoftReference,
+    RELATIVE_RAY_OFFSET,
+};
 pub use texels::{conservative_texel_sets, overlaps_texel_with_margin, FaceSelection, TexelSets};
 pub use visibility::{
-    disc_basis, reference_visibility, Light, PixelClass, VisibilityParams, VisibilityReference,
-    DISC_BASIS_POLE,
+    disc_basis, reference_visibility, reference_visibility_with_progress, Light, PixelClass,
+    VisibilityParams, VisibilityReference, DISC_BASIS_POLE,
 };

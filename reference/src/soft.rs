@@ -145,7 +145,30 @@ pub fn soft_visibility(
     light: &AreaLight,
     params: &SoftParams,
 ) -> Result<SoftReference, String> {
-    soft_visibility_with(scene, hard, light, params, ExactShortcuts::Enabled)
+    soft_visibility_with_progress(scene, hard, light, params, &|| {})
+}
+
+/// [`soft_visibility`], calling `row_done` once per row it finishes (from any thread of its pool), for a
+/// caller's progress display: `hard.height` calls in all.
+///
+/// # Errors
+///
+/// As [`soft_visibility`].
+pub fn soft_visibility_with_progress(
+    scene: &RefScene,
+    hard: &VisibilityReference,
+    light: &AreaLight,
+    params: &SoftParams,
+    row_done: &(dyn Fn() + Sync),
+) -> Result<SoftReference, String> {
+    soft_visibility_with(
+        scene,
+        hard,
+        light,
+        params,
+        ExactShortcuts::Enabled,
+        row_done,
+    )
 }
 
 /// Whether [`soft_visibility_with`] decides provable pixels without sampling (the
@@ -164,6 +187,7 @@ pub(crate) fn soft_visibility_with(
     light: &AreaLight,
     params: &SoftParams,
     shortcuts: ExactShortcuts,
+    row_done: &(dyn Fn() + Sync),
 ) -> Result<SoftReference, String> {
     let emitter = Emitter::new(light)?;
     if !(1..=MAX_STRATA).contains(&params.strata) {
@@ -185,7 +209,7 @@ pub(crate) fn soft_visibility_with(
     let rows: Vec<Vec<Outcome>> = (0..hard.height as usize)
         .into_par_iter()
         .map(|y| {
-            (0..width)
+            let row = (0..width)
                 .map(|x| {
                     let index = y * width + x;
                     let receiver = hard.receiver[index];
@@ -205,7 +229,9 @@ pub(crate) fn soft_visibility_with(
                     }
                     Outcome::Sampled(pixel.sampled_value(scene, &emitter, params, index))
                 })
-                .collect()
+                .collect();
+            row_done();
+            row
         })
         .collect();
 

@@ -172,13 +172,25 @@ pub struct VisibilityReference {
 /// 4. Degenerate triangles (zero area in 3D, or non-finite) are ignored
 ///    everywhere: they never receive, block, or make anything ambiguous.
 pub fn reference_visibility(scene: &RefScene, params: &VisibilityParams) -> VisibilityReference {
+    reference_visibility_with_progress(scene, params, &|| {})
+}
+
+/// [`reference_visibility`], calling `row_done` once per row it finishes (from any thread of its pool),
+/// for a caller's progress display: `params.height` calls in all.
+pub fn reference_visibility_with_progress(
+    scene: &RefScene,
+    params: &VisibilityParams,
+    row_done: &(dyn Fn() + Sync),
+) -> VisibilityReference {
     let camera = Camera::new(params);
     let rows: Vec<Vec<Pixel>> = (0..params.height)
         .into_par_iter()
         .map(|y| {
-            (0..params.width)
+            let row = (0..params.width)
                 .map(|x| shade_pixel(scene, params, &camera, x, y))
-                .collect()
+                .collect();
+            row_done();
+            row
         })
         .collect();
     let pixels = rows.into_iter().flatten();

@@ -43,7 +43,7 @@ pub use gltf_scene::{load_gltf, SceneFile};
 pub use hard_cases::HardCase;
 pub use light::DirectionalLight;
 pub use mesh_builder::MeshBuilder;
-pub use models::{models_dir, MODELS_ENV};
+pub use models::{models_dir, models_folder, MODELS_ENV};
 pub use obj::load_obj;
 pub use procedural::procedural_default;
 pub use random::SplitMix64;

@@ -379,15 +379,22 @@ fn exact_pixels_agree_with_sampling() {
         },
     ];
     for light in lights {
-        let fast =
-            soft_visibility_with(&scene, &hard, &light, &soft_params, ExactShortcuts::Enabled)
-                .expect("valid");
+        let fast = soft_visibility_with(
+            &scene,
+            &hard,
+            &light,
+            &soft_params,
+            ExactShortcuts::Enabled,
+            &|| {},
+        )
+        .expect("valid");
         let slow = soft_visibility_with(
             &scene,
             &hard,
             &light,
             &soft_params,
             ExactShortcuts::Disabled,
+            &|| {},
         )
         .expect("valid");
         assert_eq!(slow.exact_pixels, 0);

@@ -428,3 +428,46 @@ fn disc_basis_is_orthonormal_across_the_direction() {
     }
     assert_eq!(disc_basis(DVec3::NEG_Y), (DVec3::X, DVec3::NEG_Z));
 }
+
+/// The progress variants call back once per row (per row of each sample for area shadows, per row for
+/// soft shadows) and compute what the plain functions compute.
+#[test]
+fn progress_variants_count_every_row_and_agree() {
+    use crate::{
+        area_reference, area_reference_with_progress, reference_visibility_with_progress,
+        soft_visibility, soft_visibility_with_progress, AreaLight, SoftParams,
+    };
+    use std::sync::atomic::{AtomicU32, Ordering};
+    let scene = box_over_plane();
+    let params = params(Vec3::new(6.0, 10.0, 8.0), oblique_light());
+    let rows = AtomicU32::new(0);
+    let count = || {
+        rows.fetch_add(1, Ordering::Relaxed);
+    };
+    let hard = reference_visibility_with_progress(&scene, &params, &count);
+    assert_eq!(rows.swap(0, Ordering::Relaxed), HEIGHT);
+    let plain = reference_visibility(&scene, &params);
+    assert_eq!(hard.class, plain.class);
+    let bits = |v: &[f64]| v.iter().map(|d| d.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&hard.blocker_distance), bits(&plain.blocker_distance));
+
+    let towards = [DVec3::new(-1.0, 1.0, 0.0), DVec3::new(-1.0, 1.2, 0.1)].map(|w| w.normalize());
+    let area = area_reference_with_progress(&scene, &params, &towards, &count);
+    assert_eq!(rows.swap(0, Ordering::Relaxed), HEIGHT * 2);
+    assert_eq!(area, area_reference(&scene, &params, &towards));
+
+    let light = AreaLight::Directional {
+        direction: DVec3::new(1.0, -1.0, 0.0).normalize(),
+        angular_radius: 0.05,
+    };
+    let soft_params = SoftParams {
+        strata: 2,
+        seed: 1,
+        camera_position: params.camera_position,
+    };
+    let soft = soft_visibility_with_progress(&scene, &hard, &light, &soft_params, &count)
+        .expect("valid light");
+    assert_eq!(rows.load(Ordering::Relaxed), HEIGHT);
+    let plain = soft_visibility(&scene, &hard, &light, &soft_params).expect("valid light");
+    assert_eq!(bits(&soft.visibility), bits(&plain.visibility));
+}
