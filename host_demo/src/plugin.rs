@@ -11,7 +11,7 @@ use crate::gbuffer::{GBufferLayout, GBufferPass, GBufferPush, GBufferTargets};
 use crate::{read_images, upload_scene, CameraMatrices, FrameImages, FrameOutput, View};
 use anyhow::{bail, Context as _, Result};
 use glam::Mat4;
-use hrts_plugin::*;
+use hrts::*;
 use passes::prim_buffer::PrimBufferPass;
 use passes::MapStats;
 use passes::{

@@ -928,7 +928,7 @@ fn check_local_area(
     device: &Device,
     name: &str,
     file: &SceneFile,
-    light: hrts_plugin::HrtsLight,
+    light: hrts::HrtsLight,
     (centre, radius, samples): (Vec3, f32, u32),
     cone: Option<(Vec3, f32)>,
     (min_penumbra, max_unstable_percent): (usize, usize),
@@ -1120,7 +1120,7 @@ fn native_frame(
     device: &Device,
     file: &SceneFile,
     configs: &[ShadowConfig],
-    lights: Vec<hrts_plugin::HrtsLight>,
+    lights: Vec<hrts::HrtsLight>,
     frames: usize,
 ) -> (Vec<LightFrameReport>, Vec<Vec<f32>>) {
     let mut plugin = plugin_for(device, file);

@@ -2,7 +2,7 @@
 
 use anyhow::{Context as _, Result};
 use clap::Parser;
-use hrts_plugin::HrtsShadowMode;
+use hrts::HrtsShadowMode;
 use scene::{Camera, DirectionalLight};
 use std::path::PathBuf;
 use wgpu_host::{validation, Conventions, Gpu, Renderer};

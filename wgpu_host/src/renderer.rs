@@ -8,7 +8,7 @@ use crate::shadows::{
 };
 use anyhow::{bail, Context as _, Result};
 use glam::Mat4;
-use hrts_plugin::{HrtsFrameReport, HrtsNormalEncoding, HrtsNormalSpace, HrtsShadowMode};
+use hrts::{HrtsFrameReport, HrtsNormalEncoding, HrtsNormalSpace, HrtsShadowMode};
 use scene::{Aabb, Camera, DirectionalLight, Scene};
 
 /// The wgpu device, opened with what the plugin adopts.

@@ -5,7 +5,7 @@
 use anyhow::{bail, Context as _, Result};
 use ash::vk::{self, Handle};
 use glam::Mat4;
-use hrts_plugin::*;
+use hrts::*;
 use std::ffi::{c_char, c_void, CStr, CString};
 use wgpu::hal::api::Vulkan;
 

@@ -5,7 +5,7 @@
 use glam::{Mat4, Vec3};
 use host_demo::accuracy::{compare_with_reference, scene_visibility_params};
 use host_demo::{ShadowRenderer, View};
-use hrts_plugin::{HrtsFrameReport, HrtsShadowMode};
+use hrts::{HrtsFrameReport, HrtsShadowMode};
 use passes::PrimitiveMapConfig;
 use reference::{reference_visibility, Light, PixelClass, RefScene, VisibilityReference};
 use scene::{Camera, DirectionalLight, Scene};

@@ -45,7 +45,7 @@ mod reach;
 use crate::plugin::{c_directional_light, c_fitted_spot_light, c_point_light};
 use anyhow::{bail, Result};
 use glam::{DVec3, Mat4, Vec3};
-use hrts_plugin::{HrtsLight, HrtsLightType, HRTS_MAX_LIGHTS};
+use hrts::{HrtsLight, HrtsLightType, HRTS_MAX_LIGHTS};
 use passes::{FaceMode, FramePlan, ResourceId, ShadowConfig, ShadowMode};
 use reach::{receivers_in_view, up_hint, Cone, Pyramid, Reach};
 use scene::{Camera, LightKind, LightSize, SceneFile, SceneLight};
@@ -561,7 +561,7 @@ fn shadowed(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hrts_plugin::HrtsLightType;
+    use hrts::HrtsLightType;
     use passes::PassId;
     use scene::Scene;
 
