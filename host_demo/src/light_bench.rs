@@ -526,7 +526,7 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, models: &Path) -> Resu
         let extent = (bounds.max - bounds.min).length();
         let mut sun = None;
         for &fraction in &sizes {
-            let emitter_radius = (fraction > 0.0).then(|| fraction * extent);
+            let emitter_radius = (fraction > 0.0).then_some(fraction * extent);
             let size_cell =
                 emitter_radius.map_or("0".to_owned(), |_| format!("{:.1} %", fraction * 100.0));
             if let Some(r) = emitter_radius {
