@@ -119,22 +119,6 @@ fn with_context(
     })
 }
 
-/// For Rust hosts linking the rlib: the pipeline resource an `HrtsResource` value names.
-pub fn resource_from_c(value: u32) -> Option<passes::ResourceId> {
-    convert::resource_id(value).ok()
-}
-
-/// For Rust hosts linking the rlib: the `HrtsResource` value of a pipeline resource, if it has one.
-pub fn resource_to_c(id: passes::ResourceId) -> Option<u32> {
-    convert::resource_index(id).ok()
-}
-
-/// For Rust hosts linking the rlib: the C configuration of a Rust one (the inverse of what
-/// `hrts_configure` reads), or why it has none.
-pub fn config_to_c(config: &passes::ShadowConfig) -> Result<HrtsConfig, String> {
-    convert::config_to_c(config).map_err(|e| e.message)
-}
-
 /// The library's `HRTS_API_VERSION`.
 #[no_mangle]
 pub extern "C" fn hrts_get_api_version() -> u32 {
