@@ -21,18 +21,18 @@ case "$profile" in
 esac
 cargo="${CARGO:-cargo}"
 
-# What `cargo rustc -p hrts --crate-type staticlib -- --print native-static-libs` prints: the system
+# What `cargo rustc -p hrts-capi --crate-type staticlib -- --print native-static-libs` prints: the system
 # libraries that Rust's std and the dependencies use (the Vulkan loader is opened with dlopen at run time).
 # glslang is only a build dependency (the shaders are compiled into the library), so libhrts.a holds no
 # C++ code and needs no -lstdc++.
 static_libs=(dl gcc_s util rt pthread m dl c)
 
-"$cargo" build --profile "$profile" -p hrts
+"$cargo" build --profile "$profile" -p hrts-capi
 metadata="$("$cargo" metadata --no-deps --format-version 1)"
-version="$(sed -n 's/.*"name":"plugin_api","version":"\([^"]*\)".*/\1/p' <<<"$metadata")"
+version="$(sed -n 's/.*"name":"hrts","version":"\([^"]*\)".*/\1/p' <<<"$metadata")"
 target_dir="$(sed -n 's/.*"target_directory":"\([^"]*\)".*/\1/p' <<<"$metadata")"
 if [[ -z "$version" || -z "$target_dir" ]]; then
-  echo "error: cannot read plugin_api's version and the target folder from cargo metadata" >&2
+  echo "error: cannot read hrts's version and the target folder from cargo metadata" >&2
   exit 1
 fi
 build="$target_dir/$folder"
@@ -41,7 +41,7 @@ major="$((10#$major))"
 pointer_size="$(($(getconf LONG_BIT) / 8))"
 
 install -d "$prefix/include" "$prefix/lib/pkgconfig" "$prefix/lib/cmake/hrts"
-install -m 644 plugin_api/include/hrts.h "$prefix/include/"
+install -m 644 hrts/include/hrts.h "$prefix/include/"
 install -m 755 "$build/libhrts.so" "$prefix/lib/"
 install -m 644 "$build/libhrts.a" "$prefix/lib/"
 

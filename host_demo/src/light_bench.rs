@@ -11,7 +11,7 @@
 
 use crate::bench::{keep_only, models_folder, BenchArgs};
 use crate::gbuffer::GBufferLayout;
-use crate::plugin::{c_point_light, LightsFrame, PluginRenderer};
+use crate::plugin::{LightsFrame, PluginRenderer};
 use crate::scene_plan::{plan_scene, PlanSettings};
 use crate::scene_render::SceneRenderer;
 use crate::CameraMatrices;
@@ -451,10 +451,16 @@ fn measure_native_points(
     }
     plugin.configure_lights(device, &vec![config; positions.len()])?;
     let matrices = CameraMatrices::of_camera(camera, args.width, args.height);
-    let lights: Vec<_> = positions.iter().map(|&p| c_point_light(p, 0.0)).collect();
+    let lights: Vec<_> = positions
+        .iter()
+        .map(|&position| hrts::Light::Point {
+            position,
+            range: None,
+        })
+        .collect();
     let mut frames = Vec::new();
     for _ in 0..args.frames.max(2) {
-        frames.push(plugin.render_c_lights(device, &matrices, lights.clone())?);
+        frames.push(plugin.render_plugin_lights(device, &matrices, &lights)?);
         progress.inc(1);
     }
     drop(progress);

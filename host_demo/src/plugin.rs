@@ -1,17 +1,17 @@
-//! The demo's frames through the plugin's C ABI, the way an engine integrates it. The demo owns the
-//! device, the scene's vertex and index buffers, a G-buffer and the visibility image (a layer per
-//! light: the plugin shades any number of lights, each with its own configuration); the plugin adopts
-//! the device (`hrts_context_create`), reads the scene from the demo's buffers
-//! (`hrts_set_geometry_vulkan_meshes`) and records into the demo's command buffer (`hrts_record_passes`): the
-//! light-space passes before the G-buffer, the screen-space passes and the output copy after it. Debug
-//! images come back through `hrts_record_resource_readback`, the report through `hrts_get_frame_report`.
-//! So what the demo shows is what an integrator gets.
+//! The demo's frames through the plugin's safe API over its C ABI, the way an engine integrates it. The
+//! demo owns the device, the scene's vertex and index buffers, a G-buffer and the visibility image (a
+//! layer per light: the plugin shades any number of lights, each with its own configuration); the plugin
+//! adopts the device ([`hrts::Context::adopt`]), reads the scene from the demo's buffers
+//! ([`hrts::Context::set_geometry_vulkan`]) and records into the demo's command buffer
+//! ([`hrts::Context::record_passes`]): the light-space passes before the G-buffer, the screen-space passes
+//! and the output copy after it. Debug images come back through
+//! [`hrts::Context::record_resource_readback`], the report through [`hrts::Context::frame_report`]. So
+//! what the demo shows is what an integrator gets.
 
 use crate::gbuffer::{GBufferLayout, GBufferPass, GBufferPush, GBufferTargets};
 use crate::{read_images, upload_scene, CameraMatrices, FrameImages, FrameOutput, View};
 use anyhow::{bail, Context as _, Result};
-use glam::Mat4;
-use hrts_plugin::*;
+use hrts::passes_bridge;
 use passes::prim_buffer::PrimBufferPass;
 use passes::MapStats;
 use passes::{
@@ -23,7 +23,7 @@ use rhi::{
     ImageDesc, ImageUsage, MemoryLocation, PassTiming, ResourceState as S,
 };
 use scene::{Aabb, Scene};
-use std::ffi::{c_char, CStr, CString};
+use std::ffi::CString;
 
 /// The line the demo's commands print first: the device and the plugin's API version.
 pub fn device_banner(caps: &rhi::Capabilities) -> String {
@@ -38,70 +38,34 @@ pub fn device_banner(caps: &rhi::Capabilities) -> String {
 
 /// "libhrts API major.minor.patch", as the loaded library reports it.
 pub fn api_version() -> String {
-    let v = hrts_get_api_version();
-    format!(
-        "libhrts API {}.{}.{}",
-        v >> 22,
-        (v >> 12) & 0x3ff,
-        v & 0xfff
-    )
-}
-
-/// A live plugin context, destroyed on drop.
-struct Context(*mut HrtsContext);
-
-impl Context {
-    /// Turns a result code into an error carrying the context's message.
-    fn check(&self, call: &str, result: HrtsResult) -> Result<()> {
-        if result == HrtsResult::Ok {
-            return Ok(());
-        }
-        // SAFETY: `self.0` is live; both strings are NUL-terminated and outlive this statement.
-        let (name, message) = unsafe {
-            (
-                CStr::from_ptr(hrts_result_name(result as i32)),
-                CStr::from_ptr(hrts_last_error(self.0)),
-            )
-        };
-        bail!(
-            "{call}: {} ({})",
-            name.to_string_lossy(),
-            message.to_string_lossy()
-        )
-    }
-}
-
-impl Drop for Context {
-    fn drop(&mut self) {
-        // SAFETY: created by hrts_context_create and destroyed only here; the demo waited for its GPU work.
-        unsafe { hrts_context_destroy(self.0) };
-    }
+    format!("libhrts API {}", hrts::api_version())
 }
 
 /// What one plugin light's passes did in a frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LightFrameReport {
-    /// The plugin's report of the light, as the Rust [`FrameReport`].
+    /// The plugin's report of the light as the Rust passes' [`FrameReport`], which the demo's reports share
+    /// with the frames it renders through the passes directly.
     pub report: FrameReport,
     /// How many times the plugin built the light's passes since the context was created
-    /// (`HrtsFrameReport::light_builds`).
+    /// ([`hrts::FrameReport::light_builds`]).
     pub light_builds: u32,
-    /// Frusta the plugin shadowed the light through this frame (`HrtsFrameReport::frusta`: up to 6 for a
-    /// point light).
+    /// Frusta the plugin shadowed the light through this frame ([`hrts::FrameReport::frusta`]: up to 6 for
+    /// a point light).
     pub frusta: u32,
     /// Frusta of the light the plugin skipped this frame, holding no receiver in view within range
-    /// (`HrtsFrameReport::frusta_culled`).
+    /// ([`hrts::FrameReport::frusta_culled`]).
     pub frusta_culled: u32,
-    /// The plugin's decision for the light, in words (`HrtsFrameReport::decision_reason`).
+    /// The plugin's decision for the light, in words ([`hrts::FrameReport::decision_reason`]).
     pub decision: String,
-    /// GPU milliseconds of all of the light's passes (`HrtsFrameReport::gpu_milliseconds`).
+    /// GPU milliseconds of all of the light's passes ([`hrts::FrameReport::gpu_milliseconds`]).
     pub gpu_ms: f64,
 }
 
 /// What a frame of several lights did.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LightsFrame {
-    /// The frame's index (`HrtsFrame::frame_index`).
+    /// The frame's index ([`hrts::Frame::frame_index`]).
     pub frame_index: u64,
     /// One report per plugin light, in configuration order (none when no light was given to the plugin).
     pub lights: Vec<LightFrameReport>,
@@ -109,11 +73,12 @@ pub struct LightsFrame {
     pub host_timings: Vec<PassTiming>,
 }
 
-/// The demo frame driven through the C ABI, for any number of lights: the plugin gets the lights it is
-/// configured with (none: it records nothing, and the demo draws its G-buffer alone), and writes light
-/// `i`'s visibility to layer `i` of the demo's visibility image.
+/// The demo frame driven through the plugin's API, for any number of lights: the plugin gets the lights
+/// it is configured with (none: it records nothing, and the demo draws its G-buffer alone), and writes
+/// light `i`'s visibility to layer `i` of the demo's visibility image.
 pub struct PluginRenderer {
-    context: Context,
+    /// The plugin's context, dropped first: it uses the buffers and images of the fields after it.
+    context: hrts::Context,
     geometry: Geometry,
     prim_buffer: PrimBufferPass,
     gbuffer: GBufferPass,
@@ -124,7 +89,7 @@ pub struct PluginRenderer {
     /// once the frames recorded so far complete, so they are kept as long as the renderer.
     replaced_outputs: Vec<Image>,
     /// The configurations the plugin holds, one per light.
-    configured: Vec<ShadowConfig>,
+    configured: Vec<hrts::Config>,
     /// Usage of the visibility image: with storage usage, each light's last pass writes its layer
     /// directly (its final output can then only be read from the visibility image).
     output_usage: ImageUsage,
@@ -246,19 +211,23 @@ impl PluginRenderer {
     }
 
     /// Gives the visibility image storage usage, as an engine whose output the lights write directly
-    /// (`HrtsFrameReport::output_direct`): the final outputs are then read from it, not read back as
+    /// ([`hrts::FrameReport::output_direct`]): the final outputs are then read from it, not read back as
     /// resources. Takes effect when the lights are next configured with more layers than the image has.
     pub fn write_outputs_directly(&mut self) {
         self.output_usage = self.output_usage | ImageUsage::STORAGE;
     }
 
-    /// Gives the plugin one configuration per light (`hrts_configure_lights`; none: later frames give the
-    /// plugin nothing). The plugin keeps the passes of every light whose configuration is unchanged, unless
-    /// the number of lights changes. A visibility image with too few layers is replaced
-    /// (`hrts_set_targets`, which rebuilds every light).
+    /// Gives the plugin one configuration per light ([`hrts::Context::configure_lights`], each as the C
+    /// ABI carries it; none: later frames give the plugin nothing). The plugin keeps the passes of every
+    /// light whose configuration is unchanged, unless the number of lights changes. A visibility image with
+    /// too few layers is replaced ([`hrts::Context::set_targets`], which rebuilds every light).
     pub fn configure_lights(&mut self, device: &Device, configs: &[ShadowConfig]) -> Result<()> {
-        if configs.is_empty() || configs == self.configured.as_slice() {
-            self.configured = configs.to_vec();
+        let configs = configs
+            .iter()
+            .map(passes_bridge::config)
+            .collect::<Result<Vec<_>, _>>()?;
+        if configs.is_empty() || configs == self.configured {
+            self.configured = configs;
             return Ok(());
         }
         let layers = configs.len() as u32;
@@ -272,43 +241,26 @@ impl PluginRenderer {
                 usage: self.output_usage,
             })?;
             let t = &self.targets;
-            let c_targets = HrtsTargets {
-                struct_size: size_of::<HrtsTargets>() as u32,
+            let targets = hrts::Targets {
                 width: t.depth.width(),
                 height: t.depth.height(),
-                depth_image: t.depth.raw_handle(),
-                depth_usage: t.depth.raw_usage(),
-                depth_format: t.depth.format().raw_vk() as u32,
-                normal_image: t.normal.raw_handle(),
-                normal_usage: t.normal.raw_usage(),
-                normal_format: t.normal.format().raw_vk() as u32,
-                normal_encoding: normal_encoding(t.layout.surface.encoding) as u32,
+                depth: target_image(&t.depth),
+                normal: target_image(&t.normal),
+                normal_encoding: normal_encoding(t.layout.surface.encoding),
                 normal_space: match t.layout.surface.space {
-                    passes::NormalSpace::World => HrtsNormalSpace::World,
-                    passes::NormalSpace::View => HrtsNormalSpace::View,
-                } as u32,
-                output_image: output.raw_handle(),
-                output_usage: output.raw_usage(),
+                    passes::NormalSpace::World => hrts::NormalSpace::World,
+                    passes::NormalSpace::View => hrts::NormalSpace::View,
+                },
+                output: target_image(&output),
                 output_layers: layers,
-                output_format: output.format().raw_vk() as u32,
             };
-            // SAFETY: live context; the images live as long as the renderer, which destroys the context
-            // first.
-            self.context.check("hrts_set_targets", unsafe {
-                hrts_set_targets(self.context.0, &c_targets)
-            })?;
+            // SAFETY: the images are the demo device's, created as `targets` states; they live as long as
+            // the renderer, which drops the context first (and keeps replaced outputs).
+            unsafe { self.context.set_targets(&targets) }?;
             self.replaced_outputs.extend(self.output.replace(output));
         }
-        let c_configs = configs
-            .iter()
-            .map(config_to_c)
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(anyhow::Error::msg)?;
-        // SAFETY: live context; `c_configs` holds `layers` valid configurations.
-        self.context.check("hrts_configure_lights", unsafe {
-            hrts_configure_lights(self.context.0, layers, c_configs.as_ptr())
-        })?;
-        self.configured = configs.to_vec();
+        self.context.configure_lights(&configs)?;
+        self.configured = configs;
         Ok(())
     }
 
@@ -358,18 +310,18 @@ impl PluginRenderer {
         camera: &CameraMatrices,
         lights: &[Light],
     ) -> Result<LightsFrame> {
-        self.render_c_lights(device, camera, lights.iter().map(c_light).collect())
+        let lights: Vec<hrts::Light> = lights.iter().map(plugin_light).collect();
+        self.render_plugin_lights(device, camera, &lights)
     }
 
-    /// [`render_lights`](Self::render_lights) with the lights as the C ABI takes them (point lights, spot
-    /// lights whose frusta the plugin fits).
-    pub fn render_c_lights(
+    /// [`render_lights`](Self::render_lights) with the lights as the plugin takes them (point lights, spot
+    /// lights whose frusta the plugin fits, directional lights fitted to the casters).
+    pub fn render_plugin_lights(
         &mut self,
         device: &Device,
         camera: &CameraMatrices,
-        c_lights: Vec<HrtsLight>,
+        lights: &[hrts::Light],
     ) -> Result<LightsFrame> {
-        let lights = &c_lights;
         if lights.len() != self.configured.len() {
             bail!(
                 "{} lights given for a frame, {} configured",
@@ -381,10 +333,9 @@ impl PluginRenderer {
         self.last_camera = Some(*camera);
         let tris = self.geometry.triangle_count();
         let rebuild_prims = self.frames == 0 || self.dynamic_geometry;
-        let with_plugin = !c_lights.is_empty();
+        let with_plugin = !lights.is_empty();
         let t = &self.targets;
-        let frame_in =
-            |command_buffer| c_frame(command_buffer, self.frames, camera, &c_lights, &self.bounds);
+        let frame = plugin_frame(self.frames, camera, lights, &self.bounds);
         device.submit_and_wait(|enc| {
             if rebuild_prims {
                 self.prim_buffer
@@ -394,7 +345,16 @@ impl PluginRenderer {
             }
             enc.attach_timer(&self.timer);
             if with_plugin {
-                self.record_passes(&frame_in(enc.raw_handle()), HRTS_PASS_MASK_LIGHT_SPACE)?;
+                // SAFETY: the demo's recording command buffer, outside a render pass, submitted and waited
+                // for here.
+                unsafe {
+                    self.context.record_passes(
+                        enc.raw_handle(),
+                        &frame,
+                        hrts::PassMask::LIGHT_SPACE,
+                    )
+                }
+                .map_err(recording_error)?;
             }
             enc.barriers(&t.to_render());
             self.gbuffer
@@ -419,10 +379,18 @@ impl PluginRenderer {
         if with_plugin {
             let start = std::time::Instant::now();
             device.submit_and_wait(|enc| {
-                self.record_passes(&frame_in(enc.raw_handle()), HRTS_PASS_MASK_SCREEN_SPACE)
+                // SAFETY: as for the light-space passes.
+                unsafe {
+                    self.context.record_passes(
+                        enc.raw_handle(),
+                        &frame,
+                        hrts::PassMask::SCREEN_SPACE,
+                    )
+                }
+                .map_err(recording_error)
             })?;
             let wall = start.elapsed().as_secs_f64() * 1e3;
-            for light in 0..c_lights.len() as u32 {
+            for light in 0..lights.len() as u32 {
                 reports.push(self.report(self.frames, light)?);
             }
             host_timings.extend(self.timer.resolve()?);
@@ -443,71 +411,50 @@ impl PluginRenderer {
         })
     }
 
-    fn record_passes(&self, frame: &HrtsFrame, mask: u32) -> rhi::Result<()> {
-        // SAFETY: live context; the command buffer is recording outside a render pass.
-        let result = unsafe { hrts_record_passes(self.context.0, frame, mask) };
-        self.context
-            .check("hrts_record_passes", result)
-            .map_err(recording_error)
-    }
-
-    /// The plugin's report of `light` in frame `frame` (completed), as the Rust [`FrameReport`].
+    /// The plugin's report of `light` in frame `frame` (completed), with the Rust passes' [`FrameReport`].
     fn report(&self, frame: u64, light: u32) -> Result<LightFrameReport> {
-        // SAFETY: plain-old-data C struct; every field is valid zeroed.
-        let mut r: HrtsFrameReport = unsafe { std::mem::zeroed() };
-        r.struct_size = size_of::<HrtsFrameReport>() as u32;
-        // SAFETY: live context, valid out pointer.
-        self.context.check("hrts_get_frame_report", unsafe {
-            hrts_get_frame_report(self.context.0, frame, light, &mut r)
-        })?;
-        let timings = r.passes[..r.pass_count as usize]
+        let r = self.context.frame_report(frame, light)?;
+        let timings = r
+            .timings
             .iter()
             .map(|p| PassTiming {
-                // SAFETY: the plugin NUL-terminates every name within the array.
-                name: unsafe { CStr::from_ptr(p.name.as_ptr()) }
-                    .to_string_lossy()
-                    .into_owned(),
+                name: p.name.clone(),
                 ms: p.milliseconds,
             })
             .collect();
         let binning_path = match r.binning_path {
-            v if v == HrtsBinningPath::Software as u32 => BinningPath::Software,
-            v if v == HrtsBinningPath::Compute as u32 => BinningPath::Compute,
-            v if v == HrtsBinningPath::EmulatedTier1 as u32 => BinningPath::EmulatedTier1 {
+            hrts::BinningPath::Software => BinningPath::Software,
+            hrts::BinningPath::Compute => BinningPath::Compute,
+            hrts::BinningPath::EmulatedTier1 => BinningPath::EmulatedTier1 {
                 native: self.native_tier,
             },
-            _ => BinningPath::Hardware(match r.tier {
-                1 => ConservativeRasterTier::Tier1,
-                2 => ConservativeRasterTier::Tier2,
-                _ => ConservativeRasterTier::Tier3,
-            }),
+            hrts::BinningPath::Hardware | hrts::BinningPath::Auto => {
+                BinningPath::Hardware(match r.tier {
+                    1 => ConservativeRasterTier::Tier1,
+                    2 => ConservativeRasterTier::Tier2,
+                    _ => ConservativeRasterTier::Tier3,
+                })
+            }
         };
+        // The C passes are the pipeline's, in its order.
         let passes = PassId::ALL
             .iter()
             .map(|&p| {
                 let status = match r.pass_status[p as usize] {
-                    s if s == HrtsPassStatus::Ran as u32 => PassStatus::Ran,
-                    s if s == HrtsPassStatus::UpToDate as u32 => {
-                        PassStatus::Skipped(SkipReason::UpToDate)
-                    }
-                    s if s == HrtsPassStatus::Shared as u32 => {
-                        PassStatus::Skipped(SkipReason::Shared)
-                    }
-                    s if s == HrtsPassStatus::Culled as u32 => {
-                        PassStatus::Skipped(SkipReason::Culled)
-                    }
-                    _ => PassStatus::Skipped(SkipReason::NotRequested),
+                    hrts::PassStatus::Ran => PassStatus::Ran,
+                    hrts::PassStatus::UpToDate => PassStatus::Skipped(SkipReason::UpToDate),
+                    hrts::PassStatus::Shared => PassStatus::Skipped(SkipReason::Shared),
+                    hrts::PassStatus::Culled => PassStatus::Skipped(SkipReason::Culled),
+                    hrts::PassStatus::NotInPlan => PassStatus::Skipped(SkipReason::NotRequested),
                 };
                 (p, status)
             })
             .collect();
-        let mut resources: Vec<ResourceReport> = (0..HRTS_RESOURCE_COUNT as u32)
-            .filter(|&h| r.resource_bytes[h as usize] > 0)
-            .filter_map(|h| {
-                resource_from_c(h).map(|resource| ResourceReport {
-                    resource,
-                    bytes: r.resource_bytes[h as usize],
-                })
+        let mut resources: Vec<ResourceReport> = r
+            .allocated_resources()
+            .map(|(resource, bytes)| ResourceReport {
+                resource: passes_bridge::resource_id(resource),
+                bytes,
             })
             .collect();
         if r.prim_buffer_bytes > 0 {
@@ -519,32 +466,31 @@ impl PluginRenderer {
                 },
             );
         }
-        let output = resource_from_c(r.output_resource)
-            .context("the report names an unknown output resource")?;
+        let st = &r.stats;
         let report = FrameReport {
             timings,
             binning_path,
             stats: MapStats {
-                receiver_pixels: r.receiver_pixels,
-                receiver_texels: r.receiver_texels,
-                triangles_binned: r.triangles_binned,
-                texels_with_list: r.texels_with_list,
-                longest_list: r.longest_list,
-                entries: r.entries,
-                capacity: r.entry_capacity,
-                texels_past_capacity: r.texels_past_capacity,
-                pairs: r.bin_pairs,
-                pair_capacity: r.bin_pair_capacity,
-                texels_past_limit: r.texels_past_limit,
-                bin_items: r.bin_items,
-                lists_skipped: r.frusta_without_lists > 0,
-                pixels_walked: r.pixels_walked,
-                walks_unfinished: r.walks_unfinished,
+                receiver_pixels: st.receiver_pixels,
+                receiver_texels: st.receiver_texels,
+                triangles_binned: st.triangles_binned,
+                texels_with_list: st.texels_with_list,
+                longest_list: st.longest_list,
+                entries: st.entries,
+                capacity: st.entry_capacity,
+                texels_past_capacity: st.texels_past_capacity,
+                pairs: st.bin_pairs,
+                pair_capacity: st.bin_pair_capacity,
+                texels_past_limit: st.texels_past_limit,
+                bin_items: st.bin_items,
+                lists_skipped: st.frusta_without_lists > 0,
+                pixels_walked: st.pixels_walked,
+                walks_unfinished: st.walks_unfinished,
             },
-            map_to_texels: Mat4::from_cols_array(&r.map_to_texels),
+            map_to_texels: r.map_to_texels,
             passes,
             resources,
-            output,
+            output: passes_bridge::resource_id(r.output_resource),
             map_scratch_bytes: r.map_scratch_bytes,
             prim_triangles_rebuilt: r.prim_triangles_rebuilt,
         };
@@ -553,10 +499,7 @@ impl PluginRenderer {
             light_builds: r.light_builds,
             frusta: r.frusta,
             frusta_culled: r.frusta_culled,
-            // SAFETY: the plugin NUL-terminates the reason within the array.
-            decision: unsafe { CStr::from_ptr(r.decision_reason.as_ptr()) }
-                .to_string_lossy()
-                .into_owned(),
+            decision: r.decision_reason,
             gpu_ms: r.gpu_milliseconds,
         })
     }
@@ -614,7 +557,7 @@ impl PluginRenderer {
 
     /// Reads back the last frame: the demo's G-buffer, `light`'s layer of the visibility image, and every
     /// plugin resource of [`FrameImages`] the light's configuration allocates (the list entries only if
-    /// `with_entries`) through `hrts_record_resource_readback`.
+    /// `with_entries`) through [`hrts::Context::record_resource_readback`].
     pub fn read_back_light(
         &self,
         device: &Device,
@@ -640,15 +583,9 @@ impl PluginRenderer {
         }
         let mut wanted = Vec::new();
         for &(output, id) in &sources {
-            let resource = resource_to_c(id).context("a read-back resource has no C value")?;
-            // SAFETY: plain-old-data C struct; every field is valid zeroed.
-            let mut info: HrtsResourceInfo = unsafe { std::mem::zeroed() };
-            info.struct_size = size_of::<HrtsResourceInfo>() as u32;
-            // SAFETY: live context, valid out pointer.
-            self.context.check("hrts_get_resource_info", unsafe {
-                hrts_get_resource_info(self.context.0, light, resource, &mut info)
-            })?;
-            if info.allocated != 0 {
+            let resource =
+                passes_bridge::resource(id).context("a read-back resource has no C value")?;
+            if let Some(info) = self.context.resource_info(light, resource)? {
                 let buffer = device.create_buffer(
                     id.name(),
                     info.bytes,
@@ -660,20 +597,20 @@ impl PluginRenderer {
         }
         device.submit_and_wait(|enc| {
             for (_, resource, buffer) in &wanted {
-                let readback = HrtsResourceReadback {
-                    struct_size: size_of::<HrtsResourceReadback>() as u32,
-                    command_buffer: enc.raw_handle(),
+                let readback = hrts::ResourceReadback {
                     resource: *resource,
                     light,
                     buffer: buffer.raw_handle(),
                     buffer_size: buffer.size(),
                     offset: 0,
                 };
-                // SAFETY: live context; recording command buffer; the buffer outlives the submission.
-                let result = unsafe { hrts_record_resource_readback(self.context.0, &readback) };
-                self.context
-                    .check("hrts_record_resource_readback", result)
-                    .map_err(recording_error)?;
+                // SAFETY: the demo's recording command buffer, outside a render pass; the buffer is the
+                // demo device's, of its size, and outlives the submission waited for here.
+                unsafe {
+                    self.context
+                        .record_resource_readback(enc.raw_handle(), &readback)
+                }
+                .map_err(recording_error)?;
             }
             Ok(())
         })?;
@@ -712,63 +649,57 @@ fn recording_error(e: impl std::fmt::Display) -> rhi::RhiError {
     rhi::RhiError::InvalidArgument(format!("{e:#}"))
 }
 
-/// The C encoding of `encoding`.
-fn normal_encoding(encoding: passes::NormalEncoding) -> HrtsNormalEncoding {
+/// The plugin's encoding of `encoding`.
+fn normal_encoding(encoding: passes::NormalEncoding) -> hrts::NormalEncoding {
     match encoding {
-        passes::NormalEncoding::XyzCoverage => HrtsNormalEncoding::XyzCoverage,
-        passes::NormalEncoding::Xyz => HrtsNormalEncoding::Xyz,
-        passes::NormalEncoding::Octahedral => HrtsNormalEncoding::Octahedral,
-        passes::NormalEncoding::FromDepth => HrtsNormalEncoding::None,
+        passes::NormalEncoding::XyzCoverage => hrts::NormalEncoding::XyzCoverage,
+        passes::NormalEncoding::Xyz => hrts::NormalEncoding::Xyz,
+        passes::NormalEncoding::Octahedral => hrts::NormalEncoding::Octahedral,
+        passes::NormalEncoding::FromDepth => hrts::NormalEncoding::None,
+    }
+}
+
+/// One of the demo's images as the plugin takes it.
+fn target_image(image: &Image) -> hrts::TargetImage {
+    hrts::TargetImage {
+        image: image.raw_handle(),
+        usage: image.raw_usage(),
+        format: image.format().raw_vk() as u32,
+    }
+}
+
+/// The plugin's bounds of `bounds`.
+fn plugin_bounds(bounds: &Aabb) -> hrts::Bounds {
+    hrts::Bounds {
+        min: bounds.min,
+        max: bounds.max,
     }
 }
 
 /// A context adopting `device`.
-fn create_context(device: &Device) -> Result<Context> {
+fn create_context(device: &Device) -> Result<hrts::Context> {
     let desc = device.adopt_desc();
-    let names = desc
-        .enabled_extensions
-        .iter()
-        .map(|n| CString::new(n.as_str()))
-        .collect::<Result<Vec<_>, _>>()?;
-    let name_ptrs: Vec<*const c_char> = names.iter().map(|n| n.as_ptr()).collect();
     let f = desc.enabled_features;
-    let vulkan = HrtsVulkanDevice {
-        struct_size: size_of::<HrtsVulkanDevice>() as u32,
+    let vulkan = hrts::VulkanDevice {
         get_instance_proc_addr: Some(desc.get_instance_proc_addr),
         instance: desc.instance,
         physical_device: desc.physical_device,
         device: desc.device,
         queue_family_index: desc.queue_family_index,
         queue_index: desc.queue_index,
-        enabled_extensions: name_ptrs.as_ptr(),
-        enabled_extension_count: name_ptrs.len() as u32,
-        geometry_shader: f.geometry_shader.into(),
-        fragment_stores_and_atomics: f.fragment_stores_and_atomics.into(),
-        depth_clamp: f.depth_clamp.into(),
-        debug_utils: desc.debug_utils.into(),
+        enabled_extensions: desc
+            .enabled_extensions
+            .iter()
+            .map(|n| CString::new(n.as_str()))
+            .collect::<Result<_, _>>()?,
+        geometry_shader: f.geometry_shader,
+        fragment_stores_and_atomics: f.fragment_stores_and_atomics,
+        depth_clamp: f.depth_clamp,
+        debug_utils: desc.debug_utils,
     };
-    let info = HrtsContextCreateInfo {
-        struct_size: size_of::<HrtsContextCreateInfo>() as u32,
-        api_version: HRTS_API_VERSION,
-        vulkan: &vulkan,
-        device_name_filter: std::ptr::null(),
-        enable_validation: 0,
-        frames_in_flight: 0,
-    };
-    let mut context = std::ptr::null_mut();
-    // SAFETY: valid structs; the names outlive the call; the device outlives the context (the renderer
-    // that holds it borrows nothing but is dropped before the demo's device by every caller).
-    let result = unsafe { hrts_context_create(&info, &mut context) };
-    if result != HrtsResult::Ok {
-        // SAFETY: NULL context: the thread's last error.
-        let message = unsafe { CStr::from_ptr(hrts_last_error(std::ptr::null())) };
-        bail!(
-            "hrts_context_create: {:?} ({})",
-            result,
-            message.to_string_lossy()
-        );
-    }
-    Ok(Context(context))
+    // SAFETY: the handles are the demo's live device, as it was created; it outlives the context (the
+    // renderer that holds it borrows nothing but is dropped before the demo's device by every caller).
+    Ok(unsafe { hrts::Context::adopt(&vulkan, 0) }?)
 }
 
 /// Hands the demo's meshes (their vertex and index buffers) to the plugin with the draws of the objects
@@ -776,32 +707,29 @@ fn create_context(device: &Device) -> Result<Context> {
 /// caster is left out), each mesh with the casters' `bounds`, which enclose its draws given (the plugin's
 /// frame origin is their centre).
 fn set_geometry(
-    context: &Context,
+    context: &hrts::Context,
     geometry: &Geometry,
     casters: &[bool],
     bounds: &Aabb,
 ) -> Result<()> {
-    let mut b = [0.0f32; 6];
-    b[..3].copy_from_slice(&bounds.min.to_array());
-    b[3..].copy_from_slice(&bounds.max.to_array());
     let mut casts = casters.iter();
-    let draws: Vec<Vec<HrtsDraw>> = geometry
+    let draws: Vec<Vec<hrts::Draw>> = geometry
         .meshes()
         .iter()
         .map(|m| {
             m.draws()
                 .iter()
                 .filter(|_| casts.next().copied().unwrap_or(false))
-                .map(|d| HrtsDraw {
+                .map(|d| hrts::Draw {
                     first_index: d.first_index,
                     index_count: d.index_count,
-                    transform: d.model.to_cols_array(),
+                    transform: d.model,
                     base_vertex: d.base_vertex,
                 })
                 .collect()
         })
         .collect();
-    let meshes: Vec<HrtsVulkanGeometry> = geometry
+    let meshes: Vec<hrts::VulkanMesh> = geometry
         .meshes()
         .iter()
         .zip(&draws)
@@ -809,8 +737,7 @@ fn set_geometry(
         .map(|(m, draws)| {
             let (vertices, vertex) = m.vertices();
             let (indices, index) = m.indices();
-            HrtsVulkanGeometry {
-                struct_size: size_of::<HrtsVulkanGeometry>() as u32,
+            hrts::VulkanMesh {
                 vertex_buffer: vertices.raw_handle(),
                 vertex_buffer_size: vertices.size(),
                 vertex_offset: vertex.offset,
@@ -820,125 +747,67 @@ fn set_geometry(
                 index_buffer_size: indices.size(),
                 index_offset: index.offset,
                 index_type: match index.format {
-                    passes::IndexFormat::U16 => HrtsIndexType::Uint16,
-                    passes::IndexFormat::U32 => HrtsIndexType::Uint32,
-                } as u32,
+                    passes::IndexFormat::U16 => hrts::IndexType::Uint16,
+                    passes::IndexFormat::U32 => hrts::IndexType::Uint32,
+                },
                 index_count: index.count,
-                draws: draws.as_ptr(),
-                draw_count: draws.len() as u32,
-                bounds: b,
+                draws,
+                bounds: plugin_bounds(bounds),
                 vertex_format: 0,
-                position_scale: [0.0; 3],
-                position_offset: [0.0; 3],
-                draw_stride: size_of::<HrtsDraw>(),
+                position_scale: glam::Vec3::ZERO,
+                position_offset: glam::Vec3::ZERO,
             }
         })
         .collect();
-    // SAFETY: live context; `meshes` holds `meshes.len()` meshes whose draws outlive the call; the buffers
-    // live as long as the renderer, which destroys the context first.
-    context.check("hrts_set_geometry_vulkan_meshes", unsafe {
-        hrts_set_geometry_vulkan_meshes(context.0, meshes.as_ptr(), meshes.len() as u32)
-    })
+    // SAFETY: the buffers are the demo device's, of their sizes; they live as long as the renderer, which
+    // drops the context first.
+    Ok(unsafe { context.set_geometry_vulkan(&meshes) }?)
 }
 
-/// The C light of `light`.
-fn c_light(light: &Light) -> HrtsLight {
+/// The plugin's light of `light`.
+fn plugin_light(light: &Light) -> hrts::Light {
     match *light {
         Light::Directional {
             direction,
             view_proj,
-        } => c_directional_light(direction, view_proj),
+        } => hrts::Light::Directional {
+            direction,
+            view_proj: Some(view_proj),
+        },
         Light::Spot {
             position,
             direction,
             view_proj,
-        } => HrtsLight {
-            light_type: HrtsLightType::Spot as u32,
-            view_proj: view_proj.to_cols_array(),
-            direction: direction.to_array(),
-            ..c_point_light(position, 0.0)
+        } => hrts::Light::Spot {
+            position,
+            direction,
+            frustum: hrts::SpotFrustum::Given(view_proj),
+            range: None,
         },
-        Light::Point { position, range } => c_point_light(position, range.unwrap_or(0.0)),
+        Light::Point { position, range } => hrts::Light::Point { position, range },
     }
 }
 
-/// The C directional light travelling along `direction`, with the orthographic `view_proj` enclosing the
-/// scene.
-pub fn c_directional_light(direction: glam::Vec3, view_proj: glam::Mat4) -> HrtsLight {
-    HrtsLight {
-        light_type: HrtsLightType::Directional as u32,
-        position: [0.0; 3],
-        direction: direction.to_array(),
-        view_proj: view_proj.to_cols_array(),
-        range: 0.0,
-        outer_cone: 0.0,
-    }
-}
-
-/// The C point light at `position` within `range` (0: unlimited): the plugin shadows it through its cube
-/// faces and writes their minimum to the light's layer.
-pub fn c_point_light(position: glam::Vec3, range: f32) -> HrtsLight {
-    HrtsLight {
-        light_type: HrtsLightType::Point as u32,
-        position: position.to_array(),
-        direction: [0.0; 3],
-        view_proj: [0.0; 16],
-        range,
-        outer_cone: 0.0,
-    }
-}
-
-/// The C spot light at `position` along `direction` with a cone of half-angle `outer_cone` within `range`
-/// (0: unlimited), without a matrix: the plugin fits its frusta.
-pub fn c_fitted_spot_light(
-    position: glam::Vec3,
-    direction: glam::Vec3,
-    outer_cone: f32,
-    range: f32,
-) -> HrtsLight {
-    HrtsLight {
-        light_type: HrtsLightType::Spot as u32,
-        direction: direction.to_array(),
-        outer_cone,
-        ..c_point_light(position, range)
-    }
-}
-
-/// The C frame `frame_index` of `camera` with `lights`, recorded into `command_buffer`; depth and normal
-/// are sampled (`SHADER_READ_ONLY_OPTIMAL`) and the visibility image is left ready for sampling.
-fn c_frame(
-    command_buffer: u64,
+/// Frame `frame_index` of `camera` with `lights`; depth and normal are sampled
+/// (`SHADER_READ_ONLY_OPTIMAL`) and the visibility image is left ready for sampling.
+fn plugin_frame<'a>(
     frame_index: u64,
     camera: &CameraMatrices,
-    lights: &[HrtsLight],
+    lights: &'a [hrts::Light],
     bounds: &Aabb,
-) -> HrtsFrame {
+) -> hrts::Frame<'a> {
     let sampled = S::ShaderResource.raw_layout();
-    HrtsFrame {
-        struct_size: size_of::<HrtsFrame>() as u32,
-        command_buffer,
+    hrts::Frame {
         frame_index,
-        view: camera.view.to_cols_array(),
-        proj: camera.proj.to_cols_array(),
-        camera_position: camera.position.to_array(),
-        lights: lights.as_ptr(),
-        light_count: lights.len() as u32,
+        view: camera.view,
+        proj: camera.proj,
+        camera_position: camera.position,
+        lights,
         depth_layout: sampled,
         normal_layout: sampled,
         output_layout_before: S::Undefined.raw_layout(),
         output_layout_after: sampled,
-        bounds: [
-            bounds.min.x,
-            bounds.min.y,
-            bounds.min.z,
-            bounds.max.x,
-            bounds.max.y,
-            bounds.max.z,
-        ],
-        has_bounds: 1,
-        deformed: std::ptr::null(),
-        deformed_count: 0,
-        light_stride: size_of::<HrtsLight>(),
-        deformed_stride: size_of::<HrtsMeshVertices>(),
+        bounds: Some(plugin_bounds(bounds)),
+        deformed: &[],
     }
 }

@@ -84,10 +84,10 @@ impl SceneRenderer {
     ) -> Result<LightsFrame> {
         self.plugin
             .configure_lights(device, &plan.plugin_configs())?;
-        self.plugin.render_c_lights(
+        self.plugin.render_plugin_lights(
             device,
             &CameraMatrices::of_camera(camera, self.width, self.height),
-            plan.plugin_frame_lights(),
+            &plan.plugin_frame_lights(),
         )
     }
 

@@ -12,7 +12,7 @@ use std::process::Command;
 
 #[test]
 fn header_compiles_as_c99_and_cxx() {
-    let include = workspace().join("plugin_api/include");
+    let include = workspace().join("hrts/include");
     let dir = std::env::temp_dir().join(format!("hrts-header-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let src = dir.join("use_header.c");
@@ -54,7 +54,7 @@ fn build_c_program(name: &str, include: &Path, sources: &[&str]) -> PathBuf {
 
 #[test]
 fn c_host_matches_the_exact_shadow_and_survives_misuse() {
-    let include = workspace().join("plugin_api/include");
+    let include = workspace().join("hrts/include");
     let exe = build_c_program("c-host", &include, &["c_host.c", "engine.c"]);
     let out = run(&mut Command::new(&exe));
     let stdout = String::from_utf8_lossy(&out.stdout);

@@ -15,10 +15,7 @@ use common::{
 };
 use glam::Vec3;
 use host_demo::accuracy::{compare_area_counts, AreaComparison};
-use host_demo::plugin::{
-    c_directional_light, c_fitted_spot_light, c_point_light, LightFrameReport, LightsFrame,
-    PluginRenderer,
-};
+use host_demo::plugin::{LightFrameReport, LightsFrame, PluginRenderer};
 use host_demo::scene_plan::{
     plan_scene, scene_camera, LightDecision, NoPassReason, PlanSettings, ScenePlan,
 };
@@ -601,7 +598,7 @@ fn native_point_frames(
     (0..frames)
         .map(|_| {
             let frame = plugin
-                .render_c_lights(device, &matrices, vec![c_point_light(lamp, 0.0)])
+                .render_plugin_lights(device, &matrices, &[plugin_point_light(lamp)])
                 .expect("frame");
             let report = &frame.lights[0].report;
             let (_, layers) = plugin.read_frame(device).expect("read back");
@@ -928,7 +925,7 @@ fn check_local_area(
     device: &Device,
     name: &str,
     file: &SceneFile,
-    light: hrts_plugin::HrtsLight,
+    light: hrts::Light,
     (centre, radius, samples): (Vec3, f32, u32),
     cone: Option<(Vec3, f32)>,
     (min_penumbra, max_unstable_percent): (usize, usize),
@@ -978,7 +975,7 @@ fn check_local_area(
         for _ in 0..2 {
             frame = Some(
                 plugin
-                    .render_c_lights(device, &matrices, vec![light])
+                    .render_plugin_lights(device, &matrices, &[light])
                     .expect("frame"),
             );
         }
@@ -1028,7 +1025,7 @@ fn a_sized_point_light_inside_a_closed_room_matches_the_reference_sample_for_sam
             &device,
             "point lamp in a closed room",
             &file,
-            c_point_light(lamp, 0.0),
+            plugin_point_light(lamp),
             (lamp, radius, samples),
             None,
             (min_penumbra, 25),
@@ -1050,7 +1047,7 @@ fn sized_spot_lights_match_the_reference_sample_for_sample() {
             &device,
             &format!("spot of {cone}°"),
             &file,
-            c_fitted_spot_light(lamp, down, cone.to_radians(), 0.0),
+            plugin_spot_light(lamp, down, cone.to_radians()),
             (lamp, 0.25, 16),
             Some((down, cone.to_radians())),
             (100, 25),
@@ -1070,7 +1067,7 @@ fn emitters_touching_geometry_match_the_reference_sample_for_sample() {
         &device,
         "lamp just over the table",
         &file,
-        c_point_light(over_table, 0.0),
+        plugin_point_light(over_table),
         (over_table, 0.1, 32),
         None,
         (40, 25),
@@ -1081,7 +1078,7 @@ fn emitters_touching_geometry_match_the_reference_sample_for_sample() {
         &device,
         "lamp on a wall",
         &file,
-        c_point_light(on_wall, 0.0),
+        plugin_point_light(on_wall),
         (on_wall, 0.2, 16),
         None,
         (200, 40),
@@ -1114,13 +1111,41 @@ fn sun_direction() -> Vec3 {
     Vec3::new(0.45, -1.0, 0.25).normalize()
 }
 
+/// The plugin's point light at `position`, of unlimited range.
+fn plugin_point_light(position: Vec3) -> hrts::Light {
+    hrts::Light::Point {
+        position,
+        range: None,
+    }
+}
+
+/// The plugin's spot light at `position` along `direction`, of unlimited range, whose frusta the plugin
+/// fits to the cone of half-angle `outer_cone`.
+fn plugin_spot_light(position: Vec3, direction: Vec3, outer_cone: f32) -> hrts::Light {
+    hrts::Light::Spot {
+        position,
+        direction,
+        frustum: hrts::SpotFrustum::Fitted { outer_cone },
+        range: None,
+    }
+}
+
+/// The plugin's directional light along `direction`, with the host's `view_proj` or (`None`) fitted by
+/// the plugin.
+fn plugin_directional_light(direction: Vec3, view_proj: Option<glam::Mat4>) -> hrts::Light {
+    hrts::Light::Directional {
+        direction,
+        view_proj,
+    }
+}
+
 /// Every light's layer of `file` from its camera after `frames` frames of `lights` under `configs`, and
 /// each light's report of the last frame.
 fn native_frame(
     device: &Device,
     file: &SceneFile,
     configs: &[ShadowConfig],
-    lights: Vec<hrts_plugin::HrtsLight>,
+    lights: Vec<hrts::Light>,
     frames: usize,
 ) -> (Vec<LightFrameReport>, Vec<Vec<f32>>) {
     let mut plugin = plugin_for(device, file);
@@ -1129,7 +1154,7 @@ fn native_frame(
     let mut reports = Vec::new();
     for _ in 0..frames {
         reports = plugin
-            .render_c_lights(device, &matrices, lights.clone())
+            .render_plugin_lights(device, &matrices, &lights)
             .expect("frame")
             .lights;
     }
@@ -1137,10 +1162,10 @@ fn native_frame(
     (reports, layers)
 }
 
-/// A sun given without a matrix (the C ABI's directional light with `view_proj` all zeros): the plugin fits
-/// its frustum to the frame's bounds, and its visibility is the same, pixel for pixel, as the same sun's
-/// given the host's own fitted matrix (`scene::DirectionalLight::view_proj` of the same bounds); both are
-/// the exact shadow.
+/// A sun given without a matrix (`view_proj: None`, the C ABI's directional light with `view_proj` all
+/// zeros): the plugin fits its frustum to the frame's bounds, and its visibility is the same, pixel for
+/// pixel, as the same sun's given the host's own fitted matrix (`scene::DirectionalLight::view_proj` of the
+/// same bounds); both are the exact shadow.
 #[test]
 fn a_sun_fitted_by_the_plugin_shadows_as_the_hosts_matrix_does() {
     let device = device();
@@ -1157,8 +1182,8 @@ fn a_sun_fitted_by_the_plugin_shadows_as_the_hosts_matrix_does() {
         &file,
         &[config, config],
         vec![
-            c_directional_light(direction, host),
-            c_directional_light(direction, glam::Mat4::ZERO),
+            plugin_directional_light(direction, Some(host)),
+            plugin_directional_light(direction, None),
         ],
         1,
     );
@@ -1220,8 +1245,8 @@ fn mode_auto_shadows_a_zero_size_sun_hard_and_a_sized_lamp_area() {
         &file,
         &[config, config],
         vec![
-            c_directional_light(direction, glam::Mat4::ZERO),
-            c_point_light(lamp, 0.0),
+            plugin_directional_light(direction, None),
+            plugin_point_light(lamp),
         ],
         2,
     );
@@ -1301,7 +1326,7 @@ fn a_sized_point_light_1e4_from_the_origin_matches_the_reference() {
         &device,
         "point lamp 1e4 from the origin",
         &file,
-        c_point_light(lamp, 0.0),
+        plugin_point_light(lamp),
         (lamp, 0.3, 16),
         None,
         (200, 25),

@@ -2,7 +2,7 @@
 
 use anyhow::{Context as _, Result};
 use clap::Parser;
-use hrts_plugin::HrtsShadowMode;
+use hrts::ShadowMode;
 use scene::{Camera, DirectionalLight};
 use std::path::PathBuf;
 use wgpu_host::{validation, Conventions, Gpu, Renderer};
@@ -33,9 +33,9 @@ fn main() -> Result<()> {
     let gpu = Gpu::new(false)?;
     let scene = scene::procedural_default();
     let mode = if args.hard {
-        HrtsShadowMode::Hard
+        ShadowMode::Hard
     } else {
-        HrtsShadowMode::Hybrid
+        ShadowMode::Hybrid
     };
     let conventions = Conventions::default();
     let mut renderer = Renderer::new(&gpu, &scene, conventions, args.width, args.height, mode)?;

@@ -8,7 +8,7 @@ use crate::shadows::{
 };
 use anyhow::{bail, Context as _, Result};
 use glam::Mat4;
-use hrts_plugin::{HrtsFrameReport, HrtsNormalEncoding, HrtsNormalSpace, HrtsShadowMode};
+use hrts::{FrameReport, NormalEncoding, NormalSpace, ShadowMode};
 use scene::{Aabb, Camera, DirectionalLight, Scene};
 
 /// The wgpu device, opened with what the plugin adopts.
@@ -77,7 +77,7 @@ pub struct Frame {
     /// The shaded image, RGBA8, row-major from the top.
     pub color: Vec<u8>,
     /// The plugin's report of the frame.
-    pub report: HrtsFrameReport,
+    pub report: FrameReport,
 }
 
 /// The renderer: meshes, G-buffer, shadow image, shading, and the plugin's context.
@@ -133,7 +133,7 @@ impl Renderer {
         conventions: Conventions,
         width: u32,
         height: u32,
-        mode: HrtsShadowMode,
+        mode: ShadowMode,
     ) -> Result<Self> {
         let device = &gpu.device;
         let meshes: Vec<GpuMesh> = meshes_of(scene, conventions.index)
@@ -302,14 +302,14 @@ impl Renderer {
             depth: self.view_z.as_ref().unwrap_or(&self.depth),
             normal: &self.normal,
             normal_encoding: if n.octahedral() {
-                HrtsNormalEncoding::Octahedral
+                NormalEncoding::Octahedral
             } else {
-                HrtsNormalEncoding::Xyz
+                NormalEncoding::Xyz
             },
             normal_space: if n.view_space() {
-                HrtsNormalSpace::View
+                NormalSpace::View
             } else {
-                HrtsNormalSpace::World
+                NormalSpace::World
             },
             shadow: &self.shadow,
         }

@@ -1,12 +1,13 @@
 //! Everything this renderer needed to add the plugin's shadows, in one file: the device wgpu opens with
 //! what the plugin adopts, the context, the renderer's meshes and images handed over as they are, and the
-//! frame recorded into a wgpu command encoder through wgpu-hal's Vulkan interop.
+//! frame recorded into a wgpu command encoder through wgpu-hal's Vulkan interop, all through the plugin's
+//! safe API ([`hrts`]).
 
-use anyhow::{bail, Context as _, Result};
+use anyhow::{Context as _, Result};
 use ash::vk::{self, Handle};
 use glam::Mat4;
-use hrts_plugin::*;
-use std::ffi::{c_char, c_void, CStr, CString};
+use hrts::{NormalEncoding, NormalSpace, ShadowMode};
+use std::ffi::{c_char, c_void};
 use wgpu::hal::api::Vulkan;
 
 /// What the plugin needs to know of the features wgpu enabled.
@@ -64,9 +65,9 @@ pub struct ShadowTargets<'a> {
     /// Normal target (`TEXTURE_BINDING`), encoded as `normal_encoding` says.
     pub normal: &'a wgpu::Texture,
     /// Octahedral or xyz.
-    pub normal_encoding: HrtsNormalEncoding,
+    pub normal_encoding: NormalEncoding,
     /// View or world space.
-    pub normal_space: HrtsNormalSpace,
+    pub normal_space: NormalSpace,
     /// The shadow image the plugin writes, one layer per light (`COPY_DST`).
     pub shadow: &'a wgpu::Texture,
 }
@@ -182,7 +183,7 @@ pub struct ShadowFrame {
 
 /// The plugin's context on the renderer's device.
 pub struct Shadows {
-    context: *mut HrtsContext,
+    context: hrts::Context,
     adapter: wgpu::Adapter,
 }
 
@@ -194,21 +195,13 @@ impl Shadows {
         device: &wgpu::Device,
         enabled: EnabledFeatures,
         frames_in_flight: u32,
-        mode: HrtsShadowMode,
+        mode: ShadowMode,
     ) -> Result<Self> {
         // SAFETY: the guard is dropped at the end of this function; the handles stay valid as long as
         // `device`, which the caller keeps beyond the context.
         let hal = unsafe { device.as_hal::<Vulkan>() }.context("the device is not Vulkan")?;
         let shared = hal.shared_instance();
-        let names: Vec<CString> = hal
-            .enabled_device_extensions()
-            .iter()
-            .map(|&n| n.to_owned())
-            .collect();
-        let name_ptrs: Vec<*const c_char> = names.iter().map(|n| n.as_ptr()).collect();
-        let debug_utils = shared.extensions().contains(&ash::ext::debug_utils::NAME);
-        let vulkan = HrtsVulkanDevice {
-            struct_size: size_of::<HrtsVulkanDevice>() as u32,
+        let vulkan = hrts::VulkanDevice {
             // SAFETY: the same function pointer type, with the loader's C calling convention.
             get_instance_proc_addr: Some(unsafe {
                 std::mem::transmute::<
@@ -224,73 +217,53 @@ impl Shadows {
             device: hal.raw_device().handle().as_raw(),
             queue_family_index: hal.queue_family_index(),
             queue_index: 0,
-            enabled_extensions: name_ptrs.as_ptr(),
-            enabled_extension_count: name_ptrs.len() as u32,
-            geometry_shader: enabled.geometry_shader.into(),
-            fragment_stores_and_atomics: enabled.fragment_stores_and_atomics.into(),
-            depth_clamp: enabled.depth_clamp.into(),
-            debug_utils: debug_utils.into(),
+            enabled_extensions: hal
+                .enabled_device_extensions()
+                .iter()
+                .map(|&n| n.to_owned())
+                .collect(),
+            geometry_shader: enabled.geometry_shader,
+            fragment_stores_and_atomics: enabled.fragment_stores_and_atomics,
+            depth_clamp: enabled.depth_clamp,
+            debug_utils: shared.extensions().contains(&ash::ext::debug_utils::NAME),
         };
-        let info = HrtsContextCreateInfo {
-            struct_size: size_of::<HrtsContextCreateInfo>() as u32,
-            api_version: HRTS_API_VERSION,
-            vulkan: &vulkan,
-            device_name_filter: std::ptr::null(),
-            enable_validation: 0,
-            frames_in_flight,
-        };
-        let mut context = std::ptr::null_mut();
-        // SAFETY: valid structs whose pointers outlive the call.
-        let result = unsafe { hrts_context_create(&info, &mut context) };
-        if result != HrtsResult::Ok {
-            // SAFETY: NULL context: the thread's last error, a NUL-terminated string.
-            let why = unsafe { CStr::from_ptr(hrts_last_error(std::ptr::null())) };
-            bail!("hrts_context_create: {result:?}: {}", why.to_string_lossy());
-        }
-        let shadows = Self {
+        // SAFETY: wgpu's live device, opened with the features stated, which the caller keeps beyond the
+        // context.
+        let context = unsafe { hrts::Context::adopt(&vulkan, frames_in_flight) }?;
+        context.configure(&hrts::Config {
+            mode,
+            // Hard shadows as the rays give them, without FXAA: exact per pixel.
+            antialiasing: mode != ShadowMode::Hard,
+            ..hrts::Config::default()
+        })?;
+        Ok(Self {
             context,
             adapter: adapter.clone(),
-        };
-        // SAFETY: plain data; all zeros is a valid value, filled by the defaults below.
-        let mut config: HrtsConfig = unsafe { std::mem::zeroed() };
-        config.struct_size = size_of::<HrtsConfig>() as u32;
-        // SAFETY: `config` is valid with its size set.
-        shadows.check("hrts_config_defaults", unsafe {
-            hrts_config_defaults(&mut config)
-        })?;
-        config.mode = mode as u32;
-        // Hard shadows as the rays give them, without FXAA: exact per pixel.
-        config.antialiasing = u32::from(mode != HrtsShadowMode::Hard);
-        // SAFETY: live context, valid configuration.
-        shadows.check("hrts_configure", unsafe {
-            hrts_configure(shadows.context, &config)
-        })?;
-        Ok(shadows)
+        })
     }
 
     /// Hands the meshes to the plugin: their buffers as they are, one draw per instance.
     pub fn set_meshes(&self, meshes: &[ShadowMesh<'_>]) -> Result<()> {
-        let draws: Vec<Vec<HrtsDraw>> = meshes
+        let draws: Vec<Vec<hrts::Draw>> = meshes
             .iter()
             .map(|m| {
                 m.instances
                     .iter()
-                    .map(|t| HrtsDraw {
+                    .map(|&transform| hrts::Draw {
                         first_index: 0,
                         index_count: m.index_count,
-                        transform: t.to_cols_array(),
+                        transform,
                         base_vertex: 0,
                     })
                     .collect()
             })
             .collect();
-        let geometry: Vec<HrtsVulkanGeometry> = meshes
+        let geometry: Vec<hrts::VulkanMesh> = meshes
             .iter()
             .zip(&draws)
             .map(|(m, draws)| {
-                let [lo, hi] = m.bounds;
-                HrtsVulkanGeometry {
-                    struct_size: size_of::<HrtsVulkanGeometry>() as u32,
+                let [min, max] = m.bounds;
+                hrts::VulkanMesh {
                     vertex_buffer: m.vertices.raw,
                     vertex_buffer_size: m.vertices.buffer.size(),
                     vertex_offset: 0,
@@ -300,69 +273,56 @@ impl Shadows {
                     index_buffer_size: m.indices.buffer.size(),
                     index_offset: 0,
                     index_type: match m.index_format {
-                        wgpu::IndexFormat::Uint16 => HrtsIndexType::Uint16,
-                        wgpu::IndexFormat::Uint32 => HrtsIndexType::Uint32,
-                    } as u32,
+                        wgpu::IndexFormat::Uint16 => hrts::IndexType::Uint16,
+                        wgpu::IndexFormat::Uint32 => hrts::IndexType::Uint32,
+                    },
                     index_count: m.index_count,
-                    draws: draws.as_ptr(),
-                    draw_count: draws.len() as u32,
-                    bounds: [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z],
+                    draws,
+                    bounds: hrts::Bounds { min, max },
                     vertex_format: vk::Format::R32G32B32_SFLOAT.as_raw() as u32,
-                    position_scale: [0.0; 3],
-                    position_offset: [0.0; 3],
-                    draw_stride: size_of::<HrtsDraw>(),
+                    position_scale: glam::Vec3::ZERO,
+                    position_offset: glam::Vec3::ZERO,
                 }
             })
             .collect();
-        // SAFETY: live context; `geometry` and the draws it points at outlive the call.
-        // SAFETY: live context; `geometry` and the draws it points at outlive the call.
-        self.check("hrts_set_geometry_vulkan_meshes", unsafe {
-            hrts_set_geometry_vulkan_meshes(self.context, geometry.as_ptr(), geometry.len() as u32)
-        })
+        // SAFETY: the buffers are live storage buffers of the adopted device, of their sizes; the renderer
+        // keeps them beyond the context.
+        Ok(unsafe { self.context.set_geometry_vulkan(&geometry) }?)
     }
 
     /// Moves the instances: one transform per instance of every mesh, in mesh order.
     pub fn move_instances(&self, transforms: &[Mat4]) -> Result<()> {
-        let floats: Vec<f32> = transforms.iter().flat_map(|t| t.to_cols_array()).collect();
-        // SAFETY: live context; 16 floats per transform.
-        self.check("hrts_set_draw_transforms", unsafe {
-            hrts_set_draw_transforms(self.context, transforms.len() as u32, floats.as_ptr())
-        })
+        Ok(self.context.set_draw_transforms(transforms)?)
     }
 
     /// Hands the renderer's images to the plugin.
     pub fn set_targets(&self, targets: &ShadowTargets<'_>) -> Result<()> {
         let size = targets.depth.size();
-        let raw = |t: &wgpu::Texture| -> Result<u64> {
-            // SAFETY: a live texture of the adopted device.
-            let hal = unsafe { t.as_hal::<Vulkan>() }.context("not a Vulkan texture")?;
-            // SAFETY: as above.
-            Ok(unsafe { hal.raw_handle() }.as_raw())
-        };
         // SAFETY: the adapter outlives the guard.
         let adapter = unsafe { self.adapter.as_hal::<Vulkan>() }.context("not a Vulkan adapter")?;
-        let format = |f| adapter.texture_format_as_raw(f).as_raw() as u32;
-        let t = HrtsTargets {
-            struct_size: size_of::<HrtsTargets>() as u32,
+        let image = |t: &wgpu::Texture| -> Result<hrts::TargetImage> {
+            // SAFETY: a live texture of the adopted device.
+            let hal = unsafe { t.as_hal::<Vulkan>() }.context("not a Vulkan texture")?;
+            Ok(hrts::TargetImage {
+                // SAFETY: as above.
+                image: unsafe { hal.raw_handle() }.as_raw(),
+                usage: vulkan_usage(t),
+                format: adapter.texture_format_as_raw(t.format()).as_raw() as u32,
+            })
+        };
+        let targets = hrts::Targets {
             width: size.width,
             height: size.height,
-            depth_image: raw(targets.depth)?,
-            depth_usage: vulkan_usage(targets.depth),
-            depth_format: format(targets.depth.format()),
-            normal_image: raw(targets.normal)?,
-            normal_usage: vulkan_usage(targets.normal),
-            normal_format: format(targets.normal.format()),
-            normal_encoding: targets.normal_encoding as u32,
-            normal_space: targets.normal_space as u32,
-            output_image: raw(targets.shadow)?,
-            output_usage: vulkan_usage(targets.shadow),
+            depth: image(targets.depth)?,
+            normal: image(targets.normal)?,
+            normal_encoding: targets.normal_encoding,
+            normal_space: targets.normal_space,
+            output: image(targets.shadow)?,
             output_layers: targets.shadow.depth_or_array_layers(),
-            output_format: format(targets.shadow.format()),
         };
-        // SAFETY: live context and images.
-        self.check("hrts_set_targets", unsafe {
-            hrts_set_targets(self.context, &t)
-        })
+        // SAFETY: live textures of the adopted device, created with the usages and formats stated; the
+        // renderer keeps them beyond the context.
+        Ok(unsafe { self.context.set_targets(&targets) }?)
     }
 
     /// Records the frame's shadows: `before` leaves the targets in the states the plugin reads them in,
@@ -390,13 +350,9 @@ impl Shadows {
             ]
             .into_iter(),
         );
-        let light = HrtsLight {
-            light_type: HrtsLightType::Directional as u32,
-            position: [0.0; 3],
-            direction: frame.light_direction.to_array(),
-            view_proj: frame.light_view_proj.to_cols_array(),
-            range: 0.0,
-            outer_cone: 0.0,
+        let light = hrts::Light::Directional {
+            direction: frame.light_direction,
+            view_proj: Some(frame.light_view_proj),
         };
         let vulkan_clip = Mat4::from_scale(glam::Vec3::new(1.0, -1.0, 1.0));
         // The layouts wgpu gives a sampled texture: depth formats are read in a depth read-only layout.
@@ -406,68 +362,39 @@ impl Shadows {
             vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL
         };
         let transfer_dst = vk::ImageLayout::TRANSFER_DST_OPTIMAL.as_raw();
-        let [lo, hi] = frame.bounds;
+        let [min, max] = frame.bounds;
+        let plugin_frame = hrts::Frame {
+            frame_index: frame.index,
+            view: frame.view,
+            proj: vulkan_clip * frame.proj,
+            camera_position: frame.camera_position,
+            lights: std::slice::from_ref(&light),
+            depth_layout: depth_layout.as_raw(),
+            normal_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL.as_raw(),
+            output_layout_before: transfer_dst,
+            output_layout_after: transfer_dst,
+            bounds: Some(hrts::Bounds { min, max }),
+            deformed: &[],
+        };
         let mut plugin = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("shadows"),
         });
         // SAFETY: nothing else records into `plugin` while the callback runs; the plugin leaves the command
-        // buffer open and the images in the layouts wgpu's states above give them.
-        let result = unsafe {
+        // buffer open and the images in the layouts wgpu's states above give them; the renderer submits
+        // the buffer and waits for its frames before it drops the context.
+        unsafe {
             plugin.as_hal_mut::<Vulkan, _, _>(|encoder| {
                 let encoder = encoder.context("not a Vulkan command encoder")?;
-                let f = HrtsFrame {
-                    struct_size: size_of::<HrtsFrame>() as u32,
-                    command_buffer: encoder.raw_handle().as_raw(),
-                    frame_index: frame.index,
-                    view: frame.view.to_cols_array(),
-                    proj: (vulkan_clip * frame.proj).to_cols_array(),
-                    camera_position: frame.camera_position.to_array(),
-                    lights: &light,
-                    light_count: 1,
-                    depth_layout: depth_layout.as_raw(),
-                    normal_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL.as_raw(),
-                    output_layout_before: transfer_dst,
-                    output_layout_after: transfer_dst,
-                    bounds: [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z],
-                    has_bounds: 1,
-                    deformed: std::ptr::null(),
-                    deformed_count: 0,
-                    light_stride: size_of::<HrtsLight>(),
-                    deformed_stride: size_of::<HrtsMeshVertices>(),
-                };
-                anyhow::Ok(hrts_record_frame(self.context, &f))
+                let command_buffer = encoder.raw_handle().as_raw();
+                anyhow::Ok(self.context.record_frame(command_buffer, &plugin_frame)?)
             })
         }?;
-        self.check("hrts_record_frame", result)?;
         Ok(plugin.finish())
     }
 
     /// The report of frame `frame_index` (completed on the GPU).
-    pub fn report(&self, frame_index: u64) -> Result<HrtsFrameReport> {
-        // SAFETY: plain data; all zeros is a valid value.
-        let mut report: HrtsFrameReport = unsafe { std::mem::zeroed() };
-        report.struct_size = size_of::<HrtsFrameReport>() as u32;
-        // SAFETY: live context; `report` has its size set.
-        self.check("hrts_get_frame_report", unsafe {
-            hrts_get_frame_report(self.context, frame_index, 0, &mut report)
-        })?;
-        Ok(report)
-    }
-
-    fn check(&self, call: &str, result: HrtsResult) -> Result<()> {
-        if result == HrtsResult::Ok {
-            return Ok(());
-        }
-        // SAFETY: live context; the message is NUL-terminated and read before the next call.
-        let why = unsafe { CStr::from_ptr(hrts_last_error(self.context)) };
-        bail!("{call}: {result:?}: {}", why.to_string_lossy())
-    }
-}
-
-impl Drop for Shadows {
-    fn drop(&mut self) {
-        // SAFETY: the context is live and destroyed once; the renderer waited for its frames.
-        unsafe { hrts_context_destroy(self.context) };
+    pub fn report(&self, frame_index: u64) -> Result<hrts::FrameReport> {
+        Ok(self.context.frame_report(frame_index, 0)?)
     }
 }
 

@@ -5,7 +5,7 @@
 use glam::{Mat4, Vec3};
 use host_demo::accuracy::{compare_with_reference, scene_visibility_params};
 use host_demo::{ShadowRenderer, View};
-use hrts_plugin::{HrtsFrameReport, HrtsShadowMode};
+use hrts::{FrameReport, ShadowMode};
 use passes::PrimitiveMapConfig;
 use reference::{reference_visibility, Light, PixelClass, RefScene, VisibilityReference};
 use scene::{Camera, DirectionalLight, Scene};
@@ -96,14 +96,14 @@ fn render(
     conventions: Conventions,
     view: &View,
     transforms: Option<MoveInstances<'_>>,
-) -> (Vec<f32>, Scene, HrtsFrameReport) {
+) -> (Vec<f32>, Scene, FrameReport) {
     let mut r = Renderer::new(
         gpu,
         &view.scene,
         conventions,
         WIDTH,
         HEIGHT,
-        HrtsShadowMode::Hard,
+        ShadowMode::Hard,
     )
     .expect("renderer");
     let rest: Vec<Mat4> = r.meshes().iter().map(|m| m.rest).collect();
@@ -140,8 +140,8 @@ fn same_visibility_as_host_demo() {
     );
     let c = compare_with_reference(&wgpu_ref, &wgpu_vis, None, None);
     assert_eq!(c.mismatches, 0, "wgpu_host vs reference: {:?}", c.examples);
-    assert_eq!(
-        report.output_direct, 1,
+    assert!(
+        report.output_direct,
         "an R32Float shadow image with storage usage is written directly"
     );
 

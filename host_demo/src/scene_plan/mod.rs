@@ -1,7 +1,7 @@
 //! The plan of a glTF scene: which shadow each light gets, derived from what the scene declares (its
 //! lights' kinds, sizes and flags, which objects move) and from what the camera sees. Pure: no GPU. The
-//! plan hands each shadowed light to the plugin as the C ABI takes it (`HrtsLight`), so the demo is a
-//! thin caller of what the plugin does for every engine.
+//! plan hands each shadowed light to the plugin as it takes it ([`hrts::Light`]), so the demo is a thin
+//! caller of what the plugin does for every engine.
 //!
 //! Per light, in this order:
 //! - a light that casts no shadow, emits nothing (zero colour or intensity), or whose influence (its cone
@@ -42,10 +42,9 @@
 
 mod reach;
 
-use crate::plugin::{c_directional_light, c_fitted_spot_light, c_point_light};
 use anyhow::{bail, Result};
-use glam::{DVec3, Mat4, Vec3};
-use hrts_plugin::{HrtsLight, HrtsLightType, HRTS_MAX_LIGHTS};
+use glam::{DVec3, Vec3};
+use hrts::{SpotFrustum, HRTS_MAX_LIGHTS};
 use passes::{FaceMode, FramePlan, ResourceId, ShadowConfig, ShadowMode};
 use reach::{receivers_in_view, up_hint, Cone, Pyramid, Reach};
 use scene::{Camera, LightKind, LightSize, SceneFile, SceneLight};
@@ -101,7 +100,7 @@ pub struct ShadowedLight {
     /// ([`ShadowedLight::resolved_config`]).
     pub frame_plan: FramePlan,
     /// The light as the plugin takes it.
-    pub light: HrtsLight,
+    pub light: hrts::Light,
     /// The frusta the plugin shadows it through, by name: "whole" for one, else cube faces ("+X" ...
     /// "-Z" for a point light; "front", "right", "left", "up", "down" around a wide spot light's axis).
     pub frusta: &'static [&'static str],
@@ -110,7 +109,7 @@ pub struct ShadowedLight {
 impl ShadowedLight {
     /// Whether the plugin is given a directional light.
     pub fn is_directional(&self) -> bool {
-        self.light.light_type == HrtsLightType::Directional as u32
+        matches!(self.light, hrts::Light::Directional { .. })
     }
 
     /// The configuration the plugin builds the light's passes with: mode auto resolved by the light's size
@@ -225,8 +224,9 @@ impl ScenePlan {
             .collect()
     }
 
-    /// The C light of each plugin light for a frame ([`ScenePlan::plugin_lights`] order).
-    pub fn plugin_frame_lights(&self) -> Vec<HrtsLight> {
+    /// The light of each plugin light for a frame, as the plugin takes it ([`ScenePlan::plugin_lights`]
+    /// order).
+    pub fn plugin_frame_lights(&self) -> Vec<hrts::Light> {
         self.plugin_lights()
             .iter()
             .map(|l| l.shadowed.light)
@@ -472,11 +472,14 @@ fn decide(
     if receivers.is_empty() {
         return NoPass(NoPassReason::NothingInView);
     }
-    let (position, range, cone, c_light) = match light.kind {
+    let (position, range, cone, plugin_light) = match light.kind {
         LightKind::Directional { direction } => {
             // No matrix: the plugin fits the frustum to the scene's bounds.
-            let c_light = c_directional_light(direction, Mat4::ZERO);
-            return shadowed(light, settings, dynamic_geometry, c_light, 1);
+            let plugin_light = hrts::Light::Directional {
+                direction,
+                view_proj: None,
+            };
+            return shadowed(light, settings, dynamic_geometry, plugin_light, 1);
         }
         LightKind::Spot {
             position,
@@ -488,13 +491,18 @@ fn decide(
             position,
             range,
             Some((direction, outer_cone)),
-            c_fitted_spot_light(position, direction, outer_cone, range.unwrap_or(0.0)),
+            hrts::Light::Spot {
+                position,
+                direction,
+                frustum: SpotFrustum::Fitted { outer_cone },
+                range,
+            },
         ),
         LightKind::Point { position, range } => (
             position,
             range,
             None,
-            c_point_light(position, range.unwrap_or(0.0)),
+            hrts::Light::Point { position, range },
         ),
     };
     let reach = Reach {
@@ -516,7 +524,7 @@ fn decide(
         }
         None => passes::point_light_faces(position, range).len(),
     };
-    shadowed(light, settings, dynamic_geometry, c_light, frusta)
+    shadowed(light, settings, dynamic_geometry, plugin_light, frusta)
 }
 
 /// A shadowed light: its configuration from the settings' base, mode auto with the light's size, and its
@@ -525,7 +533,7 @@ fn shadowed(
     light: &SceneLight,
     settings: &PlanSettings,
     dynamic_geometry: bool,
-    c_light: HrtsLight,
+    plugin_light: hrts::Light,
     frusta: usize,
 ) -> LightDecision {
     let mut config = settings.base;
@@ -548,7 +556,7 @@ fn shadowed(
     LightDecision::Shadowed(Box::new(ShadowedLight {
         config,
         frame_plan: FramePlan::derive(resolved.plan_request()),
-        light: c_light,
+        light: plugin_light,
         frusta: if matches!(light.kind, LightKind::Point { .. }) && resolved.shadows_point_as_cube()
         {
             &passes::CUBE_MAP_NAME
@@ -561,7 +569,6 @@ fn shadowed(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hrts_plugin::HrtsLightType;
     use passes::PassId;
     use scene::Scene;
 
@@ -658,9 +665,18 @@ mod tests {
         assert_eq!(s.config.pcss.angular_radius, 0.0);
         assert_eq!(s.resolved_config().mode, ShadowMode::Hard);
         assert_eq!(s.frusta, ["whole"]);
-        assert_eq!(s.light.light_type, HrtsLightType::Directional as u32);
         // No matrix: the plugin fits the sun's frustum to the scene's bounds.
-        assert!(s.light.view_proj.iter().all(|&x| x == 0.0));
+        assert!(
+            matches!(
+                s.light,
+                hrts::Light::Directional {
+                    view_proj: None,
+                    ..
+                }
+            ),
+            "{:?}",
+            s.light
+        );
         for r in [ResourceId::ShadowMap, ResourceId::Pcss] {
             assert!(!s.frame_plan.resources().contains(r), "{r:?}");
         }
@@ -727,11 +743,15 @@ mod tests {
         assert_eq!(s.config.map.faces, FaceMode::Both);
         // A fitted spot light: no matrix; the plugin fits one frustum to its cone and range.
         assert_eq!(s.frusta, ["whole"]);
-        assert_eq!(s.light.light_type, HrtsLightType::Spot as u32);
-        assert_eq!(s.light.position, [0.0, 4.0, 0.0]);
-        assert_eq!(s.light.direction, [0.0, -1.0, 0.0]);
-        assert_eq!((s.light.outer_cone, s.light.range), (0.5, 10.0));
-        assert!(s.light.view_proj.iter().all(|&x| x == 0.0));
+        assert_eq!(
+            s.light,
+            hrts::Light::Spot {
+                position: Vec3::new(0.0, 4.0, 0.0),
+                direction: Vec3::NEG_Y,
+                frustum: SpotFrustum::Fitted { outer_cone: 0.5 },
+                range: Some(10.0),
+            }
+        );
     }
 
     #[test]
@@ -815,8 +835,13 @@ mod tests {
         );
         let p = only(ground_and_box(vec![lamp]));
         let s = p.shadowed().expect("shadowed");
-        assert_eq!(s.light.light_type, HrtsLightType::Point as u32);
-        assert_eq!((s.light.position, s.light.range), ([2.0, 1.5, 2.0], 20.0));
+        assert_eq!(
+            s.light,
+            hrts::Light::Point {
+                position: Vec3::new(2.0, 1.5, 2.0),
+                range: Some(20.0),
+            }
+        );
         // Area shadows of a point light: its six faces as one cube map.
         assert_eq!(s.frusta, ["cube"]);
         assert_eq!(s.resolved_config().mode, ShadowMode::Area);
@@ -845,7 +870,11 @@ mod tests {
         let p = only(ground_and_box(vec![wide]));
         let s = p.shadowed().expect("shadowed");
         assert_eq!(s.frusta, ["front", "right", "left", "up", "down"]);
-        assert_eq!(s.light.range, 0.0);
+        assert!(
+            matches!(s.light, hrts::Light::Spot { range: None, .. }),
+            "{:?}",
+            s.light
+        );
         // A lamp whose range reaches no receiver in view gets no pass.
         let far_lamp = light(
             "lamp",

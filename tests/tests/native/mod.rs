@@ -41,7 +41,7 @@ pub fn current_build() -> Build {
 }
 
 /// The folder holding `libhrts.so` for this build profile (target/<profile>), building the plugin's
-/// shared library there first (the `hrts` package, which `cargo test` of this crate does not build).
+/// shared library there first (the `hrts-capi` package, which `cargo test` of this crate does not build).
 pub fn library_dir() -> PathBuf {
     let Build {
         target,
@@ -50,12 +50,19 @@ pub fn library_dir() -> PathBuf {
     } = current_build();
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     run(Command::new(cargo)
-        .args(["build", "-p", "hrts", "--profile", &profile, "--target-dir"])
+        .args([
+            "build",
+            "-p",
+            "hrts-capi",
+            "--profile",
+            &profile,
+            "--target-dir",
+        ])
         .arg(&target)
         .current_dir(workspace()));
     assert!(
         dir.join("libhrts.so").exists(),
-        "libhrts.so not found in {} after building the hrts package",
+        "libhrts.so not found in {} after building the hrts-capi package",
         dir.display()
     );
     dir

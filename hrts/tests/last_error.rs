@@ -1,7 +1,7 @@
 //! The last error of a context read from one thread while another makes failing calls on it, through
 //! `hrts_last_error` and `hrts_get_last_error`: every message read is whole, one the failing calls give.
 
-use hrts_plugin::*;
+use hrts::*;
 use std::collections::HashSet;
 use std::ffi::CStr;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};

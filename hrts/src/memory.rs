@@ -1,5 +1,5 @@
 //! Host memory of the plugin: [`CountingAllocator`], the global allocator of the plugin's shared and static
-//! libraries (the `hrts` package installs it; this rlib does not, so a Rust program linking it keeps its
+//! libraries (the `hrts-capi` package installs it; this rlib does not, so a Rust program linking it keeps its
 //! own allocator), counts the bytes the plugin holds, so an engine (and the C host test) can see exactly
 //! what the plugin owns apart from what the Vulkan driver keeps; and it forwards to the engine's
 //! allocation callbacks when they were installed first.

@@ -21,7 +21,7 @@ fn committed_header_is_current() {
     let committed = std::fs::read(&path).unwrap_or_default();
     assert!(
         committed == generated,
-        "{} is missing or stale: run `HRTS_BLESS=1 cargo test -p plugin_api --test header` and commit it",
+        "{} is missing or stale: run `HRTS_BLESS=1 cargo test -p hrts --test header` and commit it",
         path.display()
     );
 }

@@ -1,0 +1,200 @@
+//! The C enumerations under their Rust names, the sets of passes and resources, and how the safe API
+//! reads the enumeration values the plugin writes into its structs.
+
+use super::error::{Error, Result};
+use crate::types::*;
+
+pub use crate::types::{
+    HrtsBinningPath as BinningPath, HrtsFaces as Faces, HrtsIndexType as IndexType,
+    HrtsLightDecision as LightDecision, HrtsNormalEncoding as NormalEncoding,
+    HrtsNormalSpace as NormalSpace, HrtsPass as Pass, HrtsPassStatus as PassStatus,
+    HrtsPenumbraFilter as PenumbraFilter, HrtsResource as Resource, HrtsShadowMode as ShadowMode,
+};
+
+/// A C enumeration whose values are 0, 1, 2, ... in the order of [`CEnum::ALL`].
+pub(crate) trait CEnum: Copy + 'static {
+    /// Every value, in value order.
+    const ALL: &'static [Self];
+    /// The C type's name, for messages.
+    const C_NAME: &'static str;
+    /// The C value.
+    #[cfg(test)]
+    fn value(self) -> u32;
+}
+
+macro_rules! c_enums {
+    ($($name:ident [$($variant:ident),* $(,)?];)*) => {$(
+        impl CEnum for $name {
+            const ALL: &'static [Self] = &[$(Self::$variant),*];
+            const C_NAME: &'static str = stringify!($name);
+            #[cfg(test)]
+            fn value(self) -> u32 {
+                self as u32
+            }
+        }
+    )*};
+}
+
+c_enums! {
+    HrtsShadowMode [None, Hard, Soft, Hybrid, Area, Auto];
+    HrtsFaces [Both, FrontOnly];
+    HrtsBinningPath [Auto, Hardware, Software, EmulatedTier1, Compute];
+    HrtsPenumbraFilter [Shrinking, Standard];
+    HrtsPass [
+        PrimBuffer, ShadowMap, PrimitiveMap, Occupancy, RayTrace, ShadowMapTest, Pcss, Fxaa, LerpFactor,
+        Blend, FillLit, OutputCopy,
+    ];
+    HrtsPassStatus [NotInPlan, Ran, UpToDate, Shared, Culled];
+    HrtsLightDecision [Shadowed, OutOfView];
+    HrtsResource [
+        ShadowMap, PrimListOffsets, PrimListEntries, Occupancy, RtVisibility, BlockerDistance,
+        ShadowMapVisibility, Pcss, RtAntialiased, LerpFactor, Hybrid, Lit,
+    ];
+}
+
+/// The enumeration value `value` of field `field`, which `call` wrote.
+pub(crate) fn decode<T: CEnum>(call: &'static str, field: &str, value: u32) -> Result<T> {
+    T::ALL.get(value as usize).copied().ok_or_else(|| {
+        Error::new(
+            call,
+            HrtsResult::ErrorInvalidEnum,
+            format!("{field} is {value}, which names no {}", T::C_NAME),
+        )
+    })
+}
+
+/// A set of [`Resource`]s: bit `1 << resource`, as `HrtsConfig::extra_outputs` holds them.
+///
+/// ```
+/// use hrts::{Resource, ResourceSet};
+///
+/// let set = ResourceSet::EMPTY.with(Resource::BlockerDistance).with(Resource::Pcss);
+/// assert!(set.contains(Resource::Pcss) && !set.contains(Resource::Hybrid));
+/// assert_eq!(set.iter().collect::<Vec<_>>(), [Resource::BlockerDistance, Resource::Pcss]);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
+pub struct ResourceSet(u32);
+
+impl ResourceSet {
+    /// No resource.
+    pub const EMPTY: Self = Self(0);
+
+    /// The set with `resource` added.
+    pub fn with(self, resource: Resource) -> Self {
+        Self(self.0 | 1 << resource as u32)
+    }
+
+    /// Whether the set holds `resource`.
+    pub fn contains(self, resource: Resource) -> bool {
+        self.0 & 1 << resource as u32 != 0
+    }
+
+    /// The resources of the set, in value order.
+    pub fn iter(self) -> impl Iterator<Item = Resource> {
+        Resource::ALL
+            .iter()
+            .copied()
+            .filter(move |&r| self.contains(r))
+    }
+
+    /// The C bits (`HrtsConfig::extra_outputs`).
+    pub(crate) fn bits(self) -> u32 {
+        self.0
+    }
+
+    /// The set of C bits, all of which name resources.
+    pub(crate) fn from_bits(call: &'static str, field: &str, bits: u32) -> Result<Self> {
+        if bits >> HRTS_RESOURCE_COUNT != 0 {
+            return Err(Error::new(
+                call,
+                HrtsResult::ErrorInvalidEnum,
+                format!("{field} 0x{bits:x} has bits of no HrtsResource"),
+            ));
+        }
+        Ok(Self(bits))
+    }
+}
+
+impl FromIterator<Resource> for ResourceSet {
+    fn from_iter<I: IntoIterator<Item = Resource>>(resources: I) -> Self {
+        resources.into_iter().fold(Self::EMPTY, Self::with)
+    }
+}
+
+/// A set of [`Pass`]es to record (bit `1 << pass`): see
+/// [`Context::record_passes`](crate::Context::record_passes).
+///
+/// ```
+/// use hrts::{Pass, PassMask};
+///
+/// assert!(PassMask::LIGHT_SPACE.contains(Pass::ShadowMap));
+/// assert!(PassMask::SCREEN_SPACE.contains(Pass::RayTrace));
+/// assert_eq!(PassMask::LIGHT_SPACE.union(PassMask::SCREEN_SPACE), PassMask::ALL);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct PassMask(u32);
+
+impl PassMask {
+    /// The light-space passes, which read neither depth nor normal (`HRTS_PASS_MASK_LIGHT_SPACE`): record
+    /// them before the engine's depth pass.
+    pub const LIGHT_SPACE: Self = Self(HRTS_PASS_MASK_LIGHT_SPACE);
+    /// The passes that read the engine's depth and normal, and the output copy
+    /// (`HRTS_PASS_MASK_SCREEN_SPACE`): record them after the engine's G-buffer.
+    pub const SCREEN_SPACE: Self = Self(HRTS_PASS_MASK_SCREEN_SPACE);
+    /// Every pass (`HRTS_PASS_MASK_ALL`).
+    pub const ALL: Self = Self(HRTS_PASS_MASK_ALL);
+
+    /// The passes of both masks.
+    pub fn union(self, other: Self) -> Self {
+        Self(self.0 | other.0)
+    }
+
+    /// Whether the mask holds `pass`.
+    pub fn contains(self, pass: Pass) -> bool {
+        self.0 & 1 << pass as u32 != 0
+    }
+
+    /// The C bits.
+    pub(crate) fn bits(self) -> u32 {
+        self.0
+    }
+}
+
+impl From<Pass> for PassMask {
+    fn from(pass: Pass) -> Self {
+        Self(1 << pass as u32)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn values_are_indices<T: CEnum>() {
+        for (i, v) in T::ALL.iter().enumerate() {
+            assert_eq!(v.value() as usize, i, "{}", T::C_NAME);
+        }
+    }
+
+    #[test]
+    fn every_c_enum_lists_its_values_in_order() {
+        values_are_indices::<HrtsShadowMode>();
+        values_are_indices::<HrtsFaces>();
+        values_are_indices::<HrtsBinningPath>();
+        values_are_indices::<HrtsPenumbraFilter>();
+        values_are_indices::<HrtsPass>();
+        values_are_indices::<HrtsPassStatus>();
+        values_are_indices::<HrtsLightDecision>();
+        values_are_indices::<HrtsResource>();
+        assert_eq!(HrtsPass::ALL.len(), HRTS_PASS_COUNT);
+        assert_eq!(HrtsResource::ALL.len(), HRTS_RESOURCE_COUNT);
+    }
+
+    #[test]
+    fn unknown_values_are_errors() {
+        let e = decode::<HrtsFaces>("hrts_get_frame_report", "faces", 2).unwrap_err();
+        assert_eq!(e.code(), HrtsResult::ErrorInvalidEnum);
+        assert_eq!(e.message(), "faces is 2, which names no HrtsFaces");
+        assert!(ResourceSet::from_bits("x", "extra_outputs", 1 << HRTS_RESOURCE_COUNT).is_err());
+    }
+}
