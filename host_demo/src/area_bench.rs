@@ -6,7 +6,7 @@
 //! GPU timestamps around every pass; medians over the frames after the first.
 
 use crate::accuracy::compare_area;
-use crate::bench::{frames_of, median_of, view_of, BenchArgs, BenchModel};
+use crate::bench_models::{frames_of, median_of, view_of, BenchArgs, BenchModel};
 use crate::render::{map_bytes, median_timings};
 use crate::View;
 use anyhow::{Context, Result};

@@ -12,6 +12,7 @@
 pub mod accuracy;
 pub mod area_bench;
 pub mod bench;
+mod bench_models;
 pub mod compare;
 pub mod gbuffer;
 pub mod hardcases;

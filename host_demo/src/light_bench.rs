@@ -9,7 +9,7 @@
 //! `--emitter-size` runs every light at each size given, sized lights with exact soft shadows, each also
 //! traced by the ray-tracing-pipeline peer at equal samples (trace only).
 
-use crate::bench::{keep_only, models_folder, BenchArgs};
+use crate::bench_models::{keep_only, models_folder, BenchArgs};
 use crate::gbuffer::GBufferLayout;
 use crate::plugin::{LightsFrame, PluginRenderer};
 use crate::scene_plan::{plan_scene, PlanSettings};

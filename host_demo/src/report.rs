@@ -3,7 +3,7 @@
 //! the pixels it gets wrong against the exact f64 reference (near-edge pixels counted apart).
 
 use crate::accuracy::{compare_visibility_to, view_reference};
-use crate::bench::median_of;
+use crate::bench_models::median_of;
 use crate::plugin::PluginRenderer;
 use crate::render::{map_bytes, median_timings};
 use crate::View;

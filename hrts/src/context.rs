@@ -4,7 +4,7 @@
 use crate::convert::finite;
 use crate::convert::{
     binning_path_to_c, require_usage, resource_id, resource_index, shadow_config, surface_input,
-    FrameLight, RESOURCES,
+    FrameLight, LightShape, RESOURCES,
 };
 use crate::error::{invalid, ApiError, ApiResult};
 use crate::geometry::{cpu_geometry, geometry_from, vulkan_geometry, GeometrySource};
@@ -35,36 +35,6 @@ pub(crate) struct TargetSource {
     pub(crate) output_layers: u32,
     /// Usage of the output image: with storage usage and `R32_SFLOAT`, lights write their layers directly.
     pub(crate) output_usage: ImageUsage,
-}
-
-/// How a light is shadowed in a frame: through how many frusta, whether its one frustum is a point
-/// light's cube map, and whether it is a directional light (mode auto chooses by the size of its kind).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct LightShape {
-    pub(crate) frusta: usize,
-    pub(crate) cube: bool,
-    pub(crate) directional: bool,
-}
-
-impl Default for LightShape {
-    /// Before any frame: one frustum of a directional light.
-    fn default() -> Self {
-        Self {
-            frusta: 1,
-            cube: false,
-            directional: true,
-        }
-    }
-}
-
-impl LightShape {
-    /// The configuration the light's passes are built with: `configured` with mode auto resolved for the
-    /// light's kind, and a cube primitive map for a point light shadowed as one.
-    pub(crate) fn config(&self, configured: &ShadowConfig) -> ShadowConfig {
-        let mut config = configured.resolved(self.directional);
-        config.map.cube = self.cube;
-        config
-    }
 }
 
 /// The passes of one light: one pipeline per frustum it is shadowed through and, for several, the

@@ -1,6 +1,5 @@
 //! Conversion between the C types and the Rust ones, checking every value.
 
-use crate::context::LightShape;
 use crate::error::{invalid, ApiError, ApiResult};
 use crate::types::*;
 use crate::version::read_elements;
@@ -592,6 +591,36 @@ pub(crate) fn config_to_c(config: &ShadowConfig) -> ApiResult<HrtsConfig> {
     })
 }
 
+/// How a light is shadowed in a frame: through how many frusta, whether its one frustum is a point
+/// light's cube map, and whether it is a directional light (mode auto chooses by the size of its kind).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct LightShape {
+    pub(crate) frusta: usize,
+    pub(crate) cube: bool,
+    pub(crate) directional: bool,
+}
+
+impl Default for LightShape {
+    /// Before any frame: one frustum of a directional light.
+    fn default() -> Self {
+        Self {
+            frusta: 1,
+            cube: false,
+            directional: true,
+        }
+    }
+}
+
+impl LightShape {
+    /// The configuration the light's passes are built with: `configured` with mode auto resolved for the
+    /// light's kind, and a cube primitive map for a point light shadowed as one.
+    pub(crate) fn config(&self, configured: &ShadowConfig) -> ShadowConfig {
+        let mut config = configured.resolved(self.directional);
+        config.map.cube = self.cube;
+        config
+    }
+}
+
 /// Fills `out` with the defaults of [`ShadowConfig::default`].
 pub(crate) fn config_defaults(out: &mut HrtsConfig) -> ApiResult<()> {
     *out = config_to_c(&ShadowConfig::default())?;
@@ -601,7 +630,6 @@ pub(crate) fn config_defaults(out: &mut HrtsConfig) -> ApiResult<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::record::DEPTH_NORMAL_READERS;
 
     #[test]
     fn c_pass_values_are_the_pipeline_order() {
@@ -630,7 +658,6 @@ mod tests {
             HRTS_PASS_MASK_ALL
         );
         assert_eq!(HRTS_PASS_MASK_LIGHT_SPACE & HRTS_PASS_MASK_SCREEN_SPACE, 0);
-        assert_eq!(HRTS_PASS_MASK_LIGHT_SPACE & DEPTH_NORMAL_READERS, 0);
     }
 
     #[test]

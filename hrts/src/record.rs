@@ -519,3 +519,14 @@ fn record_output_layers(
     enc.end_pass();
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::DEPTH_NORMAL_READERS;
+    use crate::types::HRTS_PASS_MASK_LIGHT_SPACE;
+
+    #[test]
+    fn light_space_passes_read_no_depth_or_normals() {
+        assert_eq!(HRTS_PASS_MASK_LIGHT_SPACE & DEPTH_NORMAL_READERS, 0);
+    }
+}

@@ -27,8 +27,7 @@ use crate::PassError;
 use bytemuck::Zeroable;
 use glam::{DVec2, DVec3, DVec4, Mat4, UVec4, Vec2, Vec3, Vec4};
 
-/// Most light samples per pixel (the bits of the shader's sample mask).
-pub const MAX_AREA_SAMPLES: u32 = 128;
+pub use crate::gpu_types::MAX_AREA_SAMPLES;
 
 /// Light samples per pixel by default.
 pub const DEFAULT_AREA_SAMPLES: u32 = 64;

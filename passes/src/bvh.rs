@@ -12,7 +12,8 @@
 //! Reads: prim buffer. Writes: the hierarchy's nodes (and its build scratch).
 
 use crate::scan::{PrefixScan, ScanPipeline};
-use crate::{shader, PassError};
+use crate::shaders::shader;
+use crate::PassError;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec4;
 use rhi::{

@@ -77,10 +77,10 @@ pub struct MapPush {
     /// Area shadows of a spot or point light: the emitter's radius (frame units; 0: otherwise).
     pub emitter_radius: f32,
     /// Area shadows of a spot or point light: triangles nearer the light than this are listed in every
-    /// texel with receivers ([`crate::area::LocalAreaReach`]).
+    /// texel with receivers (the area trace's `LocalAreaReach`).
     pub near_radius: f32,
     /// Area shadows of a spot or point light: a depth key below which no point of a farther triangle can
-    /// block a receiver of the frustum ([`crate::area::LocalAreaReach`]).
+    /// block a receiver of the frustum (the area trace's `LocalAreaReach`).
     pub depth_floor: f32,
     /// A texel whose list would pass this many entries keeps none: its pixels walk the BVH.
     pub list_limit: u32,
@@ -350,7 +350,10 @@ pub struct HybridPush {
     pub hard_shadow_percentage: f32,
 }
 
-/// The area trace's light samples (`area_samples.glsl`), built by [`crate::area::area_samples`].
+/// Most light samples per pixel (the bits of the area trace's sample mask).
+pub const MAX_AREA_SAMPLES: u32 = 128;
+
+/// The area trace's light samples (`area_samples.glsl`), built by the area trace's `area_samples`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub struct AreaSamples {
@@ -358,12 +361,12 @@ pub struct AreaSamples {
     /// direction from it.
     pub center: Vec4,
     /// xyz: the first axis of the light's frame (unit, orthogonal to C); w: the half-extent of the edge
-    /// table's line offsets ([`crate::area::AreaEdgeTable`]).
+    /// table's line offsets (the area trace's `AreaEdgeTable`).
     pub axis_u: Vec4,
     /// xyz: the second axis; w: offset cells per gnomonic unit.
     pub axis_v: Vec4,
     /// The sample directions towards the light (xyz, unit; w unused); the first `samples` are used.
-    pub dirs: [Vec4; crate::area::MAX_AREA_SAMPLES as usize],
+    pub dirs: [Vec4; MAX_AREA_SAMPLES as usize],
 }
 
 const _: () = {

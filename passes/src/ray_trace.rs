@@ -13,7 +13,8 @@
 use crate::area::{area_edge_table, area_sample_bands, local_area_edge_table, local_sample_bands};
 use crate::gpu_types::{constant_buffer, AreaSamples, RayTraceConstants};
 use crate::primitive_map::PrimitiveMap;
-use crate::{shader, PassError};
+use crate::shaders::shader;
+use crate::PassError;
 use rhi::{
     Barrier, BindGroup, BindingKind, Buffer, BufferUsage, ComputePipeline, Device, Encoder, Format,
     Image, ImageDesc, ImageUsage, Resource, ResourceState as S,

@@ -9,8 +9,9 @@
 use crate::gpu_types::{AreaSamples, GpuTriangle, RayTraceConstants};
 use crate::light::{rebased, LightFrame};
 use crate::ray_trace::{RAY_OFFSET_FLOAT_BOUND, RAY_OFFSET_PIXELS};
+use crate::shaders::shader;
 use crate::shadow_pipeline::{camera_in_frame, FrameInputs};
-use crate::{shader, PassError};
+use crate::PassError;
 use bytemuck::Zeroable;
 use glam::{DVec3, UVec4, Vec4};
 use rhi::{

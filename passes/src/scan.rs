@@ -6,7 +6,8 @@
 //!
 //! Reads and writes: the data buffer. Owns: the block-total buffers of each level.
 
-use crate::{shader, PassError};
+use crate::shaders::shader;
+use crate::PassError;
 use rhi::{
     Barrier, BindGroup, BindingKind, Buffer, BufferUsage, ComputePipeline, Device, Encoder,
     MemoryLocation, Resource,

@@ -1,7 +1,8 @@
 //! A full-screen compute pass (one invocation per pixel, 8x8 groups) and the visibility images the
 //! screen-space passes write.
 
-use crate::{shader, PassError};
+use crate::shaders::shader;
+use crate::PassError;
 use rhi::{
     BindGroup, BindingKind, ComputePipeline, Device, Encoder, Format, Image, ImageDesc, ImageUsage,
     Resource,

@@ -4,7 +4,8 @@
 //! Reads: prim buffer, light. Writes: shadow map (`D32_SFLOAT`, size²).
 
 use crate::gpu_types::ShadowMapPush;
-use crate::{shader, PassError};
+use crate::shaders::shader;
+use crate::PassError;
 use rhi::{
     Barrier, BindGroup, BindingKind, Buffer, Capabilities, DepthState, DepthTarget, Device,
     Encoder, Format, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, ImageUsage,

@@ -15,7 +15,8 @@ pub(crate) use shared::PrimBufferClaim;
 pub use shared::{MeshVertices, SharedGeometry};
 
 use crate::gpu_types::{GpuTriangle, PrimBufferPush};
-use crate::{shader, PassError};
+use crate::shaders::shader;
+use crate::PassError;
 use glam::{DMat4, Mat4};
 use rhi::{
     BindGroup, BindingKind, Buffer, BufferUsage, ComputePipeline, Device, Encoder, MemoryLocation,

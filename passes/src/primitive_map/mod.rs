@@ -23,7 +23,8 @@
 
 use crate::gpu_types::{constant_buffer, MapConstants, MapPush, MapState, RayTraceConstants};
 use crate::scan::ScanPipeline;
-use crate::{shader, PassError};
+use crate::shaders::shader;
+use crate::PassError;
 use rhi::{
     Barrier, BindGroup, BindingKind, Buffer, BufferUsage, ComputePipeline, Device, Encoder, Format,
     GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, ImageUsage, MemoryLocation, Resource,
