@@ -50,14 +50,9 @@ pub fn library_dir() -> PathBuf {
     } = current_build();
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     run(Command::new(cargo)
-        .args([
-            "build",
-            "-p",
-            "hrts-capi",
-            "--profile",
-            &profile,
-            "--target-dir",
-        ])
+        // Every library of the workspace rather than `-p hrts-capi`: the dependencies' features are then
+        // those of the workspace, so this builds libhrts and none of them again.
+        .args(["build", "--lib", "--profile", &profile, "--target-dir"])
         .arg(&target)
         .current_dir(workspace()));
     assert!(
