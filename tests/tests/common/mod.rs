@@ -25,13 +25,24 @@ pub fn model(name: &str) -> PathBuf {
     p
 }
 
-/// A device with validation layers on. Fails (never skips) without a Vulkan device.
+/// A device with the validation layer and its synchronization validation on (through whichever of
+/// `VK_EXT_layer_settings` and `VK_EXT_validation_features` the installed layer offers, printed). Fails
+/// (never skips) without a Vulkan device, the layer or synchronization validation.
 pub fn device() -> Device {
     let mut desc = DeviceDesc::from_env();
     desc.validation = true;
-    Device::new_headless(&desc).unwrap_or_else(|e| {
+    desc.synchronization_validation = true;
+    let device = Device::new_headless(&desc).unwrap_or_else(|e| {
         panic!("GPU tests need a Vulkan device with validation layers (CI installs mesa-vulkan-drivers and vulkan-validationlayers): {e}")
-    })
+    });
+    let sync = device
+        .synchronization_validation()
+        .expect("synchronization validation was asked for");
+    println!(
+        "validation layer on, synchronization validation through {}",
+        sync.extension()
+    );
+    device
 }
 
 /// A device without the validation layer. Only for `hard_cases.rs`'s run of every normal encoding (21 families
@@ -46,13 +57,13 @@ pub fn device_without_validation() -> Device {
     Device::new_headless(&desc).unwrap_or_else(|e| panic!("GPU tests need a Vulkan device: {e}"))
 }
 
-/// Fails the test if the validation layers reported any error.
+/// Fails the test if the validation layers reported any error or synchronization hazard.
 pub fn assert_no_validation_errors(device: &Device) {
     let v = device.validation();
     assert_eq!(
-        v.errors(),
-        0,
-        "Vulkan validation errors: {:#?}",
+        (v.errors(), v.hazards()),
+        (0, 0),
+        "Vulkan validation errors and synchronization hazards: {:#?}",
         v.messages()
     );
 }
