@@ -197,9 +197,26 @@ impl Drop for Shared {
 /// A Vulkan device with a graphics+compute queue, a memory allocator and its capabilities.
 pub struct Device {
     pub(crate) shared: Arc<Shared>,
-    /// The pool of `submit_and_wait`'s command buffers; its lock also serialises this device's own queue
-    /// submissions, so `Device` may be shared between threads.
-    pub(crate) command_pool: Mutex<vk::CommandPool>,
+    /// `submit_and_wait`'s command pool, command buffer and fence; its lock also serialises this device's
+    /// own queue submissions, so `Device` may be shared between threads.
+    pub(crate) submitter: Mutex<Submitter>,
+}
+
+/// The command buffer and fence that every `submit_and_wait` of a device reuses (created by the first),
+/// and their pool.
+///
+/// Reused rather than allocated and freed per submission: Debian 12's Khronos validation layer (1.3.239)
+/// retires submissions on a thread of its own, which can drop the last reference to a command buffer the
+/// application has just freed; its destructor then erases the command buffer's debug labels from a map
+/// of the instance without the lock that the application thread's label calls take, corrupting the heap
+/// (docs/heap_corruption.md; fixed in the layer after 1.3.239). A command buffer that is never freed
+/// while the device lives is never destroyed on that thread.
+pub(crate) struct Submitter {
+    pub(crate) pool: vk::CommandPool,
+    /// Null until the first submission.
+    pub(crate) cmd: vk::CommandBuffer,
+    /// Null until the first submission; unsignalled between submissions.
+    pub(crate) fence: vk::Fence,
 }
 
 /// `vkGetInstanceProcAddr` as a plain C function pointer (`VkInstance` is a pointer-sized handle).
@@ -642,7 +659,11 @@ impl Device {
         });
         Ok(Self {
             shared,
-            command_pool: Mutex::new(command_pool),
+            submitter: Mutex::new(Submitter {
+                pool: command_pool,
+                cmd: vk::CommandBuffer::null(),
+                fence: vk::Fence::null(),
+            }),
         })
     }
 
@@ -726,9 +747,9 @@ impl Device {
     pub fn wait_idle(&self) -> Result<()> {
         self.require_owned("wait_idle")?;
         let _queue = self
-            .command_pool
+            .submitter
             .lock()
-            .map_err(|_| RhiError::InvalidArgument("command pool lock poisoned".into()))?;
+            .map_err(|_| RhiError::InvalidArgument("submission lock poisoned".into()))?;
         // SAFETY: valid device; its only queue is used under the lock held here.
         unsafe { self.shared.device.device_wait_idle() }.call("vkDeviceWaitIdle")
     }
@@ -751,18 +772,21 @@ impl Device {
 
 impl Drop for Device {
     fn drop(&mut self) {
-        let pool = match self.command_pool.get_mut() {
-            Ok(pool) => *pool,
-            Err(poisoned) => *poisoned.into_inner(),
+        let s = match self.submitter.get_mut() {
+            Ok(s) => &*s,
+            Err(poisoned) => &*poisoned.into_inner(),
         };
-        // SAFETY: command buffers from this pool are freed after each submission. A device of our own is
-        // waited idle; an adopted one's engine has finished the work that used the plugin (its contract), and
-        // its queues are the engine's to synchronise, so it is not waited on here.
+        // SAFETY: the command buffer (freed with its pool) and the fence are used by `submit_and_wait` alone,
+        // which waits for its submission. A device of our own is waited idle; an adopted one never submits
+        // (`submit_and_wait` refuses it: its queues are the engine's), so it is not waited on here.
         unsafe {
             if self.shared.owned {
                 let _ = self.shared.device.device_wait_idle();
             }
-            self.shared.device.destroy_command_pool(pool, None);
+            if s.fence != vk::Fence::null() {
+                self.shared.device.destroy_fence(s.fence, None);
+            }
+            self.shared.device.destroy_command_pool(s.pool, None);
         }
     }
 }

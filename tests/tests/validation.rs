@@ -61,3 +61,25 @@ fn ordered_writes_are_no_hazard() {
         .expect("submission");
     common::assert_no_validation_errors(&device);
 }
+
+/// A recording that fails half-way leaves `submit_and_wait`'s command buffer recording; the next
+/// submission, which reuses it, must still be valid.
+#[test]
+fn a_failed_recording_leaves_the_next_submission_valid() {
+    let device = device();
+    let buffer = device
+        .create_buffer("after", 256, BufferUsage::COPY_DST, MemoryLocation::GpuOnly)
+        .expect("buffer");
+    let failed = device.submit_and_wait(|enc| {
+        enc.fill_buffer(&buffer, 1);
+        Err::<(), _>(rhi::RhiError::InvalidArgument("stop".into()))
+    });
+    assert!(failed.is_err());
+    device
+        .submit_and_wait(|enc| {
+            enc.fill_buffer(&buffer, 2);
+            Ok(())
+        })
+        .expect("the next submission");
+    common::assert_no_validation_errors(&device);
+}
