@@ -45,18 +45,6 @@ pub fn device() -> Device {
     device
 }
 
-/// A device without the validation layer. Only for `hard_cases.rs`'s run of every normal encoding (21 families
-/// of cases on one device): under Debian 12's Khronos validation layer it meets heap corruption inside the
-/// layer in about one run in five (`malloc(): unaligned fastbin chunk detected`, caught in the layer's
-/// `vkCmdWriteTimestamp2`), reproduced on the code before the area lights of spot and point lights, and
-/// never in 14 runs without the layer. The same encodings run under validation and synchronization
-/// validation in the C host.
-pub fn device_without_validation() -> Device {
-    let mut desc = DeviceDesc::from_env();
-    desc.validation = false;
-    Device::new_headless(&desc).unwrap_or_else(|e| panic!("GPU tests need a Vulkan device: {e}"))
-}
-
 /// Fails the test if the validation layers reported any error or synchronization hazard.
 pub fn assert_no_validation_errors(device: &Device) {
     let v = device.validation();
