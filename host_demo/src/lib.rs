@@ -194,10 +194,12 @@ pub fn focus_bounds(scene: &Scene) -> Aabb {
 const GROUND: &str = "ground";
 
 /// Opens the device the command line asks for: a name filter (else `HRTS_DEVICE`), validation layers if
-/// `validation` (or `HRTS_VALIDATION=1`).
+/// `validation` (or `HRTS_VALIDATION=1`), with their synchronization validation, whose hazards count as
+/// validation errors.
 pub fn open_device(filter: Option<String>, validation: bool) -> anyhow::Result<Device> {
     let mut desc = rhi::DeviceDesc::from_env();
     desc.validation |= validation;
+    desc.synchronization_validation = desc.validation;
     if filter.is_some() {
         desc.device_filter = filter;
     }
@@ -247,6 +249,14 @@ mod tests {
         assert!(parse_vec3("1,2").is_err());
         assert!(parse_vec3("1,nan,2").is_err());
         assert!(parse_vec3("a,b,c").is_err());
+    }
+
+    /// `--validation` (and `HRTS_VALIDATION=1`) brings synchronization validation along.
+    #[test]
+    fn a_validated_device_has_synchronization_validation() {
+        let device = open_device(None, true).expect("a device with validation layers");
+        assert!(device.synchronization_validation().is_some());
+        assert_eq!(device.validation().errors(), 0);
     }
 
     #[test]

@@ -21,6 +21,7 @@ pub(crate) fn device(info: &HrtsContextCreateInfo) -> ApiResult<Device> {
         };
         return Ok(Device::new_headless(&rhi::DeviceDesc {
             validation: info.enable_validation != 0,
+            synchronization_validation: false,
             device_filter: filter,
         })?);
     }

@@ -29,6 +29,12 @@ const NO_DRIVER_ADVICE: &str = "Run scripts/setup.sh from the checkout (it insta
 pub struct DeviceDesc {
     /// Enable `VK_LAYER_KHRONOS_validation`; device creation fails if the layer is missing.
     pub validation: bool,
+    /// With `validation`: also enable the layer's synchronization validation (hazards between commands,
+    /// command buffers and submissions, reported as errors whose message ids begin with `SYNC-HAZARD-`),
+    /// through whichever of `VK_EXT_layer_settings` and `VK_EXT_validation_features` the installed layer
+    /// offers ([`Device::synchronization_validation`] tells which); device creation fails if it offers
+    /// neither.
+    pub synchronization_validation: bool,
     /// Only accept devices whose name contains this (case-insensitive), e.g. "llvmpipe" or "NVIDIA".
     pub device_filter: Option<String>,
 }
@@ -42,7 +48,27 @@ impl DeviceDesc {
         let device_filter = std::env::var("HRTS_DEVICE").ok().filter(|s| !s.is_empty());
         Self {
             validation,
+            synchronization_validation: false,
             device_filter,
+        }
+    }
+}
+
+/// How synchronization validation was enabled on a device's instance.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SyncValidation {
+    /// `VK_EXT_layer_settings`: the layer's `validate_sync` setting.
+    LayerSettings,
+    /// `VK_EXT_validation_features`: `VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT`.
+    ValidationFeatures,
+}
+
+impl SyncValidation {
+    /// The instance extension that carries it.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Self::LayerSettings => "VK_EXT_layer_settings",
+            Self::ValidationFeatures => "VK_EXT_validation_features",
         }
     }
 }
@@ -52,6 +78,7 @@ impl DeviceDesc {
 pub struct ValidationLog {
     errors: AtomicU32,
     warnings: AtomicU32,
+    hazards: AtomicU32,
     messages: Mutex<Vec<String>>,
 }
 
@@ -64,11 +91,19 @@ impl ValidationLog {
     pub fn warnings(&self) -> u32 {
         self.warnings.load(Ordering::SeqCst)
     }
+    /// Number of synchronization hazards reported (message ids `SYNC-HAZARD-*`, whatever their severity;
+    /// those reported as errors are counted by [`ValidationLog::errors`] too).
+    pub fn hazards(&self) -> u32 {
+        self.hazards.load(Ordering::SeqCst)
+    }
     /// The first messages (errors and warnings), for test failure output.
     pub fn messages(&self) -> Vec<String> {
         self.messages.lock().map(|m| m.clone()).unwrap_or_default()
     }
-    fn record(&self, error: bool, text: String) {
+    fn record(&self, error: bool, hazard: bool, text: String) {
+        if hazard {
+            self.hazards.fetch_add(1, Ordering::SeqCst);
+        }
         if error {
             self.errors.fetch_add(1, Ordering::SeqCst);
             log::error!("validation: {text}");
@@ -101,10 +136,15 @@ unsafe extern "system" fn debug_callback(
                 .to_string_lossy()
                 .into_owned()
         };
+        let hazard = !data.is_null()
+            && !(*data).p_message_id_name.is_null()
+            && CStr::from_ptr((*data).p_message_id_name)
+                .to_bytes()
+                .starts_with(b"SYNC-HAZARD-");
         if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
-            log.record(true, text);
+            log.record(true, hazard, text);
         } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
-            log.record(false, text);
+            log.record(false, hazard, text);
         }
     });
     vk::FALSE
@@ -129,6 +169,7 @@ pub(crate) struct Shared {
     pub(crate) ray_tracing: std::result::Result<RayTracingDevice, String>,
     messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     validation: Arc<ValidationLog>,
+    sync_validation: Option<SyncValidation>,
     owned: bool,
 }
 
@@ -156,9 +197,26 @@ impl Drop for Shared {
 /// A Vulkan device with a graphics+compute queue, a memory allocator and its capabilities.
 pub struct Device {
     pub(crate) shared: Arc<Shared>,
-    /// The pool of `submit_and_wait`'s command buffers; its lock also serialises this device's own queue
-    /// submissions, so `Device` may be shared between threads.
-    pub(crate) command_pool: Mutex<vk::CommandPool>,
+    /// `submit_and_wait`'s command pool, command buffer and fence; its lock also serialises this device's
+    /// own queue submissions, so `Device` may be shared between threads.
+    pub(crate) submitter: Mutex<Submitter>,
+}
+
+/// The command buffer and fence that every `submit_and_wait` of a device reuses (created by the first),
+/// and their pool.
+///
+/// Reused rather than allocated and freed per submission: Debian 12's Khronos validation layer (1.3.239)
+/// retires submissions on a thread of its own, which can drop the last reference to a command buffer the
+/// application has just freed; its destructor then erases the command buffer's debug labels from a map
+/// of the instance without the lock that the application thread's label calls take, corrupting the heap
+/// (docs/heap_corruption.md; fixed in the layer after 1.3.239). A command buffer that is never freed
+/// while the device lives is never destroyed on that thread.
+pub(crate) struct Submitter {
+    pub(crate) pool: vk::CommandPool,
+    /// Null until the first submission.
+    pub(crate) cmd: vk::CommandBuffer,
+    /// Null until the first submission; unsignalled between submissions.
+    pub(crate) fence: vk::Fence,
 }
 
 /// `vkGetInstanceProcAddr` as a plain C function pointer (`VkInstance` is a pointer-sized handle).
@@ -233,6 +291,35 @@ impl Device {
         let has_debug_utils = inst_exts
             .iter()
             .any(|e| e.extension_name_as_c_str() == Ok(ash::ext::debug_utils::NAME));
+        let sync_validation = if desc.validation && desc.synchronization_validation {
+            // SAFETY: a plain enumeration call naming an installed layer.
+            let layer_exts =
+                unsafe { entry.enumerate_instance_extension_properties(Some(validation_layer)) }
+                    .call("vkEnumerateInstanceExtensionProperties")?;
+            let offers = |name: &CStr| {
+                layer_exts
+                    .iter()
+                    .any(|e| e.extension_name_as_c_str() == Ok(name))
+            };
+            let mechanism = if offers(ash::ext::layer_settings::NAME) {
+                SyncValidation::LayerSettings
+            } else if offers(ash::ext::validation_features::NAME) {
+                SyncValidation::ValidationFeatures
+            } else {
+                return Err(RhiError::MissingFeature(
+                    "synchronization validation: the validation layer offers neither VK_EXT_layer_settings nor \
+                     VK_EXT_validation_features"
+                        .into(),
+                ));
+            };
+            log::info!(
+                "synchronization validation on, through {}",
+                mechanism.extension()
+            );
+            Some(mechanism)
+        } else {
+            None
+        };
         let app_name = c"hybrid-rt-shadows";
         let app = vk::ApplicationInfo::default()
             .application_name(app_name)
@@ -243,11 +330,29 @@ impl Device {
         } else {
             vec![]
         };
-        let ext_ptrs: Vec<*const std::ffi::c_char> = if has_debug_utils {
+        let mut ext_ptrs: Vec<*const std::ffi::c_char> = if has_debug_utils {
             vec![ash::ext::debug_utils::NAME.as_ptr()]
         } else {
             vec![]
         };
+        ext_ptrs.extend(sync_validation.map(|m| match m {
+            SyncValidation::LayerSettings => ash::ext::layer_settings::NAME.as_ptr(),
+            SyncValidation::ValidationFeatures => ash::ext::validation_features::NAME.as_ptr(),
+        }));
+        let validate_sync: vk::Bool32 = vk::TRUE;
+        // One VkBool32 (ash's `values` takes bytes and would count 4 values).
+        let settings = [vk::LayerSettingEXT {
+            value_count: 1,
+            p_values: std::ptr::from_ref(&validate_sync).cast(),
+            ..vk::LayerSettingEXT::default()
+                .layer_name(validation_layer)
+                .setting_name(c"validate_sync")
+                .ty(vk::LayerSettingTypeEXT::BOOL32)
+        }];
+        let mut layer_settings = vk::LayerSettingsCreateInfoEXT::default().settings(&settings);
+        let sync_features = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        let mut validation_features =
+            vk::ValidationFeaturesEXT::default().enabled_validation_features(&sync_features);
         let validation = Arc::new(ValidationLog::default());
         let mut messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
             .message_severity(
@@ -267,6 +372,13 @@ impl Device {
             .enabled_extension_names(&ext_ptrs);
         if desc.validation && has_debug_utils {
             info = info.push_next(&mut messenger_info);
+        }
+        match sync_validation {
+            Some(SyncValidation::LayerSettings) => info = info.push_next(&mut layer_settings),
+            Some(SyncValidation::ValidationFeatures) => {
+                info = info.push_next(&mut validation_features)
+            }
+            None => {}
         }
         // SAFETY: all pointers in `info` outlive the call.
         let instance = match unsafe { entry.create_instance(&info, None) } {
@@ -392,6 +504,7 @@ impl Device {
             has_debug_utils,
             messenger,
             validation,
+            sync_validation,
             owned: true,
             ray_tracing: if ray_tracing {
                 Ok(())
@@ -460,6 +573,7 @@ impl Device {
             has_debug_utils: desc.debug_utils,
             messenger: None,
             validation: Arc::new(ValidationLog::default()),
+            sync_validation: None,
             owned: false,
             ray_tracing: Err(
                 "an adopted device (the RHI cannot tell whether the engine enabled bufferDeviceAddress, \
@@ -540,11 +654,16 @@ impl Device {
             ray_tracing,
             messenger: p.messenger,
             validation: p.validation,
+            sync_validation: p.sync_validation,
             owned: p.owned,
         });
         Ok(Self {
             shared,
-            command_pool: Mutex::new(command_pool),
+            submitter: Mutex::new(Submitter {
+                pool: command_pool,
+                cmd: vk::CommandBuffer::null(),
+                fence: vk::Fence::null(),
+            }),
         })
     }
 
@@ -618,13 +737,19 @@ impl Device {
         &self.shared.validation
     }
 
+    /// How synchronization validation was enabled ([`DeviceDesc::synchronization_validation`]), or `None`
+    /// where it is off (always on an adopted device: its instance is the engine's).
+    pub fn synchronization_validation(&self) -> Option<SyncValidation> {
+        self.shared.sync_validation
+    }
+
     /// Waits until the GPU is idle. Only on a device of the RHI's own (see `Device::submit_and_wait`).
     pub fn wait_idle(&self) -> Result<()> {
         self.require_owned("wait_idle")?;
         let _queue = self
-            .command_pool
+            .submitter
             .lock()
-            .map_err(|_| RhiError::InvalidArgument("command pool lock poisoned".into()))?;
+            .map_err(|_| RhiError::InvalidArgument("submission lock poisoned".into()))?;
         // SAFETY: valid device; its only queue is used under the lock held here.
         unsafe { self.shared.device.device_wait_idle() }.call("vkDeviceWaitIdle")
     }
@@ -647,18 +772,21 @@ impl Device {
 
 impl Drop for Device {
     fn drop(&mut self) {
-        let pool = match self.command_pool.get_mut() {
-            Ok(pool) => *pool,
-            Err(poisoned) => *poisoned.into_inner(),
+        let s = match self.submitter.get_mut() {
+            Ok(s) => &*s,
+            Err(poisoned) => &*poisoned.into_inner(),
         };
-        // SAFETY: command buffers from this pool are freed after each submission. A device of our own is
-        // waited idle; an adopted one's engine has finished the work that used the plugin (its contract), and
-        // its queues are the engine's to synchronise, so it is not waited on here.
+        // SAFETY: the command buffer (freed with its pool) and the fence are used by `submit_and_wait` alone,
+        // which waits for its submission. A device of our own is waited idle; an adopted one never submits
+        // (`submit_and_wait` refuses it: its queues are the engine's), so it is not waited on here.
         unsafe {
             if self.shared.owned {
                 let _ = self.shared.device.device_wait_idle();
             }
-            self.shared.device.destroy_command_pool(pool, None);
+            if s.fence != vk::Fence::null() {
+                self.shared.device.destroy_fence(s.fence, None);
+            }
+            self.shared.device.destroy_command_pool(s.pool, None);
         }
     }
 }
@@ -676,6 +804,7 @@ struct PartsDesc {
     has_debug_utils: bool,
     messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     validation: Arc<ValidationLog>,
+    sync_validation: Option<SyncValidation>,
     owned: bool,
     /// Ok if the device was created with ray tracing enabled, else what is missing.
     ray_tracing: std::result::Result<(), String>,

@@ -817,48 +817,52 @@ impl Device {
         record: impl FnOnce(&mut Encoder<'_>) -> Result<R>,
     ) -> Result<R> {
         self.require_owned("submit_and_wait")?;
-        let pool = self
-            .command_pool
+        let mut submitter = self
+            .submitter
             .lock()
-            .map_err(|_| RhiError::InvalidArgument("command pool lock poisoned".into()))?;
+            .map_err(|_| RhiError::InvalidArgument("submission lock poisoned".into()))?;
+        let s = &mut *submitter;
         let d = &self.shared.device;
-        let alloc = vk::CommandBufferAllocateInfo::default()
-            .command_pool(*pool)
-            .level(vk::CommandBufferLevel::PRIMARY)
-            .command_buffer_count(1);
-        // SAFETY: the pool and the queue are used only under the pool's lock, held until this returns; the
-        // command buffer is freed below on every path.
+        // SAFETY: the pool, its command buffer, the fence and the queue are used only under the lock held
+        // until this returns; the command buffer and the fence are created once and reused (see `Submitter`:
+        // never freed while the device lives); every submission is waited for before this returns, so
+        // neither is pending when it is reset.
         unsafe {
-            let cmd = d
-                .allocate_command_buffers(&alloc)
-                .call("vkAllocateCommandBuffers")?[0];
-            let result = (|| {
-                d.begin_command_buffer(
-                    cmd,
-                    &vk::CommandBufferBeginInfo::default()
-                        .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-                )
-                .call("vkBeginCommandBuffer")?;
-                let mut enc = Encoder::new(self, cmd);
-                let r = record(&mut enc)?;
-                d.end_command_buffer(cmd).call("vkEndCommandBuffer")?;
-                let fence = d
+            if s.cmd == vk::CommandBuffer::null() {
+                let alloc = vk::CommandBufferAllocateInfo::default()
+                    .command_pool(s.pool)
+                    .level(vk::CommandBufferLevel::PRIMARY)
+                    .command_buffer_count(1);
+                s.cmd = d
+                    .allocate_command_buffers(&alloc)
+                    .call("vkAllocateCommandBuffers")?[0];
+            }
+            if s.fence == vk::Fence::null() {
+                s.fence = d
                     .create_fence(&vk::FenceCreateInfo::default(), None)
                     .call("vkCreateFence")?;
-                let cmds = [cmd];
-                let submit = vk::SubmitInfo::default().command_buffers(&cmds);
-                let submitted = d
-                    .queue_submit(self.shared.queue, &[submit], fence)
-                    .call("vkQueueSubmit");
-                let waited = submitted.and_then(|_| {
-                    d.wait_for_fences(&[fence], true, u64::MAX)
-                        .call("vkWaitForFences")
-                });
-                d.destroy_fence(fence, None);
-                waited.map(|_| r)
-            })();
-            d.free_command_buffers(*pool, &[cmd]);
-            result
+            }
+            let cmd = s.cmd;
+            // A recording that failed half-way left the command buffer recording: reset it either way.
+            d.reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())
+                .call("vkResetCommandBuffer")?;
+            d.begin_command_buffer(
+                cmd,
+                &vk::CommandBufferBeginInfo::default()
+                    .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+            )
+            .call("vkBeginCommandBuffer")?;
+            let mut enc = Encoder::new(self, cmd);
+            let r = record(&mut enc)?;
+            d.end_command_buffer(cmd).call("vkEndCommandBuffer")?;
+            let cmds = [cmd];
+            let submit = vk::SubmitInfo::default().command_buffers(&cmds);
+            d.queue_submit(self.shared.queue, &[submit], s.fence)
+                .call("vkQueueSubmit")?;
+            d.wait_for_fences(&[s.fence], true, u64::MAX)
+                .call("vkWaitForFences")?;
+            d.reset_fences(&[s.fence]).call("vkResetFences")?;
+            Ok(r)
         }
     }
 }

@@ -28,7 +28,8 @@ pub use accel::{BottomLevel, TopLevel};
 pub use caps::Capabilities;
 pub use conv::{ConservativeRasterTier, Format, ResourceState};
 pub use device::{
-    AdoptDesc, Device, DeviceDesc, EnabledFeatures, RawGetInstanceProcAddr, ValidationLog,
+    AdoptDesc, Device, DeviceDesc, EnabledFeatures, RawGetInstanceProcAddr, SyncValidation,
+    ValidationLog,
 };
 pub use encoder::{Barrier, ColorTarget, DepthTarget, Encoder, GpuTimer, PassTiming};
 pub use error::{Result, RhiError};

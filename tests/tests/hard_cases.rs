@@ -17,7 +17,7 @@
 
 mod common;
 
-use common::{assert_no_validation_errors, device, device_without_validation, models};
+use common::{assert_no_validation_errors, device, models};
 use host_demo::gbuffer::GBufferLayout;
 use host_demo::hardcases::{run_cases, table, Outcome};
 use rhi::Device;
@@ -182,8 +182,7 @@ fn overflow_keeps_the_guard_layer_and_exact_visibility() {
 /// encoding: `host_demo hardcases --normals NAME`, docs/hardcases_normal_encodings_lavapipe.txt.)
 #[test]
 fn grazing_and_contact_cases_hold_with_every_normal_encoding() {
-    // Without the validation layer: see common::device_without_validation.
-    let device = device_without_validation();
+    let device = device();
     for (name, ..) in host_demo::gbuffer::NORMAL_TARGETS.iter().skip(1) {
         let layout = GBufferLayout::analysis_with(name).expect("a named normal target");
         for f in [Family::Grazing, Family::Contact, Family::Coplanar] {

@@ -25,34 +25,33 @@ pub fn model(name: &str) -> PathBuf {
     p
 }
 
-/// A device with validation layers on. Fails (never skips) without a Vulkan device.
+/// A device with the validation layer and its synchronization validation on (through whichever of
+/// `VK_EXT_layer_settings` and `VK_EXT_validation_features` the installed layer offers, printed). Fails
+/// (never skips) without a Vulkan device, the layer or synchronization validation.
 pub fn device() -> Device {
     let mut desc = DeviceDesc::from_env();
     desc.validation = true;
-    Device::new_headless(&desc).unwrap_or_else(|e| {
+    desc.synchronization_validation = true;
+    let device = Device::new_headless(&desc).unwrap_or_else(|e| {
         panic!("GPU tests need a Vulkan device with validation layers (CI installs mesa-vulkan-drivers and vulkan-validationlayers): {e}")
-    })
+    });
+    let sync = device
+        .synchronization_validation()
+        .expect("synchronization validation was asked for");
+    println!(
+        "validation layer on, synchronization validation through {}",
+        sync.extension()
+    );
+    device
 }
 
-/// A device without the validation layer. Only for `hard_cases.rs`'s run of every normal encoding (21 families
-/// of cases on one device): under Debian 12's Khronos validation layer it meets heap corruption inside the
-/// layer in about one run in five (`malloc(): unaligned fastbin chunk detected`, caught in the layer's
-/// `vkCmdWriteTimestamp2`), reproduced on the code before the area lights of spot and point lights, and
-/// never in 14 runs without the layer. The same encodings run under validation and synchronization
-/// validation in the C host.
-pub fn device_without_validation() -> Device {
-    let mut desc = DeviceDesc::from_env();
-    desc.validation = false;
-    Device::new_headless(&desc).unwrap_or_else(|e| panic!("GPU tests need a Vulkan device: {e}"))
-}
-
-/// Fails the test if the validation layers reported any error.
+/// Fails the test if the validation layers reported any error or synchronization hazard.
 pub fn assert_no_validation_errors(device: &Device) {
     let v = device.validation();
     assert_eq!(
-        v.errors(),
-        0,
-        "Vulkan validation errors: {:#?}",
+        (v.errors(), v.hazards()),
+        (0, 0),
+        "Vulkan validation errors and synchronization hazards: {:#?}",
         v.messages()
     );
 }
