@@ -326,30 +326,30 @@ fn help_of(exe: &Path, args: &[&str]) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
-/// wgpu_host's executable beside host_demo's, built for the same profile (cargo builds only this
-/// package's binaries for its tests; `--bin` keeps the workspace's features, so nothing else rebuilds).
+/// wgpu_host's executable beside host_demo's, built for the same profile the way the README builds
+/// everything (`cargo build --workspace --all-targets`: the features `cargo test --workspace` resolves,
+/// so nothing is compiled again).
 fn wgpu_host_binary(host_demo: &Path) -> PathBuf {
     let dir = host_demo.parent().expect("target/<profile>");
-    let profile = match dir.file_name().and_then(|n| n.to_str()) {
-        Some("debug") => "dev",
-        Some(other) => other,
+    let mut cargo = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+    cargo.args(["build", "--workspace", "--all-targets"]);
+    match dir.file_name().and_then(|n| n.to_str()) {
+        Some("debug") => {}
+        Some(profile) => {
+            cargo.args(["--profile", profile]);
+        }
         None => panic!("unexpected target folder {}", dir.display()),
-    };
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
-        .args([
-            "build",
-            "--bin",
-            "wgpu_host",
-            "--profile",
-            profile,
-            "--target-dir",
-        ])
+    }
+    let status = cargo
+        .arg("--target-dir")
         .arg(dir.parent().expect("target"))
         .current_dir(workspace())
         .status()
         .expect("cargo runs");
-    assert!(status.success(), "cargo build --bin wgpu_host failed");
+    assert!(
+        status.success(),
+        "cargo build --workspace --all-targets failed"
+    );
     dir.join("wgpu_host")
 }
 

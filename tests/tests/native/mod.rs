@@ -41,26 +41,36 @@ pub fn current_build() -> Build {
 }
 
 /// The folder holding `libhrts.so` for this build profile (target/<profile>), building the plugin's
-/// shared library there first (the `hrts-capi` package, which `cargo test` of this crate does not build).
+/// shared library there first (the `hrts-capi` package's, which `cargo test` does not build).
 pub fn library_dir() -> PathBuf {
     let Build {
         target,
         profile,
         dir,
     } = current_build();
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    run(Command::new(cargo)
-        // Every library of the workspace rather than `-p hrts-capi`: the dependencies' features are then
-        // those of the workspace, so this builds libhrts and none of them again.
-        .args(["build", "--lib", "--profile", &profile, "--target-dir"])
-        .arg(&target)
-        .current_dir(workspace()));
+    run(&mut build_everything(&profile, &target));
     assert!(
         dir.join("libhrts.so").exists(),
         "libhrts.so not found in {} after building the hrts-capi package",
         dir.display()
     );
     dir
+}
+
+/// `cargo build --workspace --all-targets` for `profile` into `target`: what `cargo test --workspace` builds,
+/// with the same features (a narrower selection such as `-p hrts-capi` resolves other features and
+/// compiles the dependencies again), plus the C libraries `cargo test` leaves out.
+pub fn build_everything(profile: &str, target: &Path) -> Command {
+    let mut cargo = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+    cargo.args(["build", "--workspace", "--all-targets"]);
+    if profile != "dev" {
+        cargo.args(["--profile", profile]);
+    }
+    cargo
+        .arg("--target-dir")
+        .arg(target)
+        .current_dir(workspace());
+    cargo
 }
 
 pub fn compiler(name: &str) -> String {
