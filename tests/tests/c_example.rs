@@ -6,7 +6,7 @@
 
 mod native;
 
-use native::{compiler, library_dir, run, workspace};
+use native::{compile_c, library_dir, run, workspace};
 use std::process::Command;
 
 /// The number printed just before `label` in `text` (e.g. 812 in "812 shadowed").
@@ -30,17 +30,8 @@ fn minimal_c_example_matches_the_exact_shadow_without_validation_errors() {
     let dir = std::env::temp_dir().join(format!("hrts-c-example-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let exe = dir.join("minimal");
-    run(Command::new(compiler("cc"))
-        .args(["-std=c99", "-Wall", "-Wextra", "-Werror"])
-        .arg("-I")
-        .arg(root.join("hrts/include"))
-        .arg(root.join("examples/c/minimal.c"))
-        .arg("-o")
-        .arg(&exe)
-        .arg("-L")
-        .arg(&lib)
-        .arg(format!("-Wl,-rpath,{}", lib.display()))
-        .args(["-lhrts", "-lvulkan", "-lm"]));
+    let source = root.join("examples/c/minimal.c");
+    compile_c(&exe, &root.join("hrts/include"), &[source], &lib);
     // `run` asserts the exit status: 0 only with no mismatch and no validation error.
     let out = run(Command::new(&exe)
         .current_dir(&dir)

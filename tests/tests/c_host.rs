@@ -6,7 +6,7 @@
 
 mod native;
 
-use native::{compiler, library_dir, run, workspace};
+use native::{compile_c, compiler, library_dir, run, workspace};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -38,17 +38,11 @@ fn build_c_program(name: &str, include: &Path, sources: &[&str]) -> PathBuf {
     let root = workspace();
     let lib = library_dir();
     let exe = std::env::temp_dir().join(format!("hrts-{name}-{}", std::process::id()));
-    run(Command::new(compiler("cc"))
-        .args(["-std=c99", "-O1", "-Wall", "-Wextra", "-Werror"])
-        .arg("-I")
-        .arg(include)
-        .args(sources.iter().map(|s| root.join("tests/c_host").join(s)))
-        .arg("-o")
-        .arg(&exe)
-        .arg("-L")
-        .arg(&lib)
-        .arg(format!("-Wl,-rpath,{}", lib.display()))
-        .args(["-lhrts", "-lvulkan", "-lm"]));
+    let sources: Vec<_> = sources
+        .iter()
+        .map(|s| root.join("tests/c_host").join(s))
+        .collect();
+    compile_c(&exe, include, &sources, &lib);
     exe
 }
 

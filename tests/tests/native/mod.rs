@@ -73,6 +73,22 @@ pub fn build_everything(profile: &str, target: &Path) -> Command {
     cargo
 }
 
+/// Compiles the C `sources` as C99 (`-Wall -Wextra -Werror`) against the `hrts.h` in `include` and links
+/// them with the plugin's shared library in `lib` into `exe`.
+pub fn compile_c(exe: &Path, include: &Path, sources: &[PathBuf], lib: &Path) {
+    run(Command::new(compiler("cc"))
+        .args(["-std=c99", "-O1", "-Wall", "-Wextra", "-Werror"])
+        .arg("-I")
+        .arg(include)
+        .args(sources)
+        .arg("-o")
+        .arg(exe)
+        .arg("-L")
+        .arg(lib)
+        .arg(format!("-Wl,-rpath,{}", lib.display()))
+        .args(["-lhrts", "-lvulkan", "-lm"]));
+}
+
 pub fn compiler(name: &str) -> String {
     std::env::var(name.to_uppercase()).unwrap_or_else(|_| name.to_owned())
 }
