@@ -1,8 +1,8 @@
 /* The engine of the C tests (engine.c): a scene of a box floating over a ground plane, its camera and lights
  * and their exact shadow, a Vulkan device of its own (validation and synchronization validation on), its
  * images and buffers, a G-buffer drawn on the CPU, and the frames it records the plugin into. Built with
- * c_host.c against the current hrts.h, and with old_caller.c against the header of an older API version:
- * it uses nothing newer than API 5.1. */
+ * the C host (c_host.c and the files of its checks, see c_host.h) against the current hrts.h, and with
+ * old_caller.c against the header of an older API version: it uses nothing newer than API 5.1. */
 #ifndef HRTS_TEST_ENGINE_H
 #define HRTS_TEST_ENGINE_H
 
