@@ -6,27 +6,30 @@ mod common;
 use common::device;
 use rhi::{Barrier, BufferUsage, MemoryLocation};
 
+/// Two fills of one 256-byte buffer named `name`, with a full barrier between them or none.
+fn two_fills(device: &rhi::Device, name: &str, ordered: bool) {
+    let buffer = device
+        .create_buffer(name, 256, BufferUsage::COPY_DST, MemoryLocation::GpuOnly)
+        .expect("buffer");
+    device
+        .submit_and_wait(|enc| {
+            enc.fill_buffer(&buffer, 1);
+            if ordered {
+                enc.barriers(&[Barrier::Full]);
+            }
+            enc.fill_buffer(&buffer, 2);
+            Ok(())
+        })
+        .expect("submission");
+}
+
 /// Two fills of one buffer with no barrier between them are a write-after-write hazard: synchronization
 /// validation reports it, and the log counts it as an error and as a hazard. (A suite that ran without
 /// synchronization validation, or that did not count its hazards, fails here.)
 #[test]
 fn synchronization_hazards_are_reported_and_counted_as_errors() {
     let device = device();
-    let buffer = device
-        .create_buffer(
-            "hazard",
-            256,
-            BufferUsage::COPY_DST,
-            MemoryLocation::GpuOnly,
-        )
-        .expect("buffer");
-    device
-        .submit_and_wait(|enc| {
-            enc.fill_buffer(&buffer, 1);
-            enc.fill_buffer(&buffer, 2);
-            Ok(())
-        })
-        .expect("submission");
+    two_fills(&device, "hazard", false);
     let v = device.validation();
     assert!(v.hazards() >= 1, "no hazard reported: {:#?}", v.messages());
     assert!(v.errors() >= v.hazards(), "hazards not counted as errors");
@@ -43,22 +46,7 @@ fn synchronization_hazards_are_reported_and_counted_as_errors() {
 #[test]
 fn ordered_writes_are_no_hazard() {
     let device = device();
-    let buffer = device
-        .create_buffer(
-            "ordered",
-            256,
-            BufferUsage::COPY_DST,
-            MemoryLocation::GpuOnly,
-        )
-        .expect("buffer");
-    device
-        .submit_and_wait(|enc| {
-            enc.fill_buffer(&buffer, 1);
-            enc.barriers(&[Barrier::Full]);
-            enc.fill_buffer(&buffer, 2);
-            Ok(())
-        })
-        .expect("submission");
+    two_fills(&device, "ordered", true);
     common::assert_no_validation_errors(&device);
 }
 
