@@ -474,6 +474,8 @@ pub fn render_scene_to_folder(
     bar.set_message("creating the renderer");
     let mut renderer = SceneRenderer::new(device, file, settings.width, settings.height)
         .context("creating the renderer")?;
+    // As an engine that gives its output storage usage: each light writes its layer, no copy.
+    renderer.write_outputs_directly();
     bar.inc(1);
     let mut reports: Vec<LightsFrame> = Vec::new();
     for index in 1..=frames {
