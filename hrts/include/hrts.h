@@ -719,7 +719,8 @@ typedef struct HrtsVulkanGeometry {
   size_t draw_stride;
 } HrtsVulkanGeometry;
 
-// The engine's images the plugin reads and writes. All are 2D, one mip, one layer, same size.
+// The engine's images the plugin reads and writes. All are 2D, one mip, same size; depth and normal have one
+// layer, the output `output_layers` (one per light).
 typedef struct HrtsTargets {
   // `sizeof(HrtsTargets)`.
   uint32_t struct_size;

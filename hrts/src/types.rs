@@ -632,7 +632,8 @@ pub struct HrtsVulkanGeometry {
     pub draw_stride: usize,
 }
 
-/// The engine's images the plugin reads and writes. All are 2D, one mip, one layer, same size.
+/// The engine's images the plugin reads and writes. All are 2D, one mip, same size; depth and normal have one
+/// layer, the output `output_layers` (one per light).
 #[repr(C)]
 pub struct HrtsTargets {
     /// `sizeof(HrtsTargets)`.
