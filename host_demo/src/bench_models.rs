@@ -80,6 +80,11 @@ pub struct BenchArgs {
     /// (0: always the BVH; inf: always lists).
     #[arg(long, default_value_t = passes::primitive_map::DEFAULT_BIN_BUDGET)]
     pub bin_budget: f32,
+    /// With --lights: give the plugin an R32F output without storage usage, as an engine whose output the
+    /// lights cannot write: each light's layer is copied in ("output copy" in the per-pass split). Default:
+    /// a storage output each light writes directly.
+    #[arg(long, requires = "lights")]
+    pub copied_output: bool,
     /// With --lights: the primitive map's N (texels per side; a point light's cube faces share N²).
     #[arg(long, default_value_t = passes::PrimitiveMapConfig::DEFAULT_SIZE, requires = "lights", value_parser = clap::value_parser!(u32).range(1..=i64::from(u16::MAX)))]
     pub map_size: u32,

@@ -338,7 +338,9 @@ fn measure_light(
     let plan = plan_scene(file, camera, &settings)?;
     let progress = crate::progress::phase("frames", u64::from(args.frames.max(2)));
     let mut renderer = SceneRenderer::new(device, file, args.width, args.height)?;
-    renderer.write_outputs_directly();
+    if !args.copied_output {
+        renderer.write_outputs_directly();
+    }
     let mut frames = Vec::new();
     for _ in 0..args.frames.max(2) {
         frames.push(renderer.render(device, camera, &plan)?);
@@ -434,7 +436,9 @@ fn measure_native_points(
         false,
         GBufferLayout::ANALYSIS,
     )?;
-    plugin.write_outputs_directly();
+    if !args.copied_output {
+        plugin.write_outputs_directly();
+    }
     let mut config = ShadowConfig {
         mode: ShadowMode::Hard,
         antialiasing: false,
@@ -516,9 +520,8 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
         "Device: {} ({}); {}×{}, {}, primitive map N = {}, no FXAA; one light at a time, planned as \
          `render --scene` plans it; GPU ms = median over {} frames after the first of the light's passes \
          summed over its frusta (the shared prim buffer excluded), max = the slowest frame, the first \
-         included; memory = the light's own resources (each light writes its layer of an R32F storage output \
-         directly; the build scratch shared by all lights is listed below); frusta = recorded / built (the \
-         plugin skips those holding no receiver in view).\n\n\
+         included; memory = the light's own resources ({}; the build scratch shared by all lights is listed \
+         below); frusta = recorded / built (the plugin skips those holding no receiver in view).\n\n\
          | scene | light | emitter | frusta | GPU ms | max ms | × sun | map ms | ray trace ms | RT peer trace ms | \
          MiB | entries | mean list | longest | bin items | lists | past limit | past capacity | BVH pixels |\n\
          |---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|\n",
@@ -536,7 +539,12 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
             "hard shadows (zero-size lights)".to_owned()
         },
         args.map_size,
-        args.frames.max(2) - 1
+        args.frames.max(2) - 1,
+        if args.copied_output {
+            "each light's layer is copied into an R32F output without storage usage"
+        } else {
+            "each light writes its layer of an R32F storage output directly"
+        }
     );
     let total: usize = scenes
         .scenes
