@@ -63,7 +63,7 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 0.02)]
     pub angular_radius: f32,
     /// With --area, or --lights --emitter-size: light samples per pixel.
-    #[arg(long, default_value_t = passes::DEFAULT_AREA_SAMPLES)]
+    #[arg(long, default_value_t = hrts::Config::default().area_samples)]
     pub area_samples: u32,
     /// With --lights: sized lights with exact soft shadows (mode area) instead of hard ones, one run per
     /// size (comma-separated): spot and point lights get a spherical emitter whose radius is this fraction
@@ -74,11 +74,11 @@ pub struct BenchArgs {
     pub emitter_size: Vec<f32>,
     /// A texel whose list would pass this many entries keeps none: its pixels walk the BVH (0: the
     /// plugin's choice by mode).
-    #[arg(long, default_value_t = passes::primitive_map::DEFAULT_LIST_LIMIT)]
+    #[arg(long, default_value_t = hrts::Config::default().map_list_limit)]
     pub list_limit: u32,
     /// Bin items per pixel with a ray past which a frame builds no list and every pixel walks the BVH
     /// (0: always the BVH; inf: always lists).
-    #[arg(long, default_value_t = passes::primitive_map::DEFAULT_BIN_BUDGET)]
+    #[arg(long, default_value_t = hrts::Config::default().map_bin_budget)]
     pub bin_budget: f32,
     /// With --lights: give the plugin an R32F output without storage usage, as an engine whose output the
     /// lights cannot write: each light's layer is copied in ("output copy" in the per-pass split). Default:
@@ -86,7 +86,7 @@ pub struct BenchArgs {
     #[arg(long, requires = "lights")]
     pub copied_output: bool,
     /// With --lights: the primitive map's N (texels per side; a point light's cube faces share N²).
-    #[arg(long, default_value_t = passes::PrimitiveMapConfig::DEFAULT_SIZE, requires = "lights", value_parser = clap::value_parser!(u32).range(1..=i64::from(u16::MAX)))]
+    #[arg(long, default_value_t = hrts::Config::default().map_size, requires = "lights", value_parser = clap::value_parser!(u32).range(1..=i64::from(u16::MAX)))]
     pub map_size: u32,
 }
 

@@ -130,11 +130,11 @@ struct RenderArgs {
     binning: BinningRequest,
     /// A texel whose list would pass this many entries keeps none: its pixels walk the BVH (0: the
     /// plugin's choice by mode; moves cost, never exactness).
-    #[arg(long, default_value_t = passes::primitive_map::DEFAULT_LIST_LIMIT)]
+    #[arg(long, default_value_t = hrts::Config::default().map_list_limit)]
     list_limit: u32,
     /// Bin items per pixel with a ray past which a frame builds no list and every pixel walks the BVH
     /// (0: always the BVH; inf: always lists; moves cost, never exactness).
-    #[arg(long, default_value_t = passes::primitive_map::DEFAULT_BIN_BUDGET)]
+    #[arg(long, default_value_t = hrts::Config::default().map_bin_budget)]
     bin_budget: f32,
     /// Frames to render (timings are medians over all but the first; at least 2 with --scene, so that the
     /// second frame's report shows what was kept).

@@ -52,7 +52,7 @@ pub struct SoftShadowArgs {
     #[arg(long, default_value_t = 4.0)]
     pub phs: f32,
     /// Area shadows: light samples per pixel (1 to 128).
-    #[arg(long, default_value_t = passes::DEFAULT_AREA_SAMPLES)]
+    #[arg(long, default_value_t = hrts::Config::default().area_samples)]
     pub area_samples: u32,
 }
 
@@ -68,7 +68,7 @@ impl Default for SoftShadowArgs {
             pcf_taps: 32,
             wss: None,
             phs: 4.0,
-            area_samples: passes::DEFAULT_AREA_SAMPLES,
+            area_samples: hrts::Config::default().area_samples,
         }
     }
 }
