@@ -9,7 +9,7 @@ use crate::View;
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
 use passes::{FrameReport, PrimitiveMapConfig, ShadowConfig};
-use rhi::Device;
+use rhi::{Device, Format};
 use scene::{Camera, DirectionalLight};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -85,12 +85,26 @@ pub struct BenchArgs {
     /// a storage output each light writes directly.
     #[arg(long, requires = "lights")]
     pub copied_output: bool,
+    /// With --lights: the output's format, as an engine's shadow mask: r32f, r16f (R16_SFLOAT) or r8
+    /// (R8_UNORM). With storage usage each light writes its layer in this format directly; with
+    /// --copied-output each layer is copied (r32f) or converted by a blit.
+    #[arg(long, default_value = "r32f", requires = "lights", value_parser = ["r32f", "r16f", "r8"])]
+    pub output_format: String,
     /// With --lights: the primitive map's N (texels per side; a point light's cube faces share N²).
     #[arg(long, default_value_t = hrts::Config::default().map_size, requires = "lights", value_parser = clap::value_parser!(u32).range(1..=i64::from(u16::MAX)))]
     pub map_size: u32,
 }
 
 impl BenchArgs {
+    /// The output's format (`--output-format`).
+    pub fn output_format(&self) -> Format {
+        match self.output_format.as_str() {
+            "r16f" => Format::R16Float,
+            "r8" => Format::R8Unorm,
+            _ => Format::R32Float,
+        }
+    }
+
     /// The primitive map the benchmark's configurations take: the default with the given list limit and
     /// bin budget (and, for --lights, N).
     pub fn map(&self) -> PrimitiveMapConfig {

@@ -338,6 +338,7 @@ fn measure_light(
     let plan = plan_scene(file, camera, &settings)?;
     let progress = crate::progress::phase("frames", u64::from(args.frames.max(2)));
     let mut renderer = SceneRenderer::new(device, file, args.width, args.height)?;
+    renderer.set_output_format(args.output_format());
     if !args.copied_output {
         renderer.write_outputs_directly();
     }
@@ -436,6 +437,7 @@ fn measure_native_points(
         false,
         GBufferLayout::ANALYSIS,
     )?;
+    plugin.set_output_format(args.output_format());
     if !args.copied_output {
         plugin.write_outputs_directly();
     }
@@ -540,10 +542,14 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
         },
         args.map_size,
         args.frames.max(2) - 1,
-        if args.copied_output {
-            "each light's layer is copied into an R32F output without storage usage"
-        } else {
-            "each light writes its layer of an R32F storage output directly"
+        match (args.copied_output, args.output_format.to_uppercase()) {
+            (true, format) if format == "R32F" =>
+                "each light's layer is copied into an R32F output without storage usage".to_owned(),
+            (true, format) => format!(
+                "each light's layer is converted by a blit into an {format} output without storage usage"
+            ),
+            (false, format) =>
+                format!("each light writes its layer of an {format} storage output directly"),
         }
     );
     let total: usize = scenes

@@ -93,6 +93,8 @@ pub struct PluginRenderer {
     /// Usage of the visibility image: with storage usage, each light's last pass writes its layer
     /// directly (its final output can then only be read from the visibility image).
     output_usage: ImageUsage,
+    /// Format of the visibility image: `R32Float`, `R16Float` or `R8Unorm` (read back as `f32`).
+    output_format: Format,
     timer: GpuTimer,
     dynamic_geometry: bool,
     /// The bounds of the shadow casters, given with every frame: the demo does not animate its scenes, so
@@ -200,6 +202,7 @@ impl PluginRenderer {
             replaced_outputs: Vec::new(),
             configured: Vec::new(),
             output_usage: ImageUsage::COPY_DST | ImageUsage::COPY_SRC | ImageUsage::SAMPLED,
+            output_format: Format::R32Float,
             timer: device.create_timer(4)?,
             dynamic_geometry,
             bounds,
@@ -215,6 +218,13 @@ impl PluginRenderer {
     /// resources. Takes effect when the lights are next configured with more layers than the image has.
     pub fn write_outputs_directly(&mut self) {
         self.output_usage = self.output_usage | ImageUsage::STORAGE;
+    }
+
+    /// Gives the visibility image `format` (`R32Float`, the default, `R16Float` or `R8Unorm`), as an
+    /// engine whose shadow mask is half float or 8-bit; read back, it is converted to `f32`. Takes effect
+    /// when the image is next created (the lights first configured).
+    pub fn set_output_format(&mut self, format: Format) {
+        self.output_format = format;
     }
 
     /// Gives the plugin one configuration per light ([`hrts::Context::configure_lights`], each as the C
@@ -234,7 +244,7 @@ impl PluginRenderer {
         if self.output.as_ref().is_none_or(|o| o.layers() < layers) {
             let output = device.create_image(&ImageDesc {
                 name: "visibility",
-                format: Format::R32Float,
+                format: self.output_format,
                 width: self.targets.depth.width(),
                 height: self.targets.depth.height(),
                 layers,
@@ -519,7 +529,7 @@ impl PluginRenderer {
         let mut bytes = read_images(device, &images)?;
         let layers = match output {
             Some(_) => {
-                let all: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes.pop().unwrap_or_default());
+                let all = visibility_values(self.output_format, &bytes.pop().unwrap_or_default());
                 let pixels =
                     self.targets.depth.width() as usize * self.targets.depth.height() as usize;
                 all.chunks_exact(pixels)
@@ -809,5 +819,17 @@ fn plugin_frame<'a>(
         output_layout_after: sampled,
         bounds: Some(plugin_bounds(bounds)),
         deformed: &[],
+    }
+}
+
+/// The visibility values of an image of `format` (`R32Float`, `R16Float` or `R8Unorm`) read back as bytes.
+fn visibility_values(format: Format, bytes: &[u8]) -> Vec<f32> {
+    match format {
+        Format::R16Float => bytes
+            .chunks_exact(2)
+            .map(|b| half::f16::from_le_bytes([b[0], b[1]]).to_f32())
+            .collect(),
+        Format::R8Unorm => bytes.iter().map(|&b| f32::from(b) / 255.0).collect(),
+        _ => bytemuck::pod_collect_to_vec(bytes),
     }
 }

@@ -12,7 +12,7 @@ use crate::{CameraMatrices, FrameImages};
 use anyhow::{Context, Result};
 use glam::Vec3;
 use passes::{FrameReport, MapStats, PassId, PassStatus, ResourceId, SkipReason};
-use rhi::Device;
+use rhi::{Device, Format};
 use scene::{Camera, SceneFile};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -67,6 +67,11 @@ impl SceneRenderer {
     /// ([`PluginRenderer::write_outputs_directly`]); call before the first frame.
     pub fn write_outputs_directly(&mut self) {
         self.plugin.write_outputs_directly();
+    }
+
+    /// The visibility image's format ([`PluginRenderer::set_output_format`]); call before the first frame.
+    pub fn set_output_format(&mut self, format: Format) {
+        self.plugin.set_output_format(format);
     }
 
     /// The plugin driver.

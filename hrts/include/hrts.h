@@ -765,10 +765,10 @@ typedef struct HrtsTargets {
   uint32_t output_usage;
   // Array layers of the output image: at least the number of lights when a frame is recorded.
   uint32_t output_layers;
-  // `VkFormat` of the output image: `VK_FORMAT_R32_SFLOAT` (or 0), written by a copy, or directly by
-  // each light's last pass when the image also has STORAGE usage (no copy), or
-  // `VK_FORMAT_R8_UNORM` or `VK_FORMAT_R16_SFLOAT`, written by a converting blit (the device must
-  // support blits from `R32_SFLOAT` to it).
+  // `VkFormat` of the output image: `VK_FORMAT_R32_SFLOAT` (or 0), `VK_FORMAT_R16_SFLOAT` or
+  // `VK_FORMAT_R8_UNORM`. With STORAGE usage (and a device that supports storage images of the format),
+  // each light's last pass writes its layer directly, with no copy; otherwise each layer is copied in
+  // (`R32_SFLOAT`) or converted by a blit (the device must support blits from `R32_SFLOAT` to it).
   uint32_t output_format;
 } HrtsTargets;
 
@@ -998,9 +998,10 @@ typedef struct HrtsFrameReport {
   // frame with `dynamic_geometry`; 0 when the prim buffer was up to date.
   uint32_t prim_triangles_rebuilt;
   // Whether the light's last pass wrote its layer of the output image directly, with no copy: the
-  // output is `R32_SFLOAT` with STORAGE usage (the layer is then in the GENERAL layout between that
-  // pass and the output-copy call, which takes it to `output_layout_after`), and the configuration does
-  // not read the final output back through `extra_outputs`. API 5.3.
+  // output has STORAGE usage in a format the lights write (`HrtsTargets::output_format`). The layer is
+  // then in the GENERAL layout between that pass and the output-copy call, which takes it to
+  // `output_layout_after`; the configuration must not read the final output back through
+  // `extra_outputs`. API 5.3.
   HrtsBool output_direct;
   // A point light shadowed as one cube map: the (triangle, face) pairs its setup kept this frame (0
   // for other lights). Past `bin_pair_capacity`, the frame traced every ray of the light against every

@@ -460,7 +460,7 @@ fn record_output_copy(
     Ok(())
 }
 
-/// [`record_output_copy`] into an output image the lights may write directly (`R32_SFLOAT` with storage
+/// [`record_output_copy`] into an output image the lights may write directly (storage
 /// usage), layer by layer: a layer its light wrote goes to `output_layout_after`; the others get their
 /// light's visibility copied in, or 1 for a light with no frustum recorded.
 fn record_output_layers(
@@ -501,7 +501,10 @@ fn record_output_layers(
         }));
         enc.barriers(&to_copy);
         match source {
-            Some(image) => enc.copy_image_into_layer(image, layer, 0)?,
+            Some(image) if layer.format() == Format::R32Float => {
+                enc.copy_image_into_layer(image, layer, 0)?
+            }
+            Some(image) => enc.blit_into_layer(image, layer, 0)?,
             None => enc.clear_uint_layer(layer, 0, 1.0f32.to_bits())?,
         }
         let mut back = vec![Barrier::Image {

@@ -11,7 +11,8 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0, r32f) uniform readonly image2D src;
-layout(set = 0, binding = 1, r32f) uniform writeonly image2D dst;
+#include "output_format.glsl"
+layout(set = 0, binding = 1, OUTPUT_FORMAT) uniform writeonly image2D dst;
 layout(push_constant) uniform Push { FxaaPush pc; };
 
 float at(ivec2 q) {

@@ -8,7 +8,8 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0, r32f) uniform readonly image2D rts;
 layout(set = 0, binding = 1, r32f) uniform readonly image2D pcss;
 layout(set = 0, binding = 2, r32f) uniform readonly image2D lerp_factor;
-layout(set = 0, binding = 3, r32f) uniform writeonly image2D result;
+#include "output_format.glsl"
+layout(set = 0, binding = 3, OUTPUT_FORMAT) uniform writeonly image2D result;
 layout(push_constant) uniform Push { HybridPush pc; };
 
 void main() {

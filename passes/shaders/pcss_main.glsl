@@ -25,7 +25,8 @@ layout(set = 0, binding = 1) uniform sampler2D depth_tex;
 layout(set = 0, binding = 2) uniform sampler2D normal_tex;
 layout(set = 0, binding = 3) uniform sampler2D shadow_map;
 #include "engine_surface.glsl"
-layout(set = 0, binding = 4, r32f) uniform writeonly image2D result;
+#include "output_format.glsl"
+layout(set = 0, binding = 4, OUTPUT_FORMAT) uniform writeonly image2D result;
 #ifdef HARD_EDGE_FROM_RAY_TRACE
 layout(set = 0, binding = 5, r32f) uniform readonly image2D rt_visibility;
 #endif

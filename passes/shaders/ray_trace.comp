@@ -37,7 +37,8 @@ layout(set = 0, binding = 5) readonly buffer Offsets { uint offsets[]; };
 #include "map_offsets.glsl"
 layout(set = 0, binding = 6) readonly buffer Entries { uint entries[]; };
 layout(set = 0, binding = 7) readonly buffer Prims { Triangle tris[]; };
-layout(set = 0, binding = 8, r32f) uniform writeonly image2D visibility;
+#include "output_format.glsl"
+layout(set = 0, binding = 8, OUTPUT_FORMAT) uniform writeonly image2D visibility;
 layout(set = 0, binding = 9, r32f) uniform writeonly image2D blocker;
 layout(set = 0, binding = 10) readonly buffer Bvh { BvhNode bvh_nodes[]; };
 #include "shadow_ray.glsl"

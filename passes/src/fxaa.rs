@@ -11,6 +11,7 @@
 
 use crate::gpu_types::FxaaPush;
 use crate::screen_pass::{visibility_image, ScreenPass};
+use crate::shaders::output_variant;
 use crate::PassError;
 use glam::Vec4;
 use rhi::{BindingKind, Device, Encoder, Image, Resource};
@@ -47,7 +48,7 @@ impl FxaaPass {
         let step = ScreenPass::new(
             device,
             "FXAA",
-            "fxaa.comp",
+            &output_variant("fxaa.comp", output.format())?,
             &[BindingKind::StorageImage, BindingKind::StorageImage],
             &[Resource::Image(input), Resource::Image(&output)],
             std::mem::size_of::<FxaaPush>() as u32,

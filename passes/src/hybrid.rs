@@ -5,6 +5,7 @@
 
 use crate::gpu_types::HybridPush;
 use crate::screen_pass::{visibility_image, ScreenPass};
+use crate::shaders::output_variant;
 use crate::PassError;
 use rhi::{BindingKind, Device, Encoder, Image, Resource};
 
@@ -124,7 +125,7 @@ impl BlendPass {
         let step = ScreenPass::new(
             device,
             "hybrid blend",
-            "hybrid_blend.comp",
+            &output_variant("hybrid_blend.comp", output.format())?,
             &[BindingKind::StorageImage; 4],
             &[
                 Resource::Image(rts),

@@ -4,23 +4,21 @@
 //! Reads: each frustum's output. Writes: the combined visibility.
 
 use crate::screen_pass::{visibility_image, ScreenPass};
+use crate::shaders::output_variant;
 use crate::PassError;
 use rhi::{Barrier, BindingKind, Device, Encoder, Image, Resource, ResourceState as S};
 
 /// The min-combine pass of one light and its output.
 pub struct MinCombine {
     steps: Vec<ScreenPass>,
-    /// Fills the output with 1 (no frustum recorded); bound to the output alone, since a frustum that never
-    /// ran has an image in no layout to bind.
-    lit: ScreenPass,
-    /// `R32_SFLOAT` visibility of the light.
+    /// Visibility of the light: `R32_SFLOAT`, or the engine's `R16_SFLOAT` or `R8_UNORM` layer.
     pub output: Image,
 }
 
 impl MinCombine {
     /// Creates the pass over `frusta` (at least one, all of the same size), writing `output` when given
-    /// (an `R32_SFLOAT` storage image of their size, such as a layer of the engine's output) or an image of
-    /// its own.
+    /// (a storage image of their size, such as a layer of the engine's output, in a format of
+    /// [`output_variant`]) or an image of its own.
     pub fn new(
         device: &Device,
         frusta: &[&Image],
@@ -38,28 +36,21 @@ impl MinCombine {
                 first.height(),
             )?,
         };
+        let shader_name = output_variant("min_combine.comp", output.format())?;
         let steps = frusta
             .iter()
             .map(|frustum| {
                 ScreenPass::new(
                     device,
                     "min over frusta",
-                    "min_combine.comp",
+                    &shader_name,
                     &[BindingKind::StorageImage, BindingKind::StorageImage],
                     &[Resource::Image(frustum), Resource::Image(&output)],
                     12,
                 )
             })
             .collect::<Result<_, _>>()?;
-        let lit = ScreenPass::new(
-            device,
-            "min over frusta",
-            "min_combine.comp",
-            &[BindingKind::StorageImage, BindingKind::StorageImage],
-            &[Resource::Image(&output), Resource::Image(&output)],
-            12,
-        )?;
-        Ok(Self { steps, lit, output })
+        Ok(Self { steps, output })
     }
 
     /// GPU bytes of the combined image.
@@ -79,27 +70,38 @@ impl MinCombine {
             )));
         }
         let (width, height) = (self.output.width(), self.output.height());
+        if !recorded.contains(&true) {
+            enc.begin_pass("min over frusta");
+            enc.barriers(&[Barrier::Image {
+                image: &self.output,
+                before: S::Undefined,
+                after: S::CopyDest,
+            }]);
+            enc.clear_uint(&self.output, 1.0f32.to_bits());
+            enc.barriers(&[Barrier::Image {
+                image: &self.output,
+                before: S::CopyDest,
+                after: S::UnorderedAccess,
+            }]);
+            enc.end_pass();
+            return Ok(());
+        }
         enc.barriers(&[Barrier::Image {
             image: &self.output,
             before: S::Undefined,
             after: S::UnorderedAccess,
         }]);
-        let mut folded = 0;
-        for (step, _) in self.steps.iter().zip(recorded).filter(|(_, &r)| r) {
+        for (folded, (step, _)) in self
+            .steps
+            .iter()
+            .zip(recorded)
+            .filter(|(_, &r)| r)
+            .enumerate()
+        {
             let push: [u32; 3] = [width, height, u32::from(folded > 0)];
             step.record(enc, bytemuck::bytes_of(&push), width, height)?;
-            enc.barriers(&[Barrier::Uav]);
-            folded += 1;
-        }
-        if folded == 0 {
-            let push: [u32; 3] = [width, height, MODE_LIT];
-            self.lit
-                .record(enc, bytemuck::bytes_of(&push), width, height)?;
             enc.barriers(&[Barrier::Uav]);
         }
         Ok(())
     }
 }
-
-/// Push-constant mode of `min_combine.comp` that writes 1 (no frustum recorded).
-const MODE_LIT: u32 = 2;

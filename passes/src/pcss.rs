@@ -8,6 +8,7 @@
 use crate::frame_plan::{HardEdge, PenumbraFilter};
 use crate::gpu_types::PcssConstants;
 use crate::screen_pass::{visibility_image, ScreenPass};
+use crate::shaders::output_variant;
 use crate::PassError;
 
 use crate::gpu_types::constant_buffer;
@@ -176,7 +177,8 @@ impl PcssPass {
             }
             _ => "pcss.comp",
         };
-        let step = ScreenPass::new(device, name, shader_name, &bindings, &resources, 0)?;
+        let shader_name = output_variant(shader_name, output.format())?;
+        let step = ScreenPass::new(device, name, &shader_name, &bindings, &resources, 0)?;
         drop(resources);
         Ok(Self {
             step,

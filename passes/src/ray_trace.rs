@@ -13,7 +13,7 @@
 use crate::area::{area_edge_table, area_sample_bands, local_area_edge_table, local_sample_bands};
 use crate::gpu_types::{constant_buffer, AreaSamples, RayTraceConstants};
 use crate::primitive_map::PrimitiveMap;
-use crate::shaders::shader;
+use crate::shaders::{output_variant, shader};
 use crate::PassError;
 use rhi::{
     Barrier, BindGroup, BindingKind, Buffer, BufferUsage, ComputePipeline, Device, Encoder, Format,
@@ -211,13 +211,19 @@ impl RayTracePass {
             RayTraceKind::Area { .. } => ("area trace (directional lights)", "area_trace.comp"),
             RayTraceKind::Hard { .. } => ("ray trace", "ray_trace.comp"),
         };
-        let pipeline = device.create_compute_pipeline(name, &shader(shader_name)?, &kinds, 0)?;
+        let format = visibility.format();
+        let pipeline = device.create_compute_pipeline(
+            name,
+            &shader(&output_variant(shader_name, format)?)?,
+            &kinds,
+            0,
+        )?;
         let group = device.create_bind_group(pipeline.layout(), &resources)?;
         let local = match kind {
             RayTraceKind::Area { .. } if !cube => {
                 let pipeline = device.create_compute_pipeline(
                     "area trace (spot and point lights)",
-                    &shader("area_trace_local.comp")?,
+                    &shader(&output_variant("area_trace_local.comp", format)?)?,
                     &kinds,
                     0,
                 )?;

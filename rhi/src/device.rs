@@ -701,6 +701,12 @@ impl Device {
             .contains(vk::FormatFeatureFlags::SAMPLED_IMAGE)
     }
 
+    /// Whether optimally tiled images of `format` can be shader storage images.
+    pub fn can_store(&self, format: Format) -> bool {
+        self.optimal_features(format)
+            .contains(vk::FormatFeatureFlags::STORAGE_IMAGE)
+    }
+
     /// Whether images of `format` can be rendered to with optimal tiling: as a colour attachment, or as a
     /// depth attachment for depth formats.
     pub fn can_render(&self, format: Format) -> bool {

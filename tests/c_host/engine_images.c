@@ -302,10 +302,12 @@ void engine_depth(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
 }
 
 /* ---------- the engine's output format ---------- */
-/* The visibility written into an R8_UNORM or R16_SFLOAT output image (a converting blit) equals the
- * R32_SFLOAT output to the format's precision: hard shadows exactly (0 and 1), the hybrid's penumbrae
- * within half a step of R8 and the rounding of a half float. A colour format the plugin does not write is
- * refused. */
+/* The visibility written into an R8_UNORM or R16_SFLOAT output image equals the R32_SFLOAT output to the
+ * format's precision: hard shadows exactly (0 and 1), the hybrid's penumbrae and the area shadows' sample
+ * fractions within a step of R8 and the rounding of a half float. Without STORAGE usage each layer is
+ * converted by a blit; with it, the light's last pass writes the layer directly (the report says so) and
+ * the store converts (Vulkan lets it round to either neighbour: a whole R8 step). A colour format the
+ * plugin does not write is refused. */
 static float half_to_float(uint16_t h) {
     int exponent = (h >> 10) & 31, mantissa = h & 1023;
     double v = exponent == 0 ? ldexp(mantissa, -24) : ldexp(mantissa | 1024, exponent - 25);
@@ -313,72 +315,87 @@ static float half_to_float(uint16_t h) {
 }
 
 void output_formats(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
-    enum { PX = W * H };
+    enum { PX = W * H, MODES = 3 };
     setup_camera(0.0);
     Emitter sun = directional(v3(0.45, -1.0, 0.2));
     set_lights(&sun, 1);
     upload_gbuffer();
-    const uint32_t modes[2] = {HRTS_SHADOW_MODE_HARD, HRTS_SHADOW_MODE_HYBRID};
-    static float reference[2][PX];
-    for (int m = 0; m < 2; m++) {
+    const uint32_t modes[MODES] = {HRTS_SHADOW_MODE_HARD, HRTS_SHADOW_MODE_HYBRID, HRTS_SHADOW_MODE_AREA};
+    const char *mode_names[MODES] = {"hard", "hybrid", "area"};
+    static float reference[MODES][PX];
+    for (int m = 0; m < MODES; m++) {
         HrtsContext *ctx = create_context(vk, 1);
         HrtsTargets t = targets();
         CHECK(configure_all(ctx, 1, modes[m]) == HRTS_RESULT_OK && hrts_set_geometry_cpu(ctx, g) == HRTS_RESULT_OK &&
                   hrts_set_targets(ctx, &t) == HRTS_RESULT_OK && run_frame(ctx, reference[m]) == HRTS_RESULT_OK,
-              "output formats: R32_SFLOAT frame: %s", hrts_last_error(ctx));
+              "output formats: R32_SFLOAT frame (%s): %s", mode_names[m], hrts_last_error(ctx));
         CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
     }
     const struct {
         VkFormat format;
         const char *name;
         size_t texel;
-        double tolerance;
-    } formats[] = {{VK_FORMAT_R8_UNORM, "R8_UNORM", 1, 0.5 / 255.0 + 1e-6}, {VK_FORMAT_R16_SFLOAT, "R16_SFLOAT", 2, 1.0 / 1024.0}};
+        double blit_tolerance, store_tolerance;
+    } formats[] = {{VK_FORMAT_R8_UNORM, "R8_UNORM", 1, 0.5 / 255.0 + 1e-6, 1.0 / 255.0 + 1e-6},
+                   {VK_FORMAT_R16_SFLOAT, "R16_SFLOAT", 2, 1.0 / 1024.0, 1.0 / 1024.0}};
     for (int k = 0; k < 2; k++) {
         VkFormatProperties props;
         vkGetPhysicalDeviceFormatProperties(phys, formats[k].format, &props);
         CHECK(props.optimalTilingFeatures & VK_FORMAT_FEATURE_BLIT_DST_BIT, "%s: the device cannot blit into it",
               formats[k].name);
-        for (int m = 0; m < 2; m++) {
-            Img out = make_image(formats[k].format, VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, 1);
-            HrtsContext *ctx = create_context(vk, 1);
-            HrtsTargets t = targets();
-            t.output_image = (uint64_t)(uintptr_t)out.image;
-            t.output_layers = 1;
-            t.output_format = (uint32_t)formats[k].format;
-            HrtsResult r = configure_all(ctx, 1, modes[m]);
-            if (r == HRTS_RESULT_OK) r = hrts_set_geometry_cpu(ctx, g);
-            if (r == HRTS_RESULT_OK) r = hrts_set_targets(ctx, &t);
-            Buf back = make_host_buffer(formats[k].texel * PX, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-            if (r == HRTS_RESULT_OK) {
-                VkCommandBuffer cmd = begin();
-                HrtsFrame f = frame(cmd, next_frame++);
-                r = hrts_record_frame(ctx, &f);
+        int storable = (props.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT) != 0;
+        for (int storage = 0; storage <= storable; storage++)
+            for (int m = 0; m < MODES; m++) {
+                VkImageUsageFlags usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+                                          (storage ? VK_IMAGE_USAGE_STORAGE_BIT : 0);
+                Img out = make_image(formats[k].format, usage, 1);
+                HrtsContext *ctx = create_context(vk, 1);
+                HrtsTargets t = targets();
+                t.output_image = (uint64_t)(uintptr_t)out.image;
+                t.output_layers = 1;
+                t.output_format = (uint32_t)formats[k].format;
+                t.output_usage = usage;
+                HrtsResult r = configure_all(ctx, 1, modes[m]);
+                if (r == HRTS_RESULT_OK) r = hrts_set_geometry_cpu(ctx, g);
+                if (r == HRTS_RESULT_OK) r = hrts_set_targets(ctx, &t);
+                Buf back = make_host_buffer(formats[k].texel * PX, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
                 if (r == HRTS_RESULT_OK) {
-                    VkBufferImageCopy region = frame_region(VK_IMAGE_ASPECT_COLOR_BIT, 1);
-                    vkCmdCopyImageToBuffer(cmd, out.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, back.buffer, 1, &region);
-                    host_read_barrier(cmd);
+                    VkCommandBuffer cmd = begin();
+                    HrtsFrame f = frame(cmd, next_frame++);
+                    r = hrts_record_frame(ctx, &f);
+                    if (r == HRTS_RESULT_OK) {
+                        VkBufferImageCopy region = frame_region(VK_IMAGE_ASPECT_COLOR_BIT, 1);
+                        vkCmdCopyImageToBuffer(cmd, out.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, back.buffer, 1, &region);
+                        host_read_barrier(cmd);
+                    }
+                    submit_and_wait(cmd);
                 }
-                submit_and_wait(cmd);
+                const char *how = storage ? "written directly" : "blitted";
+                CHECK(r == HRTS_RESULT_OK, "output %s (%s): %s", formats[k].name, how, hrts_last_error(ctx));
+                HrtsFrameReport rep;
+                int direct = -1;
+                if (r == HRTS_RESULT_OK && report(ctx, next_frame - 1, 0, &rep) == HRTS_RESULT_OK) direct = rep.output_direct != 0;
+                CHECK(direct == storage, "output %s (%s, %s): the report says output_direct %d", formats[k].name,
+                      mode_names[m], how, direct);
+                double tolerance = storage ? formats[k].store_tolerance : formats[k].blit_tolerance;
+                int beyond = 0, soft = 0;
+                double worst = 0.0;
+                for (int i = 0; i < PX && r == HRTS_RESULT_OK; i++) {
+                    float v = formats[k].texel == 1 ? ((uint8_t *)back.map)[i] / 255.0f : half_to_float(((uint16_t *)back.map)[i]);
+                    double d = fabs((double)v - reference[m][i]);
+                    if (d > worst) worst = d;
+                    beyond += d > (m == 0 ? 0.0 : tolerance);
+                    soft += reference[m][i] > 0.0f && reference[m][i] < 1.0f;
+                }
+                printf("output %s %s, %s: %d soft pixels, largest difference from R32_SFLOAT %.6f, %d px beyond the format's "
+                       "precision\n",
+                       formats[k].name, how, mode_names[m], soft, worst, beyond);
+                CHECK(r == HRTS_RESULT_OK && beyond == 0 && (m == 0 || soft > 0), "output %s (%s, %s): %d px differ, %d soft",
+                      formats[k].name, mode_names[m], how, beyond, soft);
+                free_buffer(back);
+                CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
+                free_image(out);
             }
-            CHECK(r == HRTS_RESULT_OK, "output %s: %s", formats[k].name, hrts_last_error(ctx));
-            int beyond = 0, soft = 0;
-            double worst = 0.0;
-            for (int i = 0; i < PX && r == HRTS_RESULT_OK; i++) {
-                float v = formats[k].texel == 1 ? ((uint8_t *)back.map)[i] / 255.0f : half_to_float(((uint16_t *)back.map)[i]);
-                double d = fabs((double)v - reference[m][i]);
-                if (d > worst) worst = d;
-                beyond += d > (m == 0 ? 0.0 : formats[k].tolerance);
-                soft += reference[m][i] > 0.0f && reference[m][i] < 1.0f;
-            }
-            printf("output %s, %s: %d soft pixels, largest difference from R32_SFLOAT %.6f, %d px beyond the format's precision\n",
-                   formats[k].name, m == 0 ? "hard" : "hybrid", soft, worst, beyond);
-            CHECK(r == HRTS_RESULT_OK && beyond == 0, "output %s (%s): %d px differ", formats[k].name, m == 0 ? "hard" : "hybrid",
-                  beyond);
-            free_buffer(back);
-            CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
-            free_image(out);
-        }
     }
     HrtsContext *ctx = create_context(vk, 1);
     HrtsTargets t = targets();

@@ -104,21 +104,24 @@ impl Context {
             // SAFETY: the engine guarantees its images are live and match the description (contract).
             unsafe { device.external_image(handle, &desc) }
         };
-        let direct =
-            t.output_format == Format::R32Float && t.output_usage.contains(ImageUsage::STORAGE);
+        let direct = [Format::R32Float, Format::R16Float, Format::R8Unorm]
+            .contains(&t.output_format)
+            && t.output_usage.contains(ImageUsage::STORAGE)
+            && device.can_store(t.output_format);
         let output_layers = if direct {
             (0..t.output_layers)
                 .map(|layer| {
                     let desc = ImageDesc {
                         name: "engine visibility layer",
-                        format: Format::R32Float,
+                        format: t.output_format,
                         width: t.width,
                         height: t.height,
                         layers: 1,
                         usage: ImageUsage::STORAGE | ImageUsage::COPY_DST,
                     };
-                    // SAFETY: the engine guarantees its output is live, R32_SFLOAT with storage usage, of
-                    // `output_layers` layers (contract; checked against its stated usage and format).
+                    // SAFETY: the engine guarantees its output is live, of its stated format (R32_SFLOAT,
+                    // R16_SFLOAT or R8_UNORM) with storage usage, of `output_layers` layers (contract; checked
+                    // against its stated usage and format).
                     unsafe { device.external_image_layer(t.output, &desc, layer) }
                 })
                 .collect::<Result<Vec<_>, _>>()?

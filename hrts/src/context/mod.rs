@@ -67,7 +67,8 @@ pub(crate) struct Built {
     /// How the passes decode the normal.
     pub(crate) surface: SurfaceInput,
     pub(crate) output: Image,
-    /// Each layer of the output, when lights may write theirs directly (`R32_SFLOAT` with storage usage);
+    /// Each layer of the output, when lights may write theirs directly (`R32_SFLOAT`, `R16_SFLOAT` or `R8_UNORM`
+    /// with storage usage);
     /// empty otherwise.
     pub(crate) output_layers: Vec<Image>,
 }

@@ -22,7 +22,7 @@ pub(crate) struct TargetSource {
     pub(crate) surface: SurfaceInput,
     pub(crate) output: u64,
     pub(crate) output_layers: u32,
-    /// Usage of the output image: with storage usage and `R32_SFLOAT`, lights write their layers directly.
+    /// Usage of the output image: with storage usage, lights write their layers directly.
     pub(crate) output_usage: ImageUsage,
 }
 

@@ -143,8 +143,9 @@ pub struct Targets {
     pub normal_encoding: NormalEncoding,
     /// The space of the normals.
     pub normal_space: NormalSpace,
-    /// The visibility image the plugin writes (1 = lit), light `i` to layer `i`: R32 float (0 too),
-    /// written by a copy or, with STORAGE usage, directly; or R8 unorm or R16 float, by a blit.
+    /// The visibility image the plugin writes (1 = lit), light `i` to layer `i`: R32 float (0 too), R16
+    /// float or R8 unorm; with STORAGE usage each light writes its layer directly, else it is copied in
+    /// (R32) or converted by a blit.
     pub output: TargetImage,
     /// Array layers of the output image: at least the number of lights when a frame is recorded.
     pub output_layers: u32,

@@ -1,6 +1,10 @@
 //! For build scripts: compiles every GLSL shader of a folder to SPIR-V with the glslang crate (Vulkan 1.3,
 //! SPIR-V 1.6) and writes `$OUT_DIR/shaders.rs`, a table `ALL: &[(&str, &[u8])]` of the modules by file
 //! name, for `include!`. A shader that does not compile fails the build with glslang's message.
+//!
+//! A shader whose source or includes name [`OUTPUT_FORMAT`] (the format qualifier of the image its final
+//! visibility goes into, `r32f` unless defined) is also compiled once per [`OUTPUT_FORMAT_VARIANTS`] value,
+//! embedded as `NAME@VALUE` (`ray_trace.comp@r16f`).
 
 use glslang::{
     include::{IncludeHandler, IncludeResult, IncludeType},
@@ -9,8 +13,17 @@ use glslang::{
 };
 use std::path::{Path, PathBuf};
 
-/// Include folders, searched in order.
-struct Includes(Vec<PathBuf>);
+/// The macro naming the format qualifier of a shader's final output image.
+pub const OUTPUT_FORMAT: &str = "OUTPUT_FORMAT";
+
+/// The values of [`OUTPUT_FORMAT`] besides the default `r32f` that each shader naming it is compiled with.
+pub const OUTPUT_FORMAT_VARIANTS: [&str; 2] = ["r16f", "r8"];
+
+/// Include folders, searched in order, and whether an included file named [`OUTPUT_FORMAT`].
+struct Includes {
+    dirs: Vec<PathBuf>,
+    names_output_format: bool,
+}
 
 impl IncludeHandler for Includes {
     fn include(
@@ -20,7 +33,7 @@ impl IncludeHandler for Includes {
         _includer: &str,
         _depth: usize,
     ) -> Option<IncludeResult> {
-        self.0.iter().find_map(|dir| {
+        let found = self.dirs.iter().find_map(|dir| {
             let path = dir.join(name);
             let data = std::fs::read_to_string(&path).ok()?;
             println!("cargo:rerun-if-changed={}", path.display());
@@ -28,7 +41,14 @@ impl IncludeHandler for Includes {
                 name: path.to_string_lossy().into_owned(),
                 data,
             })
-        })
+        });
+        if found
+            .as_ref()
+            .is_some_and(|f| f.data.contains(OUTPUT_FORMAT))
+        {
+            self.names_output_format = true;
+        }
+        found
     }
 }
 
@@ -79,27 +99,55 @@ pub fn embed_shaders(dir: &Path, include_dirs: &[PathBuf]) {
             .expect("utf-8 shader name")
             .to_owned();
         let text = std::fs::read_to_string(&path).expect("readable shader");
-        let source = ShaderSource::from(text);
-        let mut includes = Includes(search.clone());
-        let input = ShaderInput::new(
-            &source,
-            stage_of(&path),
-            &options,
-            None::<&[(&str, Option<&str>)]>,
-            Some(&mut includes),
-        )
-        .unwrap_or_else(|e| panic!("{name}: {e}"));
-        let shader = compiler
-            .create_shader(input)
-            .unwrap_or_else(|e| panic!("{name}: {e}"));
-        let words = shader.compile().unwrap_or_else(|e| panic!("{name}: {e}"));
-        let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
-        let file = format!("{name}.spv");
-        std::fs::write(out.join(&file), bytes).expect("write SPIR-V");
-        table.push_str(&format!(
-            "    (\"{name}\", include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{file}\"))),\n"
-        ));
+        let mut includes = Includes {
+            dirs: search.clone(),
+            names_output_format: false,
+        };
+        let words = compile(compiler, &options, &path, &text, &mut includes, None);
+        let mut modules = vec![(name.clone(), words)];
+        if includes.names_output_format || text.contains(OUTPUT_FORMAT) {
+            for value in OUTPUT_FORMAT_VARIANTS {
+                let define = Some((OUTPUT_FORMAT, value));
+                let words = compile(compiler, &options, &path, &text, &mut includes, define);
+                modules.push((format!("{name}@{value}"), words));
+            }
+        }
+        for (name, words) in modules {
+            let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+            let file = format!("{name}.spv");
+            std::fs::write(out.join(&file), bytes).expect("write SPIR-V");
+            table.push_str(&format!(
+                "    (\"{name}\", include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{file}\"))),\n"
+            ));
+        }
     }
     table.push_str("];\n");
     std::fs::write(out.join("shaders.rs"), table).expect("write shader table");
+}
+
+/// The SPIR-V of the shader at `path` (source `text`), with the macro `define` set if given.
+fn compile(
+    compiler: &Compiler,
+    options: &CompilerOptions,
+    path: &Path,
+    text: &str,
+    includes: &mut Includes,
+    define: Option<(&str, &str)>,
+) -> Vec<u32> {
+    let name = path.display();
+    let source = ShaderSource::from(text.to_owned());
+    let defines: Vec<(&str, Option<&str>)> =
+        define.map(|(k, v)| (k, Some(v))).into_iter().collect();
+    let input = ShaderInput::new(
+        &source,
+        stage_of(path),
+        options,
+        Some(defines.as_slice()),
+        Some(includes),
+    )
+    .unwrap_or_else(|e| panic!("{name}: {e}"));
+    let shader = compiler
+        .create_shader(input)
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    shader.compile().unwrap_or_else(|e| panic!("{name}: {e}"))
 }

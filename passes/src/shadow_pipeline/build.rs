@@ -334,13 +334,18 @@ impl ShadowPipeline {
 /// The pipeline's own handle on the engine's image its final pass writes, checked against what that pass
 /// writes.
 fn direct_output(image: &rhi::Image, width: u32, height: u32) -> Result<rhi::Image, PassError> {
-    if image.format() != rhi::Format::R32Float
+    let written = [
+        rhi::Format::R32Float,
+        rhi::Format::R16Float,
+        rhi::Format::R8Unorm,
+    ];
+    if !written.contains(&image.format())
         || image.layers() != 1
         || (image.width(), image.height()) != (width, height)
         || !image.usage().contains(rhi::ImageUsage::STORAGE)
     {
         return Err(PassError::InvalidConfig(format!(
-            "an output written directly must be one R32_SFLOAT layer of {width}x{height} with storage usage, not {:?} {}x{}x{}",
+            "an output written directly must be one R32_SFLOAT, R16_SFLOAT or R8_UNORM layer of {width}x{height} with storage usage, not {:?} {}x{}x{}",
             image.format(),
             image.width(),
             image.height(),
