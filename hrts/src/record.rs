@@ -110,7 +110,7 @@ impl Context {
             .schedules
             .back()
             .filter(|s| continues && s.index == f.frame_index);
-        let schedule = match kept {
+        let mut schedule = match kept {
             Some(_) => None,
             None => Some(self.schedule(&inputs, bounds)),
         };
@@ -216,8 +216,36 @@ impl Context {
         if reads_depth {
             engine_inputs(&mut enc, built, f, true);
         }
+        // The lights' fits first, batched (each phase of every light, then one barrier), when several
+        // build their maps in this call: their passes then record the lists alone.
         let mut outcome = Ok(());
+        if reads_depth && passes.contains(&PassId::PrimitiveMap) {
+            let (lights, mut pipelines): (Vec<usize>, Vec<&mut passes::ShadowPipeline>) =
+                built.scheduled_mut(&recorded).unzip();
+            match self
+                .fit_batch
+                .record(&mut enc, frame_index, &mut pipelines, &passes)
+            {
+                Ok(fitted) => {
+                    let frame_lights = match schedule.as_mut() {
+                        Some(lights) => Some(lights),
+                        None => self.schedules.back_mut().map(|s| &mut s.lights),
+                    };
+                    if let Some(frame_lights) = frame_lights {
+                        for i in fitted {
+                            if let Some(l) = frame_lights.get_mut(lights[i]) {
+                                l.fits_batched += 1;
+                            }
+                        }
+                    }
+                }
+                Err(e) => outcome = Err(e),
+            }
+        }
         for (_, pipeline) in built.scheduled_mut(&recorded) {
+            if outcome.is_err() {
+                break;
+            }
             outcome = pipeline.record_passes(&mut enc, &passes);
             if outcome.is_err() {
                 break;

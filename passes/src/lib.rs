@@ -52,8 +52,8 @@ pub use primitive_map::{
 };
 pub use shadow_map::ShadowMapConfig;
 pub use shadow_pipeline::{
-    camera_in_frame, FrameInputs, FrameReport, ResourceReport, ShadowConfig, ShadowInputs,
-    ShadowPipeline, MAX_FRAMES_IN_FLIGHT,
+    camera_in_frame, FitBatch, FrameInputs, FrameReport, ResourceReport, ShadowConfig,
+    ShadowInputs, ShadowPipeline, FIT_BATCH_PASS, MAX_FRAMES_IN_FLIGHT,
 };
 pub use surface::{NormalEncoding, NormalSpace, SurfaceInput};
 pub use view_cull::{Casters, ViewVolume};

@@ -21,6 +21,9 @@ pub(crate) struct LightSchedule {
     pub(crate) names: Vec<&'static str>,
     /// The mode auto chose for the light and why ([`ShadowConfig::auto_reason`]); `None` for a mode given.
     pub(crate) auto: Option<&'static str>,
+    /// How many of its frusta had their primitive-map fit recorded in the frame's batch
+    /// ([`passes::FitBatch`]).
+    pub(crate) fits_batched: u32,
 }
 
 impl LightSchedule {
@@ -170,6 +173,7 @@ impl Context {
                 LightSchedule {
                     kind: light.kind,
                     auto: config.auto_reason(directional),
+                    fits_batched: 0,
                     recorded: light
                         .frusta
                         .iter()
@@ -272,6 +276,7 @@ mod tests {
             recorded: vec![true],
             names: vec!["whole"],
             auto: config.auto_reason(kind == HrtsLightType::Directional),
+            fits_batched: 0,
         };
         let (decision, reason) = schedule(HrtsLightType::Directional, &auto).decision();
         assert_eq!(decision, HrtsLightDecision::Shadowed);

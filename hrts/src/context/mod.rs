@@ -15,7 +15,8 @@ use crate::version::{major_minor, OLDEST_MINOR};
 use lights::FrameSchedule;
 use passes::retire::RetireQueue;
 use passes::{
-    BinningRequest, MinCombine, ShadowConfig, ShadowPipeline, SharedGeometry, SurfaceInput,
+    BinningRequest, FitBatch, MinCombine, ShadowConfig, ShadowPipeline, SharedGeometry,
+    SurfaceInput,
 };
 use rhi::{Device, Image};
 use std::sync::Arc;
@@ -67,9 +68,8 @@ pub(crate) struct Built {
     /// How the passes decode the normal.
     pub(crate) surface: SurfaceInput,
     pub(crate) output: Image,
-    /// Each layer of the output, when lights may write theirs directly (`R32_SFLOAT`, `R16_SFLOAT` or `R8_UNORM`
-    /// with storage usage);
-    /// empty otherwise.
+    /// Each layer of the output, when lights may write theirs directly (`R32_SFLOAT`, `R16_SFLOAT` or
+    /// `R8_UNORM` with storage usage); empty otherwise.
     pub(crate) output_layers: Vec<Image>,
 }
 
@@ -175,6 +175,8 @@ pub(crate) struct Context {
     pub(crate) frusta: Vec<LightShape>,
     /// Which frusta the last `frames_in_flight` frames recorded, oldest first.
     pub(crate) schedules: std::collections::VecDeque<FrameSchedule>,
+    /// The lights' primitive-map fits recorded together, timed per frame in flight.
+    pub(crate) fit_batch: FitBatch,
 }
 
 impl Context {
@@ -213,6 +215,7 @@ impl Context {
             }
         };
         let device = crate::adopt::device(info)?;
+        let fit_batch = FitBatch::new(&device, frames_in_flight)?;
         Ok(Self {
             built: None,
             retired: RetireQueue::default(),
@@ -230,6 +233,7 @@ impl Context {
             light_builds: vec![0],
             frusta: vec![LightShape::default()],
             schedules: Default::default(),
+            fit_batch,
         })
     }
 

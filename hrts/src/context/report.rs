@@ -5,8 +5,9 @@ use super::Context;
 use crate::convert::{binning_path_to_c, resource_id, resource_index, RESOURCES};
 use crate::error::{invalid, ApiError, ApiResult};
 use crate::types::*;
-use passes::{FrameReport, PassStatus, ResourceId, ShadowPipeline, SkipReason};
+use passes::{FrameReport, PassStatus, ResourceId, ShadowPipeline, SkipReason, FIT_BATCH_PASS};
 use rhi::Format;
+use rhi::PassTiming;
 
 impl Context {
     pub(crate) fn report(
@@ -22,10 +23,8 @@ impl Context {
             )
         })?;
         let passes = built.light(light)?;
-        let schedule = self
-            .schedules
-            .iter()
-            .find(|s| s.index == frame_index)
+        let frame_schedule = self.schedules.iter().find(|s| s.index == frame_index);
+        let schedule = frame_schedule
             .and_then(|s| s.lights.get(light as usize))
             .filter(|s| s.recorded.len() == passes.frusta.len())
             .ok_or_else(|| {
@@ -78,7 +77,31 @@ impl Context {
         out.map_to_texels = reports
             .first()
             .map_or([0.0; 16], |r| r.map_to_texels.to_cols_array());
-        let timings: Vec<_> = reports.iter().flat_map(|r| &r.timings).collect();
+        // The light's share of the frame's batched fits: the batch's time over the frusta it fitted.
+        let batched_total: u32 =
+            frame_schedule.map_or(0, |s| s.lights.iter().map(|l| l.fits_batched).sum());
+        let batch_share = if schedule.fits_batched > 0 {
+            let ms = self
+                .fit_batch
+                .milliseconds(frame_index)
+                .map_err(|e| ApiError::new(HrtsResult::ErrorInternal, e.to_string()))?
+                .ok_or_else(|| {
+                    ApiError::new(
+                        HrtsResult::NotReady,
+                        format!("frame {frame_index} has not completed on the GPU: ask after its fence signalled"),
+                    )
+                })?;
+            Some(PassTiming {
+                name: FIT_BATCH_PASS.to_owned(),
+                ms: ms * f64::from(schedule.fits_batched) / f64::from(batched_total.max(1)),
+            })
+        } else {
+            None
+        };
+        let timings: Vec<_> = batch_share
+            .iter()
+            .chain(reports.iter().flat_map(|r| &r.timings))
+            .collect();
         out.pass_count = timings.len().min(HRTS_MAX_REPORTED_PASSES) as u32;
         for (slot, t) in out.passes.iter_mut().zip(&timings) {
             slot.name = [0; 32];

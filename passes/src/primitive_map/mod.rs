@@ -90,6 +90,33 @@ pub(super) struct MapPipelines {
     pub(super) occupancy: ComputePipeline,
 }
 
+/// A phase of the fit of a primitive map's grid ([`PrimitiveMap::record_fit_phase`]), in this order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FitPhase {
+    /// The frame's constants and the state reset (transfers).
+    Reset,
+    /// The receivers' light-space bounds (storage writes).
+    Bounds,
+    /// The grid fitted to the bounds (storage writes).
+    Grid,
+}
+
+impl FitPhase {
+    /// The phases in their order.
+    pub const ALL: [FitPhase; 3] = [FitPhase::Reset, FitPhase::Bounds, FitPhase::Grid];
+
+    /// The barrier that makes the phase's writes visible to the next (and the fit to storage reads).
+    pub fn barrier_after(self) -> Barrier<'static> {
+        match self {
+            FitPhase::Reset => Barrier::Global {
+                before: S::CopyDest,
+                after: S::UnorderedAccess,
+            },
+            FitPhase::Bounds | FitPhase::Grid => Barrier::Uav,
+        }
+    }
+}
+
 /// The primitive map's resources and passes.
 pub struct PrimitiveMap {
     config: PrimitiveMapConfig,
@@ -456,9 +483,67 @@ impl PrimitiveMap {
     }
 
     /// Records the build of the lists for this frame's receivers, through the light's `frusta`
-    /// view-projections in frame coordinates (one, or a cube's six). Depth and normal must be in
-    /// `ShaderResource` state; the map's buffers are visible to storage reads afterwards.
+    /// view-projections in frame coordinates (one, or a cube's six): the fit ([`FitPhase::ALL`]), then
+    /// [`PrimitiveMap::record_lists`]. Depth and normal must be in `ShaderResource` state; the map's buffers
+    /// are visible to storage reads afterwards.
     pub fn record(
+        &mut self,
+        enc: &mut Encoder<'_>,
+        constants: &RayTraceConstants,
+        push: &MapPush,
+        frusta: &[glam::Mat4],
+    ) -> Result<(), PassError> {
+        enc.begin_pass("primitive map: fit");
+        let fitted: Result<(), PassError> = FitPhase::ALL.into_iter().try_for_each(|phase| {
+            self.record_fit_phase(enc, phase, constants, push, frusta)?;
+            enc.barriers(&[phase.barrier_after()]);
+            Ok(())
+        });
+        enc.end_pass();
+        fitted?;
+        self.record_lists(enc)
+    }
+
+    /// Records one phase of the fit of the map's grid to this frame's receivers. The phases touch only the
+    /// map's own buffers (never the scratch the maps over one geometry share), so several maps' phases may
+    /// be recorded together, each phase of every map followed by one [`FitPhase::barrier_after`]. The frame's
+    /// constants, push constants and frusta are read by [`FitPhase::Reset`], which must come first.
+    pub fn record_fit_phase(
+        &mut self,
+        enc: &mut Encoder<'_>,
+        phase: FitPhase,
+        constants: &RayTraceConstants,
+        push: &MapPush,
+        frusta: &[glam::Mat4],
+    ) -> Result<(), PassError> {
+        match phase {
+            FitPhase::Reset => self.record_fit_reset(enc, constants, push, frusta),
+            FitPhase::Bounds => {
+                let push = self.fit_push()?;
+                self.dispatch_receivers(enc, &push, 0)
+            }
+            FitPhase::Grid => {
+                let push = self.fit_push()?;
+                enc.dispatch(
+                    &self.pipes.fit,
+                    &self.fit_group,
+                    bytemuck::bytes_of(&push),
+                    [1, 1, 1],
+                )?;
+                Ok(())
+            }
+        }
+    }
+
+    /// The push constants of the frame whose fit was reset.
+    fn fit_push(&self) -> Result<MapPush, PassError> {
+        self.last_push.ok_or_else(|| {
+            PassError::InvalidConfig("the map's fit was not reset this frame".into())
+        })
+    }
+
+    /// Writes the frame's constants and resets the map's state (and the guard over its entries).
+    fn record_fit_reset(
         &mut self,
         enc: &mut Encoder<'_>,
         constants: &RayTraceConstants,
@@ -478,11 +563,9 @@ impl PrimitiveMap {
             ray: *constants,
             frusta: all,
         };
-        enc.update_buffer(&self.constants, 0, bytemuck::bytes_of(&map_constants))?;
-        let n = self.config.size;
         let cube = self.config.cube;
         let push = MapPush {
-            size: n,
+            size: self.config.size,
             triangles: self.triangles,
             capacity: self.capacity,
             tile_threads: BIN_THREADS,
@@ -501,13 +584,9 @@ impl PrimitiveMap {
             count_scale: self.config.debug_count_scale,
             ..*push
         };
-        let with_mode = |mode| MapPush { mode, ..push };
-
         let reset: Vec<MapState> = (0..self.config.frusta() as usize)
             .map(|f| MapState::reset(f, push.capacity, push.pairs))
             .collect();
-
-        enc.begin_pass("primitive map: fit");
         // The state's last read was the previous build's copy into its read-back (a transfer).
         enc.barriers(&[
             Barrier::Global {
@@ -519,37 +598,45 @@ impl PrimitiveMap {
                 after: S::CopyDest,
             },
         ]);
+        enc.update_buffer(&self.constants, 0, bytemuck::bytes_of(&map_constants))?;
         enc.update_buffer(&self.state, 0, bytemuck::cast_slice(&reset))?;
-        enc.fill_buffer(&self.receivers, 0);
-        enc.fill_buffer(&self.bound.scratch.counts, 0);
-        enc.fill_buffer(&self.bound.scratch.capped, 0);
         if self.config.guard {
             enc.fill_buffer(&self.entries, GUARD_VALUE);
         }
-        enc.barriers(&[Barrier::Global {
-            before: S::CopyDest,
-            after: S::UnorderedAccess,
-        }]);
-        self.dispatch_receivers(enc, &push, 0)?;
-        enc.barriers(&[Barrier::Uav]);
-        enc.dispatch(
-            &self.pipes.fit,
-            &self.fit_group,
-            bytemuck::bytes_of(&push),
-            [1, 1, 1],
-        )?;
-        enc.barriers(&[Barrier::Uav]);
-        enc.end_pass();
-
         self.last_push = Some(push);
+        Ok(())
+    }
+
+    /// Records the lists' build after the fit ([`PrimitiveMap::record_fit_phase`]): the receivers marked, the setup, the
+    /// count, the scan and the fill, through the scratch the maps over one geometry share (cleared first).
+    pub fn record_lists(&mut self, enc: &mut Encoder<'_>) -> Result<(), PassError> {
+        let push = self.fit_push()?;
+        let with_mode = |mode| MapPush { mode, ..push };
         self.pixel_texels
             .writer
             .store(self.id, std::sync::atomic::Ordering::Relaxed);
         enc.begin_pass("primitive map: receivers");
+        // The shared scratch's last use was the previous build's storage reads (or a read-back's copy).
+        enc.barriers(&[
+            Barrier::Global {
+                before: S::UnorderedAccess,
+                after: S::CopyDest,
+            },
+            Barrier::Global {
+                before: S::CopySource,
+                after: S::CopyDest,
+            },
+        ]);
+        enc.fill_buffer(&self.receivers, 0);
+        enc.fill_buffer(&self.bound.scratch.counts, 0);
+        enc.fill_buffer(&self.bound.scratch.capped, 0);
+        enc.barriers(&[Barrier::Global {
+            before: S::CopyDest,
+            after: S::UnorderedAccess,
+        }]);
         self.dispatch_receivers(enc, &push, 1)?;
         enc.barriers(&[Barrier::Uav]);
         enc.end_pass();
-
         enc.begin_pass("primitive map: setup");
         enc.dispatch(
             &self.pipes.setup,

@@ -228,6 +228,7 @@ impl ShadowPipeline {
             next: 0,
             timer_started: false,
             marked: false,
+            map_fitted: false,
         });
         Ok(())
     }

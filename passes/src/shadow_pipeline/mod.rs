@@ -11,12 +11,14 @@
 //! `frame` (beginning a frame: constants and schedule), `record` (recording the passes with their
 //! barriers), `report` (what a completed frame did).
 
+mod batch;
 mod build;
 mod config;
 mod frame;
 mod record;
 mod report;
 
+pub use batch::{FitBatch, FIT_BATCH_PASS};
 pub use config::{FrameInputs, ShadowConfig, ShadowInputs, MAX_FRAMES_IN_FLIGHT};
 pub use report::{FrameReport, ResourceReport};
 
@@ -61,6 +63,9 @@ struct FrameState {
     timer_started: bool,
     /// Whether the frame's completion marker is recorded.
     marked: bool,
+    /// Whether the primitive map's fit was recorded ahead of the pass, batched with other lights'
+    /// ([`FitBatch`]): the pass then records the lists alone.
+    map_fitted: bool,
 }
 
 /// What the ring keeps of one frame in flight: its GPU timer, the map state read back, and its schedule.

@@ -3,6 +3,7 @@
 use super::{FrameInputs, FrameState, RetiredMap, ShadowPipeline};
 use crate::frame_plan::{PassId, PassStatus, ResourceSet};
 use crate::gpu_types::ShadowMapPush;
+use crate::primitive_map::FitPhase;
 use crate::PassError;
 use rhi::{Barrier, Device, Encoder, Image, ResourceState as S};
 
@@ -78,6 +79,67 @@ impl ShadowPipeline {
         if let Some(frame) = &self.frame {
             enc.continue_timer(&self.slots[frame.slot].timer);
         }
+    }
+
+    /// Whether a recording of `passes` (accepted by [`ShadowPipeline::check_record`]) builds the primitive
+    /// map and its fit may be recorded ahead ([`ShadowPipeline::record_map_fit`]): the pass runs this frame
+    /// and is neither recorded nor fitted yet.
+    pub fn fits_map_in(&self, passes: &[PassId]) -> bool {
+        let map = PassId::PrimitiveMap;
+        self.map.is_some()
+            && passes.contains(&map)
+            && self.statuses[map as usize].1 == PassStatus::Ran
+            && self
+                .frame
+                .as_ref()
+                .is_some_and(|f| f.next <= map as usize && !f.map_fitted)
+    }
+
+    /// Records `phase` of the primitive map's fit ahead of the primitive-map pass, which then records the
+    /// lists alone; for a light whose map [`ShadowPipeline::fits_map_in`] the call's passes. Every phase
+    /// touches only this light's own buffers (and reads depth and normal, in `ShaderResource` state), so
+    /// several lights' phases may be recorded together, each phase of every light followed by one
+    /// [`FitPhase::barrier_after`] ([`super::FitBatch`] does).
+    pub fn record_map_fit(
+        &mut self,
+        enc: &mut Encoder<'_>,
+        phase: FitPhase,
+    ) -> Result<(), PassError> {
+        let Some(mut frame) = self.frame.take() else {
+            return Err(PassError::InvalidConfig(
+                "no frame: call begin_frame first".into(),
+            ));
+        };
+        let outcome = self.record_map_fit_in(enc, &mut frame, phase);
+        self.frame = Some(frame);
+        outcome
+    }
+
+    fn record_map_fit_in(
+        &mut self,
+        enc: &mut Encoder<'_>,
+        frame: &mut FrameState,
+        phase: FitPhase,
+    ) -> Result<(), PassError> {
+        if phase == FitPhase::Reset {
+            if frame.map_fitted || frame.next > PassId::PrimitiveMap as usize {
+                return Err(PassError::InvalidConfig(
+                    "the primitive map's fit is already recorded this frame".into(),
+                ));
+            }
+            self.grow_map(enc.device(), frame.index)?;
+            frame.map_fitted = true;
+        } else if !frame.map_fitted {
+            return Err(PassError::InvalidConfig(
+                "the primitive map's fit must begin with its reset".into(),
+            ));
+        }
+        let c = &frame.constants;
+        let map = self
+            .map
+            .as_mut()
+            .ok_or_else(|| PassError::InvalidConfig("the plan has no primitive map".into()))?;
+        map.record_fit_phase(enc, phase, &c.ray, &c.map, c.light.frusta())
     }
 
     /// Whether [`ShadowPipeline::record_passes`] would accept `passes` now (without recording anything).
@@ -236,7 +298,11 @@ impl ShadowPipeline {
             PassId::PrimitiveMap => {
                 self.grow_map(enc.device(), frame.index)?;
                 if let Some(map) = self.map.as_mut() {
-                    map.record(enc, &c.ray, &c.map, c.light.frusta())?;
+                    if frame.map_fitted {
+                        map.record_lists(enc)?;
+                    } else {
+                        map.record(enc, &c.ray, &c.map, c.light.frusta())?;
+                    }
                 }
             }
             PassId::Occupancy => {
