@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The benchmark tables of docs/benchmarks.md, generated from one run on a machine with a GPU (the device
 # tool's H100): the hybrid over every model with the ray-tracing-pipeline peer, local lights hard and
-# sized (the emitter's radius a share of the scene's extent) with the peer at equal samples, 16 lights at
-# once, area shadows against PCSS 8K, the binning matrix, and a 1080p render of the built-in scene.
+# sized (the emitter's radius a share of the scene's extent) with the peer at equal samples, 16 and 64
+# lights at once, area shadows against PCSS 8K, the binning matrix, and a 1080p render of the built-in scene.
 #
 # Writes into $OUT (default out/gpu): each report's output (NAME.txt) and progress (NAME.log), the render's frame.json
 # and preview, and benchmarks.md, the assembled page (device, driver, commit and date in its header; the
@@ -23,6 +23,7 @@ sections=(
     "render|A frame of the built-in scene (hybrid, 1920×1080)|render --width 1920 --height 1080 --frames 30 --out DIR"
     "bench|Hard and hybrid shadows on every model, against the ray-tracing pipeline|bench --frames 30 --no-reference"
     "lights_hard|Hard shadows of each kind of light inside two buildings, and 16 point lights at once|bench --lights --point-lights 16 --frames 20"
+    "lights_hard_64|64 point lights at once, with their memory and the per-pass split|bench --lights --point-lights 64 --frames 20"
     "lights_area|Exact soft shadows of sized lights, from 0.25 % to 8 % of the scene's extent, against the ray-tracing pipeline at equal samples|bench --lights --emitter-size 0.0025,0.01,0.02,0.04,0.08 --frames 10"
     "lights_area_16|16 sized point lights at once (0.25 % of the extent)|bench --lights --point-lights 16 --emitter-size 0.0025 --frames 10"
     "area|Exact soft shadows of a sized sun against PCSS with an 8K shadow map|bench --area --frames 10 --no-reference"
