@@ -92,15 +92,6 @@ pub const NEAR_FRACTION_OF_RANGE: f32 = 1.0 / 1024.0;
 /// Near plane (world units) of a fitted projection for a light of unlimited range.
 pub const DEFAULT_LOCAL_NEAR: f32 = 0.01;
 
-/// An up direction for a view along `forward` (unit): +Y unless `forward` is within about 1° of ±Y, then +Z.
-fn up_hint(forward: Vec3) -> Vec3 {
-    if forward.y.abs() > 1f32.to_radians().cos() {
-        Vec3::Z
-    } else {
-        Vec3::Y
-    }
-}
-
 /// The near plane of a projection fitted for a local light of `range` (`None`: unlimited).
 fn fitted_near(range: Option<f32>) -> f32 {
     range.map_or(DEFAULT_LOCAL_NEAR, |r| r * NEAR_FRACTION_OF_RANGE)
@@ -168,9 +159,15 @@ pub fn spot_light_frusta(
     let near = fitted_near(range);
     if outer_cone <= MAX_SINGLE_FRUSTUM_CONE {
         let tan_half = outer_cone.tan() * CUBE_FACE_TAN_HALF;
-        return vec![perspective(position, axis, up_hint(axis), tan_half, near)];
+        return vec![perspective(
+            position,
+            axis,
+            light_fit::up_hint(axis),
+            tan_half,
+            near,
+        )];
     }
-    let right = axis.cross(up_hint(axis)).normalize();
+    let right = axis.cross(light_fit::up_hint(axis)).normalize();
     let up = right.cross(axis);
     [
         (axis, up),
@@ -184,18 +181,15 @@ pub fn spot_light_frusta(
     .collect()
 }
 
-/// Smallest radius (world units) of the bounding sphere a directional light's frustum is fitted around, so
-/// that bounds of a single point still have an extent.
-const MIN_FIT_RADIUS: f32 = 1e-4;
-
 /// A directional light travelling along `direction`, with the orthographic frustum the plugin fits to the
 /// scene's `bounds` (world-space min and max corners): their light-space x/y range maps exactly onto clip
 /// `[-1, 1]²`, and their depth range, widened by 1% on both sides plus a tiny margin, onto depth `[0, 1]`
 /// (near to far, standard depth). The light's view looks at the centre of the bounds' bounding sphere from
 /// twice its radius away, +Y up unless the direction is within about 1° of ±Y (then +Z). Degenerate extents
 /// (flat bounds seen edge-on, a single point) are widened to the tiny margin: 1e-4 of the sphere's radius
-/// plus 1e-5 of the centre's largest coordinate. The same construction, in the same f32 arithmetic, as
-/// `scene::DirectionalLight::view_proj`: a host fitting the same bounds gets the same matrix. `direction` is
+/// plus 1e-5 of the centre's largest coordinate. The construction is [`light_fit::directional_view_proj`],
+/// which `scene::DirectionalLight::view_proj` calls too: a host fitting the same bounds gets the same
+/// matrix. `direction` is
 /// kept as given in the light (the passes normalise it in f64).
 ///
 /// # Errors
@@ -214,46 +208,16 @@ pub fn directional_light_frustum(direction: Vec3, bounds: [Vec3; 2]) -> Result<L
             "the bounds a directional light's frustum is fitted to must be finite with min not above max, got {lo} to {hi}"
         )));
     }
-    let center = (lo + hi) * 0.5;
-    let radius = (hi - lo).length() * 0.5;
+    let (center, radius) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
     if !(center.is_finite() && radius.is_finite()) {
         return Err(invalid(&format!(
             "the bounds {lo} to {hi} are too large to fit a directional light's frustum to"
         )));
     }
-    let radius = radius.max(MIN_FIT_RADIUS);
-    let view = Mat4::look_at_rh(center - unit * radius * 2.0, center, up_hint(unit));
-    let epsilon = radius * 1e-4 + center.abs().max_element() * 1e-5;
-    let (mut min, mut max) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-    for i in 0..8 {
-        let corner = Vec3::new(
-            if i & 1 == 0 { lo.x } else { hi.x },
-            if i & 2 == 0 { lo.y } else { hi.y },
-            if i & 4 == 0 { lo.z } else { hi.z },
-        );
-        let p = view.transform_point3(corner);
-        min = min.min(p);
-        max = max.max(p);
-    }
-    let (left, right) = at_least(min.x, max.x, epsilon);
-    let (bottom, top) = at_least(min.y, max.y, epsilon);
-    let (near, far) = (-max.z, -min.z);
-    let margin = (far - near) * 0.01 + epsilon;
     Ok(Light::Directional {
         direction,
-        view_proj: Mat4::orthographic_rh(left, right, bottom, top, near - margin, far + margin)
-            * view,
+        view_proj: light_fit::directional_view_proj(unit, lo, hi),
     })
-}
-
-/// The interval `[lo, hi]`, widened symmetrically to `min_extent` if it is narrower.
-fn at_least(lo: f32, hi: f32, min_extent: f32) -> (f32, f32) {
-    if hi - lo >= min_extent {
-        (lo, hi)
-    } else {
-        let mid = (lo + hi) * 0.5;
-        (mid - min_extent * 0.5, mid + min_extent * 0.5)
-    }
 }
 
 /// Relative tolerance of the checks that a matrix matches the light it is given for.

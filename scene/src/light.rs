@@ -30,51 +30,26 @@ impl DirectionalLight {
 
     /// Light view matrix: `Mat4::look_at_rh(center - direction * r * 2, center, up)` for the
     /// bounding sphere (`center`, `r`) of `bounds`, with `up = +Y` unless the direction is within
-    /// about 1° of ±Y, then `+Z`.
+    /// about 1° of ±Y, then `+Z` ([`light_fit::directional_view`]).
     pub fn view(&self, bounds: &Aabb) -> Mat4 {
-        let cos_1_degree = 1f32.to_radians().cos();
-        let direction = self.unit_direction();
         let (center, radius) = bounds.bounding_sphere();
-        let up = if direction.y.abs() > cos_1_degree {
-            Vec3::Z
-        } else {
-            Vec3::Y
-        };
-        Mat4::look_at_rh(center - direction * radius * 2.0, center, up)
+        light_fit::directional_view(self.unit_direction(), center, radius)
     }
 
-    /// Orthographic light view-projection tightly enclosing the corners of `bounds`: their light
-    /// view-space x/y range maps exactly onto clip `[-1, 1]^2`, and their depth range, widened by
-    /// 1% on both sides plus a tiny margin, onto Vulkan depth `[0, 1]` (near to far). Degenerate
-    /// extents (a flat scene seen edge-on, a single point) are widened by that tiny margin too.
+    /// Orthographic light view-projection tightly enclosing the corners of `bounds` (a unit box if they
+    /// are empty or not finite): their light view-space x/y range maps exactly onto clip `[-1, 1]^2`, and
+    /// their depth range, widened by 1% on both sides plus a tiny margin, onto Vulkan depth `[0, 1]` (near
+    /// to far). Degenerate extents (a flat scene seen edge-on, a single point) are widened by that tiny
+    /// margin too. The plugin's own fit ([`light_fit::directional_view_proj`]): the matrix the plugin
+    /// chooses for a sun given no matrix and the same bounds.
     pub fn view_proj(&self, bounds: &Aabb) -> Mat4 {
-        let view = self.view(bounds);
-        let (center, radius) = bounds.bounding_sphere();
-        let epsilon = radius * 1e-4 + center.abs().max_element() * 1e-5;
-        let mut light_space = Aabb::empty();
-        for corner in bounds.or_unit().corners() {
-            light_space.extend(view.transform_point3(corner));
-        }
-        let (left, right) = at_least(light_space.min.x, light_space.max.x, epsilon);
-        let (bottom, top) = at_least(light_space.min.y, light_space.max.y, epsilon);
-        let (near, far) = (-light_space.max.z, -light_space.min.z);
-        let margin = (far - near) * 0.01 + epsilon;
-        Mat4::orthographic_rh(left, right, bottom, top, near - margin, far + margin) * view
+        let b = bounds.or_unit();
+        light_fit::directional_view_proj(self.unit_direction(), b.min, b.max)
     }
 
     /// `direction`, normalised; straight down if it is unusable.
     fn unit_direction(&self) -> Vec3 {
         self.direction.try_normalize().unwrap_or(Vec3::NEG_Y)
-    }
-}
-
-/// The interval `[lo, hi]`, widened symmetrically to at least `min_extent` if it is narrower.
-fn at_least(lo: f32, hi: f32, min_extent: f32) -> (f32, f32) {
-    if hi - lo >= min_extent {
-        (lo, hi)
-    } else {
-        let mid = (lo + hi) * 0.5;
-        (mid - min_extent * 0.5, mid + min_extent * 0.5)
     }
 }
 

@@ -1162,6 +1162,34 @@ fn native_frame(
     (reports, layers)
 }
 
+/// The frustum the plugin fits to a directional light given without a matrix is, bit for bit, the host's
+/// own (`scene::DirectionalLight::view_proj`) for the same bounds, far from the origin and flat ones too:
+/// both wrap `light_fit::directional_view_proj`.
+#[test]
+fn the_plugins_directional_fit_is_the_scenes() {
+    let near = scene::procedural_default();
+    let far = near.translated(Vec3::new(300.0, -20.0, 1e3));
+    let flat = scene::Scene::axis_box("flat", Vec3::new(-2.0, 1.0, -3.0), Vec3::new(4.0, 1.0, 1.0));
+    for s in [&near, &far, &flat] {
+        let bounds = s.bounds();
+        for direction in [
+            Vec3::new(0.3, -1.0, 0.2).normalize(),
+            Vec3::NEG_Y,
+            Vec3::new(0.001, -1.0, 0.0),
+            Vec3::new(-1.0, -0.05, 0.2),
+        ] {
+            let host = scene::DirectionalLight { direction }.view_proj(&bounds);
+            let plugin = passes::directional_light_frustum(direction, [bounds.min, bounds.max])
+                .expect("fitted");
+            assert_eq!(
+                plugin.view_proj().to_cols_array().map(f32::to_bits),
+                host.to_cols_array().map(f32::to_bits),
+                "{direction}"
+            );
+        }
+    }
+}
+
 /// A sun given without a matrix (`view_proj: None`, the C ABI's directional light with `view_proj` all
 /// zeros): the plugin fits its frustum to the frame's bounds, and its visibility is the same, pixel for
 /// pixel, as the same sun's given the host's own fitted matrix (`scene::DirectionalLight::view_proj` of the

@@ -17,7 +17,7 @@
 //! A shadowed light is one light of the plugin, given as a light, without a matrix:
 //! - a directional light by its direction (`HRTS_LIGHT_TYPE_DIRECTIONAL` with no matrix): the plugin
 //!   fits one orthographic frustum enclosing the scene's bounds every frame
-//!   ([`passes::directional_light_frustum`], the construction of `scene::DirectionalLight::view_proj`);
+//!   (`light_fit::directional_view_proj`, which `scene::DirectionalLight::view_proj` calls too);
 //! - a spot light by its position, axis, cone and range (`HRTS_LIGHT_TYPE_SPOT` with no matrix): the
 //!   plugin fits one perspective frustum to a cone up to 60°, the five cube faces around its axis to a
 //!   wider one;
@@ -689,36 +689,6 @@ mod tests {
             text.contains("config: auto: hard (zero-size light), FXAA on"),
             "{text}"
         );
-    }
-
-    /// The frustum the plugin fits to a directional light given without a matrix is the one the scene's
-    /// own construction gives ([`scene::DirectionalLight::view_proj`]), bit for bit, for the bounds the
-    /// demo gives the plugin with every frame (the scene's).
-    #[test]
-    fn the_plugins_directional_fit_is_the_scenes() {
-        let file = ground_and_box(Vec::new());
-        let mut example = ground_and_box(Vec::new());
-        example.scene = example.scene.translated(Vec3::new(300.0, -20.0, 1e3));
-        let flat =
-            scene::Scene::axis_box("flat", Vec3::new(-2.0, 1.0, -3.0), Vec3::new(4.0, 1.0, 1.0));
-        for scene in [&file.scene, &example.scene, &flat] {
-            let bounds = scene.bounds();
-            for direction in [
-                Vec3::new(0.3, -1.0, 0.2).normalize(),
-                Vec3::NEG_Y,
-                Vec3::new(0.001, -1.0, 0.0),
-                Vec3::new(-1.0, -0.05, 0.2),
-            ] {
-                let host = scene::DirectionalLight { direction }.view_proj(&bounds);
-                let plugin = passes::directional_light_frustum(direction, [bounds.min, bounds.max])
-                    .expect("fitted");
-                assert_eq!(
-                    plugin.view_proj().to_cols_array().map(f32::to_bits),
-                    host.to_cols_array().map(f32::to_bits),
-                    "{direction}"
-                );
-            }
-        }
     }
 
     #[test]
