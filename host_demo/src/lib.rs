@@ -1,9 +1,10 @@
 //! The standalone demo host as a library: scene setup shared by the `host_demo` binary and the
 //! integration tests, so that what the tests check is what the demo shows.
 //!
-//! The demo's own G-buffer ([`gbuffer`], shaders in `host_demo/shaders/` embedded at build time) and
-//! the frame that drives it with a [`passes::ShadowPipeline`] ([`ShadowRenderer`]) live here, not in
-//! the shipped `passes` library: an engine brings its own G-buffer.
+//! The demo's own G-buffer ([`gbuffer`], shaders in `host_demo/shaders/` embedded at build time) lives
+//! here, not in the shipped `passes` library: an engine brings its own G-buffer. (The frame that drives
+//! one `passes::ShadowPipeline` directly, which the tests compare the plugin with, is the `test_support`
+//! crate's.)
 //!
 //! A glTF scene's lights decide its shadows: [`scene_plan`] derives, without a GPU, which shadow each
 //! light gets and through which frusta; [`scene_render`] renders them through the plugin and reports per
@@ -48,7 +49,7 @@ use rhi::Device;
 use scene::{Aabb, Camera, DirectionalLight, Scene};
 
 pub use progress::progress;
-pub use renderer::{read_images, FrameImages, FrameOutput, ShadowRenderer};
+pub use renderer::{read_images, FrameImages, FrameOutput};
 
 mod shaders {
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));

@@ -1,14 +1,10 @@
-//! The demo host's frame: prim buffer → G-buffer → [`ShadowPipeline`], submitted and waited for, with
-//! read-back of every output the plan produced.
+//! What the demo reads back of a frame: the G-buffer and the plugin's outputs ([`FrameImages`]), and the
+//! read-back itself.
 
-use crate::gbuffer::{GBufferLayout, GBufferPass, GBufferPush, GBufferTargets};
-use crate::CameraMatrices;
+use crate::gbuffer::GBufferTargets;
 use glam::DVec3;
-use passes::{
-    FrameInputs, FrameReport, Geometry, PassError, PassId, ResourceId, ShadowConfig, ShadowInputs,
-    ShadowMode, ShadowPipeline,
-};
-use rhi::{Barrier, Buffer, BufferUsage, Device, Image, MemoryLocation, ResourceState as S};
+use passes::{PassError, ResourceId, ShadowConfig, ShadowMode};
+use rhi::{Barrier, BufferUsage, Device, Image, MemoryLocation, ResourceState as S};
 
 /// Everything the frame produced, read back to the host. Row-major, y = 0 at the top. Outputs the plan
 /// did not produce are empty.
@@ -42,130 +38,6 @@ pub struct FrameImages {
     pub hybrid: Vec<f32>,
     /// The pipeline's final output ([`ShadowPipeline::output`]).
     pub output: Vec<f32>,
-}
-
-/// The demo frame: a G-buffer of its own plus the engine-facing [`ShadowPipeline`].
-pub struct ShadowRenderer {
-    targets: GBufferTargets,
-    gbuffer: GBufferPass,
-    pipeline: ShadowPipeline,
-}
-
-impl ShadowRenderer {
-    /// Creates every pass for a `width` x `height` frame over `geometry`. The plan of `config` also keeps
-    /// the prim buffer, which this G-buffer rasterizes.
-    pub fn new(
-        device: &Device,
-        geometry: Geometry,
-        width: u32,
-        height: u32,
-        config: impl Into<ShadowConfig>,
-    ) -> Result<Self, PassError> {
-        if width == 0 || height == 0 {
-            return Err(PassError::InvalidConfig(
-                "frame size must be non-zero".into(),
-            ));
-        }
-        let mut config = with_blocker_distance(config.into());
-        config.extra_outputs = config.extra_outputs.with(ResourceId::PrimBuffer);
-        let targets = GBufferTargets::new(device, width, height, GBufferLayout::ANALYSIS)?;
-        let inputs = ShadowInputs {
-            depth: &targets.depth,
-            normal: &targets.normal,
-            surface: targets.layout.surface,
-            direct_output: None,
-        };
-        let pipeline = ShadowPipeline::new(device, geometry, &inputs, config)?;
-        let prims = pipeline.prims().ok_or_else(|| {
-            PassError::InvalidConfig("the demo G-buffer needs the prim buffer".into())
-        })?;
-        let gbuffer = GBufferPass::new(device, prims, &targets.layout)?;
-        Ok(Self {
-            targets,
-            gbuffer,
-            pipeline,
-        })
-    }
-
-    /// The engine-facing pipeline.
-    pub fn pipeline(&self) -> &ShadowPipeline {
-        &self.pipeline
-    }
-
-    /// Renders one frame and waits for it.
-    pub fn render(
-        &mut self,
-        device: &Device,
-        inputs: &FrameInputs,
-    ) -> Result<FrameReport, PassError> {
-        let push = GBufferPush::for_camera(
-            &CameraMatrices::of_frame(inputs),
-            self.pipeline.geometry().origin(),
-            &self.targets.layout,
-        )?;
-        let tris = self.pipeline.geometry().triangle_count();
-        let Self {
-            targets,
-            gbuffer,
-            pipeline,
-        } = self;
-        pipeline.begin_frame(inputs)?;
-        device.submit_and_wait(|enc| {
-            let (prim_buffer, rest) = PassId::ALL.split_at(1);
-            pipeline.record_passes(enc, prim_buffer).map_err(into_rhi)?;
-            enc.barriers(&targets.to_render());
-            gbuffer
-                .record(enc, targets, &push, tris)
-                .map_err(into_rhi)?;
-            enc.barriers(&[
-                Barrier::Image {
-                    image: &targets.normal,
-                    before: S::RenderTarget,
-                    after: S::ShaderResource,
-                },
-                Barrier::Image {
-                    image: &targets.depth,
-                    before: S::DepthWrite,
-                    after: S::ShaderResource,
-                },
-            ]);
-            pipeline.record_passes(enc, rest).map_err(into_rhi)
-        })?;
-        self.pipeline.report()
-    }
-
-    /// Reads back the last frame's outputs (the primitive map's list entries only if `with_entries`).
-    pub fn read_back(&self, device: &Device, with_entries: bool) -> Result<FrameImages, PassError> {
-        let p = &self.pipeline;
-        let mut wanted = self.targets.outputs();
-        wanted.extend(FrameOutput::PIPELINE.iter().filter_map(|&(output, r)| {
-            p.image(r).map(|image| (image, S::UnorderedAccess, output))
-        }));
-        wanted.push((p.output(), S::UnorderedAccess, FrameOutput::Output));
-        let images: Vec<(&Image, S)> = wanted.iter().map(|&(i, s, _)| (i, s)).collect();
-        let bytes = read_images(device, &images)?;
-        let mut frame = FrameImages::default();
-        for ((_, _, output), bytes) in wanted.iter().zip(&bytes) {
-            frame.insert(*output, bytes, p.geometry().origin());
-        }
-        let mut lists = vec![ResourceId::PrimListOffsets];
-        if with_entries {
-            lists.push(ResourceId::PrimListEntries);
-        }
-        let buffers: Vec<&Buffer> = lists.iter().filter_map(|&r| p.buffer(r)).collect();
-        let mut words = read_buffers(device, &buffers)?.into_iter();
-        if let (Some(packed), Some(map)) = (words.next(), p.primitive_map()) {
-            let packed: Vec<u32> = bytemuck::pod_collect_to_vec(&packed);
-            frame.list_offsets =
-                passes::unpack_list_offsets(&packed, map.config().texels() as usize)
-                    .map_err(PassError::InvalidConfig)?;
-        }
-        frame.list_entries = words
-            .next()
-            .map(|b| bytemuck::pod_collect_to_vec(&b))
-            .unwrap_or_default();
-        Ok(frame)
-    }
 }
 
 impl GBufferTargets {
@@ -259,37 +131,6 @@ pub fn read_images(device: &Device, images: &[(&Image, S)]) -> Result<Vec<Vec<u8
     buffers.iter().map(|b| Ok(b.read()?.to_vec())).collect()
 }
 
-/// Copies `buffers` (storage writes made visible by the frame's last UAV barrier) into host memory, waits,
-/// and returns their bytes.
-fn read_buffers(device: &Device, buffers: &[&Buffer]) -> Result<Vec<Vec<u8>>, PassError> {
-    let staging = buffers
-        .iter()
-        .map(|b| {
-            device.create_buffer(
-                "read-back",
-                b.size(),
-                BufferUsage::COPY_DST,
-                MemoryLocation::GpuToCpu,
-            )
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    device.submit_and_wait(|enc| {
-        enc.barriers(&[Barrier::Global {
-            before: S::UnorderedAccess,
-            after: S::CopySource,
-        }]);
-        for (src, dst) in buffers.iter().zip(&staging) {
-            enc.copy_buffer(src, dst)?;
-        }
-        enc.barriers(&[Barrier::Global {
-            before: S::CopyDest,
-            after: S::HostRead,
-        }]);
-        Ok(())
-    })?;
-    staging.iter().map(|b| Ok(b.read()?.to_vec())).collect()
-}
-
 /// `config` asking for the ray trace's blocker distance when its mode traces rays (hard, hybrid): the
 /// demo compares blocker distances with the exact reference, and the plugin allocates them only when
 /// asked (or for the hybrid).
@@ -363,13 +204,6 @@ impl FrameImages {
             FrameOutput::Hybrid => self.hybrid = floats(),
             FrameOutput::Output => self.output = floats(),
         }
-    }
-}
-
-fn into_rhi(e: PassError) -> rhi::RhiError {
-    match e {
-        PassError::Rhi(r) => r,
-        other => rhi::RhiError::InvalidArgument(other.to_string()),
     }
 }
 

@@ -13,7 +13,7 @@ use common::{
 };
 use glam::Vec3;
 use host_demo::accuracy::{compare_area, AreaComparison};
-use host_demo::{FrameImages, ShadowRenderer, View};
+use host_demo::{FrameImages, View};
 use passes::{
     AreaConfig, BinningRequest, FaceMode, FrameReport, PcssConfig, PrimitiveMapConfig,
     ShadowConfig, ShadowMode,
@@ -22,6 +22,7 @@ use reference::RefScene;
 use rhi::Device;
 use scene::hard_cases::{family, Family, HardCase};
 use scene::{Camera, DirectionalLight};
+use test_support::ShadowRenderer;
 
 /// Test frames are downscaled from the hard cases' 193x145 so that the reference's N passes stay short.
 const WIDTH: u32 = 96;

@@ -14,7 +14,7 @@ mod common;
 use common::*;
 use glam::Vec3;
 use host_demo::renderer::with_blocker_distance;
-use host_demo::{FrameImages, ShadowRenderer, View};
+use host_demo::{FrameImages, View};
 use passes::bvh::{BvhNode, BVH_LEAF};
 use passes::gpu_types::GpuTriangle;
 use passes::{
@@ -23,6 +23,7 @@ use passes::{
 };
 use reference::RefScene;
 use rhi::{Barrier, Buffer, BufferUsage, Device, MemoryLocation, ResourceState as S};
+use test_support::ShadowRenderer;
 
 /// Copies `buffer` to the host.
 fn read_buffer<T: bytemuck::Pod>(device: &Device, buffer: &Buffer) -> Vec<T> {

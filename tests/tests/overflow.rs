@@ -6,12 +6,13 @@
 mod common;
 
 use common::*;
-use host_demo::{FrameImages, ShadowRenderer, View};
+use host_demo::{FrameImages, View};
 use passes::{
     FrameInputs, PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig, GUARD_VALUE,
     GUARD_WORDS, MIN_ENTRY_BUDGET,
 };
 use reference::RefScene;
+use test_support::ShadowRenderer;
 
 fn frames(
     device: &rhi::Device,

@@ -1,17 +1,18 @@
 //! The demo drives the plugin through its C ABI (`host_demo::plugin::PluginRenderer`). Its frames equal,
-//! bit for bit, the frames of the Rust passes driven directly (`host_demo::ShadowRenderer`), for every
+//! bit for bit, the frames of the Rust passes driven directly (`test_support::ShadowRenderer`), for every
 //! output both produce, and its report says the same: what the demo shows is what integrators get.
 
 mod common;
 
 use common::*;
 use host_demo::plugin::PluginRenderer;
-use host_demo::{FrameImages, ShadowRenderer, View};
+use host_demo::{FrameImages, View};
 use passes::{
     BinningRequest, FrameReport, PassId, PassStatus, PrimitiveMapConfig, ResourceId, ResourceSet,
     ShadowConfig, ShadowMode,
 };
 use rhi::Device;
+use test_support::ShadowRenderer;
 
 /// Elements that differ in their bits, per output (outputs empty on both sides are skipped).
 fn differences(a: &FrameImages, b: &FrameImages) -> Vec<(&'static str, usize)> {

@@ -10,7 +10,7 @@ use common::{
     tolerance_per_distance,
 };
 use glam::{Mat4, Vec3};
-use host_demo::{FrameImages, ShadowRenderer, View};
+use host_demo::{FrameImages, View};
 use passes::hybrid::{blend, lerp_factor};
 use passes::{
     BinningRequest, FrameReport, HybridConfig, Light, PassId, PassStatus, PcssConfig,
@@ -21,6 +21,7 @@ use reference::{reference_visibility, PixelClass, RefScene, VisibilityParams};
 use rhi::Device;
 use scene::DirectionalLight;
 use std::path::PathBuf;
+use test_support::ShadowRenderer;
 
 const WSS: f32 = 1.0;
 const PHS: f32 = 4.0;

@@ -4,11 +4,12 @@
 
 use glam::{Mat4, Vec3};
 use host_demo::accuracy::{compare_with_reference, scene_visibility_params};
-use host_demo::{ShadowRenderer, View};
+use host_demo::View;
 use hrts::{FrameReport, ShadowMode};
 use passes::PrimitiveMapConfig;
 use reference::{reference_visibility, Light, PixelClass, RefScene, VisibilityReference};
 use scene::{Camera, DirectionalLight, Scene};
+use test_support::ShadowRenderer;
 use wgpu::TextureFormat as F;
 use wgpu_host::meshes::world_scene;
 use wgpu_host::{validation, Conventions, DepthDirection, Gpu, IndexType, NormalTarget, Renderer};

@@ -47,6 +47,19 @@ pub use offsets::{
 use scratch::{receiver_words, storage_buffer, BindTargets, SharedTexels, PAIR_BYTES};
 pub use scratch::{MapScratch, MapScratchPool, ScratchBindings};
 
+/// Orders earlier storage reads and transfer reads (a read-back's copy) of a buffer before transfer writes
+/// into it (an update or a fill).
+const BEFORE_TRANSFER_WRITES: [Barrier<'static>; 2] = [
+    Barrier::Global {
+        before: S::UnorderedAccess,
+        after: S::CopyDest,
+    },
+    Barrier::Global {
+        before: S::CopySource,
+        after: S::CopyDest,
+    },
+];
+
 /// Threads of the compute binning dispatch (a grid-stride loop over the bin items).
 const BIN_THREADS: u32 = 64 * 4096;
 
@@ -588,16 +601,7 @@ impl PrimitiveMap {
             .map(|f| MapState::reset(f, push.capacity, push.pairs))
             .collect();
         // The state's last read was the previous build's copy into its read-back (a transfer).
-        enc.barriers(&[
-            Barrier::Global {
-                before: S::UnorderedAccess,
-                after: S::CopyDest,
-            },
-            Barrier::Global {
-                before: S::CopySource,
-                after: S::CopyDest,
-            },
-        ]);
+        enc.barriers(&BEFORE_TRANSFER_WRITES);
         enc.update_buffer(&self.constants, 0, bytemuck::bytes_of(&map_constants))?;
         enc.update_buffer(&self.state, 0, bytemuck::cast_slice(&reset))?;
         if self.config.guard {
@@ -607,8 +611,9 @@ impl PrimitiveMap {
         Ok(())
     }
 
-    /// Records the lists' build after the fit ([`PrimitiveMap::record_fit_phase`]): the receivers marked, the setup, the
-    /// count, the scan and the fill, through the scratch the maps over one geometry share (cleared first).
+    /// Records the lists' build after the fit ([`PrimitiveMap::record_fit_phase`]): the receivers marked,
+    /// the setup, the count, the scan and the fill, through the scratch the maps over one geometry share
+    /// (cleared first).
     pub fn record_lists(&mut self, enc: &mut Encoder<'_>) -> Result<(), PassError> {
         let push = self.fit_push()?;
         let with_mode = |mode| MapPush { mode, ..push };
@@ -617,16 +622,7 @@ impl PrimitiveMap {
             .store(self.id, std::sync::atomic::Ordering::Relaxed);
         enc.begin_pass("primitive map: receivers");
         // The shared scratch's last use was the previous build's storage reads (or a read-back's copy).
-        enc.barriers(&[
-            Barrier::Global {
-                before: S::UnorderedAccess,
-                after: S::CopyDest,
-            },
-            Barrier::Global {
-                before: S::CopySource,
-                after: S::CopyDest,
-            },
-        ]);
+        enc.barriers(&BEFORE_TRANSFER_WRITES);
         enc.fill_buffer(&self.receivers, 0);
         enc.fill_buffer(&self.bound.scratch.counts, 0);
         enc.fill_buffer(&self.bound.scratch.capped, 0);

@@ -37,12 +37,21 @@ impl ShadowPipeline {
         enc: &mut Encoder<'_>,
         passes: &[PassId],
     ) -> Result<(), PassError> {
+        self.with_frame(|this, frame| this.record_forward(enc, frame, passes))
+    }
+
+    /// Runs `f` on the frame begun by [`ShadowPipeline::begin_frame`] (taken out of the pipeline for the
+    /// call); fails if none was.
+    fn with_frame<T>(
+        &mut self,
+        f: impl FnOnce(&mut Self, &mut FrameState) -> Result<T, PassError>,
+    ) -> Result<T, PassError> {
         let Some(mut frame) = self.frame.take() else {
             return Err(PassError::InvalidConfig(
                 "no frame: call begin_frame first".into(),
             ));
         };
-        let outcome = self.record_forward(enc, &mut frame, passes);
+        let outcome = f(self, &mut frame);
         self.frame = Some(frame);
         outcome
     }
@@ -105,14 +114,7 @@ impl ShadowPipeline {
         enc: &mut Encoder<'_>,
         phase: FitPhase,
     ) -> Result<(), PassError> {
-        let Some(mut frame) = self.frame.take() else {
-            return Err(PassError::InvalidConfig(
-                "no frame: call begin_frame first".into(),
-            ));
-        };
-        let outcome = self.record_map_fit_in(enc, &mut frame, phase);
-        self.frame = Some(frame);
-        outcome
+        self.with_frame(|this, frame| this.record_map_fit_in(enc, frame, phase))
     }
 
     fn record_map_fit_in(

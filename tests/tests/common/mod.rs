@@ -6,11 +6,12 @@
 
 use glam::Vec3;
 pub use host_demo::accuracy::*;
-use host_demo::{FrameImages, ShadowRenderer, View};
+use host_demo::{FrameImages, View};
 use passes::{FrameReport, PrimitiveMapConfig};
 use rhi::{Device, DeviceDesc};
 use scene::{Camera, DirectionalLight, Scene};
 use std::path::PathBuf;
+use test_support::ShadowRenderer;
 
 /// The models folder (`HRTS_MODELS`, else `../shared/models` beside the checkout); fails the test with
 /// a message saying where it looked when the models are missing.
