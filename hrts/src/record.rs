@@ -120,6 +120,9 @@ impl Context {
             .map(|lights| lights.iter().map(|l| l.recorded.clone()).collect())
             .unwrap_or_default();
         self.ensure_built()?;
+        if self.fit_batch.is_none() {
+            self.fit_batch = Some(passes::FitBatch::new(&self.device, self.frames_in_flight)?);
+        }
         let frame_index = f.frame_index;
         let (device, built) = match self.built.as_mut() {
             Some(b) => (&self.device, b),
@@ -219,13 +222,14 @@ impl Context {
         // The lights' fits first, batched (each phase of every light, then one barrier), when several
         // build their maps in this call: their passes then record the lists alone.
         let mut outcome = Ok(());
-        if reads_depth && passes.contains(&PassId::PrimitiveMap) {
+        if let Some(batch) = self
+            .fit_batch
+            .as_mut()
+            .filter(|_| reads_depth && passes.contains(&PassId::PrimitiveMap))
+        {
             let (lights, mut pipelines): (Vec<usize>, Vec<&mut passes::ShadowPipeline>) =
                 built.scheduled_mut(&recorded).unzip();
-            match self
-                .fit_batch
-                .record(&mut enc, frame_index, &mut pipelines, &passes)
-            {
+            match batch.record(&mut enc, frame_index, &mut pipelines, &passes) {
                 Ok(fitted) => {
                     let frame_lights = match schedule.as_mut() {
                         Some(lights) => Some(lights),

@@ -175,8 +175,9 @@ pub(crate) struct Context {
     pub(crate) frusta: Vec<LightShape>,
     /// Which frusta the last `frames_in_flight` frames recorded, oldest first.
     pub(crate) schedules: std::collections::VecDeque<FrameSchedule>,
-    /// The lights' primitive-map fits recorded together, timed per frame in flight.
-    pub(crate) fit_batch: FitBatch,
+    /// The lights' primitive-map fits recorded together, timed per frame in flight; created with the
+    /// first recording (its GPU timers need timestamps, as the passes do).
+    pub(crate) fit_batch: Option<FitBatch>,
 }
 
 impl Context {
@@ -215,7 +216,6 @@ impl Context {
             }
         };
         let device = crate::adopt::device(info)?;
-        let fit_batch = FitBatch::new(&device, frames_in_flight)?;
         Ok(Self {
             built: None,
             retired: RetireQueue::default(),
@@ -233,7 +233,7 @@ impl Context {
             light_builds: vec![0],
             frusta: vec![LightShape::default()],
             schedules: Default::default(),
-            fit_batch,
+            fit_batch: None,
         })
     }
 

@@ -83,6 +83,8 @@ impl Context {
         let batch_share = if schedule.fits_batched > 0 {
             let ms = self
                 .fit_batch
+                .as_ref()
+                .ok_or_else(|| ApiError::new(HrtsResult::ErrorInternal, "no fit batch"))?
                 .milliseconds(frame_index)
                 .map_err(|e| ApiError::new(HrtsResult::ErrorInternal, e.to_string()))?
                 .ok_or_else(|| {
