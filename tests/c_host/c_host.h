@@ -59,6 +59,7 @@ typedef struct {
 
 void box_snorm(uint16_t *at, int half);
 void split_scene(SplitScene *s);
+void lit_split_scene(Emitter sun, SplitScene *s);
 void free_split_scene(SplitScene *s);
 HrtsContext *meshes_context(const HrtsVulkanDevice *vk, uint32_t frames_in_flight, const HrtsVulkanGeometry *meshes,
                             uint32_t mesh_count);

@@ -119,12 +119,9 @@ static void reused_vertex_handle(HrtsContext *ctx, const float *want_a, const fl
 enum { DEFORM_FRAMES = 8 };
 void deforming_mesh(const HrtsVulkanDevice *vk) {
     enum { PX = W * H, IN_FLIGHT_2 = 2, NONE = -1, A = 0, B = 1 };
-    setup_camera(0.0);
     Emitter sun = directional(v3(0.45, -1.0, 0.2));
-    set_lights(&sun, 1);
-    upload_gbuffer();
     SplitScene s;
-    split_scene(&s);
+    lit_split_scene(sun, &s);
     /* the engine's per-frame vertex buffers: A at byte offset 8, B at 0 */
     const VkDeviceSize offsets[2] = {8, 0};
     Buf skinned[2];

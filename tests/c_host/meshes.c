@@ -104,6 +104,15 @@ void split_scene(SplitScene *s) {
     memcpy(m->bounds, ground1, sizeof ground1);
 }
 
+/* The default camera, `sun` as the one light, the G-buffer uploaded and the scene as three meshes in `s`: what
+ * the mesh tests start from. */
+void lit_split_scene(Emitter sun, SplitScene *s) {
+    setup_camera(0.0);
+    set_lights(&sun, 1);
+    upload_gbuffer();
+    split_scene(s);
+}
+
 void free_split_scene(SplitScene *s) {
     for (int i = 0; i < SPLIT_MESHES; i++) {
         free_buffer(s->vb[i]);
@@ -147,12 +156,9 @@ HrtsContext *meshes_context(const HrtsVulkanDevice *vk, uint32_t frames_in_fligh
  * naming the mesh, and the context goes on as it was. */
 void engine_meshes(const HrtsVulkanDevice *vk) {
     enum { PX = W * H };
-    setup_camera(0.0);
     Emitter sun = directional(v3(0.45, -1.0, 0.2));
-    set_lights(&sun, 1);
-    upload_gbuffer();
     SplitScene s;
-    split_scene(&s);
+    lit_split_scene(sun, &s);
     Buf one_vb, one_ib;
     HrtsVulkanGeometry one = one_mesh_scene(&one_vb, &one_ib);
     static float one_vis[PX], split_vis[PX], moved_vis[PX], one_moved_vis[PX], after_vis[PX];
@@ -252,12 +258,9 @@ void engine_meshes(const HrtsVulkanDevice *vk) {
  * the same visibility bit for bit, the exact shadow, and no triangle rebuilt. */
 void draw_transforms_all_or_nothing(const HrtsVulkanDevice *vk) {
     enum { PX = W * H };
-    setup_camera(0.0);
     Emitter sun = fitted_sun(v3(0.45, -1.0, 0.2));
-    set_lights(&sun, 1);
-    upload_gbuffer();
     SplitScene s;
-    split_scene(&s);
+    lit_split_scene(sun, &s);
     static float before[PX], after[PX];
     HrtsContext *ctx = meshes_context(vk, 2, s.meshes, SPLIT_MESHES);
     CHECK(run_frame(ctx, before) == HRTS_RESULT_OK, "all or nothing: first frame: %s", hrts_last_error(ctx));
