@@ -90,6 +90,11 @@ pub struct BenchArgs {
     /// --copied-output each layer is copied (r32f) or converted by a blit.
     #[arg(long, default_value = "r32f", requires = "lights", value_parser = ["r32f", "r16f", "r8"])]
     pub output_format: String,
+    /// With --lights and --point-lights: also write each scene with its point lights (the first emitter
+    /// size) as glTF into this folder (`MODEL_N_point_lights.glb`), so that `render --scene` renders what
+    /// the bench measured, through the scene's plan.
+    #[arg(long, requires = "point_lights")]
+    pub write_scenes: Option<std::path::PathBuf>,
     /// With --lights: the primitive map's N (texels per side; a point light's cube faces share N²).
     #[arg(long, default_value_t = hrts::Config::default().map_size, requires = "lights", value_parser = clap::value_parser!(u32).range(1..=i64::from(u16::MAX)))]
     pub map_size: u32,

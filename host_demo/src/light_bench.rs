@@ -636,6 +636,39 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
                         at(&bounds, f)
                     })
                     .collect();
+                if let (Some(dir), Some(&first)) = (&args.write_scenes, sizes.first()) {
+                    if fraction == first {
+                        let lights = positions
+                            .iter()
+                            .enumerate()
+                            .map(|(i, &position)| SceneLight {
+                                name: format!("point {}", i + 1),
+                                kind: LightKind::Point {
+                                    position,
+                                    range: None,
+                                },
+                                color: Vec3::ONE,
+                                intensity: 100.0,
+                                size: emitter_radius.map_or(LightSize::Zero, LightSize::Radius),
+                                casts_shadows: true,
+                                is_static: true,
+                            })
+                            .collect();
+                        std::fs::create_dir_all(dir)
+                            .with_context(|| format!("creating {}", dir.display()))?;
+                        let path = dir.join(format!(
+                            "{}_{n}_point_lights.glb",
+                            scene_case.file.trim_end_matches(".obj")
+                        ));
+                        scene::gltf_scene::write_scene(
+                            &path,
+                            &file_with(lights),
+                            scene::gltf_scene::GltfEncoding::default(),
+                        )
+                        .with_context(|| format!("writing {}", path.display()))?;
+                        bar.suspend(|| eprintln!("wrote {}", path.display()));
+                    }
+                }
                 costs.push(measure_native_points(
                     device,
                     &file_with(Vec::new()),
