@@ -28,7 +28,7 @@
 // - `hrts_context_create` refuses (`HRTS_RESULT_ERROR_VERSION`) another major version, a minor version
 //   newer than the library's, and 5.0, whose headers changed layouts without changing the version
 //   (`HrtsDraw` 72 then 76 bytes): its structs cannot be told apart.
-#define HRTS_API_VERSION ((5 << 22) | (9 << 12))
+#define HRTS_API_VERSION ((5 << 22) | (10 << 12))
 
 // The most lights one context shades (`hrts_configure_lights`); a point light counts once.
 #define HRTS_MAX_LIGHTS 64
@@ -920,6 +920,26 @@ typedef struct HrtsResourceReadback {
   uint64_t offset;
 } HrtsResourceReadback;
 
+// What the plugin would do with one light in a view, decided without a context or a device
+// (`hrts_plan_lights`): the decision, frusta and reason the light's `HrtsFrameReport` gives for a frame
+// of the same camera, light, configuration and casters' bounds. API 5.10.
+typedef struct HrtsLightPlan {
+  // `sizeof(HrtsLightPlan)`.
+  uint32_t struct_size;
+  // `HrtsLightDecision`: shadowed, or out of view (no frustum may shadow a receiver in view within
+  // its range: no pass would run and its layer would be 1).
+  uint32_t decision;
+  // Frusta the light would be shadowed through (`HrtsFrameReport::frusta`).
+  uint32_t frusta;
+  // Frusta it would skip (`HrtsFrameReport::frusta_culled`).
+  uint32_t frusta_culled;
+  // The `HrtsShadowMode` its passes would run: the configuration's, or under `HRTS_SHADOW_MODE_AUTO`
+  // the one the light's size chooses (hard for a zero-size light, area for a sized one).
+  uint32_t mode;
+  // Why, in words (NUL-terminated, truncated to fit), as `HrtsFrameReport::decision_reason`.
+  char decision_reason[128];
+} HrtsLightPlan;
+
 // GPU time of one pass.
 typedef struct HrtsPassTiming {
   // Pass name (NUL-terminated, truncated).
@@ -1236,6 +1256,23 @@ enum HrtsResult hrts_get_resource_info(struct HrtsContext *context,
 // a live `VkBuffer` of the adopted device of the stated size.
 enum HrtsResult hrts_record_resource_readback(struct HrtsContext *context,
                                               const struct HrtsResourceReadback *readback);
+
+// Plans `frame->light_count` lights for one view without a context or a device: fills `plans[i]` (each
+// with `struct_size` set, all alike) with what a frame of `frame`'s camera recording light `frame->lights[i]`
+// configured by `configs[i]` would do with it: its decision, frusta, mode and reason, as its
+// `HrtsFrameReport` gives them (the same test: a frustum is kept if a caster within `frame->bounds` may
+// shadow a receiver in view within the light's range). For a host that decides which lights to configure
+// (a scene with more lights than it shadows, a light whose shadows cannot reach the view). Of `frame`, the
+// camera (`view`, `proj`, `camera_position`), the lights and the casters' bounds (`has_bounds`; without
+// them the view and the ranges alone cull, as for moving Vulkan geometry) are read; its command buffer,
+// frame index, layouts and deformed meshes are not. The configurations are checked as
+// `hrts_configure_lights` checks them, less what depends on a device. API 5.10.
+//
+// # Safety
+// `configs` and `plans` point at `frame->light_count` structs each; `frame` at a frame.
+enum HrtsResult hrts_plan_lights(const struct HrtsConfig *configs,
+                                 const struct HrtsFrame *frame,
+                                 struct HrtsLightPlan *plans);
 
 // Fills `out` (with `out->struct_size` set) with what `light`'s passes did in frame `frame_index`: one
 // of the last `frames_in_flight` frames recorded. Returns `HRTS_RESULT_NOT_READY` while the GPU has not

@@ -401,6 +401,14 @@ fn taps(value: u32, field: &str) -> ApiResult<u32> {
 }
 
 /// `HrtsShadowMode` values and the modes they name (both directions use this one table).
+/// The `HrtsShadowMode` value of `mode`.
+pub(crate) fn mode_to_c(mode: ShadowMode) -> u32 {
+    MODES
+        .iter()
+        .find(|(_, m)| *m == mode)
+        .map_or(HrtsShadowMode::Auto as u32, |(c, _)| *c)
+}
+
 const MODES: [(u32, ShadowMode); 6] = [
     (HrtsShadowMode::None as u32, ShadowMode::None),
     (HrtsShadowMode::Hard as u32, ShadowMode::Hard),

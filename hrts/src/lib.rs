@@ -598,6 +598,41 @@ pub unsafe extern "C" fn hrts_record_resource_readback(
     })
 }
 
+/// Plans `frame->light_count` lights for one view without a context or a device: fills `plans[i]` (each
+/// with `struct_size` set, all alike) with what a frame of `frame`'s camera recording light `frame->lights[i]`
+/// configured by `configs[i]` would do with it: its decision, frusta, mode and reason, as its
+/// `HrtsFrameReport` gives them (the same test: a frustum is kept if a caster within `frame->bounds` may
+/// shadow a receiver in view within the light's range). For a host that decides which lights to configure
+/// (a scene with more lights than it shadows, a light whose shadows cannot reach the view). Of `frame`, the
+/// camera (`view`, `proj`, `camera_position`), the lights and the casters' bounds (`has_bounds`; without
+/// them the view and the ranges alone cull, as for moving Vulkan geometry) are read; its command buffer,
+/// frame index, layouts and deformed meshes are not. The configurations are checked as
+/// `hrts_configure_lights` checks them, less what depends on a device. API 5.10.
+///
+/// # Safety
+/// `configs` and `plans` point at `frame->light_count` structs each; `frame` at a frame.
+#[no_mangle]
+pub unsafe extern "C" fn hrts_plan_lights(
+    configs: *const HrtsConfig,
+    frame: *const HrtsFrame,
+    plans: *mut HrtsLightPlan,
+) -> HrtsResult {
+    boundary(None, || {
+        let f = version::read(frame, "frame")?;
+        if f.light_count == 0 || f.light_count > HRTS_MAX_LIGHTS {
+            return Err(error::invalid(format!(
+                "frame.light_count {} must be within 1..={HRTS_MAX_LIGHTS}",
+                f.light_count
+            )));
+        }
+        let count = f.light_count as usize;
+        let configs = version::read_array(configs, count, "configs")?;
+        let stride = version::check_array(plans, count, "plans")?;
+        let planned = context::plan_lights(&configs, &f)?;
+        version::write_array(plans, stride, "plans", &planned)
+    })
+}
+
 /// Fills `out` (with `out->struct_size` set) with what `light`'s passes did in frame `frame_index`: one
 /// of the last `frames_in_flight` frames recorded. Returns `HRTS_RESULT_NOT_READY` while the GPU has not
 /// finished that frame (ask after its fence signalled), `HRTS_RESULT_ERROR_INVALID_ARGUMENT` for a frame

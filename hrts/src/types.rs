@@ -26,7 +26,7 @@ use std::ffi::c_char;
 /// - `hrts_context_create` refuses (`HRTS_RESULT_ERROR_VERSION`) another major version, a minor version
 ///   newer than the library's, and 5.0, whose headers changed layouts without changing the version
 ///   (`HrtsDraw` 72 then 76 bytes): its structs cannot be told apart.
-pub const HRTS_API_VERSION: u32 = 5 << 22 | 9 << 12;
+pub const HRTS_API_VERSION: u32 = 5 << 22 | 10 << 12;
 
 /// A flag in the C structs: 0 is false, any other value true. (A Rust `bool` would make any byte but 0
 /// and 1 undefined behaviour when the engine writes it.)
@@ -952,6 +952,28 @@ pub struct HrtsFrameReport {
     pub pixels_walked: u32,
     /// BVH walks that could not finish (a driver that ends long loops early): 0 on a conforming device.
     pub walks_unfinished: u32,
+}
+
+/// What the plugin would do with one light in a view, decided without a context or a device
+/// (`hrts_plan_lights`): the decision, frusta and reason the light's `HrtsFrameReport` gives for a frame
+/// of the same camera, light, configuration and casters' bounds. API 5.10.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct HrtsLightPlan {
+    /// `sizeof(HrtsLightPlan)`.
+    pub struct_size: u32,
+    /// `HrtsLightDecision`: shadowed, or out of view (no frustum may shadow a receiver in view within
+    /// its range: no pass would run and its layer would be 1).
+    pub decision: u32,
+    /// Frusta the light would be shadowed through (`HrtsFrameReport::frusta`).
+    pub frusta: u32,
+    /// Frusta it would skip (`HrtsFrameReport::frusta_culled`).
+    pub frusta_culled: u32,
+    /// The `HrtsShadowMode` its passes would run: the configuration's, or under `HRTS_SHADOW_MODE_AUTO`
+    /// the one the light's size chooses (hard for a zero-size light, area for a sized one).
+    pub mode: u32,
+    /// Why, in words (NUL-terminated, truncated to fit), as `HrtsFrameReport::decision_reason`.
+    pub decision_reason: [c_char; 128],
 }
 
 /// A copy of a plugin resource into an engine buffer, recorded after a complete frame.

@@ -75,6 +75,7 @@ versions! {
     HrtsResourceInfo => [(32, 1)] versioned;
     HrtsResourceReadback => [(48, 1)] versioned;
     HrtsFrameReport => [(5560, 1), (5568, 4), (5592, 9)] versioned;
+    HrtsLightPlan => [(148, 10)] versioned;
     HrtsDraw => [(76, 1)];
     HrtsLight => [(100, 1)];
     HrtsMeshVertices => [(32, 1)];
@@ -224,6 +225,46 @@ pub(crate) fn read_array<T: Versioned>(p: *const T, count: usize, what: &str) ->
             Ok(unsafe { read_prefix(at.cast(), stride) })
         })
         .collect()
+}
+
+/// Checks the caller's array of `count` versioned structs at `p` (`what` names it) before it is written:
+/// the first's `struct_size` is the stride, and every one must have it. Returns the stride.
+pub(crate) fn check_array<T: Versioned>(p: *const T, count: usize, what: &str) -> ApiResult<usize> {
+    let stride = versioned_size(p, what)?;
+    for i in 0..count {
+        // SAFETY: the caller's array holds `count` structs `stride` bytes apart (documented contract); each
+        // is aligned (`p` is, and a version's size is a multiple of `T`'s alignment) and starts with the
+        // `u32` size.
+        let size = unsafe { p.byte_add(i * stride).cast::<u32>().read() } as usize;
+        if size != stride {
+            return Err(ApiError::new(
+                HrtsResult::ErrorStructSize,
+                format!(
+                    "{what}[{i}].struct_size is {size}, {what}[0]'s {stride}: an array holds structs of one version"
+                ),
+            ));
+        }
+    }
+    Ok(stride)
+}
+
+/// Fills the caller's array of structs at `p`, checked by [`check_array`] (`stride` bytes apart), with
+/// `values` as [`write`] fills one.
+pub(crate) fn write_array<T: Versioned + Copy>(
+    p: *mut T,
+    stride: usize,
+    what: &str,
+    values: &[T],
+) -> ApiResult<()> {
+    for (i, value) in values.iter().enumerate() {
+        // SAFETY: the caller's array holds `values.len()` structs `stride` bytes apart (checked sizes).
+        let at = unsafe { p.byte_add(i * stride) };
+        write(at, what, |out| {
+            *out = *value;
+            Ok(())
+        })?;
+    }
+    Ok(())
 }
 
 /// Reads `count` elements of `T` at `p` (`what` names the array), `stride` bytes apart: the caller's

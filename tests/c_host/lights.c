@@ -27,6 +27,49 @@ HrtsContext *hard_lights_context(const HrtsVulkanDevice *vk, const HrtsCpuGeomet
     return ctx;
 }
 
+/* hrts_plan_lights for the current camera and lights, with `count` configurations of `mode` and the bounds of
+ * the CPU geometry `g`, equals what the reports of frame `index` of `ctx` (configured alike) say of each
+ * light: decision, frusta recorded and culled, and reason. Returns how many lights differ. */
+static int plans_differ_from_reports(HrtsContext *ctx, const HrtsCpuGeometry *g, uint32_t count, uint32_t mode,
+                                     uint64_t index) {
+    HrtsConfig cfgs[HRTS_MAX_LIGHTS];
+    HrtsLightPlan plans[HRTS_MAX_LIGHTS];
+    for (uint32_t i = 0; i < count; i++) {
+        cfgs[i] = config(mode);
+        memset(&plans[i], 0, sizeof plans[i]);
+        plans[i].struct_size = sizeof plans[i];
+    }
+    HrtsFrame f = frame(VK_NULL_HANDLE, 0);
+    f.has_bounds = 1;
+    for (int k = 0; k < 3; k++) {
+        f.bounds[k] = INFINITY;
+        f.bounds[3 + k] = -INFINITY;
+    }
+    for (uint32_t v = 0; v < g->vertex_count; v++) {
+        const float *p = (const float *)((const char *)g->positions + (size_t)v * g->vertex_stride);
+        for (int k = 0; k < 3; k++) {
+            f.bounds[k] = fminf(f.bounds[k], p[k]);
+            f.bounds[3 + k] = fmaxf(f.bounds[3 + k], p[k]);
+        }
+    }
+    HrtsResult r = hrts_plan_lights(cfgs, &f, plans);
+    CHECK(r == HRTS_RESULT_OK, "hrts_plan_lights: %s", hrts_last_error(NULL));
+    int differ = 0;
+    for (uint32_t i = 0; i < count && r == HRTS_RESULT_OK; i++) {
+        HrtsFrameReport rep;
+        CHECK(report(ctx, index, i, &rep) == HRTS_RESULT_OK, "report %u: %s", i, hrts_last_error(ctx));
+        int same = plans[i].decision == rep.decision && plans[i].frusta == rep.frusta &&
+                   plans[i].frusta_culled == rep.frusta_culled && strcmp(plans[i].decision_reason, rep.decision_reason) == 0 &&
+                   plans[i].mode == mode;
+        if (!same)
+            printf("  light %u planned %u (%u frusta, %u culled: %s), reported %u (%u, %u: %s)\n", i, plans[i].decision,
+                   plans[i].frusta, plans[i].frusta_culled, plans[i].decision_reason, rep.decision, rep.frusta,
+                   rep.frusta_culled, rep.decision_reason);
+        differ += !same;
+    }
+    return differ;
+}
+
 /* ---------- several lights in one context ---------- */
 /* Eight lights, four directional and four spot, hard shadows, in one context sharing the prim buffer:
  * each light's layer of the output matches the exact shadow of that light; the prim buffer is built once,
@@ -171,6 +214,12 @@ void native_local_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
               culled.pass_count == 0 && culled.pass_status[HRTS_PASS_RAY_TRACE] == HRTS_PASS_STATUS_CULLED &&
               culled.pass_status[HRTS_PASS_OUTPUT_COPY] == HRTS_PASS_STATUS_RAN && not_lit == 0,
           "an out-of-view point light records nothing and is lit: %d px not lit", not_lit);
+    /* planned without a context, both frames' lights get the decisions their reports give */
+    int plan_differs = plans_differ_from_reports(ctx, g, N, HRTS_SHADOW_MODE_HARD, next_frame - 1);
+    set_lights(lights, N);
+    plan_differs += plans_differ_from_reports(ctx, g, N, HRTS_SHADOW_MODE_HARD, first);
+    printf("hrts_plan_lights: %d of %d lights planned otherwise than their frames reported\n", plan_differs, 2 * N);
+    CHECK(plan_differs == 0, "hrts_plan_lights: %d lights differ from their reports", plan_differs);
     set_lights(lights, N);
     float one[W * H];
     CHECK(read_resource(ctx, 1, HRTS_RESOURCE_RT_VISIBILITY, one, sizeof one) == HRTS_RESULT_ERROR_INVALID_STATE &&

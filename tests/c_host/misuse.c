@@ -46,7 +46,8 @@ enum {
     TARGETS_NULL_NORMAL, TARGETS_ZERO_LAYERS, FRAME_ZERO_DIRECTION, FRAME_NAN_PROJECTION, FRAME_LIGHT_TYPE,
     FRAME_NULL_COMMAND_BUFFER, FRAME_STRUCT_SIZE, FRAME_NULL_LIGHTS, FRAME_LIGHT_COUNT_ZERO, FRAME_LIGHT_COUNT_OTHER,
     FRAME_MISALIGNED_LIGHTS, FRAME_NEWER_STRUCT_SIZE, FRAME_LIGHT_STRIDE, FRAME_DEFORMED_STRIDE,
-    FRAME_DEFORMED_NULL, FRAME_DEFORMED_MESH,
+    FRAME_DEFORMED_NULL, FRAME_DEFORMED_MESH, PLAN_NULL_CONFIGS, PLAN_NULL_PLANS, PLAN_STRUCT_SIZE, PLAN_MIXED_SIZES,
+    PLAN_MODE, PLAN_NULL_FRAME,
     FRAME_INDEX_REPEATED, FRAME_INDEX_BACKWARDS, REPORT_STRUCT_SIZE, REPORT_OLD_FRAME, REPORT_NO_SUCH_LIGHT,
     REPORT_NOT_COMPLETED, PASSES_EMPTY_MASK, PASSES_UNKNOWN_BIT, PASSES_RAY_TRACE_FIRST, PASSES_CAMERA_MOVED,
     PASSES_COPY_TOO_EARLY, PASSES_DEPTH_LAYOUT, REPORT_HALF_RECORDED, READBACK_HALF_RECORDED, READBACK_UNKNOWN,
@@ -137,6 +138,12 @@ static const struct {
     [FRAME_DEFORMED_STRIDE] = {"frame(deformed_stride 40)", HRTS_RESULT_ERROR_STRUCT_SIZE},
     [FRAME_DEFORMED_NULL] = {"frame(deformed NULL, deformed_count 1)", HRTS_RESULT_ERROR_NULL_POINTER},
     [FRAME_DEFORMED_MESH] = {"frame(deformed mesh 1 of 1)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [PLAN_NULL_CONFIGS] = {"plan_lights(NULL configs)", HRTS_RESULT_ERROR_NULL_POINTER},
+    [PLAN_NULL_PLANS] = {"plan_lights(NULL plans)", HRTS_RESULT_ERROR_NULL_POINTER},
+    [PLAN_STRUCT_SIZE] = {"plan_lights(plans[0].struct_size 12)", HRTS_RESULT_ERROR_STRUCT_SIZE},
+    [PLAN_MIXED_SIZES] = {"plan_lights(plans of two sizes)", HRTS_RESULT_ERROR_STRUCT_SIZE},
+    [PLAN_MODE] = {"plan_lights(unknown mode)", HRTS_RESULT_ERROR_INVALID_ENUM},
+    [PLAN_NULL_FRAME] = {"plan_lights(NULL frame)", HRTS_RESULT_ERROR_NULL_POINTER},
     [FRAME_INDEX_REPEATED] = {"frame(index of the last frame again)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [FRAME_INDEX_BACKWARDS] = {"frame(index going back)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [REPORT_STRUCT_SIZE] = {"report(wrong size)", HRTS_RESULT_ERROR_STRUCT_SIZE},
@@ -378,6 +385,26 @@ static HrtsResult misuse_call(int id, Misuse *m) {
         f.deformed = &v;
         f.deformed_count = 1;
         return hrts_record_frame(ctx, &f);
+    }
+    case PLAN_NULL_CONFIGS:
+    case PLAN_NULL_PLANS:
+    case PLAN_STRUCT_SIZE:
+    case PLAN_MIXED_SIZES:
+    case PLAN_MODE:
+    case PLAN_NULL_FRAME: {
+        /* two lights planned without a context */
+        HrtsLight two[2] = {lights[0], lights[0]};
+        f.lights = two;
+        f.light_count = 2;
+        HrtsConfig cfgs[2] = {config(HRTS_SHADOW_MODE_HARD), config(HRTS_SHADOW_MODE_HARD)};
+        HrtsLightPlan plans[2];
+        memset(plans, 0, sizeof plans);
+        plans[0].struct_size = plans[1].struct_size = sizeof plans[0];
+        if (id == PLAN_STRUCT_SIZE) plans[0].struct_size = 12;
+        if (id == PLAN_MIXED_SIZES) plans[1].struct_size = 12;
+        if (id == PLAN_MODE) cfgs[1].mode = 99;
+        return hrts_plan_lights(id == PLAN_NULL_CONFIGS ? NULL : cfgs, id == PLAN_NULL_FRAME ? NULL : &f,
+                                id == PLAN_NULL_PLANS ? NULL : plans);
     }
     case FRAME_INDEX_REPEATED: {
         if (run_frame(ctx, NULL) != HRTS_RESULT_OK) return HRTS_RESULT_ERROR_INTERNAL;

@@ -749,7 +749,7 @@ fn lights_that_need_nothing_get_no_pass() {
         reasons,
         [
             LightDecision::NoPass(NoPassReason::CastsNoShadows),
-            LightDecision::NoPass(NoPassReason::OutOfReach),
+            LightDecision::NoPass(NoPassReason::OutOfView),
             LightDecision::NoPass(NoPassReason::EmitsNothing),
         ]
     );

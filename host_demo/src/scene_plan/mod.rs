@@ -28,10 +28,10 @@
 //! cube map) where a caster may shadow a receiver in view within the light's range, and writes the
 //! minimum over a wide spot light's faces to its layer; its frame report says which it culled and why.
 //!
-//! "Receivers in view" are the scene's triangles that are not entirely outside one plane of the camera
-//! frustum (occlusion is not considered), and a triangle is within a light's reach when its bounding
-//! sphere meets the light's range and cone: the test keeps every light that may light a visible pixel,
-//! and may keep a few that do not.
+//! The plan gives no pass to a light none of whose frusta the plugin would record: it asks the plugin
+//! ([`hrts::plan_lights`], with the shadow casters' bounds), so the plan and the frames decide alike.
+//! "Nothing in view" means none of the scene's triangles is in view (not entirely outside one plane of
+//! the camera frustum; occlusion is not considered).
 //!
 //! Shadow casters: the plugin is given the objects that cast shadows (`SceneFile::shadow_casters`); an
 //! object that casts none (a floor, terrain) is drawn and receives shadows, and is a receiver in view like
@@ -40,18 +40,12 @@
 //! Caching: a light marked static sets `static_light`; any shadow caster that is not static makes the
 //! geometry dynamic for every light (the plugin shares one prim buffer between its lights).
 
-mod reach;
-
 use anyhow::{bail, Result};
-use glam::{DVec3, Vec3};
+use glam::{DVec4, Vec3};
 use hrts::{SpotFrustum, HRTS_MAX_LIGHTS};
 use passes::{FaceMode, FramePlan, ResourceId, ShadowConfig, ShadowMode};
-use reach::{receivers_in_view, up_hint, Cone, Pyramid, Reach};
 use scene::{Camera, LightKind, LightSize, SceneFile, SceneLight};
 use std::fmt::Write as _;
-
-/// The pyramid enclosing a spot light's cone in the reach test is this much wider than the cone.
-const CONE_WIDENING: f32 = 1.01;
 
 /// What the plan needs besides the scene and the camera.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -75,8 +69,9 @@ pub enum NoPassReason {
     EmitsNothing,
     /// No receiver is in view at all.
     NothingInView,
-    /// No receiver in view is within its cone and range.
-    OutOfReach,
+    /// No frustum of it may shadow a receiver in view within its range: the plugin's own culling
+    /// ([`hrts::plan_lights`]), which would record nothing for it.
+    OutOfView,
 }
 
 impl NoPassReason {
@@ -86,7 +81,7 @@ impl NoPassReason {
             Self::CastsNoShadows => "casts no shadows",
             Self::EmitsNothing => "emits nothing (zero colour or intensity)",
             Self::NothingInView => "no receiver in view",
-            Self::OutOfReach => "no receiver in view within its cone and range",
+            Self::OutOfView => "no caster may shadow a receiver in view within its range",
         }
     }
 }
@@ -429,20 +424,67 @@ pub fn plan_scene(file: &SceneFile, camera: &Camera, settings: &PlanSettings) ->
     let receivers_only = objects_where(&|_, casts| !casts);
     let dynamic_geometry = !moving_objects.is_empty();
     let aspect = settings.width as f32 / settings.height as f32;
-    let receivers = receivers_in_view(file, camera, aspect);
+    let receivers_in_view = receivers_in_view(file, camera, aspect);
+    let candidates: Vec<Result<(hrts::Light, ShadowConfig), NoPassReason>> = file
+        .lights
+        .iter()
+        .map(|light| candidate(light, receivers_in_view, settings, dynamic_geometry))
+        .collect();
+    let (plugin_lights, configs): (Vec<hrts::Light>, Vec<hrts::Config>) = candidates
+        .iter()
+        .flatten()
+        .map(|(light, config)| Ok((*light, hrts::passes_bridge::config(config)?)))
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .unzip();
+    let casters = file.scene.objects_bounds(&file.shadow_casters);
+    let view = hrts::PlanView {
+        view: camera.view(),
+        proj: camera.proj(aspect),
+        camera_position: camera.position,
+        casters: Some(hrts::Bounds {
+            min: casters.min,
+            max: casters.max,
+        }),
+    };
+    // The plugin plans at most as many lights at once as one context shades.
+    let chunk = HRTS_MAX_LIGHTS as usize;
+    let mut planned = Vec::new();
+    for (configs, lights) in configs.chunks(chunk).zip(plugin_lights.chunks(chunk)) {
+        planned.extend(hrts::plan_lights(configs, lights, &view)?);
+    }
+    let mut planned = planned.into_iter();
     let lights: Vec<LightPlan> = file
         .lights
         .iter()
-        .map(|light| LightPlan {
-            light: light.clone(),
-            decision: decide(light, &receivers, settings, dynamic_geometry),
+        .zip(candidates)
+        .map(|(light, candidate)| {
+            let decision = match candidate {
+                Err(reason) => LightDecision::NoPass(reason),
+                Ok((plugin_light, config)) => match planned.next() {
+                    Some(p) if p.decision == hrts::LightDecision::OutOfView => {
+                        LightDecision::NoPass(NoPassReason::OutOfView)
+                    }
+                    Some(p) => shadowed(
+                        light,
+                        config,
+                        plugin_light,
+                        (p.frusta + p.frusta_culled) as usize,
+                    ),
+                    None => bail!("the plugin planned fewer lights than it was given"),
+                },
+            };
+            Ok(LightPlan {
+                light: light.clone(),
+                decision,
+            })
         })
-        .collect();
+        .collect::<Result<_>>()?;
     let plan = ScenePlan {
         dynamic_geometry,
         moving_objects,
         receivers_only,
-        receivers_in_view: receivers.len(),
+        receivers_in_view,
         triangles: file.scene.triangle_count(),
         lights,
     };
@@ -455,91 +497,76 @@ pub fn plan_scene(file: &SceneFile, camera: &Camera, settings: &PlanSettings) ->
     Ok(plan)
 }
 
-/// The decision for one light.
-fn decide(
+/// How many of the scene's triangles are not entirely outside one plane of the camera frustum: the
+/// receivers in view (none: no light needs a pass).
+fn receivers_in_view(file: &SceneFile, camera: &Camera, aspect: f32) -> usize {
+    let m = camera.proj(aspect).as_dmat4() * camera.view().as_dmat4();
+    let (r0, r1, r2, r3) = (m.row(0), m.row(1), m.row(2), m.row(3));
+    // Inside: -w <= x <= w, -w <= y <= w, 0 <= z <= w (reversed Z: z > w is nearer than the near plane).
+    let planes: [DVec4; 6] = [r3 + r0, r3 - r0, r3 + r1, r3 - r1, r2, r3 - r2];
+    (0..file.scene.triangle_count())
+        .filter(|&t| {
+            let corners = file.scene.triangle(t).map(|v| v.as_dvec3().extend(1.0));
+            !planes
+                .iter()
+                .any(|p| corners.iter().all(|c| p.dot(*c) < 0.0))
+        })
+        .count()
+}
+
+/// A light the plugin is to plan (as it takes the light, with its configuration), or why it gets no pass
+/// before the plugin's culling: it casts no shadows, emits nothing, or nothing is in view at all.
+fn candidate(
     light: &SceneLight,
-    receivers: &[[DVec3; 3]],
+    receivers_in_view: usize,
     settings: &PlanSettings,
     dynamic_geometry: bool,
-) -> LightDecision {
-    use LightDecision::NoPass;
+) -> Result<(hrts::Light, ShadowConfig), NoPassReason> {
     if !light.casts_shadows {
-        return NoPass(NoPassReason::CastsNoShadows);
+        return Err(NoPassReason::CastsNoShadows);
     }
     if light.intensity == 0.0 || light.color == Vec3::ZERO {
-        return NoPass(NoPassReason::EmitsNothing);
+        return Err(NoPassReason::EmitsNothing);
     }
-    if receivers.is_empty() {
-        return NoPass(NoPassReason::NothingInView);
+    if receivers_in_view == 0 {
+        return Err(NoPassReason::NothingInView);
     }
-    let (position, range, cone, plugin_light) = match light.kind {
-        LightKind::Directional { direction } => {
-            // No matrix: the plugin fits the frustum to the scene's bounds.
-            let plugin_light = hrts::Light::Directional {
-                direction,
-                view_proj: None,
-            };
-            return shadowed(light, settings, dynamic_geometry, plugin_light, 1);
-        }
+    let plugin_light = match light.kind {
+        // No matrix: the plugin fits the frustum to the casters' bounds.
+        LightKind::Directional { direction } => hrts::Light::Directional {
+            direction,
+            view_proj: None,
+        },
         LightKind::Spot {
             position,
             direction,
             outer_cone,
             range,
             ..
-        } => (
+        } => hrts::Light::Spot {
             position,
+            direction,
+            frustum: SpotFrustum::Fitted { outer_cone },
             range,
-            Some((direction, outer_cone)),
-            hrts::Light::Spot {
-                position,
-                direction,
-                frustum: SpotFrustum::Fitted { outer_cone },
-                range,
-            },
-        ),
-        LightKind::Point { position, range } => (
-            position,
-            range,
-            None,
-            hrts::Light::Point { position, range },
-        ),
+        },
+        LightKind::Point { position, range } => hrts::Light::Point { position, range },
     };
-    let reach = Reach {
-        position: position.as_dvec3(),
-        range: range.map(f64::from),
-        cone: cone.map(|(axis, angle)| Cone {
-            axis: axis.as_dvec3(),
-            half_angle: f64::from(angle),
-            enclosing: (angle < std::f32::consts::FRAC_PI_2)
-                .then(|| Pyramid::new(position, axis, up_hint(axis), angle.tan() * CONE_WIDENING)),
-        }),
-    };
-    if !receivers.iter().any(|t| reach.touches(t)) {
-        return NoPass(NoPassReason::OutOfReach);
-    }
-    let frusta = match cone {
-        Some((axis, outer_cone)) => {
-            passes::spot_light_frusta(position, axis, outer_cone, range).len()
-        }
-        None => passes::point_light_faces(position, range).len(),
-    };
-    shadowed(light, settings, dynamic_geometry, plugin_light, frusta)
+    Ok((
+        plugin_light,
+        light_config(light, settings, dynamic_geometry),
+    ))
 }
 
-/// A shadowed light: its configuration from the settings' base, mode auto with the light's size, and its
-/// flags.
-fn shadowed(
+/// A light's configuration: the settings' base, mode auto with the light's size (the plugin chooses by
+/// the size: hard shadows for no size, exact soft shadows (area) for a size), and its flags.
+fn light_config(
     light: &SceneLight,
     settings: &PlanSettings,
     dynamic_geometry: bool,
-    plugin_light: hrts::Light,
-    frusta: usize,
-) -> LightDecision {
+) -> ShadowConfig {
     let mut config = settings.base;
     config.static_geometry = !dynamic_geometry;
     config.static_light = light.is_static;
-    // The plugin chooses by the size: hard shadows for no size, exact soft shadows (area) for a size.
     config.mode = ShadowMode::Auto;
     let directional = matches!(light.kind, LightKind::Directional { .. });
     match light.size {
@@ -552,6 +579,17 @@ fn shadowed(
         // A front-only primitive map needs a directional light.
         config.map.faces = FaceMode::Both;
     }
+    config
+}
+
+/// A light the plugin shadows through `frusta` frusta (as it planned them).
+fn shadowed(
+    light: &SceneLight,
+    config: ShadowConfig,
+    plugin_light: hrts::Light,
+    frusta: usize,
+) -> LightDecision {
+    let directional = matches!(light.kind, LightKind::Directional { .. });
     let resolved = config.resolved(directional);
     LightDecision::Shadowed(Box::new(ShadowedLight {
         config,
@@ -752,11 +790,11 @@ mod tests {
         // Pointing at the sky.
         let away = spot(Vec3::new(0.0, 3.0, 0.0), Vec3::Y, 0.4, None);
         let p = only(ground_and_box(vec![away]));
-        assert_eq!(p.decision, LightDecision::NoPass(NoPassReason::OutOfReach));
+        assert_eq!(p.decision, LightDecision::NoPass(NoPassReason::OutOfView));
         // Pointing down, but its range ends 1 m short of the box.
         let short = spot(Vec3::new(0.0, 3.0, 0.0), Vec3::NEG_Y, 0.4, Some(1.0));
         let p = only(ground_and_box(vec![short]));
-        assert_eq!(p.decision, LightDecision::NoPass(NoPassReason::OutOfReach));
+        assert_eq!(p.decision, LightDecision::NoPass(NoPassReason::OutOfView));
         // Pointing at ground out of view (behind the camera).
         let behind = spot(Vec3::new(4.0, 3.0, 30.0), Vec3::NEG_Y, 0.2, None);
         let mut file = ground_and_box(vec![behind]);
@@ -768,7 +806,7 @@ mod tests {
         file.static_objects.push(true);
         file.shadow_casters.push(true);
         let p = only(file);
-        assert_eq!(p.decision, LightDecision::NoPass(NoPassReason::OutOfReach));
+        assert_eq!(p.decision, LightDecision::NoPass(NoPassReason::OutOfView));
         // Reaching the box: shadowed.
         let reaching = spot(Vec3::new(0.0, 3.0, 0.0), Vec3::NEG_Y, 0.4, Some(2.5));
         assert!(only(ground_and_box(vec![reaching])).shadowed().is_some());
@@ -855,7 +893,7 @@ mod tests {
             LightSize::Zero,
         );
         let p = only(ground_and_box(vec![far_lamp]));
-        assert_eq!(p.decision, LightDecision::NoPass(NoPassReason::OutOfReach));
+        assert_eq!(p.decision, LightDecision::NoPass(NoPassReason::OutOfView));
     }
 
     #[test]

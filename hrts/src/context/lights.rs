@@ -143,52 +143,14 @@ impl Context {
         })
     }
 
-    /// Which frusta of each light may change a pixel in view this frame ([`ViewVolume::may_shadow`]): those
-    /// holding receivers in view within the light's range that a caster within the casters' `bounds` (when
-    /// they are known: [`Context::scene_bounds`]) may shadow; and the mode auto chose for it. A light
-    /// shadowed through shadow maps (soft, hybrid) is culled by the view and its range alone.
+    /// Which frusta of each light may change a pixel in view this frame: [`schedule`] with the context's
+    /// configurations.
     pub(crate) fn schedule(
         &self,
         lights: &[FrameLight],
         bounds: Option<[glam::DVec3; 2]>,
     ) -> Vec<LightSchedule> {
-        let camera = lights.first().and_then(|l| l.frusta.first()).map(|f| {
-            ViewVolume::new(
-                f.proj.as_dmat4() * f.view.as_dmat4(),
-                f.camera_position.as_dvec3(),
-            )
-        });
-        lights
-            .iter()
-            .zip(&self.lights)
-            .map(|(light, config)| {
-                let directional = light.kind == HrtsLightType::Directional;
-                let casters =
-                    bounds
-                        .zip(config.traced_light_size(directional))
-                        .map(|(bounds, size)| Casters {
-                            bounds,
-                            light_size: f64::from(size),
-                        });
-                LightSchedule {
-                    kind: light.kind,
-                    auto: config.auto_reason(directional),
-                    fits_batched: 0,
-                    recorded: light
-                        .frusta
-                        .iter()
-                        .map(|f| {
-                            camera.as_ref().is_none_or(|c| {
-                                c.may_shadow(&f.light, light.range, casters.as_ref())
-                            })
-                        })
-                        .collect(),
-                    names: (0..light.frusta.len())
-                        .map(|k| light.frustum_name(k))
-                        .collect(),
-                }
-            })
-            .collect()
+        schedule(&self.lights, lights, bounds)
     }
 
     /// Keeps the schedule of frame `index` for its reports, with those of the frames in flight before it.
@@ -245,6 +207,54 @@ impl Context {
         }
         Ok(config)
     }
+}
+
+/// Which frusta of each light (configured by `configs`, in order) may change a pixel in view this frame
+/// ([`ViewVolume::may_shadow`]): those holding receivers in view within the light's range that a caster
+/// within the casters' `bounds` (when they are known) may shadow; and the mode auto chose for it. A light
+/// shadowed through shadow maps (soft, hybrid) is culled by the view and its range alone.
+pub(crate) fn schedule(
+    configs: &[ShadowConfig],
+    lights: &[FrameLight],
+    bounds: Option<[glam::DVec3; 2]>,
+) -> Vec<LightSchedule> {
+    let camera = lights.first().and_then(|l| l.frusta.first()).map(|f| {
+        ViewVolume::new(
+            f.proj.as_dmat4() * f.view.as_dmat4(),
+            f.camera_position.as_dvec3(),
+        )
+    });
+    lights
+        .iter()
+        .zip(configs)
+        .map(|(light, config)| {
+            let directional = light.kind == HrtsLightType::Directional;
+            let casters =
+                bounds
+                    .zip(config.traced_light_size(directional))
+                    .map(|(bounds, size)| Casters {
+                        bounds,
+                        light_size: f64::from(size),
+                    });
+            LightSchedule {
+                kind: light.kind,
+                auto: config.auto_reason(directional),
+                fits_batched: 0,
+                recorded: light
+                    .frusta
+                    .iter()
+                    .map(|f| {
+                        camera
+                            .as_ref()
+                            .is_none_or(|c| c.may_shadow(&f.light, light.range, casters.as_ref()))
+                    })
+                    .collect(),
+                names: (0..light.frusta.len())
+                    .map(|k| light.frustum_name(k))
+                    .collect(),
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -4,6 +4,8 @@
 mod build;
 mod geometry;
 mod lights;
+mod plan;
+pub(crate) use plan::plan_lights;
 mod report;
 mod targets;
 

@@ -165,10 +165,7 @@ impl Context {
         let (decision, reason) = schedule.decision();
         out.decision = decision as u32;
         out.prim_triangles_rebuilt = built.shared.triangles_rebuilt(frame_index);
-        out.decision_reason = [0; 128];
-        for (dst, src) in out.decision_reason.iter_mut().zip(reason.bytes().take(127)) {
-            *dst = src as std::ffi::c_char;
-        }
+        out.decision_reason = super::plan::reason_to_c(&reason);
         Ok(())
     }
 

@@ -9,6 +9,7 @@
 //!   [`Context::set_geometry_cpu`]), [`Context::set_targets`], and per frame [`Context::record_passes`]
 //!   (or [`Context::record_frame`]) with a [`Frame`] of [`Light`]s; after the frame completed,
 //!   [`Context::frame_report`] gives each light's [`FrameReport`].
+//! - [`plan_lights`]: which lights a view needs shadowed, before any context exists.
 //! - The C enumerations under their Rust names ([`ShadowMode`], [`Resource`], [`Pass`], ...), and
 //!   [`api_version`] and [`memory_stats`].
 
@@ -18,6 +19,7 @@ mod enums;
 mod error;
 mod frame;
 mod geometry;
+mod plan;
 mod report;
 
 pub use config::Config;
@@ -30,6 +32,7 @@ pub use enums::{
 pub use error::{Error, Result};
 pub use frame::{Frame, Light, MeshVertices, ResourceReadback, SpotFrustum, TargetImage, Targets};
 pub use geometry::{Bounds, CpuGeometry, Draw, VulkanMesh};
+pub use plan::{plan_lights, LightPlan, PlanView};
 pub use report::{Capabilities, FrameReport, MapStats, MemoryStats, PassTiming, ResourceInfo};
 
 use crate::types::{HrtsMemoryStats, HRTS_API_VERSION};

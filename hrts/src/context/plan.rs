@@ -1,0 +1,62 @@
+//! Planning lights without a context (`hrts_plan_lights`): the decision each light's frame report would
+//! give for a view, from the same conversion and culling a frame's recording runs.
+
+use super::lights::schedule;
+use crate::convert::{frame_bounds, frame_inputs, mode_to_c, shadow_config, FrameLight};
+use crate::error::{invalid, ApiError, ApiResult};
+use crate::types::*;
+
+/// For each light of `f` (configured by `configs`, one per light), what a frame of its camera, lights and
+/// casters' bounds would do with it (`struct_size` left 0).
+pub(crate) fn plan_lights(configs: &[HrtsConfig], f: &HrtsFrame) -> ApiResult<Vec<HrtsLightPlan>> {
+    let configs = configs
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            shadow_config(c).map_err(|e| ApiError {
+                message: format!("configs[{i}]: {}", e.message),
+                ..e
+            })
+        })
+        .collect::<ApiResult<Vec<_>>>()?;
+    let bounds = frame_bounds(f)?;
+    let lights: Vec<FrameLight> = frame_inputs(f, bounds)?
+        .into_iter()
+        .zip(&configs)
+        .map(|(light, config)| light.shadowed_as(config))
+        .collect();
+    if lights.len() != configs.len() {
+        return Err(invalid(format!(
+            "frame.light_count {} differs from the {} configurations",
+            lights.len(),
+            configs.len()
+        )));
+    }
+    let schedules = schedule(&configs, &lights, bounds);
+    Ok(lights
+        .iter()
+        .zip(&configs)
+        .zip(&schedules)
+        .map(|((light, config), schedule)| {
+            let (decision, reason) = schedule.decision();
+            let recorded = schedule.recorded.iter().filter(|&&r| r).count() as u32;
+            HrtsLightPlan {
+                struct_size: 0,
+                decision: decision as u32,
+                frusta: recorded,
+                frusta_culled: schedule.recorded.len() as u32 - recorded,
+                mode: mode_to_c(light.shape().config(config).mode),
+                decision_reason: reason_to_c(&reason),
+            }
+        })
+        .collect())
+}
+
+/// `reason` as a NUL-terminated C string of at most 127 bytes.
+pub(crate) fn reason_to_c(reason: &str) -> [std::ffi::c_char; 128] {
+    let mut out = [0; 128];
+    for (dst, src) in out.iter_mut().zip(reason.bytes().take(127)) {
+        *dst = src as std::ffi::c_char;
+    }
+    out
+}
