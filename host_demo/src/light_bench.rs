@@ -13,7 +13,7 @@ use crate::bench_models::{keep_only, models_folder, BenchArgs};
 use crate::gbuffer::GBufferLayout;
 use crate::plugin::{LightsFrame, PluginRenderer};
 use crate::scene_plan::{plan_scene, PlanSettings};
-use crate::scene_render::SceneRenderer;
+use crate::scene_render::{median, SceneRenderer};
 use crate::CameraMatrices;
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
@@ -227,15 +227,6 @@ impl Routes {
             walked: r.walked + u64::from(st.pixels_walked),
         })
     }
-}
-
-/// Median of `v` (0 when empty).
-fn median(mut v: Vec<f64>) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 /// GPU ms of the passes of `frame`'s lights whose name passes `keep`.

@@ -253,15 +253,6 @@ pub fn describe_frame(
         frame.frame_index
     );
     let plugin_lights = plan.plugin_lights();
-    let own_bytes = |report: &LightFrameReport| -> u64 {
-        report
-            .report
-            .resources
-            .iter()
-            .filter(|r| r.resource != ResourceId::PrimBuffer)
-            .map(|r| r.bytes)
-            .sum()
-    };
     for (i, light) in plan.lights.iter().enumerate() {
         let mine = plugin_lights
             .iter()
@@ -330,26 +321,117 @@ pub fn describe_frame(
         );
         let _ = writeln!(s, "      cost {}", describe_cost(&report.report));
     }
-    let shared = frame.lights.iter().find_map(|r| {
+    if let Some((prims, scratch)) = shared_bytes(frame) {
+        let _ = writeln!(
+            s,
+            "  shared by the lights: prim buffer {}, primitive-map build scratch {}",
+            size(prims),
+            size(scratch)
+        );
+    }
+    s
+}
+
+/// Bytes a light's report holds of its own (the shared prim buffer aside).
+fn own_bytes(report: &LightFrameReport) -> u64 {
+    report
+        .report
+        .resources
+        .iter()
+        .filter(|r| r.resource != ResourceId::PrimBuffer)
+        .map(|r| r.bytes)
+        .sum()
+}
+
+/// Bytes the lights of `frame` share: the prim buffer and the primitive maps' build scratch (none without
+/// a prim buffer).
+fn shared_bytes(frame: &LightsFrame) -> Option<(u64, u64)> {
+    let prims = frame.lights.iter().find_map(|r| {
         r.report
             .resources
             .iter()
             .find(|r| r.resource == ResourceId::PrimBuffer)
-    });
+    })?;
     let scratch = frame
         .lights
         .iter()
         .map(|r| r.report.map_scratch_bytes)
-        .max()
-        .unwrap_or(0);
-    if let Some(prims) = shared {
-        let _ = writeln!(
+        .max();
+    Some((prims.bytes, scratch.unwrap_or(0)))
+}
+
+/// Median of `v` (0 when empty).
+pub fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// The frames rendered, summed over the lights: GPU ms a frame (the median over the frames after the
+/// first, and the slowest), the per-pass split (medians of each pass's sum over the lights), and the
+/// memory the lights hold, their own and shared, as the last frame reports it. Empty without a light.
+pub fn describe_frames(frames: &[LightsFrame]) -> String {
+    let Some(last) = frames.last().filter(|f| !f.lights.is_empty()) else {
+        return String::new();
+    };
+    let steady = if frames.len() > 1 {
+        &frames[1..]
+    } else {
+        frames
+    };
+    let totals: Vec<f64> = steady
+        .iter()
+        .map(|f| f.lights.iter().map(|l| gpu_ms(&l.report).0).sum())
+        .collect();
+    let slowest = frames
+        .iter()
+        .map(|f| f.lights.iter().map(|l| gpu_ms(&l.report).0).sum::<f64>())
+        .fold(0.0, f64::max);
+    let mut per_pass: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    for f in steady {
+        let mut sums: BTreeMap<String, f64> = BTreeMap::new();
+        for l in &f.lights {
+            for (name, ms) in gpu_ms(&l.report).1 {
+                *sums.entry(name).or_default() += ms;
+            }
+        }
+        for (name, ms) in sums {
+            per_pass.entry(name).or_default().push(ms);
+        }
+    }
+    let passes: Vec<String> = per_pass
+        .into_iter()
+        .map(|(name, v)| format!("{name} {:.3}", median(v)))
+        .collect();
+    let n = last.lights.len();
+    let own: u64 = last.lights.iter().map(own_bytes).sum();
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "all {n} lights: GPU {:.3} ms a frame (median over {} frames after the first; slowest {slowest:.3}), \
+         per pass: {}",
+        median(totals),
+        steady.len(),
+        passes.join(", ")
+    );
+    let _ = write!(
+        s,
+        "  memory: the lights' own {} ({} a light)",
+        size(own),
+        size(own / n as u64)
+    );
+    if let Some((prims, scratch)) = shared_bytes(last) {
+        let _ = write!(
             s,
-            "  shared by the lights: prim buffer {}, primitive-map build scratch {}",
-            size(prims.bytes),
+            ", shared {} (prim buffer {}, primitive-map build scratch {})",
+            size(prims + scratch),
+            size(prims),
             size(scratch)
         );
     }
+    s.push('\n');
     s
 }
 
@@ -492,6 +574,7 @@ pub fn render_scene_to_folder(
         bar.suspend(|| print!("{}", describe_frame(&plan, &frame, reports.last())));
         reports.push(frame);
     }
+    bar.suspend(|| print!("{}", describe_frames(&reports)));
     bar.set_message("reading back and writing the outputs");
     let images = renderer.read_back(device, &plan).context("reading back")?;
     let (w, h) = (settings.width, settings.height);
