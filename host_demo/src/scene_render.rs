@@ -571,7 +571,19 @@ pub fn render_scene_to_folder(
             .render(device, camera, &plan)
             .context("rendering")?;
         bar.inc(1);
-        bar.suspend(|| print!("{}", describe_frame(&plan, &frame, reports.last())));
+        // Every light's passes, memory and cost for the first frame (what was built) and the last (what
+        // later frames kept); one line for the frames between.
+        let text = if index == 1 || index == frames {
+            describe_frame(&plan, &frame, reports.last())
+        } else {
+            let ms: f64 = frame.lights.iter().map(|l| gpu_ms(&l.report).0).sum();
+            format!(
+                "frame {}: {} lights, GPU {ms:.3} ms\n",
+                frame.frame_index,
+                frame.lights.len()
+            )
+        };
+        bar.suspend(|| print!("{text}"));
         reports.push(frame);
     }
     bar.suspend(|| print!("{}", describe_frames(&reports)));

@@ -317,6 +317,10 @@ fn scene_render_reports_what_each_light_ran_and_kept() {
     let dir = temp_dir("scene-render");
     let (stdout, json) = render_example(&dir, true);
     assert!(stdout.contains("frame 1: per light"), "{stdout}");
+    // The frames summed over the lights: time, the per-pass split and memory.
+    assert!(stdout.contains("all 4 lights: GPU "), "{stdout}");
+    assert!(stdout.contains("per pass: "), "{stdout}");
+    assert!(stdout.contains("memory: the lights' own "), "{stdout}");
     assert!(
         stdout.contains("fill: no pass (casts no shadows)"),
         "{stdout}"
