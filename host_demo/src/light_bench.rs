@@ -125,22 +125,30 @@ fn peer_light(light: &SceneLight, bounds: &Aabb) -> Result<Option<Light>> {
     })
 }
 
+/// A static, white, shadow-casting light of the benchmark.
+fn bench_light(name: &str, kind: LightKind, size: LightSize) -> SceneLight {
+    SceneLight {
+        name: name.into(),
+        kind,
+        color: Vec3::ONE,
+        intensity: 100.0,
+        size,
+        casts_shadows: true,
+        is_static: true,
+    }
+}
+
 /// The benchmark's lights for a scene whose bounds are `bounds`: name and light.
 fn lights(scene: &LightScene, bounds: &Aabb, sizes: Sizes) -> Vec<(String, SceneLight)> {
-    let light = |name: &str, kind: LightKind| SceneLight {
-        name: name.into(),
-        size: match (sizes, &kind) {
+    let light = |name: &str, kind: LightKind| {
+        let size = match (sizes, &kind) {
             (None, _) => LightSize::Zero,
             (Some((angular, _)), LightKind::Directional { .. }) => {
                 LightSize::AngularRadius(angular)
             }
             (Some((_, radius)), _) => LightSize::Radius(radius),
-        },
-        kind,
-        color: Vec3::ONE,
-        intensity: 100.0,
-        casts_shadows: true,
-        is_static: true,
+        };
+        bench_light(name, kind, size)
     };
     let mut out = vec![(
         "sun".to_owned(),
@@ -632,17 +640,15 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
                         let lights = positions
                             .iter()
                             .enumerate()
-                            .map(|(i, &position)| SceneLight {
-                                name: format!("point {}", i + 1),
-                                kind: LightKind::Point {
-                                    position,
-                                    range: None,
-                                },
-                                color: Vec3::ONE,
-                                intensity: 100.0,
-                                size: emitter_radius.map_or(LightSize::Zero, LightSize::Radius),
-                                casts_shadows: true,
-                                is_static: true,
+                            .map(|(i, &position)| {
+                                bench_light(
+                                    &format!("point {}", i + 1),
+                                    LightKind::Point {
+                                        position,
+                                        range: None,
+                                    },
+                                    emitter_radius.map_or(LightSize::Zero, LightSize::Radius),
+                                )
                             })
                             .collect();
                         std::fs::create_dir_all(dir)

@@ -360,6 +360,11 @@ fn shared_bytes(frame: &LightsFrame) -> Option<(u64, u64)> {
     Some((prims.bytes, scratch.unwrap_or(0)))
 }
 
+/// GPU ms of every pass of every light of `frame`.
+fn frame_gpu_ms(frame: &LightsFrame) -> f64 {
+    frame.lights.iter().map(|l| gpu_ms(&l.report).0).sum()
+}
+
 /// Median of `v` (0 when empty).
 pub fn median(mut v: Vec<f64>) -> f64 {
     if v.is_empty() {
@@ -381,14 +386,9 @@ pub fn describe_frames(frames: &[LightsFrame]) -> String {
     } else {
         frames
     };
-    let totals: Vec<f64> = steady
-        .iter()
-        .map(|f| f.lights.iter().map(|l| gpu_ms(&l.report).0).sum())
-        .collect();
-    let slowest = frames
-        .iter()
-        .map(|f| f.lights.iter().map(|l| gpu_ms(&l.report).0).sum::<f64>())
-        .fold(0.0, f64::max);
+    let totals: Vec<f64> = frames.iter().map(frame_gpu_ms).collect();
+    let slowest = totals.iter().copied().fold(0.0, f64::max);
+    let steady_totals = totals[frames.len() - steady.len()..].to_vec();
     let mut per_pass: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     for f in steady {
         let mut sums: BTreeMap<String, f64> = BTreeMap::new();
@@ -412,7 +412,7 @@ pub fn describe_frames(frames: &[LightsFrame]) -> String {
         s,
         "all {n} lights: GPU {:.3} ms a frame (median over {} frames after the first; slowest {slowest:.3}), \
          per pass: {}",
-        median(totals),
+        median(steady_totals),
         steady.len(),
         passes.join(", ")
     );
@@ -576,11 +576,11 @@ pub fn render_scene_to_folder(
         let text = if index == 1 || index == frames {
             describe_frame(&plan, &frame, reports.last())
         } else {
-            let ms: f64 = frame.lights.iter().map(|l| gpu_ms(&l.report).0).sum();
             format!(
-                "frame {}: {} lights, GPU {ms:.3} ms\n",
+                "frame {}: {} lights, GPU {:.3} ms\n",
                 frame.frame_index,
-                frame.lights.len()
+                frame.lights.len(),
+                frame_gpu_ms(&frame)
             )
         };
         bar.suspend(|| print!("{text}"));

@@ -3,10 +3,10 @@
 
 use super::lights::schedule;
 use crate::convert::{frame_bounds, frame_inputs, mode_to_c, shadow_config, FrameLight};
-use crate::error::{invalid, ApiError, ApiResult};
+use crate::error::{ApiError, ApiResult};
 use crate::types::*;
 
-/// For each light of `f` (configured by `configs`, one per light), what a frame of its camera, lights and
+/// For each light of `f` (configured by `configs`, one per light: the caller reads `f.light_count` of each), what a frame of its camera, lights and
 /// casters' bounds would do with it (`struct_size` left 0).
 pub(crate) fn plan_lights(configs: &[HrtsConfig], f: &HrtsFrame) -> ApiResult<Vec<HrtsLightPlan>> {
     let configs = configs
@@ -25,13 +25,6 @@ pub(crate) fn plan_lights(configs: &[HrtsConfig], f: &HrtsFrame) -> ApiResult<Ve
         .zip(&configs)
         .map(|(light, config)| light.shadowed_as(config))
         .collect();
-    if lights.len() != configs.len() {
-        return Err(invalid(format!(
-            "frame.light_count {} differs from the {} configurations",
-            lights.len(),
-            configs.len()
-        )));
-    }
     let schedules = schedule(&configs, &lights, bounds);
     Ok(lights
         .iter()

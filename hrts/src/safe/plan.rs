@@ -67,6 +67,17 @@ pub fn plan_lights(
     const CALL: &str = "hrts_plan_lights";
     let c_configs: Vec<_> = configs.iter().map(Config::to_c).collect();
     let c_lights: Vec<_> = lights.iter().map(|l| l.to_c()).collect();
+    if c_configs.len() != c_lights.len() {
+        return Err(super::error::Error::new(
+            CALL,
+            crate::types::HrtsResult::ErrorInvalidArgument,
+            format!(
+                "{} configurations for {} lights: give one per light",
+                c_configs.len(),
+                c_lights.len()
+            ),
+        ));
+    }
     let frame = HrtsFrame {
         struct_size: size_of::<HrtsFrame>() as u32,
         command_buffer: 0,
@@ -87,17 +98,6 @@ pub fn plan_lights(
         light_stride: size_of::<crate::types::HrtsLight>(),
         deformed_stride: size_of::<crate::types::HrtsMeshVertices>(),
     };
-    if c_configs.len() != c_lights.len() {
-        return Err(super::error::Error::new(
-            CALL,
-            crate::types::HrtsResult::ErrorInvalidArgument,
-            format!(
-                "{} configurations for {} lights: give one per light",
-                c_configs.len(),
-                c_lights.len()
-            ),
-        ));
-    }
     let mut plans = vec![
         HrtsLightPlan {
             struct_size: size_of::<HrtsLightPlan>() as u32,
