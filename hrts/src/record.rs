@@ -302,6 +302,16 @@ impl Context {
                 ),
             ));
         }
+        if pipeline.is_shared(id) {
+            return Err(ApiError::new(
+                HrtsResult::ErrorInvalidState,
+                format!(
+                    "{} of light {} is held in an image the lights' FXAA passes share (only the light's FXAA reads it): add it to extra_outputs to read it back",
+                    id.name(),
+                    r.light
+                ),
+            ));
+        }
         let (image, list) = (pipeline.image(id), pipeline.buffer(id));
         let bytes = match (image, list) {
             (Some(image), _) => image.byte_size(),

@@ -888,9 +888,12 @@ pub struct HrtsFrameReport {
     /// Bytes of the prim buffer (triangles in frame coordinates; 0 if the plan has none), shared by the
     /// context's lights.
     pub prim_buffer_bytes: u64,
-    /// Bytes of the primitive map's scratch (per-triangle bin items, per-texel counts and receivers, and the
-    /// screen-size texel of each pixel's ray origin), shared by the maps of the context's lights and frusta
-    /// (0 if the light has no primitive map).
+    /// Bytes of the scratch shared by the context's lights and frusta: the primitive map's (per-triangle bin
+    /// items, per-texel counts and receivers, and the screen-size texel of each pixel's ray origin; 0 if the
+    /// light has no primitive map), and the ray trace's visibility that the lights' FXAA read in the same
+    /// recording call (hard or area shadows with antialiasing, its `HRTS_RESOURCE_RT_VISIBILITY` not in
+    /// `extra_outputs`: it is then no resource of the light's own, and cannot be read back; a call that
+    /// records a light's ray trace without its FXAA gives the light an image of its own from then on).
     pub map_scratch_bytes: u64,
     /// Entries the lists could hold this frame (they grow to fit from the next frame on).
     pub entry_capacity: u32,

@@ -14,7 +14,7 @@ use crate::screen_pass::{visibility_image, ScreenPass};
 use crate::shaders::output_variant;
 use crate::PassError;
 use glam::Vec4;
-use rhi::{BindingKind, Device, Encoder, Image, Resource};
+use rhi::{BindGroup, BindingKind, Device, Encoder, Image, Resource};
 
 /// Relative contrast (of the neighbourhood's maximum) below which a pixel is left alone.
 pub const FXAA_RELATIVE_THRESHOLD: f32 = 0.125;
@@ -54,6 +54,16 @@ impl FxaaPass {
             std::mem::size_of::<FxaaPush>() as u32,
         )?;
         Ok(Self { step, output })
+    }
+
+    /// Reads `input` (of the same size as the output) from now on; returns the bind group used before:
+    /// frames in flight may still use it.
+    pub fn replace_input(
+        &mut self,
+        device: &Device,
+        input: &Image,
+    ) -> Result<BindGroup, PassError> {
+        self.step.rebind(device, 0, Resource::Image(input))
     }
 
     /// Records the pass; input and output in `UnorderedAccess` state.

@@ -32,6 +32,9 @@ pub const RAY_OFFSET_FLOAT_BOUND: f32 = 4.0 * f32::EPSILON;
 /// Binding of the list entries in `ray_trace.comp`.
 const ENTRIES_BINDING: u32 = 6;
 
+/// Binding of the visibility in `ray_trace.comp`.
+const VISIBILITY_BINDING: u32 = 8;
+
 /// Inputs of the ray trace.
 pub struct RayTraceInputs<'a> {
     /// Depth (`ShaderResource` state).
@@ -251,8 +254,30 @@ impl RayTracePass {
         device: &Device,
         map: &PrimitiveMap,
     ) -> Result<Vec<BindGroup>, PassError> {
+        self.rebind(device, ENTRIES_BINDING, Resource::Buffer(&map.entries))
+    }
+
+    /// Has the ray trace write `visibility` (of the same size and format) in place of its visibility image
+    /// from now on. Returns the image and the bind groups it used before: frames in flight may still use
+    /// them.
+    pub fn replace_visibility(
+        &mut self,
+        device: &Device,
+        visibility: Image,
+    ) -> Result<(Image, Vec<BindGroup>), PassError> {
+        let groups = self.rebind(device, VISIBILITY_BINDING, Resource::Image(&visibility))?;
+        Ok((std::mem::replace(&mut self.visibility, visibility), groups))
+    }
+
+    /// Rebinds `binding` of the trace's bind groups to `resource`; returns the groups used before.
+    fn rebind(
+        &mut self,
+        device: &Device,
+        binding: u32,
+        resource: Resource<'_>,
+    ) -> Result<Vec<BindGroup>, PassError> {
         let rebound = |pipeline: &ComputePipeline, group: &mut BindGroup| {
-            let new = device.rebound(pipeline.layout(), group, ENTRIES_BINDING, &map.entries)?;
+            let new = device.rebound(pipeline.layout(), group, binding, resource)?;
             Ok::<_, PassError>(std::mem::replace(group, new))
         };
         let mut old = vec![rebound(&self.pipeline, &mut self.group)?];

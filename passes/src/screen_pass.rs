@@ -39,6 +39,18 @@ impl ScreenPass {
         })
     }
 
+    /// Rebinds `binding` to `resource` (of the kind bound there) from now on; returns the bind group used
+    /// before: frames in flight may still use it.
+    pub fn rebind(
+        &mut self,
+        device: &Device,
+        binding: u32,
+        resource: Resource<'_>,
+    ) -> Result<BindGroup, PassError> {
+        let new = device.rebound(self.pipeline.layout(), &self.group, binding, resource)?;
+        Ok(std::mem::replace(&mut self.group, new))
+    }
+
     /// Records one timed dispatch covering `width` x `height` pixels.
     pub fn record(
         &self,

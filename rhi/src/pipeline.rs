@@ -34,6 +34,7 @@ fn descriptor_type(k: BindingKind) -> vk::DescriptorType {
 }
 
 /// A resource bound to one binding.
+#[derive(Clone, Copy)]
 pub enum Resource<'a> {
     /// A whole buffer.
     Buffer(&'a Buffer),
@@ -488,21 +489,49 @@ impl Device {
         Ok(group)
     }
 
-    /// A new bind group of the same layout as `group` whose buffer binding `binding` is `buffer` (a buffer
-    /// that replaced the one bound, e.g. after growing it) and whose other bindings are `group`'s. `group`
-    /// is left as it was, so frames in flight that use it stay valid; drop it once they completed.
+    /// A new bind group of the same layout as `group` whose binding `binding` is `resource` (a buffer or an
+    /// image that replaced the one bound, e.g. after growing it) and whose other bindings are `group`'s.
+    /// `group` is left as it was, so frames in flight that use it stay valid; drop it once they completed.
     pub fn rebound(
         &self,
         layout: &PipelineLayout,
         group: &BindGroup,
         binding: u32,
-        buffer: &Buffer,
+        resource: Resource<'_>,
     ) -> Result<BindGroup> {
         let kind = group.kinds.get(binding as usize).copied();
-        let Some(kind @ (BindingKind::StorageBuffer | BindingKind::UniformBuffer)) = kind else {
-            return Err(RhiError::InvalidArgument(format!(
-                "binding {binding} of the group is not a buffer binding"
-            )));
+        let buffer_info;
+        let image_info;
+        let write = vk::WriteDescriptorSet::default()
+            .dst_binding(binding)
+            .descriptor_count(1);
+        let write = match (kind, resource) {
+            (
+                Some(kind @ (BindingKind::StorageBuffer | BindingKind::UniformBuffer)),
+                Resource::Buffer(buffer),
+            ) => {
+                buffer_info = [vk::DescriptorBufferInfo::default()
+                    .buffer(buffer.raw)
+                    .range(vk::WHOLE_SIZE)];
+                write
+                    .descriptor_type(descriptor_type(kind))
+                    .buffer_info(&buffer_info)
+            }
+            (Some(kind @ BindingKind::StorageImage), Resource::Image(image))
+                if image.view != vk::ImageView::null() =>
+            {
+                image_info = [vk::DescriptorImageInfo::default()
+                    .image_view(image.view)
+                    .image_layout(vk::ImageLayout::GENERAL)];
+                write
+                    .descriptor_type(descriptor_type(kind))
+                    .image_info(&image_info)
+            }
+            _ => {
+                return Err(RhiError::InvalidArgument(format!(
+                    "binding {binding} of the group is not a buffer or storage image binding of the resource's kind"
+                )))
+            }
         };
         if layout.kinds != group.kinds {
             return Err(RhiError::InvalidArgument(
@@ -510,6 +539,7 @@ impl Device {
             ));
         }
         let fresh = self.allocate_group(layout)?;
+        let write = write.dst_set(fresh.set);
         let copies: Vec<vk::CopyDescriptorSet<'_>> = (0..group.kinds.len() as u32)
             .filter(|&i| i != binding)
             .map(|i| {
@@ -521,16 +551,8 @@ impl Device {
                     .descriptor_count(1)
             })
             .collect();
-        let info = [vk::DescriptorBufferInfo::default()
-            .buffer(buffer.raw)
-            .range(vk::WHOLE_SIZE)];
-        let write = vk::WriteDescriptorSet::default()
-            .dst_set(fresh.set)
-            .dst_binding(binding)
-            .descriptor_type(descriptor_type(kind))
-            .buffer_info(&info);
         // SAFETY: `fresh` is new and unused; `group` is only read (copying from a set in use is allowed);
-        // both have the same layout; the buffer is live and of the binding's kind.
+        // both have the same layout; the resource is live and of the binding's kind.
         unsafe { self.shared.device.update_descriptor_sets(&[write], &copies) };
         Ok(fresh)
     }

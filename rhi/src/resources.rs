@@ -157,6 +157,8 @@ pub struct Image {
     base_layer: u32,
     usage: ImageUsage,
     owned: bool,
+    /// The plugin's own image this one is another view of ([`Image::alias_shared`]), held alive by it.
+    keep_alive: Option<Arc<Image>>,
 }
 
 /// Description of an image.
@@ -369,6 +371,7 @@ impl Device {
             base_layer: 0,
             usage: desc.usage,
             owned: true,
+            keep_alive: None,
         })
     }
 
@@ -529,6 +532,7 @@ unsafe fn engine_image(
         base_layer,
         usage: desc.usage,
         owned: false,
+        keep_alive: None,
     })
 }
 
@@ -694,6 +698,25 @@ impl Image {
         // SAFETY: `self` wraps a live image of this device matching `desc` (its wrapper's contract).
         unsafe { engine_image(&self.shared, self.raw, &desc, self.base_layer) }
     }
+
+    /// Another handle on an image of the plugin's own that several holders share: its own view of the
+    /// same layers, which keeps `image` alive while it lives.
+    pub fn alias_shared(image: &Arc<Image>) -> Result<Image> {
+        let desc = ImageDesc {
+            name: "shared image",
+            format: image.format,
+            width: image.width,
+            height: image.height,
+            layers: image.layers,
+            usage: image.usage,
+        };
+        // SAFETY: `image` is a live image of this device matching `desc`; the alias holds it, so it
+        // outlives every use of the alias.
+        let mut alias = unsafe { engine_image(&image.shared, image.raw, &desc, image.base_layer) }?;
+        alias.keep_alive = Some(Arc::clone(image));
+        Ok(alias)
+    }
+
     /// Declared usage.
     pub fn usage(&self) -> ImageUsage {
         self.usage

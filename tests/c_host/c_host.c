@@ -82,6 +82,8 @@ int main(void) {
     output_formats(&vk, &g);
     phase = "output written directly";
     output_direct(&vk, &g);
+    phase = "FXAA sharing the ray trace's visibility";
+    fxaa_shared(&vk, &g);
     phase = "read-back retire";
     readback_retire(&vk, &g);
     phase = "partial record";

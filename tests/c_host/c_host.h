@@ -46,6 +46,7 @@ void engine_normals(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g);
 void engine_depth(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g);
 void output_formats(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g);
 void output_direct(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g);
+void fxaa_shared(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g);
 
 /* ---------- meshes.c: the scene as meshes of their own buffers, draw transforms all or nothing ---------- */
 enum { SPLIT_MESHES = 3, BOX_VERTICES = 8 };

@@ -480,3 +480,75 @@ void output_direct(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
         }
     free_image(direct);
 }
+
+/* ---------- the visibility the lights' FXAA share ---------- */
+/* With antialiasing, hard shadows' ray traces write one visibility image the lights share, each light's
+ * FXAA reading it in the same recording call: the output equals, bit for bit, lights that keep their own
+ * (RT visibility in extra_outputs), for a sun, a point light and a fitted spot light. In one call a light's
+ * report lists no RT visibility of its own, the shared scratch grows by one image, and the shared image
+ * cannot be read back; likewise with the light-space and screen-space passes in two submissions. Recorded
+ * pass by pass (every light's ray trace in a call before any FXAA) after a frame in one call, each light
+ * takes an image of its own from its first such call: the same output, the same bytes as lights keeping
+ * their own, and still one ray trace per light. */
+void fxaa_shared(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
+    enum { PX = W * H, N = 3 };
+    setup_camera(0.0);
+    Emitter lights[N] = {directional(v3(0.45, -1.0, 0.2)), point(v3(0.9, 2.3, 0.7)),
+                         fitted_spot(v3(-1.5, 3.2, 1.8), v3(0, 0, 0), 0.6)};
+    set_lights(lights, N);
+    upload_gbuffer();
+    static float vis[2][N * PX];
+    static const char *modes[3] = {"one call", "two submissions", "pass by pass"};
+    for (int split = 0; split < 3; split++) {
+        int own_after = split == 2;
+        uint64_t scratch[2] = {0, 0}, rt_bytes[2] = {0, 0};
+        uint32_t traces[2] = {0, 0};
+        for (int shared = 0; shared < 2; shared++) {
+            HrtsContext *ctx = create_context(vk, 1);
+            HrtsConfig cfgs[N];
+            for (int i = 0; i < N; i++) {
+                cfgs[i] = config(HRTS_SHADOW_MODE_HARD);
+                cfgs[i].antialiasing = 1;
+                if (!shared) cfgs[i].extra_outputs = 1u << HRTS_RESOURCE_RT_VISIBILITY;
+            }
+            HrtsTargets t = targets();
+            HrtsResult r = hrts_configure_lights(ctx, N, cfgs);
+            if (r == HRTS_RESULT_OK) r = hrts_set_geometry_cpu(ctx, g);
+            if (r == HRTS_RESULT_OK) r = hrts_set_targets(ctx, &t);
+            /* Pass by pass after a frame in one call: the switch to an image of the light's own retires the
+             * shared one's views while that frame may still use them. */
+            if (r == HRTS_RESULT_OK && own_after) r = run_frame(ctx, vis[shared]);
+            if (r == HRTS_RESULT_OK) r = split ? run_frame_in_parts(ctx, vis[shared], own_after) : run_frame(ctx, vis[shared]);
+            CHECK(r == HRTS_RESULT_OK, "FXAA %s: %s", shared ? "shared" : "own", hrts_last_error(ctx));
+            for (uint32_t l = 0; l < N && r == HRTS_RESULT_OK; l++) {
+                HrtsFrameReport rep;
+                CHECK(report(ctx, next_frame - 1, l, &rep) == HRTS_RESULT_OK, "report: %s", hrts_last_error(ctx));
+                rt_bytes[shared] += rep.resource_bytes[HRTS_RESOURCE_RT_VISIBILITY];
+                if (rep.map_scratch_bytes > scratch[shared]) scratch[shared] = rep.map_scratch_bytes;
+                for (uint32_t p = 0; p < rep.pass_count; p++) traces[shared] += strcmp(rep.passes[p].name, "ray trace") == 0;
+            }
+            if (shared && !own_after && r == HRTS_RESULT_OK) {
+                static float one[PX];
+                CHECK(read_resource(ctx, 1, HRTS_RESOURCE_RT_VISIBILITY, one, sizeof one) == HRTS_RESULT_ERROR_INVALID_STATE &&
+                          strstr(hrts_last_error(ctx), "share"),
+                      "the shared RT visibility is not read back: %s", hrts_last_error(ctx));
+            }
+            CHECK(hrts_context_destroy(ctx) == HRTS_RESULT_OK, "destroy");
+        }
+        int differ = 0, soft = 0;
+        for (int i = 0; i < N * PX; i++) {
+            differ += memcmp(&vis[0][i], &vis[1][i], sizeof(float)) != 0;
+            soft += vis[1][i] > 0.0f && vis[1][i] < 1.0f;
+        }
+        printf("FXAA sharing the RT visibility (%s): %d px differ from lights keeping their own, %d antialiased px; "
+               "own RT visibility %llu and %llu bytes, shared scratch %llu and %llu bytes; %u and %u ray traces\n",
+               modes[split], differ, soft, (unsigned long long)rt_bytes[0],
+               (unsigned long long)rt_bytes[1], (unsigned long long)scratch[0], (unsigned long long)scratch[1],
+               traces[0], traces[1]);
+        uint64_t own = (uint64_t)N * PX * 4;
+        CHECK(differ == 0 && soft > 0 && rt_bytes[0] == own && rt_bytes[1] == (own_after ? own : 0) &&
+                  scratch[1] == scratch[0] + (own_after ? 0 : (uint64_t)PX * 4) && traces[0] == N && traces[1] == N,
+              "FXAA sharing the RT visibility (%s): %d px differ, %d soft, %u/%u traces",
+              modes[split], differ, soft, traces[0], traces[1]);
+    }
+}

@@ -177,7 +177,9 @@ impl Context {
     ) -> ApiResult<()> {
         let id = resource_id(resource)?;
         let pipeline = self.ensure_built()?.light(light)?.single(light)?;
-        match (pipeline.image(id), pipeline.buffer(id)) {
+        // A resource the lights share is not the light's own ([`passes::ShadowPipeline::is_shared`]).
+        let own = !pipeline.is_shared(id);
+        match (pipeline.image(id).filter(|_| own), pipeline.buffer(id)) {
             (Some(image), _) => {
                 out.allocated = 1;
                 out.width = image.width();

@@ -61,6 +61,9 @@ pub struct SharedGeometry {
     bvh: SceneBvh,
     state: Mutex<PrimBufferState>,
     map_scratch: MapScratchPool,
+    /// The ray traces' visibility that each light's FXAA reads right after, shared
+    /// ([`SharedGeometry::antialias_source`]); freed when no pipeline holds it any more.
+    antialias_source: Mutex<std::sync::Weak<rhi::Image>>,
 }
 
 struct PrimBufferState {
@@ -130,6 +133,7 @@ impl SharedGeometry {
             pass,
             bvh,
             map_scratch: MapScratchPool::default(),
+            antialias_source: Mutex::new(std::sync::Weak::new()),
         }))
     }
 
@@ -151,6 +155,35 @@ impl SharedGeometry {
     /// The build scratch the primitive maps over this geometry share (one light's map is built at a time).
     pub fn map_scratch(&self) -> &MapScratchPool {
         &self.map_scratch
+    }
+
+    /// The `width` x `height` `R32_SFLOAT` visibility the lights' ray traces write and their FXAA reads
+    /// right after, in the same recording call: the one the pipelines hold, or a new one (which then serves
+    /// the pipelines built after) if they hold none of that size.
+    pub(crate) fn antialias_source(
+        &self,
+        device: &Device,
+        width: u32,
+        height: u32,
+    ) -> Result<Arc<rhi::Image>, PassError> {
+        let mut slot = self
+            .antialias_source
+            .lock()
+            .map_err(|_| PassError::InvalidConfig("shared image poisoned".into()))?;
+        if let Some(image) = slot
+            .upgrade()
+            .filter(|s| (s.width(), s.height()) == (width, height))
+        {
+            return Ok(image);
+        }
+        let image = Arc::new(crate::screen_pass::visibility_image(
+            device,
+            "rt visibility (shared by the lights' FXAA)",
+            width,
+            height,
+        )?);
+        *slot = Arc::downgrade(&image);
+        Ok(image)
     }
 
     /// Whether the prim buffer is rebuilt every frame.

@@ -149,6 +149,23 @@ impl ShadowPipeline {
             Some(m) => m.path(),
             None => choose_binning_path(caps, config.map.binning).unwrap_or(BinningPath::Compute),
         };
+        // A ray trace whose visibility only the light's FXAA reads (hard or area shadows antialiased, not
+        // read back) writes an image the lights share instead of one of its own, while each recording call
+        // holds both passes ([`ShadowPipeline::is_shared`]).
+        let rt_readers: Vec<PassId> = PassId::ALL
+            .iter()
+            .copied()
+            .filter(|&p| runs(p) && plan.reads(p).contains(ResourceId::RtVisibility))
+            .collect();
+        let rt_shared = rt_readers == [PassId::Fxaa]
+            && final_output != ResourceId::RtVisibility
+            && !config.extra_outputs.contains(ResourceId::RtVisibility);
+        let ray_visibility = if rt_shared {
+            let image = shared.antialias_source(device, width, height)?;
+            Some(rhi::Image::alias_shared(&image)?)
+        } else {
+            direct_for(ResourceId::RtVisibility)
+        };
         let ray = match (&map, runs(PassId::RayTrace)) {
             (Some(m), true) => Some(RayTracePass::new(
                 device,
@@ -173,7 +190,7 @@ impl ShadowPipeline {
                             .contains(ResourceId::BlockerDistance),
                     }
                 },
-                direct_for(ResourceId::RtVisibility),
+                ray_visibility,
             )?),
             _ => None,
         };
@@ -314,6 +331,7 @@ impl ShadowPipeline {
             depth_format: inputs.depth.format(),
             surface_mode: inputs.surface.mode(inputs.normal.format()),
             normal_precision: inputs.surface.normal_precision(inputs.normal.format()),
+            rt_shared,
         };
         // Every resource of the plan exists (a missing one would be a bug in the wiring above).
         if let Some(r) = pipeline

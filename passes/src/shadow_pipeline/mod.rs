@@ -91,6 +91,12 @@ enum RetiredMap {
     Pairs {
         _bindings: Box<ScratchBindings>,
     },
+    /// The shared ray-trace visibility's view and the bind groups that used it, replaced by an image of
+    /// the light's own.
+    SharedVisibility {
+        _image: Image,
+        _groups: Vec<BindGroup>,
+    },
 }
 
 /// The passes of one view of one light, and the resources the plan allocates for them.
@@ -136,6 +142,8 @@ pub struct ShadowPipeline {
     surface_mode: UVec4,
     /// The engine's normal image's precision ([`crate::surface::SurfaceInput::normal_precision`]).
     normal_precision: f32,
+    /// Whether the ray trace writes the visibility the lights' FXAA share ([`ShadowPipeline::is_shared`]).
+    rt_shared: bool,
 }
 
 impl ShadowPipeline {
@@ -192,6 +200,17 @@ impl ShadowPipeline {
             ResourceId::PrimBuffer => self.prims(),
             _ => None,
         }
+    }
+
+    /// Whether `resource` is held in an image the lights share rather than one of the pipeline's own: the
+    /// ray trace's visibility when only the light's FXAA reads it, in the same recording call. Its report
+    /// lists it as shared scratch, not as the light's; it cannot be read back (it holds whichever light's
+    /// ray trace was recorded last): ask for it in `extra_outputs` to keep an image of the light's own. A
+    /// recording call that holds the ray trace without the FXAA (a host recording every light's ray trace
+    /// before any FXAA) gives the light an image of its own from then on, so nothing else writes it between
+    /// the two.
+    pub fn is_shared(&self, resource: ResourceId) -> bool {
+        resource == ResourceId::RtVisibility && self.rt_shared
     }
 
     /// Bytes of `resource` if the pipeline allocated it.

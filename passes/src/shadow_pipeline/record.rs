@@ -4,6 +4,7 @@ use super::{FrameInputs, FrameState, RetiredMap, ShadowPipeline};
 use crate::frame_plan::{PassId, PassStatus, ResourceSet};
 use crate::gpu_types::ShadowMapPush;
 use crate::primitive_map::FitPhase;
+use crate::screen_pass::visibility_image;
 use crate::PassError;
 use rhi::{Barrier, Device, Encoder, Image, ResourceState as S};
 
@@ -78,7 +79,7 @@ impl ShadowPipeline {
         if passes.contains(&PassId::PrimitiveMap) && self.plan.runs(PassId::PrimitiveMap) {
             self.grow_map(device, index)?;
         }
-        Ok(())
+        self.own_visibility_if_split(device, passes, index)
     }
 
     /// Times the next passes recorded into `enc` in the current frame's GPU timer, as part of this
@@ -187,6 +188,7 @@ impl ShadowPipeline {
         let last = passes.iter().max().copied();
         let statuses = self.statuses.clone();
         let runs = |p: PassId| statuses[p as usize].1 == PassStatus::Ran;
+        self.own_visibility_if_split(enc.device(), passes, frame.index)?;
         // Checked: from here on the call records.
         let timer = &self.slots[frame.slot].timer;
         if frame.timer_started {
@@ -402,6 +404,39 @@ impl ShadowPipeline {
             for r in retired {
                 self.retired.retire(last_user, r);
             }
+        }
+        Ok(())
+    }
+}
+
+impl ShadowPipeline {
+    /// Gives the ray trace an image of the light's own, in place of the visibility the lights' FXAA share,
+    /// when a recording call of `passes` in frame `frame` holds the ray trace without the FXAA (another
+    /// light's ray trace could then overwrite the shared image before this light's FXAA reads it). The
+    /// replaced view and bind groups are held until the frames before `frame` completed.
+    fn own_visibility_if_split(
+        &mut self,
+        device: &Device,
+        passes: &[PassId],
+        frame: u64,
+    ) -> Result<(), PassError> {
+        let split = passes.contains(&PassId::RayTrace) && !passes.contains(&PassId::Fxaa);
+        let (true, true, Some(ray), Some(fxaa)) =
+            (self.rt_shared, split, self.ray.as_mut(), self.fxaa.as_mut())
+        else {
+            return Ok(());
+        };
+        let (width, height) = (ray.visibility.width(), ray.visibility.height());
+        let own = visibility_image(device, "rt visibility", width, height)?;
+        let (image, mut groups) = ray.replace_visibility(device, own)?;
+        groups.push(fxaa.replace_input(device, &ray.visibility)?);
+        self.rt_shared = false;
+        let retired = RetiredMap::SharedVisibility {
+            _image: image,
+            _groups: groups,
+        };
+        if let Some(last_user) = frame.checked_sub(1) {
+            self.retired.retire(last_user, retired);
         }
         Ok(())
     }

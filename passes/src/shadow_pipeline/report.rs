@@ -73,6 +73,7 @@ impl ShadowPipeline {
         self.plan
             .resources()
             .iter()
+            .filter(|&r| !self.is_shared(r))
             .filter_map(|r| {
                 self.resource_bytes(r)
                     .map(|bytes| ResourceReport { resource: r, bytes })
@@ -80,12 +81,19 @@ impl ShadowPipeline {
             .collect()
     }
 
-    /// GPU bytes of the primitive-map scratch this pipeline shares with the other lights' (the build
-    /// scratch, the receiver map and the screen-size pixel texels; 0 without a primitive map).
+    /// GPU bytes of the scratch this pipeline shares with the other lights' (the primitive map's build
+    /// scratch, receiver map and screen-size pixel texels; the ray trace's visibility when the lights'
+    /// FXAA share it: [`ShadowPipeline::is_shared`]; 0 without either).
     pub fn map_scratch_bytes(&self) -> u64 {
-        self.map
+        let map = self
+            .map
             .as_ref()
-            .map_or(0, |_| self.shared.map_scratch().bytes())
+            .map_or(0, |_| self.shared.map_scratch().bytes());
+        let visibility = match &self.ray {
+            Some(ray) if self.rt_shared => ray.visibility.byte_size(),
+            _ => 0,
+        };
+        map + visibility
     }
 
     /// The binning path of the primitive map (what the device would use when the plan has none).
