@@ -2,11 +2,10 @@
 #extension GL_GOOGLE_include_directive : require
 // G-buffer for analysis: frame-relative position and the exact geometric normal of the visible triangle,
 // facing the camera (world xyz, coverage in w), which the plugin reads as it is.
-#include "triangle.glsl"
 #include "gbuffer_push.glsl"
 
-layout(set = 0, binding = 0) readonly buffer Prims { Triangle tris[]; };
 layout(push_constant) uniform Push { GBufferPush pc; };
+#include "gbuffer_scene.glsl"
 #include "gbuffer_surface.glsl"
 layout(location = 0) in vec3 rel_pos;
 layout(location = 0) out vec4 out_position;

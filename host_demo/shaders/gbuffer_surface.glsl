@@ -1,9 +1,10 @@
 // The G-buffer's surface: the exact geometric normal of the visible triangle, facing the camera, and the
-// engine-style encodings of it the demo can store. Needs the includer's `tris` and `pc` (GBufferPush).
+// engine-style encodings of it the demo can store. Needs the includer's `pc` (GBufferPush) and
+// gbuffer_scene.glsl.
 
 vec3 facing_normal(uint primitive, vec3 rel_pos) {
-    Triangle t = tris[primitive];
-    vec3 c = cross(t.v[1].xyz - t.v[0].xyz, t.v[2].xyz - t.v[0].xyz);
+    vec3 a = frame_vertex(3u * primitive);
+    vec3 c = cross(frame_vertex(3u * primitive + 1u) - a, frame_vertex(3u * primitive + 2u) - a);
     float len = length(c);
     vec3 n = len > 0.0 ? c / len : vec3(0.0);
     // Face the camera, decided geometrically (independent of winding and projection handedness).

@@ -94,8 +94,15 @@ fn peer_trace_ms(
         return Ok(None);
     }
     let inputs = view.frame_inputs();
-    let run =
-        crate::peer::run_area_peer(device, renderer, &inputs, angular_radius, samples, frames)?;
+    let run = crate::peer::run_area_peer(
+        device,
+        renderer,
+        &view.scene,
+        &inputs,
+        angular_radius,
+        samples,
+        frames,
+    )?;
     Ok(Some(run.trace_ms))
 }
 

@@ -69,7 +69,7 @@ fn measure(device: &Device, model: &BenchModel, args: &BenchArgs) -> Result<Meas
         None => None,
     };
     let peer = if device.capabilities().ray_tracing_pipeline {
-        let run = run_peer(device, &renderer, &inputs, args.frames)?;
+        let run = run_peer(device, &renderer, &view.scene, &inputs, args.frames)?;
         let wrong = match &reference {
             Some(r) => {
                 let images = crate::FrameImages {

@@ -1,16 +1,17 @@
 //! G-buffer for the demo host: depth, the normal target the plugin reads (in any of the encodings engines
 //! keep), and, for analysis, frame-relative positions and world normals in RGBA32F.
 //!
-//! Reads: the pipeline's prim buffer. Writes: the targets of its [`GBufferLayout`]. Shaders: `gbuffer.vert`
+//! Reads: the scene's index and vertex buffers ([`SceneBuffers`]). Writes: the targets of its [`GBufferLayout`]. Shaders: `gbuffer.vert`
 //! and `gbuffer.frag` (analysis), `gbuffer_encoded.frag` (analysis and an encoded normal target),
 //! `gbuffer_compact.frag` (depth and the encoded normal alone) in `host_demo/shaders/`.
 
+use crate::scene_buffers::SceneBuffers;
 use crate::{shader, CameraMatrices, FrameImages};
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, Mat3, Mat4, Vec4};
 use passes::{NormalEncoding, NormalSpace, PassError, SurfaceInput};
 use rhi::{
-    BindGroup, BindingKind, Buffer, ColorTarget, DepthState, DepthTarget, Device, Encoder, Format,
+    BindGroup, BindingKind, ColorTarget, DepthState, DepthTarget, Device, Encoder, Format,
     GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, ImageUsage, Resource,
 };
 
@@ -24,12 +25,14 @@ pub struct GBufferPush {
     pub camera_pos: Vec4,
     /// The view rotation's rows (world to view).
     pub view_rows: [Vec4; 3],
+    /// The frame origin in world coordinates (xyz, f32), subtracted from every vertex.
+    pub origin: Vec4,
 }
 
-const _: () = assert!(std::mem::size_of::<GBufferPush>() == 128);
+const _: () = assert!(std::mem::size_of::<GBufferPush>() == 144);
 
 impl GBufferPush {
-    /// The constants of `camera` for a prim buffer relative to `origin` and a G-buffer of `layout`: the
+    /// The constants of `camera` for vertices relative to `origin` (f32) and a G-buffer of `layout`: the
     /// view-projection of coordinates relative to the camera, composed in f64 as the plugin composes its own
     /// (`passes::camera_in_frame`), so that the G-buffer and the plugin agree on every pixel's ray.
     pub fn for_camera(
@@ -51,6 +54,7 @@ impl GBufferPush {
             view_proj_rel,
             camera_pos: camera_frame.extend(layout.code() as f32),
             view_rows: [rows.x_axis, rows.y_axis, rows.z_axis].map(|r| r.extend(0.0)),
+            origin: origin.as_vec3().extend(1.0),
         })
     }
 }
@@ -294,21 +298,25 @@ impl GBufferTargets {
     }
 }
 
-/// The G-buffer pass over the prim buffer.
+/// The G-buffer pass over the scene's buffers.
 pub struct GBufferPass {
     pipeline: GraphicsPipeline,
     group: BindGroup,
 }
 
 impl GBufferPass {
-    /// Creates the pass rasterizing `prims` into targets of `layout`.
-    pub fn new(device: &Device, prims: &Buffer, layout: &GBufferLayout) -> Result<Self, PassError> {
+    /// Creates the pass rasterizing `scene`'s triangles into targets of `layout`.
+    pub fn new(
+        device: &Device,
+        scene: &SceneBuffers,
+        layout: &GBufferLayout,
+    ) -> Result<Self, PassError> {
         let pipeline = device.create_graphics_pipeline(&GraphicsPipelineDesc {
             name: "gbuffer",
             vertex: &shader("gbuffer.vert")?,
             geometry: None,
             fragment: &shader(layout.fragment_shader())?,
-            bindings: &[BindingKind::StorageBuffer],
+            bindings: &[BindingKind::StorageBuffer, BindingKind::StorageBuffer],
             push_constant_size: std::mem::size_of::<GBufferPush>() as u32,
             color_formats: &layout.color_formats(),
             depth: Some(DepthState {
@@ -319,7 +327,13 @@ impl GBufferPass {
             conservative_extra_overestimation: None,
             depth_clamp: false,
         })?;
-        let group = device.create_bind_group(pipeline.layout(), &[Resource::Buffer(prims)])?;
+        let group = device.create_bind_group(
+            pipeline.layout(),
+            &[
+                Resource::Buffer(scene.indices()),
+                Resource::Buffer(scene.vertices()),
+            ],
+        )?;
         Ok(Self { pipeline, group })
     }
 

@@ -37,6 +37,7 @@ pub mod ray_dump;
 pub mod render;
 pub mod renderer;
 pub mod report;
+pub mod scene_buffers;
 pub mod scene_plan;
 pub mod scene_render;
 pub mod shading;

@@ -22,7 +22,7 @@ use passes::{
     PrimitiveMapConfig, ResourceId, ShadowConfig, ShadowMode,
 };
 use rhi::Device;
-use scene::{Aabb, Camera, LightKind, LightSize, SceneFile, SceneLight};
+use scene::{Aabb, Camera, LightKind, LightSize, Scene, SceneFile, SceneLight};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -286,6 +286,7 @@ fn medians(frames: &[LightsFrame]) -> (f64, f64, f64) {
 fn peer_ms(
     device: &Device,
     plugin: &PluginRenderer,
+    scene: &Scene,
     camera: &Camera,
     light: Option<Light>,
     size: f32,
@@ -304,6 +305,7 @@ fn peer_ms(
     let run = crate::peer::run_area_peer(
         device,
         plugin,
+        scene,
         &inputs,
         size,
         args.area_samples,
@@ -352,7 +354,15 @@ fn measure_light(
     let last = frames.last().context("no frame rendered")?;
     let reports: Vec<_> = last.lights.iter().map(|l| &l.report).collect();
     let peer_ms = match peer {
-        Some((light, size)) => peer_ms(device, renderer.plugin(), camera, Some(light), size, args)?,
+        Some((light, size)) => peer_ms(
+            device,
+            renderer.plugin(),
+            &file.scene,
+            camera,
+            Some(light),
+            size,
+            args,
+        )?,
         None => None,
     };
     let entries: u64 = reports.iter().map(|r| u64::from(r.stats.entries)).sum();
@@ -433,7 +443,6 @@ fn measure_native_points(
         &file.shadow_casters,
         args.width,
         args.height,
-        false,
         GBufferLayout::ANALYSIS,
     )?;
     plugin.set_output_format(args.output_format());

@@ -1,16 +1,19 @@
 //! The ray-tracing-pipeline peer on the demo's frame: the same shadow rays as the primitive-map ray trace,
-//! traced through the GPU's ray-tracing pipeline over acceleration structures the driver builds from the
-//! demo's prim buffer ([`passes::rt_peer::RtPeerPass`]). What a user would pick instead of our technique.
+//! traced through the GPU's ray-tracing pipeline over acceleration structures the driver builds from a
+//! prim buffer of the scene's triangles in the frame's coordinates ([`passes::rt_peer::RtPeerPass`]). What
+//! a user would pick instead of our technique.
 //! For area shadows ([`run_area_peer`]) each of a pixel's light samples is its own ray: the same samples
 //! as the plugin's area trace, so equal samples give equal answers.
 
 use crate::plugin::PluginRenderer;
-use crate::{read_images, FrameImages, FrameOutput};
+use crate::{read_images, upload_scene, FrameImages, FrameOutput};
 use anyhow::{Context as _, Result};
 use passes::gpu_types::{AreaSamples, RayTraceConstants};
+use passes::prim_buffer::PrimBufferPass;
 use passes::rt_peer::{area_peer_constants, shadow_ray_constants, RtPeerPass};
 use passes::{FrameInputs, PassError};
-use rhi::{Device, ResourceState as S};
+use rhi::{Barrier, Device, ResourceState as S};
+use scene::Scene;
 
 /// The name of the peer's build pass (bottom and top level).
 pub const BUILD_PASS: &str = "rt peer build";
@@ -28,21 +31,22 @@ pub struct PeerRun {
     pub visibility: Vec<f32>,
 }
 
-/// Builds the acceleration structures and traces the shadow rays of the frame `renderer` last rendered
-/// with `inputs`, `frames` times (at least 2), each frame one submission timed by GPU timestamps. Returns
-/// the medians over the frames after the first and the last frame's visibility. On a device without ray
-/// tracing the error is a [`PassError::Unsupported`] naming what is missing (`downcast_ref` tells it apart).
+/// Builds the acceleration structures of `scene` (the scene `renderer` draws) and traces the shadow rays
+/// of the frame `renderer` last rendered with `inputs`, `frames` times (at least 2), each frame one
+/// submission timed by GPU timestamps. Returns the medians over the frames after the first and the last
+/// frame's visibility. On a device without ray tracing the error is a [`PassError::Unsupported`] naming
+/// what is missing (`downcast_ref` tells it apart).
 pub fn run_peer(
     device: &Device,
     renderer: &PluginRenderer,
+    scene: &Scene,
     inputs: &FrameInputs,
     frames: u32,
 ) -> Result<PeerRun> {
-    let geometry = renderer.geometry();
     let targets = renderer.targets();
     let size = (targets.depth.width(), targets.depth.height());
-    let constants = shadow_ray_constants(inputs, geometry.origin(), size.0, size.1)?;
-    run(device, renderer, &constants, None, frames)
+    let constants = shadow_ray_constants(inputs, renderer.scene().origin(), size.0, size.1)?;
+    run(device, renderer, scene, &constants, None, frames)
 }
 
 /// [`run_peer`] for area shadows: each of the `samples` light samples of every pixel of a light of size
@@ -51,27 +55,39 @@ pub fn run_peer(
 pub fn run_area_peer(
     device: &Device,
     renderer: &PluginRenderer,
+    scene: &Scene,
     inputs: &FrameInputs,
     light_size: f32,
     samples: u32,
     frames: u32,
 ) -> Result<PeerRun> {
-    let geometry = renderer.geometry();
     let targets = renderer.targets();
     let size = (targets.depth.width(), targets.depth.height());
     let (constants, area) =
-        area_peer_constants(inputs, geometry.origin(), size, light_size, samples)?;
-    run(device, renderer, &constants, Some(&area), frames)
+        area_peer_constants(inputs, renderer.scene().origin(), size, light_size, samples)?;
+    run(device, renderer, scene, &constants, Some(&area), frames)
 }
 
 fn run(
     device: &Device,
     renderer: &PluginRenderer,
+    scene: &Scene,
     constants: &RayTraceConstants,
     area: Option<&AreaSamples>,
     frames: u32,
 ) -> Result<PeerRun> {
-    let geometry = renderer.geometry();
+    // The scene's triangles relative to the frame origin the renderer's G-buffer and the constants use.
+    let geometry = upload_scene(device, scene)?;
+    let drawn = renderer.scene();
+    if (geometry.origin(), geometry.triangle_count()) != (drawn.origin(), drawn.triangle_count()) {
+        anyhow::bail!("the peer's scene is not the one the renderer draws");
+    }
+    let prim_buffer = PrimBufferPass::new(device, &geometry)?;
+    device.submit_and_wait(|enc| {
+        prim_buffer.record(enc, &geometry, None).map_err(into_rhi)?;
+        enc.barriers(&[Barrier::Full]);
+        Ok(())
+    })?;
     let targets = renderer.targets();
     let (width, height) = (targets.depth.width(), targets.depth.height());
     let normal = targets
@@ -86,7 +102,7 @@ fn run(
     };
     let mut peer = new(
         device,
-        renderer.prims(),
+        prim_buffer.prims(),
         geometry.triangle_count(),
         &targets.depth,
         normal,

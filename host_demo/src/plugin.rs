@@ -9,18 +9,18 @@
 //! what the demo shows is what an integrator gets.
 
 use crate::gbuffer::{GBufferLayout, GBufferPass, GBufferPush, GBufferTargets};
-use crate::{read_images, upload_scene, CameraMatrices, FrameImages, FrameOutput, View};
+use crate::scene_buffers::SceneBuffers;
+use crate::{read_images, CameraMatrices, FrameImages, FrameOutput, View};
 use anyhow::{bail, Context as _, Result};
 use hrts::passes_bridge;
-use passes::prim_buffer::PrimBufferPass;
 use passes::MapStats;
 use passes::{
-    BinningPath, FrameInputs, FrameReport, Geometry, Light, PassId, PassStatus, ResourceId,
-    ResourceReport, ShadowConfig, SkipReason,
+    BinningPath, FrameInputs, FrameReport, Light, PassId, PassStatus, ResourceId, ResourceReport,
+    ShadowConfig, SkipReason,
 };
 use rhi::{
-    Barrier, Buffer, BufferUsage, ConservativeRasterTier, Device, Format, GpuTimer, Image,
-    ImageDesc, ImageUsage, MemoryLocation, PassTiming, ResourceState as S,
+    Barrier, BufferUsage, ConservativeRasterTier, Device, Format, GpuTimer, Image, ImageDesc,
+    ImageUsage, MemoryLocation, PassTiming, ResourceState as S,
 };
 use scene::{Aabb, Scene};
 use std::ffi::CString;
@@ -79,8 +79,7 @@ pub struct LightsFrame {
 pub struct PluginRenderer {
     /// The plugin's context, dropped first: it uses the buffers and images of the fields after it.
     context: hrts::Context,
-    geometry: Geometry,
-    prim_buffer: PrimBufferPass,
+    scene: SceneBuffers,
     gbuffer: GBufferPass,
     targets: GBufferTargets,
     /// The visibility image, one layer per light (none before lights are configured).
@@ -96,7 +95,6 @@ pub struct PluginRenderer {
     /// Format of the visibility image: `R32Float`, `R16Float` or `R8Unorm` (read back as `f32`).
     output_format: Format,
     timer: GpuTimer,
-    dynamic_geometry: bool,
     /// The bounds of the shadow casters, given with every frame: the demo does not animate its scenes, so
     /// they hold in every frame even when the geometry counts as moving.
     bounds: Aabb,
@@ -124,40 +122,23 @@ impl PluginRenderer {
         layout: GBufferLayout,
     ) -> Result<Self> {
         let config = crate::renderer::with_blocker_distance(config.into());
-        let mut renderer = Self::for_scene(
-            device,
-            &view.scene,
-            view.width,
-            view.height,
-            !config.static_geometry,
-            layout,
-        )?;
+        let mut renderer = Self::for_scene(device, &view.scene, view.width, view.height, layout)?;
         renderer.configure_lights(device, &[config])?;
         Ok(renderer)
     }
 
     /// Uploads `scene` into the demo's buffers, creates the G-buffer for a `width` x `height` frame and a
     /// plugin context on `device` that has the geometry but no light yet ([`PluginRenderer::configure_lights`]).
-    /// `dynamic_geometry`: the demo rebuilds its own prim buffer every frame, as the plugin does when a
-    /// light's configuration says so. `layout`: what the G-buffer keeps. Every object casts shadows.
+    /// `layout`: what the G-buffer keeps. Every object casts shadows.
     pub fn for_scene(
         device: &Device,
         scene: &Scene,
         width: u32,
         height: u32,
-        dynamic_geometry: bool,
         layout: GBufferLayout,
     ) -> Result<Self> {
         let casters = vec![true; scene.objects.len()];
-        Self::for_scene_casters(
-            device,
-            scene,
-            &casters,
-            width,
-            height,
-            dynamic_geometry,
-            layout,
-        )
+        Self::for_scene_casters(device, scene, &casters, width, height, layout)
     }
 
     /// [`PluginRenderer::for_scene`] where only the objects marked in `casters` (one flag per object) cast
@@ -169,7 +150,6 @@ impl PluginRenderer {
         casters: &[bool],
         width: u32,
         height: u32,
-        dynamic_geometry: bool,
         layout: GBufferLayout,
     ) -> Result<Self> {
         if width == 0 || height == 0 {
@@ -186,16 +166,18 @@ impl PluginRenderer {
         if !casters.iter().any(|&c| c) || bounds == Aabb::empty() {
             bail!("no object of the scene casts shadows: the plugin needs at least one caster");
         }
-        let geometry = upload_scene(device, scene).context("uploading the scene")?;
-        let prim_buffer = PrimBufferPass::new(device, &geometry)?;
-        let gbuffer = GBufferPass::new(device, prim_buffer.prims(), &layout)?;
+        let scene = SceneBuffers::upload(device, scene).context("uploading the scene")?;
+        let gbuffer = GBufferPass::new(device, &scene, &layout)?;
         let targets = GBufferTargets::new(device, width, height, layout)?;
         let context = create_context(device)?;
-        set_geometry(&context, &geometry, casters, &bounds)?;
+        let draws = scene.caster_draws(casters);
+        let mesh = scene.plugin_mesh(&draws, &bounds);
+        // SAFETY: the buffers are the demo device's, of their sizes; they live as long as the renderer,
+        // which drops the context first.
+        unsafe { context.set_geometry_vulkan(&[mesh]) }?;
         Ok(Self {
             context,
-            geometry,
-            prim_buffer,
+            scene,
             gbuffer,
             targets,
             output: None,
@@ -204,7 +186,6 @@ impl PluginRenderer {
             output_usage: ImageUsage::COPY_DST | ImageUsage::COPY_SRC | ImageUsage::SAMPLED,
             output_format: Format::R32Float,
             timer: device.create_timer(4)?,
-            dynamic_geometry,
             bounds,
             frames: 0,
             frames_with_plugin_passes: 0,
@@ -274,19 +255,14 @@ impl PluginRenderer {
         Ok(())
     }
 
-    /// The demo's prim buffer (`GpuTriangle`s relative to the frame origin), filled by the first frame.
-    pub fn prims(&self) -> &Buffer {
-        self.prim_buffer.prims()
-    }
-
     /// The demo's G-buffer; after a frame, depth and normal are in `ShaderResource` state.
     pub fn targets(&self) -> &GBufferTargets {
         &self.targets
     }
 
-    /// The scene's geometry as uploaded.
-    pub fn geometry(&self) -> &Geometry {
-        &self.geometry
+    /// The scene's buffers as uploaded.
+    pub fn scene(&self) -> &SceneBuffers {
+        &self.scene
     }
 
     /// Frames rendered in which the plugin recorded passes (a frame without lights records none).
@@ -307,8 +283,8 @@ impl PluginRenderer {
         Ok(report)
     }
 
-    /// Renders one frame and waits for it, in two submissions: the demo's prim buffer (first frame, or
-    /// every frame with dynamic geometry), the plugin's light-space passes and the demo's G-buffer; then
+    /// Renders one frame and waits for it, in two submissions: the plugin's light-space passes and the
+    /// demo's G-buffer; then
     /// the plugin's screen-space passes (primitive map, ray trace, soft shadows) and output copy. `lights`
     /// holds one light per configured light (none: the plugin records nothing). Returns the plugin's
     /// report of each light, the G-buffer's GPU time and, with lights, [`SCREEN_SPACE_WALL`]: the host's
@@ -339,20 +315,13 @@ impl PluginRenderer {
                 self.configured.len()
             );
         }
-        let push = GBufferPush::for_camera(camera, self.geometry.origin(), &self.targets.layout)?;
+        let push = GBufferPush::for_camera(camera, self.scene.origin(), &self.targets.layout)?;
         self.last_camera = Some(*camera);
-        let tris = self.geometry.triangle_count();
-        let rebuild_prims = self.frames == 0 || self.dynamic_geometry;
+        let tris = self.scene.triangle_count();
         let with_plugin = !lights.is_empty();
         let t = &self.targets;
         let frame = plugin_frame(self.frames, camera, lights, &self.bounds);
         device.submit_and_wait(|enc| {
-            if rebuild_prims {
-                self.prim_buffer
-                    .record(enc, &self.geometry, None)
-                    .map_err(recording_error)?;
-                enc.barriers(&[Barrier::Uav]);
-            }
             enc.attach_timer(&self.timer);
             if with_plugin {
                 // SAFETY: the demo's recording command buffer, outside a render pass, submitted and waited
@@ -539,7 +508,7 @@ impl PluginRenderer {
             }
             None => Vec::new(),
         };
-        let origin = self.geometry.origin();
+        let origin = self.scene.origin();
         let mut frame = FrameImages::default();
         if compact {
             let camera = self.last_camera.context("no frame rendered")?;
@@ -582,7 +551,7 @@ impl PluginRenderer {
             );
         }
         frame.output = layers.swap_remove(light as usize);
-        let origin = self.geometry.origin();
+        let origin = self.scene.origin();
         let mut sources: Vec<(Destination, ResourceId)> = FrameOutput::PIPELINE
             .iter()
             .map(|&(output, id)| (Destination::Image(output), id))
@@ -679,7 +648,7 @@ fn target_image(image: &Image) -> hrts::TargetImage {
 }
 
 /// The plugin's bounds of `bounds`.
-fn plugin_bounds(bounds: &Aabb) -> hrts::Bounds {
+pub(crate) fn plugin_bounds(bounds: &Aabb) -> hrts::Bounds {
     hrts::Bounds {
         min: bounds.min,
         max: bounds.max,
@@ -710,68 +679,6 @@ fn create_context(device: &Device) -> Result<hrts::Context> {
     // SAFETY: the handles are the demo's live device, as it was created; it outlives the context (the
     // renderer that holds it borrows nothing but is dropped before the demo's device by every caller).
     Ok(unsafe { hrts::Context::adopt(&vulkan, 0) }?)
-}
-
-/// Hands the demo's meshes (their vertex and index buffers) to the plugin with the draws of the objects
-/// marked in `casters` (the demo's draws are its objects, in order, over all meshes; a mesh without a
-/// caster is left out), each mesh with the casters' `bounds`, which enclose its draws given (the plugin's
-/// frame origin is their centre).
-fn set_geometry(
-    context: &hrts::Context,
-    geometry: &Geometry,
-    casters: &[bool],
-    bounds: &Aabb,
-) -> Result<()> {
-    let mut casts = casters.iter();
-    let draws: Vec<Vec<hrts::Draw>> = geometry
-        .meshes()
-        .iter()
-        .map(|m| {
-            m.draws()
-                .iter()
-                .filter(|_| casts.next().copied().unwrap_or(false))
-                .map(|d| hrts::Draw {
-                    first_index: d.first_index,
-                    index_count: d.index_count,
-                    transform: d.model,
-                    base_vertex: d.base_vertex,
-                })
-                .collect()
-        })
-        .collect();
-    let meshes: Vec<hrts::VulkanMesh> = geometry
-        .meshes()
-        .iter()
-        .zip(&draws)
-        .filter(|(_, draws)| !draws.is_empty())
-        .map(|(m, draws)| {
-            let (vertices, vertex) = m.vertices();
-            let (indices, index) = m.indices();
-            hrts::VulkanMesh {
-                vertex_buffer: vertices.raw_handle(),
-                vertex_buffer_size: vertices.size(),
-                vertex_offset: vertex.offset,
-                vertex_stride: vertex.stride,
-                vertex_count: vertex.count,
-                index_buffer: indices.raw_handle(),
-                index_buffer_size: indices.size(),
-                index_offset: index.offset,
-                index_type: match index.format {
-                    passes::IndexFormat::U16 => hrts::IndexType::Uint16,
-                    passes::IndexFormat::U32 => hrts::IndexType::Uint32,
-                },
-                index_count: index.count,
-                draws,
-                bounds: plugin_bounds(bounds),
-                vertex_format: 0,
-                position_scale: glam::Vec3::ZERO,
-                position_offset: glam::Vec3::ZERO,
-            }
-        })
-        .collect();
-    // SAFETY: the buffers are the demo device's, of their sizes; they live as long as the renderer, which
-    // drops the context first.
-    Ok(unsafe { context.set_geometry_vulkan(&meshes) }?)
 }
 
 /// The plugin's light of `light`.

@@ -43,17 +43,15 @@ pub struct SceneImages {
 
 impl SceneRenderer {
     /// Uploads `file`'s scene and creates the G-buffer and a plugin context for a `width` x `height`
-    /// frame; the geometry is dynamic if any object is not static. Every object is drawn; the plugin is
-    /// given the objects that cast shadows (`SceneFile::shadow_casters`).
+    /// frame. Every object is drawn; the plugin is given the objects that cast shadows
+    /// (`SceneFile::shadow_casters`).
     pub fn new(device: &Device, file: &SceneFile, width: u32, height: u32) -> Result<Self> {
-        let dynamic_geometry = file.static_objects.iter().any(|&s| !s);
         let plugin = PluginRenderer::for_scene_casters(
             device,
             &file.scene,
             &file.shadow_casters,
             width,
             height,
-            dynamic_geometry,
             GBufferLayout::ANALYSIS,
         )?;
         Ok(Self {

@@ -79,8 +79,7 @@ pub fn tier_matrix(device: &Device, scenes: &[(&str, View)], size: u32) -> Resul
             let inputs = view.frame_inputs();
             let report = renderer.render(device, &inputs)?;
             let images = renderer.read_back(device, true)?;
-            let light =
-                fitted_light_matrix(report.map_to_texels, renderer.geometry().origin(), size);
+            let light = fitted_light_matrix(report.map_to_texels, renderer.scene().origin(), size);
             let map = compare_map(
                 &rs,
                 light,

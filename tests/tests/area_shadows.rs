@@ -48,9 +48,7 @@ fn area_config(angular_radius: f32, samples: u32, faces: FaceMode) -> ShadowConf
 }
 
 fn render(device: &Device, view: &View, config: ShadowConfig) -> (FrameReport, FrameImages) {
-    let geometry = view.upload(device).expect("upload");
-    let mut r =
-        ShadowRenderer::new(device, geometry, view.width, view.height, config).expect("renderer");
+    let mut r = ShadowRenderer::new(device, view, config).expect("renderer");
     let report = r.render(device, &view.frame_inputs()).expect("render");
     (report, r.read_back(device, false).expect("read back"))
 }
@@ -215,9 +213,8 @@ fn invalid_light_sizes_and_sample_counts_are_rejected() {
         (0.02, 0, "light samples"),
         (0.02, 129, "light samples"),
     ] {
-        let geometry = view.upload(&device).expect("upload");
         let config = area_config(radius, samples, FaceMode::Both);
-        let err = match ShadowRenderer::new(&device, geometry, view.width, view.height, config) {
+        let err = match ShadowRenderer::new(&device, &view, config) {
             Err(e) => e,
             Ok(mut r) => r
                 .render(&device, &view.frame_inputs())
@@ -227,10 +224,9 @@ fn invalid_light_sizes_and_sample_counts_are_rejected() {
         assert!(err.contains(what), "{err}");
     }
     // Area shadows need compute binning.
-    let geometry = view.upload(&device).expect("upload");
     let mut config = area_config(0.02, 32, FaceMode::Both);
     config.map.binning = BinningRequest::Software;
-    let err = ShadowRenderer::new(&device, geometry, view.width, view.height, config)
+    let err = ShadowRenderer::new(&device, &view, config)
         .err()
         .expect("software binning accepted")
         .to_string();
@@ -248,11 +244,9 @@ fn invalid_light_sizes_and_sample_counts_are_rejected() {
         (0.0, narrow, "emitter radius"),
         (0.05, wide, "narrower than 174°"),
     ] {
-        let geometry = view.upload(&device).expect("upload");
         let mut config = area_config(0.02, 32, FaceMode::Both);
         config.pcss.spot_radius = spot_radius;
-        let mut r = ShadowRenderer::new(&device, geometry, view.width, view.height, config)
-            .expect("renderer");
+        let mut r = ShadowRenderer::new(&device, &view, config).expect("renderer");
         let mut inputs = view.frame_inputs();
         inputs.light = light;
         let err = r

@@ -54,21 +54,16 @@ fn read_buffer<T: bytemuck::Pod>(device: &Device, buffer: &Buffer) -> Vec<T> {
 
 /// Renders `view` once with `config` and reads everything back.
 fn render_with(device: &Device, view: &View, config: ShadowConfig) -> (FrameReport, FrameImages) {
-    let geometry = view.upload(device).expect("upload");
-    let mut r =
-        ShadowRenderer::new(device, geometry, view.width, view.height, config).expect("renderer");
+    let mut r = ShadowRenderer::new(device, view, config).expect("renderer");
     let report = r.render(device, &view.frame_inputs()).expect("render");
     (report, r.read_back(device, false).expect("read back"))
 }
 
 /// Builds the BVH of `view`'s scene (a frame of hard shadows) and checks it against its triangles.
 fn check_hierarchy(device: &Device, view: &View) {
-    let geometry = view.upload(device).expect("upload");
     let mut r = ShadowRenderer::new(
         device,
-        geometry,
-        view.width,
-        view.height,
+        view,
         ShadowConfig {
             mode: ShadowMode::Hard,
             ..ShadowConfig::default()

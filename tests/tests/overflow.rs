@@ -20,11 +20,9 @@ fn frames(
     config: PrimitiveMapConfig,
     count: usize,
 ) -> Vec<(passes::FrameReport, FrameImages)> {
-    let geometry = view.upload(device).expect("upload");
     let mut config = ShadowConfig::from(config);
     config.extra_outputs = ResourceSet::of(&[ResourceId::Occupancy]);
-    let mut r =
-        ShadowRenderer::new(device, geometry, view.width, view.height, config).expect("renderer");
+    let mut r = ShadowRenderer::new(device, view, config).expect("renderer");
     let inputs: FrameInputs = view.frame_inputs();
     (0..count)
         .map(|_| {

@@ -104,9 +104,7 @@ fn both(
     with_indices: bool,
 ) -> [(FrameReport, FrameImages); 2] {
     let inputs = view.frame_inputs();
-    let geometry = view.upload(device).expect("upload");
-    let mut direct = ShadowRenderer::new(device, geometry, view.width, view.height, config)
-        .expect("Rust renderer");
+    let mut direct = ShadowRenderer::new(device, view, config).expect("Rust renderer");
     let mut plugin = PluginRenderer::new(device, view, config).expect("plugin renderer");
     let mut out = Vec::new();
     let mut last_direct = None;

@@ -35,7 +35,7 @@ fn check(view: &View, max_near_edge_fraction: f64) {
     let mut renderer = PluginRenderer::new(&device, view, config).expect("renderer");
     let inputs = view.frame_inputs();
     renderer.render(&device, &inputs).expect("render");
-    let peer = match run_peer(&device, &renderer, &inputs, 3) {
+    let peer = match run_peer(&device, &renderer, &view.scene, &inputs, 3) {
         Ok(peer) => peer,
         Err(e) => match e.downcast_ref::<PassError>() {
             Some(PassError::Unsupported(why)) => not_run(&device, why),
@@ -135,7 +135,8 @@ fn area_peer_counts_equal_the_plugins_on_stable_pixels() {
             .read_back(&device, false)
             .expect("read back")
             .output;
-        let peer = match run_area_peer(&device, &renderer, &inputs, radius, samples, 3) {
+        let peer = match run_area_peer(&device, &renderer, &view.scene, &inputs, radius, samples, 3)
+        {
             Ok(peer) => peer,
             Err(e) => match e.downcast_ref::<PassError>() {
                 Some(PassError::Unsupported(why)) => not_run(&device, why),

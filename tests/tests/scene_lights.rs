@@ -1368,7 +1368,6 @@ fn plugin_for(device: &Device, file: &SceneFile) -> PluginRenderer {
         &file.scene,
         WIDTH,
         HEIGHT,
-        false,
         host_demo::gbuffer::GBufferLayout::ANALYSIS,
     )
     .expect("plugin")

@@ -64,9 +64,7 @@ fn render_frames(
     config: ShadowConfig,
     inputs: &[passes::FrameInputs],
 ) -> (Vec<FrameReport>, FrameImages) {
-    let geometry = view.upload(device).expect("upload");
-    let mut r =
-        ShadowRenderer::new(device, geometry, view.width, view.height, config).expect("renderer");
+    let mut r = ShadowRenderer::new(device, view, config).expect("renderer");
     let reports = inputs
         .iter()
         .map(|i| r.render(device, i).expect("render"))

@@ -151,15 +151,8 @@ fn same_visibility_as_host_demo() {
         ..rhi::DeviceDesc::from_env()
     })
     .expect("device");
-    let geometry = view.upload(&device).expect("upload");
-    let mut demo = ShadowRenderer::new(
-        &device,
-        geometry,
-        WIDTH,
-        HEIGHT,
-        PrimitiveMapConfig::default(),
-    )
-    .expect("renderer");
+    let mut demo =
+        ShadowRenderer::new(&device, &view, PrimitiveMapConfig::default()).expect("renderer");
     demo.render(&device, &view.frame_inputs()).expect("render");
     let demo_vis = demo
         .read_back(&device, false)

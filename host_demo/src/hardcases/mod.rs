@@ -373,11 +373,7 @@ fn measure(
         FaceMode::FrontOnly => FaceSelection::FrontOnly,
         FaceMode::Both => FaceSelection::Both,
     };
-    let light = fitted_light_matrix(
-        report.map_to_texels,
-        renderer.geometry().origin(),
-        config.size,
-    );
+    let light = fitted_light_matrix(report.map_to_texels, renderer.scene().origin(), config.size);
     let m = compare_map(
         &rs,
         light,

@@ -1,13 +1,14 @@
 //! Test support: [`ShadowRenderer`], a frame that drives one [`ShadowPipeline`] of the passes directly
-//! (prim buffer, the demo's G-buffer, the pipeline's passes), submitted and waited for, with read-back of
+//! (the demo's G-buffer over its own scene buffers, the pipeline's passes), submitted and waited for, with read-back of
 //! every output its plan produced. The integration tests and wgpu_host's tests compare the plugin's C ABI
 //! frames with it; the demo itself drives the plugin through its public API only.
 
 use host_demo::gbuffer::{GBufferLayout, GBufferPass, GBufferPush, GBufferTargets};
 use host_demo::renderer::with_blocker_distance;
-use host_demo::{read_images, CameraMatrices, FrameImages, FrameOutput};
+use host_demo::scene_buffers::SceneBuffers;
+use host_demo::{read_images, CameraMatrices, FrameImages, FrameOutput, View};
 use passes::{
-    FrameInputs, FrameReport, Geometry, PassError, PassId, ResourceId, ShadowConfig, ShadowInputs,
+    FrameInputs, FrameReport, PassError, PassId, ResourceId, ShadowConfig, ShadowInputs,
     ShadowPipeline,
 };
 use rhi::{Barrier, Buffer, BufferUsage, Device, Image, MemoryLocation, ResourceState as S};
@@ -15,27 +16,29 @@ use rhi::{Barrier, Buffer, BufferUsage, Device, Image, MemoryLocation, ResourceS
 /// The demo frame: a G-buffer of its own plus the engine-facing [`ShadowPipeline`].
 pub struct ShadowRenderer {
     targets: GBufferTargets,
+    scene: SceneBuffers,
     gbuffer: GBufferPass,
     pipeline: ShadowPipeline,
 }
 
 impl ShadowRenderer {
-    /// Creates every pass for a `width` x `height` frame over `geometry`. The plan of `config` also keeps
-    /// the prim buffer, which this G-buffer rasterizes.
+    /// Uploads `view`'s scene (into the demo's buffers, which its G-buffer draws, and into the pipeline's
+    /// geometry) and creates every pass for a frame of its size.
     pub fn new(
         device: &Device,
-        geometry: Geometry,
-        width: u32,
-        height: u32,
+        view: &View,
         config: impl Into<ShadowConfig>,
     ) -> Result<Self, PassError> {
+        let (width, height) = (view.width, view.height);
         if width == 0 || height == 0 {
             return Err(PassError::InvalidConfig(
                 "frame size must be non-zero".into(),
             ));
         }
-        let mut config = with_blocker_distance(config.into());
-        config.extra_outputs = config.extra_outputs.with(ResourceId::PrimBuffer);
+        let geometry = view.upload(device)?;
+        let scene = SceneBuffers::upload(device, &view.scene)
+            .map_err(|e| PassError::InvalidGeometry(format!("{e:#}")))?;
+        let config = with_blocker_distance(config.into());
         let targets = GBufferTargets::new(device, width, height, GBufferLayout::ANALYSIS)?;
         let inputs = ShadowInputs {
             depth: &targets.depth,
@@ -44,12 +47,10 @@ impl ShadowRenderer {
             direct_output: None,
         };
         let pipeline = ShadowPipeline::new(device, geometry, &inputs, config)?;
-        let prims = pipeline.prims().ok_or_else(|| {
-            PassError::InvalidConfig("the demo G-buffer needs the prim buffer".into())
-        })?;
-        let gbuffer = GBufferPass::new(device, prims, &targets.layout)?;
+        let gbuffer = GBufferPass::new(device, &scene, &targets.layout)?;
         Ok(Self {
             targets,
+            scene,
             gbuffer,
             pipeline,
         })
@@ -68,14 +69,15 @@ impl ShadowRenderer {
     ) -> Result<FrameReport, PassError> {
         let push = GBufferPush::for_camera(
             &CameraMatrices::of_frame(inputs),
-            self.pipeline.geometry().origin(),
+            self.scene.origin(),
             &self.targets.layout,
         )?;
-        let tris = self.pipeline.geometry().triangle_count();
+        let tris = self.scene.triangle_count();
         let Self {
             targets,
             gbuffer,
             pipeline,
+            ..
         } = self;
         pipeline.begin_frame(inputs)?;
         device.submit_and_wait(|enc| {

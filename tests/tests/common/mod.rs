@@ -64,9 +64,7 @@ pub fn render(
     config: PrimitiveMapConfig,
     with_entries: bool,
 ) -> (FrameReport, FrameImages) {
-    let geometry = view.upload(device).expect("upload");
-    let mut r =
-        ShadowRenderer::new(device, geometry, view.width, view.height, config).expect("renderer");
+    let mut r = ShadowRenderer::new(device, view, config).expect("renderer");
     let report = r.render(device, &view.frame_inputs()).expect("render");
     let images = r.read_back(device, with_entries).expect("read back");
     (report, images)
