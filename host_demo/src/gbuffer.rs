@@ -9,7 +9,8 @@ use crate::scene_buffers::SceneBuffers;
 use crate::{shader, CameraMatrices, FrameImages};
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, Mat3, Mat4, Vec4};
-use passes::{NormalEncoding, NormalSpace, PassError, SurfaceInput};
+use hrts::{NormalEncoding, NormalSpace};
+use passes::PassError;
 use rhi::{
     BindGroup, BindingKind, ColorTarget, DepthState, DepthTarget, Device, Encoder, Format,
     GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, ImageUsage, Resource,
@@ -68,7 +69,9 @@ pub struct GBufferLayout {
     /// Format of the normal target the plugin reads.
     pub normal: Format,
     /// How that target encodes the normal.
-    pub surface: SurfaceInput,
+    pub normal_encoding: NormalEncoding,
+    /// The space of the normals it holds.
+    pub normal_space: NormalSpace,
     /// Whether the G-buffer keeps frame-relative positions and world normals (RGBA32F) to read back.
     pub analysis: bool,
 }
@@ -131,10 +134,8 @@ impl GBufferLayout {
     pub const ANALYSIS: Self = Self {
         depth: Format::D32Float,
         normal: Format::Rgba32Float,
-        surface: SurfaceInput {
-            encoding: NormalEncoding::XyzCoverage,
-            space: NormalSpace::World,
-        },
+        normal_encoding: NormalEncoding::XyzCoverage,
+        normal_space: NormalSpace::World,
         analysis: true,
     };
 
@@ -146,10 +147,8 @@ impl GBufferLayout {
         Self {
             depth: if usable { d24s8 } else { Format::D32Float },
             normal: Format::Rg16Float,
-            surface: SurfaceInput {
-                encoding: NormalEncoding::Octahedral,
-                space: NormalSpace::View,
-            },
+            normal_encoding: NormalEncoding::Octahedral,
+            normal_space: NormalSpace::View,
             analysis: false,
         }
     }
@@ -166,23 +165,25 @@ impl GBufferLayout {
             })?;
         Ok(Self {
             normal,
-            surface: SurfaceInput { encoding, space },
+            normal_encoding: encoding,
+            normal_space: space,
             ..Self::ANALYSIS
         })
     }
 
     /// The shaders' code of the normal target: bit 0 octahedral, bit 1 unorm channels, bit 2 view space.
     pub fn code(&self) -> u32 {
-        u32::from(self.surface.encoding == NormalEncoding::Octahedral)
+        u32::from(self.normal_encoding == NormalEncoding::Octahedral)
             | u32::from(self.normal.is_unorm()) << 1
-            | u32::from(self.surface.space == NormalSpace::View) << 2
+            | u32::from(self.normal_space == NormalSpace::View) << 2
     }
 
     /// Whether the plugin reads the analysis normals themselves (no separate normal target).
     fn reads_analysis_normals(&self) -> bool {
         self.analysis
             && self.normal == Self::ANALYSIS.normal
-            && self.surface == Self::ANALYSIS.surface
+            && self.normal_encoding == Self::ANALYSIS.normal_encoding
+            && self.normal_space == Self::ANALYSIS.normal_space
     }
 
     /// Colour formats of the pass, in attachment order.
@@ -386,8 +387,8 @@ pub fn decode_compact(
 ) -> Result<FrameImages, PassError> {
     let pixels = width as usize * height as usize;
     if layout.normal != Format::Rg16Float
-        || layout.surface.encoding != NormalEncoding::Octahedral
-        || layout.surface.space != NormalSpace::View
+        || layout.normal_encoding != NormalEncoding::Octahedral
+        || layout.normal_space != NormalSpace::View
         || normal.len() != pixels * 4
         || depth.len() != pixels * 4
     {

@@ -237,11 +237,8 @@ impl PluginRenderer {
                 height: t.depth.height(),
                 depth: target_image(&t.depth),
                 normal: target_image(&t.normal),
-                normal_encoding: normal_encoding(t.layout.surface.encoding),
-                normal_space: match t.layout.surface.space {
-                    passes::NormalSpace::World => hrts::NormalSpace::World,
-                    passes::NormalSpace::View => hrts::NormalSpace::View,
-                },
+                normal_encoding: t.layout.normal_encoding,
+                normal_space: t.layout.normal_space,
                 output: target_image(&output),
                 output_layers: layers,
             };
@@ -626,16 +623,6 @@ pub const SCREEN_SPACE_WALL: &str = "screen-space submission (wall clock)";
 /// An error while recording, in the form `Device::submit_and_wait` passes on.
 fn recording_error(e: impl std::fmt::Display) -> rhi::RhiError {
     rhi::RhiError::InvalidArgument(format!("{e:#}"))
-}
-
-/// The plugin's encoding of `encoding`.
-fn normal_encoding(encoding: passes::NormalEncoding) -> hrts::NormalEncoding {
-    match encoding {
-        passes::NormalEncoding::XyzCoverage => hrts::NormalEncoding::XyzCoverage,
-        passes::NormalEncoding::Xyz => hrts::NormalEncoding::Xyz,
-        passes::NormalEncoding::Octahedral => hrts::NormalEncoding::Octahedral,
-        passes::NormalEncoding::FromDepth => hrts::NormalEncoding::None,
-    }
 }
 
 /// One of the demo's images as the plugin takes it.

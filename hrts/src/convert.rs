@@ -146,8 +146,13 @@ pub(crate) fn frame_inputs(
 
 /// How the engine's normal image encodes the normal (`normal_encoding`, `normal_space`).
 pub(crate) fn surface_input(t: &HrtsTargets) -> ApiResult<SurfaceInput> {
+    normal_input(t.normal_encoding, t.normal_space)
+}
+
+/// The passes' reading of normals of `HrtsNormalEncoding` `encoding` in `HrtsNormalSpace` `space`.
+pub(crate) fn normal_input(encoding: u32, space: u32) -> ApiResult<SurfaceInput> {
     let encoding = enum_value(
-        t.normal_encoding,
+        encoding,
         &[
             (
                 HrtsNormalEncoding::XyzCoverage as u32,
@@ -164,7 +169,7 @@ pub(crate) fn surface_input(t: &HrtsTargets) -> ApiResult<SurfaceInput> {
         "HrtsNormalEncoding",
     )?;
     let space = enum_value(
-        t.normal_space,
+        space,
         &[
             (HrtsNormalSpace::World as u32, NormalSpace::World),
             (HrtsNormalSpace::View as u32, NormalSpace::View),

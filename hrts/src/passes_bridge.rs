@@ -4,7 +4,7 @@
 //! host_demo holds the plugin's own types.
 
 use crate::convert;
-use crate::safe::{Config, Error, Resource, Result};
+use crate::safe::{Config, Error, NormalEncoding, NormalSpace, Resource, Result};
 
 /// The plugin configuration of a `passes` one: the `HrtsConfig` that `hrts_configure` reads back as
 /// `config` (settings the C ABI does not carry are left out). Fails if an extra output has no
@@ -24,4 +24,11 @@ pub fn resource_id(resource: Resource) -> passes::ResourceId {
 pub fn resource(id: passes::ResourceId) -> Option<Resource> {
     let value = convert::resource_index(id).ok()?;
     crate::safe::decode("hrts::passes_bridge::resource", "resource", value).ok()
+}
+
+/// How the passes read an engine normal image of `encoding` in `space`, as the C ABI converts them.
+pub fn surface_input(encoding: NormalEncoding, space: NormalSpace) -> Result<passes::SurfaceInput> {
+    const CALL: &str = "hrts::passes_bridge::surface_input";
+    convert::normal_input(encoding as u32, space as u32)
+        .map_err(|e| Error::new(CALL, e.code, e.message))
 }

@@ -75,9 +75,9 @@ pub fn run_cli(
         caps.driver,
         path,
         if validation { "on" } else { "off" },
-        args.normals.surface.encoding,
+        args.normals.normal_encoding,
         args.normals.normal,
-        args.normals.surface.space,
+        args.normals.normal_space,
         start.elapsed().as_secs_f64()
     );
     print!("{}", table(&outcomes, args.markdown));

@@ -43,7 +43,11 @@ impl ShadowRenderer {
         let inputs = ShadowInputs {
             depth: &targets.depth,
             normal: &targets.normal,
-            surface: targets.layout.surface,
+            surface: hrts::passes_bridge::surface_input(
+                targets.layout.normal_encoding,
+                targets.layout.normal_space,
+            )
+            .map_err(|e| PassError::InvalidConfig(e.to_string()))?,
             direct_output: None,
         };
         let pipeline = ShadowPipeline::new(device, geometry, &inputs, config)?;
