@@ -938,6 +938,13 @@ typedef struct HrtsLightPlan {
   uint32_t mode;
   // Why, in words (NUL-terminated, truncated to fit), as `HrtsFrameReport::decision_reason`.
   char decision_reason[128];
+  // The passes of the light's plan in that mode (bit `1 << HrtsPass`): those whose
+  // `HrtsFrameReport::pass_status` is not `HRTS_PASS_STATUS_NOT_IN_PLAN`. 0 when out of view.
+  uint32_t passes;
+  // The resources of the light's plan that have an `HrtsResource` value (bit `1 << HrtsResource`):
+  // what its passes write, held by the light or shared by the context's lights (the report's
+  // `resource_bytes` counts those the light holds). 0 when out of view.
+  uint32_t resources;
 } HrtsLightPlan;
 
 // GPU time of one pass.

@@ -977,6 +977,13 @@ pub struct HrtsLightPlan {
     pub mode: u32,
     /// Why, in words (NUL-terminated, truncated to fit), as `HrtsFrameReport::decision_reason`.
     pub decision_reason: [c_char; 128],
+    /// The passes of the light's plan in that mode (bit `1 << HrtsPass`): those whose
+    /// `HrtsFrameReport::pass_status` is not `HRTS_PASS_STATUS_NOT_IN_PLAN`. 0 when out of view.
+    pub passes: u32,
+    /// The resources of the light's plan that have an `HrtsResource` value (bit `1 << HrtsResource`):
+    /// what its passes write, held by the light or shared by the context's lights (the report's
+    /// `resource_bytes` counts those the light holds). 0 when out of view.
+    pub resources: u32,
 }
 
 /// A copy of a plugin resource into an engine buffer, recorded after a complete frame.

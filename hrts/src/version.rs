@@ -75,7 +75,7 @@ versions! {
     HrtsResourceInfo => [(32, 1)] versioned;
     HrtsResourceReadback => [(48, 1)] versioned;
     HrtsFrameReport => [(5560, 1), (5568, 4), (5592, 9)] versioned;
-    HrtsLightPlan => [(148, 10)] versioned;
+    HrtsLightPlan => [(156, 10)] versioned;
     HrtsDraw => [(76, 1)];
     HrtsLight => [(100, 1)];
     HrtsMeshVertices => [(32, 1)];

@@ -29,7 +29,9 @@ HrtsContext *hard_lights_context(const HrtsVulkanDevice *vk, const HrtsCpuGeomet
 
 /* hrts_plan_lights for the current camera and lights, with `count` configurations of `mode` and the bounds of
  * the CPU geometry `g`, equals what the reports of frame `index` of `ctx` (configured alike) say of each
- * light: decision, frusta recorded and culled, and reason. Returns how many lights differ. */
+ * light: decision, frusta recorded and culled, and reason; for a shadowed light, its passes are those the
+ * report has in the plan (the context's output copy aside) and its resources hold every one the light
+ * allocated; an out-of-view light plans none. Returns how many lights differ. */
 static int plans_differ_from_reports(HrtsContext *ctx, const HrtsCpuGeometry *g, uint32_t count, uint32_t mode,
                                      uint64_t index) {
     HrtsConfig cfgs[HRTS_MAX_LIGHTS];
@@ -58,13 +60,22 @@ static int plans_differ_from_reports(HrtsContext *ctx, const HrtsCpuGeometry *g,
     for (uint32_t i = 0; i < count && r == HRTS_RESULT_OK; i++) {
         HrtsFrameReport rep;
         CHECK(report(ctx, index, i, &rep) == HRTS_RESULT_OK, "report %u: %s", i, hrts_last_error(ctx));
+        uint32_t in_plan = 0, allocated = 0;
+        for (uint32_t p = 0; p < HRTS_PASS_COUNT; p++)
+            if (p != HRTS_PASS_OUTPUT_COPY && rep.pass_status[p] != HRTS_PASS_STATUS_NOT_IN_PLAN) in_plan |= 1u << p;
+        for (uint32_t q = 0; q < HRTS_RESOURCE_COUNT; q++)
+            if (rep.resource_bytes[q] > 0) allocated |= 1u << q;
+        int shadowed = plans[i].decision == HRTS_LIGHT_DECISION_SHADOWED;
+        int same_plan = shadowed ? plans[i].passes == in_plan && (allocated & ~plans[i].resources) == 0 && allocated != 0
+                                 : plans[i].passes == 0 && plans[i].resources == 0;
         int same = plans[i].decision == rep.decision && plans[i].frusta == rep.frusta &&
                    plans[i].frusta_culled == rep.frusta_culled && strcmp(plans[i].decision_reason, rep.decision_reason) == 0 &&
-                   plans[i].mode == mode;
+                   plans[i].mode == mode && same_plan;
         if (!same)
-            printf("  light %u planned %u (%u frusta, %u culled: %s), reported %u (%u, %u: %s)\n", i, plans[i].decision,
-                   plans[i].frusta, plans[i].frusta_culled, plans[i].decision_reason, rep.decision, rep.frusta,
-                   rep.frusta_culled, rep.decision_reason);
+            printf("  light %u planned %u (%u frusta, %u culled: %s; passes 0x%x, resources 0x%x), reported %u (%u, %u: %s; "
+                   "passes 0x%x, resources allocated 0x%x)\n",
+                   i, plans[i].decision, plans[i].frusta, plans[i].frusta_culled, plans[i].decision_reason, plans[i].passes,
+                   plans[i].resources, rep.decision, rep.frusta, rep.frusta_culled, rep.decision_reason, in_plan, allocated);
         differ += !same;
     }
     return differ;

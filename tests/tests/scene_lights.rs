@@ -96,7 +96,8 @@ fn well_inside_reach(light: &SceneLight, p: glam::DVec3) -> bool {
 }
 
 /// `plan` with every shadowed light in mode hard: what the plugin writes is then the ray-traced visibility
-/// itself (for a light of several frusta, the minimum over those it recorded).
+/// itself (for a light of several frusta, the minimum over those it recorded). The lights' planned passes
+/// and resources, which rendering does not read, stay those of their own modes.
 fn all_hard(plan: &ScenePlan) -> ScenePlan {
     let mut hard = plan.clone();
     for light in &mut hard.lights {
@@ -104,7 +105,6 @@ fn all_hard(plan: &ScenePlan) -> ScenePlan {
             // Hard shadows ignore the light's size, and take only sizes above 0 (0 is mode auto's).
             s.config.mode = ShadowMode::Hard;
             s.config.pcss = passes::PcssConfig::default();
-            s.frame_plan = passes::FramePlan::derive(s.config.plan_request());
         }
     }
     hard

@@ -43,7 +43,7 @@
 use anyhow::{bail, Result};
 use glam::{DVec4, Vec3};
 use hrts::{SpotFrustum, HRTS_MAX_LIGHTS};
-use passes::{FaceMode, FramePlan, ResourceId, ShadowConfig, ShadowMode};
+use passes::{FaceMode, ShadowConfig, ShadowMode};
 use scene::{Camera, LightKind, LightSize, SceneFile, SceneLight};
 use std::fmt::Write as _;
 
@@ -91,9 +91,11 @@ impl NoPassReason {
 pub struct ShadowedLight {
     /// The light's configuration as the plugin is given it (mode auto, and the light's size).
     pub config: ShadowConfig,
-    /// The passes and resources the plugin derives from the configuration it resolves for the light
-    /// ([`ShadowedLight::resolved_config`]).
-    pub frame_plan: FramePlan,
+    /// The passes of the light's plan, as the plugin plans them ([`hrts::LightPlan::passes`]) for the
+    /// configuration it resolves ([`ShadowedLight::resolved_config`]).
+    pub passes: hrts::PassMask,
+    /// The resources of the light's plan, as the plugin plans them ([`hrts::LightPlan::resources`]).
+    pub resources: hrts::ResourceSet,
     /// The light as the plugin takes it.
     pub light: hrts::Light,
     /// The frusta the plugin shadows it through, by name: "whole" for one, else cube faces ("+X" ...
@@ -299,7 +301,7 @@ impl ScenePlan {
                     .config
                     .auto_reason(shadowed.is_directional())
                     .map_or_else(|| format!("mode {}", c.mode.name()), str::to_owned),
-                if shadowed.frame_plan.runs(passes::PassId::Fxaa) {
+                if shadowed.passes.contains(hrts::Pass::Fxaa) {
                     "on"
                 } else {
                     "off"
@@ -307,24 +309,18 @@ impl ScenePlan {
                 c.static_light,
                 !c.static_geometry,
                 c.map.size,
-                if shadowed.frame_plan.resources().contains(ResourceId::ShadowMap) {
+                if shadowed.resources.contains(hrts::Resource::ShadowMap) {
                     format!("{0}x{0}", c.shadow_map.size)
                 } else {
                     "none".to_owned()
                 }
             );
-            let passes: Vec<&str> = shadowed
-                .frame_plan
-                .passes()
-                .iter()
-                .map(|p| p.name())
-                .collect();
+            let passes: Vec<&str> = shadowed.passes.iter().map(hrts::Pass::name).collect();
             let _ = writeln!(s, "      passes: {}", passes.join(", "));
             let resources: Vec<&str> = shadowed
-                .frame_plan
-                .resources()
+                .resources
                 .iter()
-                .map(|r| r.name())
+                .map(hrts::Resource::name)
                 .collect();
             let _ = writeln!(s, "      resources: {}", resources.join(", "));
         }
@@ -465,12 +461,7 @@ pub fn plan_scene(file: &SceneFile, camera: &Camera, settings: &PlanSettings) ->
                     Some(p) if p.decision == hrts::LightDecision::OutOfView => {
                         LightDecision::NoPass(NoPassReason::OutOfView)
                     }
-                    Some(p) => shadowed(
-                        light,
-                        config,
-                        plugin_light,
-                        (p.frusta + p.frusta_culled) as usize,
-                    ),
+                    Some(p) => shadowed(light, config, plugin_light, &p),
                     None => bail!("the plugin planned fewer lights than it was given"),
                 },
             };
@@ -582,18 +573,20 @@ fn light_config(
     config
 }
 
-/// A light the plugin shadows through `frusta` frusta (as it planned them).
+/// A light the plugin shadows as it planned it (`plan`).
 fn shadowed(
     light: &SceneLight,
     config: ShadowConfig,
     plugin_light: hrts::Light,
-    frusta: usize,
+    plan: &hrts::LightPlan,
 ) -> LightDecision {
     let directional = matches!(light.kind, LightKind::Directional { .. });
     let resolved = config.resolved(directional);
+    let frusta = (plan.frusta + plan.frusta_culled) as usize;
     LightDecision::Shadowed(Box::new(ShadowedLight {
         config,
-        frame_plan: FramePlan::derive(resolved.plan_request()),
+        passes: plan.passes,
+        resources: plan.resources,
         light: plugin_light,
         frusta: if matches!(light.kind, LightKind::Point { .. }) && resolved.shadows_point_as_cube()
         {
@@ -607,7 +600,7 @@ fn shadowed(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use passes::PassId;
+    use hrts::{Pass, Resource};
     use scene::Scene;
 
     /// A 10 m ground square at y = 0 and a 1 m box on it at the origin, both static.
@@ -715,11 +708,11 @@ mod tests {
             "{:?}",
             s.light
         );
-        for r in [ResourceId::ShadowMap, ResourceId::Pcss] {
-            assert!(!s.frame_plan.resources().contains(r), "{r:?}");
+        for r in [Resource::ShadowMap, Resource::Pcss] {
+            assert!(!s.resources.contains(r), "{r:?}");
         }
-        assert!(!s.frame_plan.runs(PassId::ShadowMap) && !s.frame_plan.runs(PassId::Pcss));
-        assert!(s.frame_plan.runs(PassId::RayTrace));
+        assert!(!s.passes.contains(Pass::ShadowMap) && !s.passes.contains(Pass::Pcss));
+        assert!(s.passes.contains(Pass::RayTrace));
         assert!(p.describe_decision().starts_with("hard"));
         let file = ground_and_box(vec![sun(LightSize::Zero)]);
         let text = plan(&file).describe();
@@ -736,7 +729,7 @@ mod tests {
         assert_eq!(s.config.mode, ShadowMode::Auto);
         assert_eq!(s.resolved_config().mode, ShadowMode::Area);
         assert_eq!(s.config.pcss.angular_radius, 0.03);
-        assert!(s.frame_plan.runs(PassId::RayTrace) && !s.frame_plan.runs(PassId::ShadowMap));
+        assert!(s.passes.contains(Pass::RayTrace) && !s.passes.contains(Pass::ShadowMap));
         assert!(p.describe_decision().starts_with("area"));
         let p = only(ground_and_box(vec![spot(
             Vec3::new(0.0, 4.0, 0.0),

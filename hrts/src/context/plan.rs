@@ -2,9 +2,12 @@
 //! give for a view, from the same conversion and culling a frame's recording runs.
 
 use super::lights::schedule;
-use crate::convert::{frame_bounds, frame_inputs, mode_to_c, shadow_config, FrameLight};
+use crate::convert::{
+    frame_bounds, frame_inputs, mode_to_c, resource_index, shadow_config, FrameLight,
+};
 use crate::error::{ApiError, ApiResult};
 use crate::types::*;
+use passes::FramePlan;
 
 /// For each light of `f` (configured by `configs`, one per light: the caller reads `f.light_count` of each), what a frame of its camera, lights and
 /// casters' bounds would do with it (`struct_size` left 0).
@@ -33,16 +36,38 @@ pub(crate) fn plan_lights(configs: &[HrtsConfig], f: &HrtsFrame) -> ApiResult<Ve
         .map(|((light, config), schedule)| {
             let (decision, reason) = schedule.decision();
             let recorded = schedule.recorded.iter().filter(|&&r| r).count() as u32;
+            let config = light.shape().config(config);
+            let (passes, resources) = match decision {
+                HrtsLightDecision::Shadowed => plan_bits(&FramePlan::derive(config.plan_request())),
+                HrtsLightDecision::OutOfView => (0, 0),
+            };
             HrtsLightPlan {
                 struct_size: 0,
                 decision: decision as u32,
                 frusta: recorded,
                 frusta_culled: schedule.recorded.len() as u32 - recorded,
-                mode: mode_to_c(light.shape().config(config).mode),
+                mode: mode_to_c(config.mode),
                 decision_reason: reason_to_c(&reason),
+                passes,
+                resources,
             }
         })
         .collect())
+}
+
+/// The `HrtsPass` bits of `plan`'s passes and the `HrtsResource` bits of its resources (those with a
+/// value: not the engine's inputs, the light or the scene's geometry).
+fn plan_bits(plan: &FramePlan) -> (u32, u32) {
+    let passes = plan
+        .passes()
+        .iter()
+        .fold(0, |bits, &p| bits | 1 << p as u32);
+    let resources = plan
+        .resources()
+        .iter()
+        .filter_map(|r| resource_index(r).ok())
+        .fold(0, |bits, r| bits | 1 << r);
+    (passes, resources)
 }
 
 /// `reason` as a NUL-terminated C string of at most 127 bytes.

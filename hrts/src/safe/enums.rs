@@ -11,6 +11,20 @@ pub use crate::types::{
     HrtsPenumbraFilter as PenumbraFilter, HrtsResource as Resource, HrtsShadowMode as ShadowMode,
 };
 
+impl Pass {
+    /// The pass's name, as frame reports and logs give it ("ray trace", "FXAA", ...).
+    pub fn name(self) -> &'static str {
+        crate::convert::pass_from_index(self as u32).map_or("unknown pass", |p| p.name())
+    }
+}
+
+impl Resource {
+    /// The resource's name, as frame reports and logs give it ("list entries", "rt visibility", ...).
+    pub fn name(self) -> &'static str {
+        crate::convert::RESOURCES[self as usize].name()
+    }
+}
+
 /// A C enumeration whose values are 0, 1, 2, ... in the order of [`CEnum::ALL`].
 pub(crate) trait CEnum: Copy + 'static {
     /// Every value, in value order.
@@ -152,6 +166,23 @@ impl PassMask {
     /// Whether the mask holds `pass`.
     pub fn contains(self, pass: Pass) -> bool {
         self.0 & 1 << pass as u32 != 0
+    }
+
+    /// The passes of the mask, in recording order.
+    pub fn iter(self) -> impl Iterator<Item = Pass> {
+        Pass::ALL.iter().copied().filter(move |&p| self.contains(p))
+    }
+
+    /// The mask of C bits, all of which name passes.
+    pub(crate) fn from_bits(call: &'static str, field: &str, bits: u32) -> Result<Self> {
+        if bits & !HRTS_PASS_MASK_ALL != 0 {
+            return Err(Error::new(
+                call,
+                HrtsResult::ErrorInvalidEnum,
+                format!("{field} 0x{bits:x} has bits of no HrtsPass"),
+            ));
+        }
+        Ok(Self(bits))
     }
 
     /// The C bits.

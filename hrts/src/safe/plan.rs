@@ -1,6 +1,6 @@
 //! [`plan_lights`]: what the plugin would do with each light in a view, without a context or a device.
 
-use super::enums::{decode, LightDecision, ShadowMode};
+use super::enums::{decode, LightDecision, PassMask, ResourceSet, ShadowMode};
 use super::error::{c_chars, check, Result};
 use super::geometry::Bounds;
 use super::{Config, Light};
@@ -35,13 +35,19 @@ pub struct LightPlan {
     pub mode: ShadowMode,
     /// Why, in words.
     pub reason: String,
+    /// The passes of its plan in that mode (those its frame report lists as in the plan); none when out
+    /// of view.
+    pub passes: PassMask,
+    /// The resources of its plan (held by the light or shared by the context's lights); none when out of
+    /// view.
+    pub resources: ResourceSet,
 }
 
 /// Plans `lights` (configured by `configs`, one per light) for `view` without a context or a device
 /// (`hrts_plan_lights`): for a host that decides which lights to configure.
 ///
 /// ```
-/// use hrts::{plan_lights, Bounds, Config, Light, LightDecision, PlanView};
+/// use hrts::{plan_lights, Bounds, Config, Light, LightDecision, Pass, PlanView, Resource};
 /// use hrts::glam::{Mat4, Vec3};
 ///
 /// let eye = Vec3::new(0.0, 2.0, 6.0);
@@ -57,6 +63,11 @@ pub struct LightPlan {
 /// let plans = plan_lights(&[Config::default(), Config::default()], &[far, near], &view)?;
 /// assert_eq!(plans[0].decision, LightDecision::OutOfView);
 /// assert_eq!(plans[1].decision, LightDecision::Shadowed);
+/// // The default configuration is the talk's hybrid: the ray-traced hard shadow blended with PCSS.
+/// let hybrid = [Pass::ShadowMap, Pass::PrimitiveMap, Pass::RayTrace, Pass::Pcss, Pass::Blend];
+/// assert!(hybrid.iter().all(|&p| plans[1].passes.contains(p)));
+/// assert!(plans[1].resources.contains(Resource::PrimListEntries));
+/// assert_eq!(plans[1].passes.iter().next().map(Pass::name), Some("prim buffer"));
 /// # Ok::<(), hrts::Error>(())
 /// ```
 pub fn plan_lights(
@@ -106,6 +117,8 @@ pub fn plan_lights(
             frusta_culled: 0,
             mode: 0,
             decision_reason: [0; 128],
+            passes: 0,
+            resources: 0,
         };
         c_lights.len()
     ];
@@ -126,6 +139,8 @@ pub fn plan_lights(
                 frusta_culled: p.frusta_culled,
                 mode: decode(CALL, "mode", p.mode)?,
                 reason: c_chars(&p.decision_reason),
+                passes: PassMask::from_bits(CALL, "passes", p.passes)?,
+                resources: ResourceSet::from_bits(CALL, "resources", p.resources)?,
             })
         })
         .collect()
