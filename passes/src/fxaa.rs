@@ -56,14 +56,16 @@ impl FxaaPass {
         Ok(Self { step, output })
     }
 
-    /// Reads `input` (of the same size as the output) from now on; returns the bind group used before:
-    /// frames in flight may still use it.
-    pub fn replace_input(
-        &mut self,
-        device: &Device,
-        input: &Image,
-    ) -> Result<BindGroup, PassError> {
-        self.step.rebind(device, 0, Resource::Image(input))
+    /// A bind group of the pass reading `input` (of the same size as the output), for
+    /// [`FxaaPass::use_group`].
+    pub fn rebound_input(&self, device: &Device, input: &Image) -> Result<BindGroup, PassError> {
+        self.step.rebound(device, 0, Resource::Image(input))
+    }
+
+    /// Dispatches with `group` (from [`FxaaPass::rebound_input`]) from now on; returns the group used
+    /// before: frames in flight may still use it.
+    pub fn use_group(&mut self, group: BindGroup) -> BindGroup {
+        self.step.use_group(group)
     }
 
     /// Records the pass; input and output in `UnorderedAccess` state.

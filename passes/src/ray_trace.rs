@@ -258,8 +258,8 @@ impl RayTracePass {
     }
 
     /// Has the ray trace write `visibility` (of the same size and format) in place of its visibility image
-    /// from now on. Returns the image and the bind groups it used before: frames in flight may still use
-    /// them.
+    /// from now on (nothing changes if it fails). Returns the image and the bind groups it used before:
+    /// frames in flight may still use them.
     pub fn replace_visibility(
         &mut self,
         device: &Device,
@@ -269,20 +269,24 @@ impl RayTracePass {
         Ok((std::mem::replace(&mut self.visibility, visibility), groups))
     }
 
-    /// Rebinds `binding` of the trace's bind groups to `resource`; returns the groups used before.
+    /// Rebinds `binding` of the trace's bind groups to `resource`, all or none of them; returns the groups
+    /// used before.
     fn rebind(
         &mut self,
         device: &Device,
         binding: u32,
         resource: Resource<'_>,
     ) -> Result<Vec<BindGroup>, PassError> {
-        let rebound = |pipeline: &ComputePipeline, group: &mut BindGroup| {
-            let new = device.rebound(pipeline.layout(), group, binding, resource)?;
-            Ok::<_, PassError>(std::mem::replace(group, new))
+        let main = device.rebound(self.pipeline.layout(), &self.group, binding, resource)?;
+        let local = match &self.local {
+            Some((pipeline, group)) => {
+                Some(device.rebound(pipeline.layout(), group, binding, resource)?)
+            }
+            None => None,
         };
-        let mut old = vec![rebound(&self.pipeline, &mut self.group)?];
-        if let Some((pipeline, group)) = &mut self.local {
-            old.push(rebound(pipeline, group)?);
+        let mut old = vec![std::mem::replace(&mut self.group, main)];
+        if let (Some((_, group)), Some(new)) = (&mut self.local, local) {
+            old.push(std::mem::replace(group, new));
         }
         Ok(old)
     }

@@ -39,16 +39,21 @@ impl ScreenPass {
         })
     }
 
-    /// Rebinds `binding` to `resource` (of the kind bound there) from now on; returns the bind group used
-    /// before: frames in flight may still use it.
-    pub fn rebind(
-        &mut self,
+    /// A bind group of the pass with `binding` bound to `resource` (of the kind bound there), the others
+    /// as they are, for [`ScreenPass::use_group`].
+    pub fn rebound(
+        &self,
         device: &Device,
         binding: u32,
         resource: Resource<'_>,
     ) -> Result<BindGroup, PassError> {
-        let new = device.rebound(self.pipeline.layout(), &self.group, binding, resource)?;
-        Ok(std::mem::replace(&mut self.group, new))
+        Ok(device.rebound(self.pipeline.layout(), &self.group, binding, resource)?)
+    }
+
+    /// Dispatches with `group` (from [`ScreenPass::rebound`]) from now on; returns the group used before:
+    /// frames in flight may still use it.
+    pub fn use_group(&mut self, group: BindGroup) -> BindGroup {
+        std::mem::replace(&mut self.group, group)
     }
 
     /// Records one timed dispatch covering `width` x `height` pixels.

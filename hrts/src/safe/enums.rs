@@ -12,14 +12,18 @@ pub use crate::types::{
 };
 
 impl Pass {
-    /// The pass's name, as frame reports and logs give it ("ray trace", "FXAA", ...).
+    /// The pass's name, as frame reports and logs give it ("ray trace", "FXAA", ..., "output copy").
     pub fn name(self) -> &'static str {
-        crate::convert::pass_from_index(self as u32).map_or("unknown pass", |p| p.name())
+        match crate::convert::pass_from_index(self as u32) {
+            Some(pass) => pass.name(),
+            // The context's own pass, after the pipelines'.
+            None => "output copy",
+        }
     }
 }
 
 impl Resource {
-    /// The resource's name, as frame reports and logs give it ("list entries", "rt visibility", ...).
+    /// The resource's name, as frame reports and logs give it ("prim list entries", "rt visibility", ...).
     pub fn name(self) -> &'static str {
         crate::convert::RESOURCES[self as usize].name()
     }
@@ -200,6 +204,18 @@ impl From<Pass> for PassMask {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_pass_and_resource_has_its_own_name() {
+        let passes: std::collections::HashSet<&str> = Pass::ALL.iter().map(|p| p.name()).collect();
+        assert_eq!(passes.len(), Pass::ALL.len());
+        assert_eq!(Pass::RayTrace.name(), "ray trace");
+        assert_eq!(Pass::OutputCopy.name(), "output copy");
+        let resources: std::collections::HashSet<&str> =
+            Resource::ALL.iter().map(|r| r.name()).collect();
+        assert_eq!(resources.len(), Resource::ALL.len());
+        assert_eq!(Resource::PrimListEntries.name(), "prim list entries");
+    }
 
     fn values_are_indices<T: CEnum>() {
         for (i, v) in T::ALL.iter().enumerate() {

@@ -407,9 +407,7 @@ impl ShadowPipeline {
         }
         Ok(())
     }
-}
 
-impl ShadowPipeline {
     /// Gives the ray trace an image of the light's own, in place of the visibility the lights' FXAA share,
     /// when a recording call of `passes` in frame `frame` holds the ray trace without the FXAA (another
     /// light's ray trace could then overwrite the shared image before this light's FXAA reads it). The
@@ -427,9 +425,11 @@ impl ShadowPipeline {
             return Ok(());
         };
         let (width, height) = (ray.visibility.width(), ray.visibility.height());
+        // Everything that can fail comes before the FXAA takes its new group: a failure changes nothing.
         let own = visibility_image(device, "rt visibility", width, height)?;
+        let fxaa_group = fxaa.rebound_input(device, &own)?;
         let (image, mut groups) = ray.replace_visibility(device, own)?;
-        groups.push(fxaa.replace_input(device, &ray.visibility)?);
+        groups.push(fxaa.use_group(fxaa_group));
         self.rt_shared = false;
         let retired = RetiredMap::SharedVisibility {
             _image: image,
