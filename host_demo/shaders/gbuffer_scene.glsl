@@ -13,3 +13,11 @@ vec3 frame_vertex(uint i) {
     }
     return vec3(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]) - pc.origin.xyz;
 }
+
+// The unit geometric normal of triangle `t` (zero for a degenerate one), wound as its vertices are.
+vec3 triangle_normal(uint t) {
+    vec3 a = frame_vertex(3u * t);
+    vec3 c = cross(frame_vertex(3u * t + 1u) - a, frame_vertex(3u * t + 2u) - a);
+    float len = length(c);
+    return len > 0.0 ? c / len : vec3(0.0);
+}

@@ -1,12 +1,9 @@
 // The G-buffer's surface: the exact geometric normal of the visible triangle, facing the camera, and the
-// engine-style encodings of it the demo can store. Needs the includer's `pc` (GBufferPush) and
-// gbuffer_scene.glsl.
+// engine-style encodings of it the demo can store. Needs the includer's `pc` (GBufferPush).
 
-vec3 facing_normal(uint primitive, vec3 rel_pos) {
-    vec3 a = frame_vertex(3u * primitive);
-    vec3 c = cross(frame_vertex(3u * primitive + 1u) - a, frame_vertex(3u * primitive + 2u) - a);
-    float len = length(c);
-    vec3 n = len > 0.0 ? c / len : vec3(0.0);
+// The triangle's unit normal `n` (gbuffer_scene.glsl's triangle_normal), turned to face the camera from
+// the fragment at `rel_pos`.
+vec3 facing_normal(vec3 n, vec3 rel_pos) {
     // Face the camera, decided geometrically (independent of winding and projection handedness).
     if (dot(n, -rel_pos) < 0.0) {
         n = -n;

@@ -322,7 +322,7 @@ pub fn describe_frame(
     if let Some((prims, scratch)) = shared_bytes(frame) {
         let _ = writeln!(
             s,
-            "  shared by the lights: prim buffer {}, primitive-map build scratch {}",
+            "  shared by the lights: prim buffer {}, pass scratch {} (primitive-map builds, antialiased ray traces)",
             size(prims),
             size(scratch)
         );
@@ -341,8 +341,8 @@ fn own_bytes(report: &LightFrameReport) -> u64 {
         .sum()
 }
 
-/// Bytes the lights of `frame` share: the prim buffer and the primitive maps' build scratch (none without
-/// a prim buffer).
+/// Bytes the lights of `frame` share: the prim buffer and the passes' scratch (the primitive maps' build,
+/// the antialiased lights' ray-trace visibility; none without a prim buffer).
 fn shared_bytes(frame: &LightsFrame) -> Option<(u64, u64)> {
     let prims = frame.lights.iter().find_map(|r| {
         r.report
@@ -423,7 +423,7 @@ pub fn describe_frames(frames: &[LightsFrame]) -> String {
     if let Some((prims, scratch)) = shared_bytes(last) {
         let _ = write!(
             s,
-            ", shared {} (prim buffer {}, primitive-map build scratch {})",
+            ", shared {} (prim buffer {}, pass scratch {})",
             size(prims + scratch),
             size(prims),
             size(scratch)
