@@ -5,13 +5,13 @@
 #include "gbuffer_push.glsl"
 
 layout(push_constant) uniform Push { GBufferPush pc; };
+#include "gbuffer_scene.glsl"
 #include "gbuffer_surface.glsl"
 layout(location = 0) in vec3 rel_pos;
-layout(location = 1) flat in vec3 triangle_normal;
 layout(location = 0) out vec4 out_position;
 layout(location = 1) out vec4 out_normal;
 
 void main() {
     out_position = vec4(rel_pos + pc.camera_pos.xyz, 1.0);
-    out_normal = vec4(facing_normal(triangle_normal, rel_pos), 1.0);
+    out_normal = vec4(facing_normal(triangle_normal(gl_PrimitiveID), rel_pos), 1.0);
 }

@@ -4,11 +4,11 @@
 #include "gbuffer_push.glsl"
 
 layout(push_constant) uniform Push { GBufferPush pc; };
+#include "gbuffer_scene.glsl"
 #include "gbuffer_surface.glsl"
 layout(location = 0) in vec3 rel_pos;
-layout(location = 1) flat in vec3 triangle_normal;
 layout(location = 0) out vec4 out_engine_normal;
 
 void main() {
-    out_engine_normal = encode_normal(facing_normal(triangle_normal, rel_pos));
+    out_engine_normal = encode_normal(facing_normal(triangle_normal(gl_PrimitiveID), rel_pos));
 }

@@ -5,15 +5,15 @@
 #include "gbuffer_push.glsl"
 
 layout(push_constant) uniform Push { GBufferPush pc; };
+#include "gbuffer_scene.glsl"
 #include "gbuffer_surface.glsl"
 layout(location = 0) in vec3 rel_pos;
-layout(location = 1) flat in vec3 triangle_normal;
 layout(location = 0) out vec4 out_position;
 layout(location = 1) out vec4 out_normal;
 layout(location = 2) out vec4 out_engine_normal;
 
 void main() {
-    vec3 n = facing_normal(triangle_normal, rel_pos);
+    vec3 n = facing_normal(triangle_normal(gl_PrimitiveID), rel_pos);
     out_position = vec4(rel_pos + pc.camera_pos.xyz, 1.0);
     out_normal = vec4(n, 1.0);
     out_engine_normal = encode_normal(n);

@@ -317,7 +317,7 @@ impl GBufferPass {
             vertex: &shader("gbuffer.vert")?,
             geometry: None,
             fragment: &shader(layout.fragment_shader())?,
-            bindings: &[BindingKind::StorageBuffer, BindingKind::StorageBuffer],
+            bindings: &[BindingKind::StorageBuffer; 2],
             push_constant_size: std::mem::size_of::<GBufferPush>() as u32,
             color_formats: &layout.color_formats(),
             depth: Some(DepthState {
@@ -331,20 +331,21 @@ impl GBufferPass {
         let group = device.create_bind_group(
             pipeline.layout(),
             &[
-                Resource::Buffer(scene.indices()),
                 Resource::Buffer(scene.vertices()),
+                Resource::Buffer(scene.normals()),
             ],
         )?;
         Ok(Self { pipeline, group })
     }
 
-    /// Records the pass; targets must be in `RenderTarget` / `DepthWrite` state.
+    /// Records the pass, drawing through `scene`'s index buffer (the scene the pass was created over);
+    /// targets must be in `RenderTarget` / `DepthWrite` state.
     pub fn record(
         &self,
         enc: &mut Encoder<'_>,
         targets: &GBufferTargets,
         push: &GBufferPush,
-        triangle_count: u32,
+        scene: &SceneBuffers,
     ) -> Result<(), PassError> {
         enc.begin_pass("gbuffer");
         let colors: Vec<ColorTarget<'_>> = targets
@@ -363,11 +364,12 @@ impl GBufferPass {
                 clear: 0.0,
             }),
         );
-        enc.draw(
+        enc.draw_indexed(
             &self.pipeline,
             &self.group,
             bytemuck::bytes_of(push),
-            triangle_count * 3,
+            scene.indices(),
+            scene.triangle_count() * 3,
         )?;
         enc.end_rendering();
         enc.end_pass();

@@ -314,7 +314,6 @@ impl PluginRenderer {
         }
         let push = GBufferPush::for_camera(camera, self.scene.origin(), &self.targets.layout)?;
         self.last_camera = Some(*camera);
-        let tris = self.scene.triangle_count();
         let with_plugin = !lights.is_empty();
         let t = &self.targets;
         let frame = plugin_frame(self.frames, camera, lights, &self.bounds);
@@ -334,7 +333,7 @@ impl PluginRenderer {
             }
             enc.barriers(&t.to_render());
             self.gbuffer
-                .record(enc, t, &push, tris)
+                .record(enc, t, &push, &self.scene)
                 .map_err(recording_error)?;
             enc.barriers(&[
                 Barrier::Image {

@@ -1,5 +1,5 @@
-//! The scene's meshes as the demo keeps them, as an engine keeps its own: world positions (f32 xyz) and
-//! u32 indices in storage buffers, one draw per object. The G-buffer pulls its triangles from them
+//! The scene's meshes as the demo keeps them, as an engine keeps its own: world positions (f32 xyz), u32
+//! indices and a flat normal per triangle in storage buffers, one draw per object. The G-buffer pulls its triangles from them
 //! ([`crate::gbuffer::GBufferPass`]) and the plugin reads them where they are
 //! ([`hrts::Context::set_geometry_vulkan`]).
 
@@ -12,6 +12,8 @@ use scene::{Aabb, Scene};
 pub struct SceneBuffers {
     vertices: Buffer,
     indices: Buffer,
+    /// Per triangle: its unit geometric normal (f32 xyz; zero for a degenerate triangle).
+    normals: Buffer,
     vertex_count: u32,
     index_count: u32,
     /// Per object, in order: its first index and index count.
@@ -25,6 +27,16 @@ impl SceneBuffers {
     pub fn upload(device: &Device, scene: &Scene) -> Result<Self> {
         scene.validate().context("the scene to upload")?;
         let positions: Vec<f32> = scene.positions.iter().flat_map(|p| p.to_array()).collect();
+        let origin = scene.bounds().center();
+        // From the vertices relative to the frame origin, as the G-buffer places them.
+        let normals: Vec<f32> = scene
+            .indices
+            .chunks_exact(3)
+            .flat_map(|t| {
+                let [a, b, c] = [t[0], t[1], t[2]].map(|i| scene.positions[i as usize] - origin);
+                (b - a).cross(c - a).normalize_or_zero().to_array()
+            })
+            .collect();
         let usage = BufferUsage::STORAGE;
         Ok(Self {
             vertices: device.create_buffer_init(
@@ -35,6 +47,11 @@ impl SceneBuffers {
             indices: device.create_buffer_init(
                 "scene indices",
                 bytemuck::cast_slice(&scene.indices),
+                usage | BufferUsage::INDEX,
+            )?,
+            normals: device.create_buffer_init(
+                "scene triangle normals",
+                bytemuck::cast_slice(&normals),
                 usage,
             )?,
             vertex_count: u32::try_from(scene.positions.len()).context("too many vertices")?,
@@ -44,7 +61,7 @@ impl SceneBuffers {
                 .iter()
                 .map(|o| (o.first_triangle * 3, o.triangle_count * 3))
                 .collect(),
-            origin: scene.bounds().center(),
+            origin,
         })
     }
 
@@ -64,9 +81,14 @@ impl SceneBuffers {
         &self.vertices
     }
 
-    /// The index buffer: u32, three per triangle.
+    /// The index buffer: u32, three per triangle (index and storage usage).
     pub fn indices(&self) -> &Buffer {
         &self.indices
+    }
+
+    /// The triangles' unit normals: f32 xyz, one per triangle.
+    pub fn normals(&self) -> &Buffer {
+        &self.normals
     }
 
     /// The draws of the objects marked in `casters` (one flag per object), as the plugin takes them.

@@ -590,6 +590,53 @@ impl<'a> Encoder<'a> {
         push: &[u8],
         vertex_count: u32,
     ) -> Result<()> {
+        self.bind_graphics(pipeline, group, push)?;
+        // SAFETY: inside begin_rendering, with the pipeline, its set and the dynamic state bound.
+        unsafe { self.d().cmd_draw(self.cmd, vertex_count, 1, 0, 0) };
+        Ok(())
+    }
+
+    /// Draws the first `index_count` `u32` indices of `indices` (a buffer with
+    /// [`BufferUsage::INDEX`](crate::BufferUsage::INDEX);
+    /// no vertex buffers: the vertex shader pulls vertex `gl_VertexIndex`) over the whole render area.
+    pub fn draw_indexed(
+        &mut self,
+        pipeline: &GraphicsPipeline,
+        group: &BindGroup,
+        push: &[u8],
+        indices: &Buffer,
+        index_count: u32,
+    ) -> Result<()> {
+        let index_usage = indices.usage.contains(vk::BufferUsageFlags::INDEX_BUFFER);
+        if !index_usage || u64::from(index_count) * 4 > indices.size() {
+            return Err(RhiError::InvalidArgument(format!(
+                "{index_count} u32 indices drawn from a buffer of {} bytes{}",
+                indices.size(),
+                if index_usage {
+                    ""
+                } else {
+                    " without index usage"
+                }
+            )));
+        }
+        self.bind_graphics(pipeline, group, push)?;
+        // SAFETY: inside begin_rendering, with the pipeline, its set and the dynamic state bound; the
+        // buffer has index usage and holds the indices drawn (checked).
+        unsafe {
+            self.d()
+                .cmd_bind_index_buffer(self.cmd, indices.raw, 0, vk::IndexType::UINT32);
+            self.d().cmd_draw_indexed(self.cmd, index_count, 1, 0, 0, 0);
+        }
+        Ok(())
+    }
+
+    /// Binds `pipeline` with `group` and `push`, and a viewport and scissor of the whole render area.
+    fn bind_graphics(
+        &mut self,
+        pipeline: &GraphicsPipeline,
+        group: &BindGroup,
+        push: &[u8],
+    ) -> Result<()> {
         check_push(push, pipeline.layout.push_constant_size)?;
         let (w, h) = self.render_extent;
         let d = self.d();
@@ -619,7 +666,6 @@ impl<'a> Encoder<'a> {
             );
             d.cmd_set_viewport(self.cmd, 0, &[viewport]);
             d.cmd_set_scissor(self.cmd, 0, &[scissor]);
-            d.cmd_draw(self.cmd, vertex_count, 1, 0, 0);
         }
         Ok(())
     }

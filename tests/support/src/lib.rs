@@ -76,12 +76,11 @@ impl ShadowRenderer {
             self.scene.origin(),
             &self.targets.layout,
         )?;
-        let tris = self.scene.triangle_count();
         let Self {
             targets,
+            scene,
             gbuffer,
             pipeline,
-            ..
         } = self;
         pipeline.begin_frame(inputs)?;
         device.submit_and_wait(|enc| {
@@ -89,7 +88,7 @@ impl ShadowRenderer {
             pipeline.record_passes(enc, prim_buffer).map_err(into_rhi)?;
             enc.barriers(&targets.to_render());
             gbuffer
-                .record(enc, targets, &push, tris)
+                .record(enc, targets, &push, scene)
                 .map_err(into_rhi)?;
             enc.barriers(&[
                 Barrier::Image {
