@@ -1,14 +1,14 @@
 //! The scene's meshes as the demo keeps them, as an engine keeps its own: world positions (f32 xyz), u32
-//! indices and a flat normal per triangle in storage buffers, one draw per object. The G-buffer pulls its triangles from them
-//! ([`crate::gbuffer::GBufferPass`]) and the plugin reads them where they are
-//! ([`hrts::Context::set_geometry_vulkan`]).
+//! indices and a flat normal per triangle in storage buffers, one draw per object. The G-buffer draws
+//! them through the index buffer ([`crate::gbuffer::GBufferPass`]) and the plugin reads them where they
+//! are ([`hrts::Context::set_geometry_vulkan`]).
 
 use anyhow::{Context as _, Result};
 use glam::{DVec3, Vec3};
 use rhi::{Buffer, BufferUsage, Device};
 use scene::{Aabb, Scene};
 
-/// The scene's vertex and index buffers, its draws and its frame origin.
+/// The scene's vertex, index and normal buffers, its draws and its frame origin.
 pub struct SceneBuffers {
     vertices: Buffer,
     indices: Buffer,
