@@ -81,7 +81,8 @@ struct FrameSlot {
     completion: Buffer,
 }
 
-/// What growing the primitive map replaced, held while frames in flight may still use it.
+/// What growing the primitive map or giving a light its own ray-trace visibility replaced, held while frames in
+/// flight may still use it.
 enum RetiredMap {
     Entries {
         _entries: Buffer,
