@@ -42,18 +42,88 @@ static void deformed_read_once(HrtsContext *ctx, HrtsMeshVertices deformed, cons
     CHECK(differ[0] == 0 && differ[1] == 0, "deformed read once: %d / %d px differ", differ[0], differ[1]);
 }
 
+/* A host allocator for the buffers of reused_vertex_handle that hands the block freed last straight back to
+ * the next allocation it fits, as a heap may: vkCreateBuffer right after vkDestroyBuffer gets the destroyed
+ * buffer's object memory, hence its handle on drivers whose handles are object pointers (lavapipe's). The
+ * process heap does so only by chance (other threads allocate in between), which made the case untested at
+ * times. Live blocks are recorded for pfnReallocation. */
+enum { RECYCLER_BLOCKS = 256 };
+typedef struct {
+    void *live[RECYCLER_BLOCKS];
+    size_t live_size[RECYCLER_BLOCKS];
+    void *freed;
+    size_t freed_size;
+} Recycler;
+
+static int recycler_find(const Recycler *r, const void *p) {
+    for (int i = 0; i < RECYCLER_BLOCKS; i++)
+        if (r->live[i] == p) return i;
+    return -1;
+}
+
+static void *VKAPI_PTR recycler_alloc(void *user, size_t size, size_t align, VkSystemAllocationScope scope) {
+    (void)scope;
+    Recycler *r = user;
+    int slot = recycler_find(r, NULL);
+    if (slot < 0 || size == 0) return NULL;
+    void *p = NULL;
+    if (r->freed && size <= r->freed_size && (uintptr_t)r->freed % align == 0) {
+        p = r->freed;
+        size = r->freed_size;
+        r->freed = NULL;
+    } else if (posix_memalign(&p, align < sizeof(void *) ? sizeof(void *) : align, size) != 0) {
+        return NULL;
+    }
+    r->live[slot] = p;
+    r->live_size[slot] = size;
+    return p;
+}
+
+static void VKAPI_PTR recycler_free(void *user, void *p) {
+    Recycler *r = user;
+    int slot = p ? recycler_find(r, p) : -1;
+    if (slot < 0) return;
+    if (r->freed) free(r->freed);
+    r->freed = p;
+    r->freed_size = r->live_size[slot];
+    r->live[slot] = NULL;
+}
+
+static void *VKAPI_PTR recycler_realloc(void *user, void *old, size_t size, size_t align, VkSystemAllocationScope scope) {
+    Recycler *r = user;
+    if (!old) return recycler_alloc(user, size, align, scope);
+    if (size == 0) {
+        recycler_free(user, old);
+        return NULL;
+    }
+    int slot = recycler_find(r, old);
+    void *p = slot < 0 ? NULL : recycler_alloc(user, size, align, scope);
+    if (!p) return NULL;
+    memcpy(p, old, r->live_size[slot] < size ? r->live_size[slot] : size);
+    recycler_free(user, old);
+    return p;
+}
+
 /* A vertex buffer's handle reused: the engine destroys a skinned buffer once the frame that read it
  * completed and creates one of the same size over other memory of its own block; the driver hands back the
- * same VkBuffer handle. The next frame, within frames_in_flight of the first, must read the new buffer (the
- * box deformed, B), not the destroyed one's memory (the box, A). `want` holds A's and B's visibility. */
+ * same VkBuffer handle (made certain by the Recycler above). The next frame, within frames_in_flight of the
+ * first, must read the new buffer (the box deformed, B), not the destroyed one's memory (the box, A). `want`
+ * holds A's and B's visibility. */
 static void reused_vertex_handle(HrtsContext *ctx, const float *want_a, const float *want_b) {
     enum { PX = W * H, TRIES = 64 };
+    static Recycler recycler;
+    const VkAllocationCallbacks host = {
+        .pUserData = &recycler,
+        .pfnAllocation = recycler_alloc,
+        .pfnReallocation = recycler_realloc,
+        .pfnFree = recycler_free,
+    };
     const VkDeviceSize size = BOX_VERTICES * 8;
     VkBufferCreateInfo ci = {.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
     ci.size = size;
     ci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     VkBuffer first;
-    VK(vkCreateBuffer(device, &ci, NULL, &first));
+    VK(vkCreateBuffer(device, &ci, &host, &first));
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(device, first, &req);
     /* the engine's memory block: region 0 holds the box (A), region 1 the box deformed (B) */
@@ -81,11 +151,11 @@ static void reused_vertex_handle(HrtsContext *ctx, const float *want_a, const fl
     /* the frame completed (finish_frame waited for it): the buffer goes, others of its size come until one
      * gets its handle */
     const uint64_t handle = v.vertex_buffer;
-    vkDestroyBuffer(device, first, NULL);
+    vkDestroyBuffer(device, first, &host);
     VkBuffer tried[TRIES], again = VK_NULL_HANDLE;
     int n = 0;
     while (n < TRIES && again == VK_NULL_HANDLE) {
-        VK(vkCreateBuffer(device, &ci, NULL, &tried[n]));
+        VK(vkCreateBuffer(device, &ci, &host, &tried[n]));
         if ((uint64_t)(uintptr_t)tried[n] == handle) again = tried[n];
         n++;
     }
@@ -105,7 +175,9 @@ static void reused_vertex_handle(HrtsContext *ctx, const float *want_a, const fl
            again != VK_NULL_HANDLE ? "the handle came back" : "the handle did NOT come back", n, differ_a, differ_b);
     CHECK(again != VK_NULL_HANDLE, "reused handle: the handle never came back: the case was not tested");
     CHECK(differ_a == 0 && differ_b == 0, "reused handle: %d / %d px differ", differ_a, differ_b);
-    for (int k = 0; k < n; k++) vkDestroyBuffer(device, tried[k], NULL);
+    for (int k = 0; k < n; k++) vkDestroyBuffer(device, tried[k], &host);
+    free(recycler.freed);
+    recycler.freed = NULL;
     vkUnmapMemory(device, block);
     vkFreeMemory(device, block, NULL);
 }
