@@ -10,9 +10,8 @@ use crate::bench_models::{frames_of, median_of, view_of, BenchArgs, BenchModel};
 use crate::render::{map_bytes, median_timings};
 use crate::View;
 use anyhow::{Context, Result};
-use passes::{
-    AreaConfig, FrameReport, PcssConfig, PenumbraFilter, ShadowConfig, ShadowMapConfig, ShadowMode,
-};
+use hrts::FrameReport;
+use passes::{AreaConfig, PcssConfig, PenumbraFilter, ShadowConfig, ShadowMapConfig, ShadowMode};
 use reference::RefScene;
 use rhi::Device;
 use std::collections::BTreeMap;

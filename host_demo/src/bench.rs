@@ -20,9 +20,8 @@ use crate::progress::phase;
 use crate::render::{map_bytes, median_timings};
 use crate::View;
 use anyhow::{Context, Result};
-use passes::{
-    BinningRequest, FrameReport, PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig,
-};
+use hrts::FrameReport;
+use passes::{BinningRequest, PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig};
 use reference::RefScene;
 use rhi::Device;
 use std::collections::BTreeMap;

@@ -17,9 +17,10 @@ use crate::scene_render::{median, SceneRenderer};
 use crate::CameraMatrices;
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
+use hrts::MapStats;
 use passes::{
-    directional_light_frustum, spot_light_frusta, AreaConfig, FrameInputs, Light, MapStats,
-    PrimitiveMapConfig, ResourceId, ShadowConfig, ShadowMode,
+    directional_light_frustum, spot_light_frusta, AreaConfig, FrameInputs, Light,
+    PrimitiveMapConfig, ShadowConfig, ShadowMode,
 };
 use rhi::Device;
 use scene::{Aabb, Camera, LightKind, LightSize, Scene, SceneFile, SceneLight};
@@ -230,7 +231,7 @@ impl Routes {
     fn of<'a>(stats: impl IntoIterator<Item = &'a MapStats>) -> Self {
         stats.into_iter().fold(Self::default(), |r, st| Self {
             bin_items: r.bin_items + u64::from(st.bin_items),
-            skipped: r.skipped + u32::from(st.lists_skipped),
+            skipped: r.skipped + u32::from(st.frusta_without_lists > 0),
             past_limit: r.past_limit + u64::from(st.texels_past_limit),
             walked: r.walked + u64::from(st.pixels_walked),
         })
@@ -242,9 +243,9 @@ fn frame_ms(frame: &LightsFrame, keep: impl Fn(&str) -> bool) -> f64 {
     frame
         .lights
         .iter()
-        .flat_map(|l| &l.report.timings)
+        .flat_map(|l| &l.timings)
         .filter(|t| keep(&t.name))
-        .map(|t| t.ms)
+        .map(|t| t.milliseconds)
         .sum()
 }
 
@@ -254,7 +255,7 @@ fn pass_medians(frames: &[LightsFrame]) -> Vec<(String, f64)> {
     for t in frames
         .iter()
         .flat_map(|f| &f.lights)
-        .flat_map(|l| &l.report.timings)
+        .flat_map(|l| &l.timings)
     {
         if !names.contains(&t.name) {
             names.push(t.name.clone());
@@ -275,7 +276,7 @@ fn medians(frames: &[LightsFrame]) -> (f64, f64, f64) {
     let of =
         |keep: &dyn Fn(&str) -> bool| median(frames.iter().map(|f| frame_ms(f, keep)).collect());
     (
-        of(&|n| n != ResourceId::PrimBuffer.name()),
+        of(&|n| n != hrts::Pass::PrimBuffer.name()),
         of(&|n| n.starts_with("primitive map")),
         of(&|n| n == "ray trace"),
     )
@@ -352,7 +353,7 @@ fn measure_light(
     let (gpu_ms, map_ms, trace_ms) = medians(&frames[1..]);
     let max_ms = slowest(&frames);
     let last = frames.last().context("no frame rendered")?;
-    let reports: Vec<_> = last.lights.iter().map(|l| &l.report).collect();
+    let reports = &last.lights;
     let peer_ms = match peer {
         Some((light, size)) => peer_ms(
             device,
@@ -381,9 +382,8 @@ fn measure_light(
         routes: Routes::of(reports.iter().map(|r| &r.stats)),
         bytes: reports
             .iter()
-            .flat_map(|r| &r.resources)
-            .filter(|r| r.resource != ResourceId::PrimBuffer)
-            .map(|r| r.bytes)
+            .flat_map(|r| r.allocated_resources())
+            .map(|(_, bytes)| bytes)
             .sum(),
         entries,
         mean_list: if texels == 0 {
@@ -413,7 +413,7 @@ fn measure_light(
 fn slowest(frames: &[LightsFrame]) -> f64 {
     frames
         .iter()
-        .map(|f| frame_ms(f, |n| n != ResourceId::PrimBuffer.name()))
+        .map(|f| frame_ms(f, |n| n != hrts::Pass::PrimBuffer.name()))
         .fold(0.0, f64::max)
 }
 
@@ -479,12 +479,12 @@ fn measure_native_points(
     }
     drop(progress);
     let (_, map_ms, trace_ms) = medians(&frames[1..]);
-    let frame_ms = |f: &LightsFrame| f.lights.iter().map(|l| l.gpu_ms).sum::<f64>();
+    let frame_ms = |f: &LightsFrame| f.lights.iter().map(|l| l.gpu_milliseconds).sum::<f64>();
     let gpu_ms = median(frames[1..].iter().map(frame_ms).collect());
     let max_ms = frames.iter().map(frame_ms).fold(0.0, f64::max);
     let last = frames.last().context("no frame rendered")?;
     let light = last.lights.first().context("no light reported")?;
-    let st = &light.report.stats;
+    let st = &light.stats;
     Ok(LightCost {
         name,
         frusta: frusta_of(last),
@@ -493,20 +493,19 @@ fn measure_native_points(
         map_ms,
         trace_ms,
         peer_ms: None,
-        routes: Routes::of(last.lights.iter().map(|l| &l.report.stats)),
+        routes: Routes::of(last.lights.iter().map(|l| &l.stats)),
         bytes: last
             .lights
             .iter()
-            .flat_map(|l| &l.report.resources)
-            .filter(|r| r.resource != ResourceId::PrimBuffer)
-            .map(|r| r.bytes)
+            .flat_map(|l| l.allocated_resources())
+            .map(|(_, bytes)| bytes)
             .sum(),
         entries: u64::from(st.entries),
         mean_list: st.mean_list(),
         longest: st.longest_list,
         past_capacity: u64::from(st.texels_past_capacity),
         passes: pass_medians(&frames[1..]),
-        scratch_bytes: light.report.map_scratch_bytes,
+        scratch_bytes: light.map_scratch_bytes,
     })
 }
 

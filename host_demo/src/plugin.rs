@@ -13,14 +13,10 @@ use crate::scene_buffers::SceneBuffers;
 use crate::{read_images, CameraMatrices, FrameImages, FrameOutput, View};
 use anyhow::{bail, Context as _, Result};
 use hrts::passes_bridge;
-use passes::MapStats;
-use passes::{
-    BinningPath, FrameInputs, FrameReport, Light, PassId, PassStatus, ResourceId, ResourceReport,
-    ShadowConfig, SkipReason,
-};
+use passes::{FrameInputs, Light, ResourceId, ShadowConfig};
 use rhi::{
-    Barrier, BufferUsage, ConservativeRasterTier, Device, Format, GpuTimer, Image, ImageDesc,
-    ImageUsage, MemoryLocation, PassTiming, ResourceState as S,
+    Barrier, BufferUsage, Device, Format, GpuTimer, Image, ImageDesc, ImageUsage, MemoryLocation,
+    ResourceState as S,
 };
 use scene::{Aabb, Scene};
 use std::ffi::CString;
@@ -41,36 +37,16 @@ pub fn api_version() -> String {
     format!("libhrts API {}", hrts::api_version())
 }
 
-/// What one plugin light's passes did in a frame.
-#[derive(Debug, Clone, PartialEq)]
-pub struct LightFrameReport {
-    /// The plugin's report of the light as the Rust passes' [`FrameReport`], which the demo's reports share
-    /// with the frames it renders through the passes directly.
-    pub report: FrameReport,
-    /// How many times the plugin built the light's passes since the context was created
-    /// ([`hrts::FrameReport::light_builds`]).
-    pub light_builds: u32,
-    /// Frusta the plugin shadowed the light through this frame ([`hrts::FrameReport::frusta`]: up to 6 for
-    /// a point light).
-    pub frusta: u32,
-    /// Frusta of the light the plugin skipped this frame, holding no receiver in view within range
-    /// ([`hrts::FrameReport::frusta_culled`]).
-    pub frusta_culled: u32,
-    /// The plugin's decision for the light, in words ([`hrts::FrameReport::decision_reason`]).
-    pub decision: String,
-    /// GPU milliseconds of all of the light's passes ([`hrts::FrameReport::gpu_milliseconds`]).
-    pub gpu_ms: f64,
-}
-
 /// What a frame of several lights did.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LightsFrame {
     /// The frame's index ([`hrts::Frame::frame_index`]).
     pub frame_index: u64,
-    /// One report per plugin light, in configuration order (none when no light was given to the plugin).
-    pub lights: Vec<LightFrameReport>,
+    /// The plugin's report of each light, in configuration order (none when no light was given to the
+    /// plugin).
+    pub lights: Vec<hrts::FrameReport>,
     /// The demo's own GPU times (the G-buffer) and, when the plugin recorded passes, [`SCREEN_SPACE_WALL`].
-    pub host_timings: Vec<PassTiming>,
+    pub host_timings: Vec<hrts::PassTiming>,
 }
 
 /// The demo frame driven through the plugin's API, for any number of lights: the plugin gets the lights
@@ -100,7 +76,6 @@ pub struct PluginRenderer {
     bounds: Aabb,
     frames: u64,
     frames_with_plugin_passes: u64,
-    native_tier: ConservativeRasterTier,
     /// The camera of the last frame: a compact G-buffer's read-back rebuilds positions and world normals
     /// through it.
     last_camera: Option<CameraMatrices>,
@@ -190,7 +165,6 @@ impl PluginRenderer {
             frames: 0,
             frames_with_plugin_passes: 0,
             last_camera: None,
-            native_tier: device.capabilities().conservative_raster_tier,
         })
     }
 
@@ -269,13 +243,12 @@ impl PluginRenderer {
 
     /// Renders one frame of one light ([`PluginRenderer::render_lights`]) and returns the plugin's report
     /// plus the G-buffer's GPU time and [`SCREEN_SPACE_WALL`].
-    pub fn render(&mut self, device: &Device, inputs: &FrameInputs) -> Result<FrameReport> {
+    pub fn render(&mut self, device: &Device, inputs: &FrameInputs) -> Result<hrts::FrameReport> {
         let frame =
             self.render_lights(device, &CameraMatrices::of_frame(inputs), &[inputs.light])?;
-        let Some(light) = frame.lights.into_iter().next() else {
+        let Some(mut report) = frame.lights.into_iter().next() else {
             bail!("the frame reported no light");
         };
-        let mut report = light.report;
         report.timings.extend(frame.host_timings);
         Ok(report)
     }
@@ -366,16 +339,16 @@ impl PluginRenderer {
             })?;
             let wall = start.elapsed().as_secs_f64() * 1e3;
             for light in 0..lights.len() as u32 {
-                reports.push(self.report(self.frames, light)?);
+                reports.push(self.context.frame_report(self.frames, light)?);
             }
-            host_timings.extend(self.timer.resolve()?);
-            host_timings.push(PassTiming {
+            host_timings.extend(self.host_timings()?);
+            host_timings.push(hrts::PassTiming {
                 name: SCREEN_SPACE_WALL.into(),
-                ms: wall,
+                milliseconds: wall,
             });
             self.frames_with_plugin_passes += 1;
         } else {
-            host_timings.extend(self.timer.resolve()?);
+            host_timings.extend(self.host_timings()?);
         }
         let frame_index = self.frames;
         self.frames += 1;
@@ -386,97 +359,17 @@ impl PluginRenderer {
         })
     }
 
-    /// The plugin's report of `light` in frame `frame` (completed), with the Rust passes' [`FrameReport`].
-    fn report(&self, frame: u64, light: u32) -> Result<LightFrameReport> {
-        let r = self.context.frame_report(frame, light)?;
-        let timings = r
-            .timings
-            .iter()
-            .map(|p| PassTiming {
-                name: p.name.clone(),
-                ms: p.milliseconds,
+    /// The G-buffer's GPU time of the frame last submitted, as the plugin's reports give times.
+    fn host_timings(&self) -> Result<Vec<hrts::PassTiming>> {
+        Ok(self
+            .timer
+            .resolve()?
+            .into_iter()
+            .map(|t| hrts::PassTiming {
+                name: t.name,
+                milliseconds: t.ms,
             })
-            .collect();
-        let binning_path = match r.binning_path {
-            hrts::BinningPath::Software => BinningPath::Software,
-            hrts::BinningPath::Compute => BinningPath::Compute,
-            hrts::BinningPath::EmulatedTier1 => BinningPath::EmulatedTier1 {
-                native: self.native_tier,
-            },
-            hrts::BinningPath::Hardware | hrts::BinningPath::Auto => {
-                BinningPath::Hardware(match r.tier {
-                    1 => ConservativeRasterTier::Tier1,
-                    2 => ConservativeRasterTier::Tier2,
-                    _ => ConservativeRasterTier::Tier3,
-                })
-            }
-        };
-        // The C passes are the pipeline's, in its order.
-        let passes = PassId::ALL
-            .iter()
-            .map(|&p| {
-                let status = match r.pass_status[p as usize] {
-                    hrts::PassStatus::Ran => PassStatus::Ran,
-                    hrts::PassStatus::UpToDate => PassStatus::Skipped(SkipReason::UpToDate),
-                    hrts::PassStatus::Shared => PassStatus::Skipped(SkipReason::Shared),
-                    hrts::PassStatus::Culled => PassStatus::Skipped(SkipReason::Culled),
-                    hrts::PassStatus::NotInPlan => PassStatus::Skipped(SkipReason::NotRequested),
-                };
-                (p, status)
-            })
-            .collect();
-        let mut resources: Vec<ResourceReport> = r
-            .allocated_resources()
-            .map(|(resource, bytes)| ResourceReport {
-                resource: passes_bridge::resource_id(resource),
-                bytes,
-            })
-            .collect();
-        if r.prim_buffer_bytes > 0 {
-            resources.insert(
-                0,
-                ResourceReport {
-                    resource: ResourceId::PrimBuffer,
-                    bytes: r.prim_buffer_bytes,
-                },
-            );
-        }
-        let st = &r.stats;
-        let report = FrameReport {
-            timings,
-            binning_path,
-            stats: MapStats {
-                receiver_pixels: st.receiver_pixels,
-                receiver_texels: st.receiver_texels,
-                triangles_binned: st.triangles_binned,
-                texels_with_list: st.texels_with_list,
-                longest_list: st.longest_list,
-                entries: st.entries,
-                capacity: st.entry_capacity,
-                texels_past_capacity: st.texels_past_capacity,
-                pairs: st.bin_pairs,
-                pair_capacity: st.bin_pair_capacity,
-                texels_past_limit: st.texels_past_limit,
-                bin_items: st.bin_items,
-                lists_skipped: st.frusta_without_lists > 0,
-                pixels_walked: st.pixels_walked,
-                walks_unfinished: st.walks_unfinished,
-            },
-            map_to_texels: r.map_to_texels,
-            passes,
-            resources,
-            output: passes_bridge::resource_id(r.output_resource),
-            map_scratch_bytes: r.map_scratch_bytes,
-            prim_triangles_rebuilt: r.prim_triangles_rebuilt,
-        };
-        Ok(LightFrameReport {
-            report,
-            light_builds: r.light_builds,
-            frusta: r.frusta,
-            frusta_culled: r.frusta_culled,
-            decision: r.decision_reason,
-            gpu_ms: r.gpu_milliseconds,
-        })
+            .collect())
     }
 
     /// Reads back the last frame's G-buffer and the visibility of every light (one vector per layer of

@@ -6,10 +6,10 @@ use crate::output::{shade_preview, write_exr_rgba, write_exr_scalar, write_png};
 use crate::plugin::PluginRenderer;
 use crate::{focus_bounds, View};
 use anyhow::{Context, Result};
+use hrts::{FrameReport, Pass, PassStatus, Resource};
 use passes::{
-    AreaConfig, BinningRequest, FaceMode, FrameReport, HybridConfig, PassId, PassStatus,
-    PcssConfig, PenumbraFilter, PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig,
-    ShadowMapConfig, ShadowMode, SkipReason,
+    AreaConfig, BinningRequest, FaceMode, HybridConfig, PcssConfig, PenumbraFilter,
+    PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig, ShadowMapConfig, ShadowMode,
 };
 use rhi::Device;
 use scene::Scene;
@@ -283,7 +283,10 @@ pub fn median_timings(reports: &[FrameReport]) -> BTreeMap<String, f64> {
     };
     for r in steady {
         for t in &r.timings {
-            samples.entry(t.name.clone()).or_default().push(t.ms);
+            samples
+                .entry(t.name.clone())
+                .or_default()
+                .push(t.milliseconds);
         }
     }
     for t in reports
@@ -291,7 +294,9 @@ pub fn median_timings(reports: &[FrameReport]) -> BTreeMap<String, f64> {
         .map(|r| r.timings.as_slice())
         .unwrap_or_default()
     {
-        samples.entry(t.name.clone()).or_insert_with(|| vec![t.ms]);
+        samples
+            .entry(t.name.clone())
+            .or_insert_with(|| vec![t.milliseconds]);
     }
     samples
         .into_iter()
@@ -412,7 +417,7 @@ pub fn render_to_folder(
                 FaceMode::FrontOnly => "front",
             },
             binning_path: report.binning_path.name(),
-            tier: report.binning_path.tier().name(),
+            tier: tier_name(&report),
             map_to_texels: report.map_to_texels.to_cols_array(),
             receiver_pixels: stats.receiver_pixels,
             receiver_texels: stats.receiver_texels,
@@ -421,11 +426,11 @@ pub fn render_to_folder(
             entries: stats.entries,
             mean_list: stats.mean_list(),
             longest_list: stats.longest_list,
-            entry_capacity: stats.capacity,
+            entry_capacity: stats.entry_capacity,
             texels_past_capacity: stats.texels_past_capacity,
             texels_past_limit: stats.texels_past_limit,
             bin_items: stats.bin_items,
-            lists_skipped: stats.lists_skipped,
+            lists_skipped: stats.frusta_without_lists > 0,
             pixels_walked: stats.pixels_walked,
             walks_unfinished: stats.walks_unfinished,
             memory_bytes: map_bytes(&report),
@@ -459,7 +464,7 @@ pub fn render_to_folder(
     bar.finish_and_clear();
 
     println!("{}", crate::plugin::device_banner(caps));
-    if report.status(PassId::PrimitiveMap) == Some(PassStatus::Skipped(SkipReason::NotRequested)) {
+    if report.status(Pass::PrimitiveMap) == PassStatus::NotInPlan {
         println!(
             "scene: {} triangles, {}x{} px; no primitive map (the plan does not need one)",
             view.scene.triangle_count(),
@@ -475,7 +480,7 @@ pub fn render_to_folder(
             h,
             stats.receiver_texels,
             report.binning_path.name(),
-            report.binning_path.tier().name(),
+            tier_name(&report),
             stats.triangles_binned,
             view.scene.triangle_count(),
             stats.entries,
@@ -529,52 +534,75 @@ pub fn render_to_folder(
 
 fn plan_json(report: &FrameReport) -> PlanJson {
     PlanJson {
-        output: report.output.name(),
-        passes: report
-            .passes
-            .iter()
-            .map(|&(pass, status)| PassJson {
+        output: report.output_resource.name(),
+        passes: plan_passes(report)
+            .map(|(pass, status)| PassJson {
                 pass: pass.name(),
                 ran: status == PassStatus::Ran,
-                reason: match status {
-                    PassStatus::Ran => None,
-                    PassStatus::Skipped(r) => Some(r.describe()),
-                },
+                reason: status.reason(),
             })
             .collect(),
-        resources: report
-            .resources
-            .iter()
-            .map(|r| ResourceJson {
-                resource: r.resource.name(),
-                bytes: r.bytes,
-            })
+        resources: resource_bytes(report)
+            .map(|(resource, bytes)| ResourceJson { resource, bytes })
             .collect(),
-        total_bytes: report.total_bytes(),
+        total_bytes: resource_bytes(report).map(|(_, bytes)| bytes).sum(),
+    }
+}
+
+/// The passes of the light's pipeline with their status this frame, in recording order (the output copy,
+/// the context's own, aside: the timings give it).
+fn plan_passes(report: &FrameReport) -> impl Iterator<Item = (Pass, PassStatus)> + '_ {
+    hrts::PassMask::ALL
+        .iter()
+        .filter(|&p| p != Pass::OutputCopy)
+        .map(|p| (p, report.status(p)))
+}
+
+/// The bytes of each resource the light's passes use, by name: the prim buffer its context's lights share
+/// first, then those the plugin allocated for the light.
+pub fn resource_bytes(report: &FrameReport) -> impl Iterator<Item = (&'static str, u64)> + '_ {
+    let prims = (report.prim_buffer_bytes > 0).then_some(("prim buffer", report.prim_buffer_bytes));
+    prims.into_iter().chain(
+        report
+            .allocated_resources()
+            .map(|(resource, bytes)| (resource.name(), bytes)),
+    )
+}
+
+/// The conservative-raster tier the light's binning used: "none", "tier1", "tier2" or "tier3".
+pub fn tier_name(report: &FrameReport) -> &'static str {
+    match report.tier {
+        0 => "none",
+        1 => "tier1",
+        2 => "tier2",
+        _ => "tier3",
     }
 }
 
 /// Prints which passes ran in the last frame, which were skipped and why, and the memory of each
 /// resource.
 pub fn print_plan(report: &FrameReport) {
-    println!("frame plan (last frame), output: {}", report.output.name());
-    for &(pass, status) in &report.passes {
-        match status {
-            PassStatus::Ran => println!("  ran      {}", pass.name()),
-            PassStatus::Skipped(r) => println!("  skipped  {} ({})", pass.name(), r.describe()),
+    println!(
+        "frame plan (last frame), output: {}",
+        report.output_resource.name()
+    );
+    for (pass, status) in plan_passes(report) {
+        match status.reason() {
+            None => println!("  ran      {}", pass.name()),
+            Some(reason) => println!("  skipped  {} ({reason})", pass.name()),
         }
     }
-    for r in &report.resources {
+    for (resource, bytes) in resource_bytes(report) {
         println!(
             "  {:<24} {:>10.2} MB",
-            r.resource.name(),
-            r.bytes as f64 / (1024.0 * 1024.0)
+            resource,
+            bytes as f64 / (1024.0 * 1024.0)
         );
     }
     println!(
         "  {:<24} {:>10.2} MB",
         "total",
-        report.total_bytes() as f64 / (1024.0 * 1024.0)
+        resource_bytes(report).map(|(_, bytes)| bytes).sum::<u64>() as f64 / (1024.0 * 1024.0)
     );
 }
 
@@ -588,17 +616,14 @@ pub fn filter_name(f: PenumbraFilter) -> &'static str {
 
 /// Bytes of the primitive map's resources in a frame report.
 pub fn map_bytes(report: &FrameReport) -> u64 {
-    report
-        .resources
-        .iter()
-        .filter(|r| {
-            matches!(
-                r.resource,
-                ResourceId::PrimListOffsets | ResourceId::PrimListEntries | ResourceId::Occupancy
-            )
-        })
-        .map(|r| r.bytes)
-        .sum()
+    [
+        Resource::PrimListOffsets,
+        Resource::PrimListEntries,
+        Resource::Occupancy,
+    ]
+    .into_iter()
+    .map(|r| report.resource_bytes(r))
+    .sum()
 }
 
 /// Parses the binning request of the command line.

@@ -62,7 +62,7 @@ pub fn render_frames(
     view: &View,
     config: ShadowConfig,
     frames: u32,
-) -> Result<(crate::FrameImages, Vec<passes::FrameReport>)> {
+) -> Result<(crate::FrameImages, Vec<hrts::FrameReport>)> {
     let progress = crate::progress::phase("frames", u64::from(frames.max(2)));
     let mut r = PluginRenderer::new(device, view, config)?;
     let inputs = view.frame_inputs();

@@ -5,13 +5,13 @@
 
 use crate::gbuffer::GBufferLayout;
 use crate::output::{write_exr_rgba, write_exr_scalar, write_png};
-use crate::plugin::{LightFrameReport, LightsFrame, PluginRenderer};
+use crate::plugin::{LightsFrame, PluginRenderer};
 use crate::scene_plan::{plan_scene, PlanSettings, ScenePlan};
 use crate::shading::{shade, tone_map};
 use crate::{CameraMatrices, FrameImages};
 use anyhow::{Context, Result};
 use glam::Vec3;
-use passes::{FrameReport, MapStats, PassId, PassStatus, ResourceId, SkipReason};
+use hrts::{FrameReport, MapStats, Pass, PassStatus};
 use rhi::{Device, Format};
 use scene::{Camera, SceneFile};
 use serde::Serialize;
@@ -111,26 +111,15 @@ impl SceneRenderer {
     }
 }
 
-/// The C name of a pass status in the report: `RAN`, `UP_TO_DATE`, `SHARED`, `NOT_IN_PLAN` or `CULLED`.
-pub fn status_name(status: PassStatus) -> &'static str {
-    match status {
-        PassStatus::Ran => "RAN",
-        PassStatus::Skipped(SkipReason::UpToDate) => "UP_TO_DATE",
-        PassStatus::Skipped(SkipReason::Shared) => "SHARED",
-        PassStatus::Skipped(SkipReason::NotRequested) => "NOT_IN_PLAN",
-        PassStatus::Skipped(SkipReason::Culled) => "CULLED",
-    }
-}
-
 /// Why a light's light-space passes ran or were reused this frame.
 fn light_space_reason(
-    report: &LightFrameReport,
+    report: &FrameReport,
     built_now: bool,
     static_light: bool,
     dynamic_geometry: bool,
 ) -> String {
     if report.frusta == 0 {
-        return format!("nothing recorded: {}", report.decision);
+        return format!("nothing recorded: {}", report.decision_reason);
     }
     if built_now {
         return format!(
@@ -138,25 +127,25 @@ fn light_space_reason(
             report.light_builds
         );
     }
-    let prims = match report.report.status(PassId::PrimBuffer) {
-        Some(PassStatus::Ran) => "prim buffer rebuilt by this light (dynamic geometry)",
-        Some(PassStatus::Skipped(SkipReason::Shared)) => {
+    let prims = match report.status(Pass::PrimBuffer) {
+        PassStatus::Ran => "prim buffer rebuilt by this light (dynamic geometry)",
+        PassStatus::Shared => {
             "prim buffer rebuilt this frame by an earlier light (dynamic geometry)"
         }
         _ => "prim buffer reused (static geometry)",
     };
-    let shadow_map = match report.report.status(PassId::ShadowMap) {
-        Some(PassStatus::Ran) if dynamic_geometry => "shadow map re-rendered: the geometry moves",
-        Some(PassStatus::Ran) if !static_light => "shadow map re-rendered: the light is not static",
-        Some(PassStatus::Ran) => "shadow map re-rendered: the light changed",
-        Some(PassStatus::Skipped(SkipReason::UpToDate)) => {
+    let shadow_map = match report.status(Pass::ShadowMap) {
+        PassStatus::Ran if dynamic_geometry => "shadow map re-rendered: the geometry moves",
+        PassStatus::Ran if !static_light => "shadow map re-rendered: the light is not static",
+        PassStatus::Ran => "shadow map re-rendered: the light changed",
+        PassStatus::UpToDate => {
             "shadow map reused: a static light over static geometry, unchanged since it ran"
         }
         _ => "no shadow map in the plan",
     };
     let culled = match report.frusta_culled {
         0 => String::new(),
-        _ => format!("; {}", report.decision),
+        _ => format!("; {}", report.decision_reason),
     };
     format!("{prims}; {shadow_map}; the primitive map is refitted to the view every frame{culled}")
 }
@@ -175,9 +164,12 @@ fn gpu_ms(report: &FrameReport) -> (f64, BTreeMap<String, f64>) {
     let per_pass: BTreeMap<String, f64> = report
         .timings
         .iter()
-        .map(|t| (t.name.clone(), t.ms))
+        .map(|t| (t.name.clone(), t.milliseconds))
         .collect();
-    (report.timings.iter().map(|t| t.ms).sum(), per_pass)
+    (
+        report.timings.iter().map(|t| t.milliseconds).sum(),
+        per_pass,
+    )
 }
 
 /// A light's GPU time and list statistics on one line.
@@ -203,7 +195,7 @@ fn describe_cost(report: &FrameReport) -> String {
 /// Where a frame's pixels found their triangles, and what the trace cost (`ms`: GPU ms by pass name):
 /// how many walked the BVH rather than a list, and why (no list built this frame: its bin items passed the
 /// budget; texels past the list limit or the entry capacity).
-pub fn routes_line(st: &passes::MapStats, ms: &std::collections::BTreeMap<String, f64>) -> String {
+pub fn routes_line(st: &MapStats, ms: &std::collections::BTreeMap<String, f64>) -> String {
     let trace = ms.get("ray trace").copied().unwrap_or(0.0);
     if st.pixels_walked == 0 {
         return format!(
@@ -211,7 +203,7 @@ pub fn routes_line(st: &passes::MapStats, ms: &std::collections::BTreeMap<String
             st.bin_items
         );
     }
-    let why = if st.lists_skipped {
+    let why = if st.frusta_without_lists > 0 {
         format!(
             "no list built: {} bin items passed the bin budget",
             st.bin_items
@@ -220,7 +212,7 @@ pub fn routes_line(st: &passes::MapStats, ms: &std::collections::BTreeMap<String
         format!(
             "{} texels past the list limit, {} past the entry capacity of {} (the lists grow to fit the next \
              frame)",
-            st.texels_past_limit, st.texels_past_capacity, st.capacity
+            st.texels_past_limit, st.texels_past_capacity, st.entry_capacity
         )
     };
     format!(
@@ -281,14 +273,12 @@ pub fn describe_frame(
             if report.light_builds == 1 { "" } else { "s" }
         );
         let mut by_status: BTreeMap<&str, Vec<&str>> = BTreeMap::new();
-        for &(pass, status) in &report.report.passes {
+        for pass in hrts::PassMask::ALL.iter() {
             by_status
-                .entry(status_name(status))
+                .entry(report.status(pass).name())
                 .or_default()
                 .push(pass.name());
         }
-        // The output copy (a pass of the C ABI only) ends every frame of a light.
-        by_status.entry("RAN").or_default().push("output copy");
         for name in ["RAN", "UP_TO_DATE", "SHARED", "NOT_IN_PLAN", "CULLED"] {
             if let Some(passes) = by_status.get(name) {
                 let _ = writeln!(s, "      {name:<11} {}", passes.join(", "));
@@ -305,11 +295,8 @@ pub fn describe_frame(
             )
         );
         let resources: Vec<String> = report
-            .report
-            .resources
-            .iter()
-            .filter(|r| r.resource != ResourceId::PrimBuffer)
-            .map(|r| format!("{} {}", r.resource.name(), size(r.bytes)))
+            .allocated_resources()
+            .map(|(resource, bytes)| format!("{} {}", resource.name(), size(bytes)))
             .collect();
         let _ = writeln!(
             s,
@@ -317,7 +304,7 @@ pub fn describe_frame(
             size(own_bytes(report)),
             resources.join(", ")
         );
-        let _ = writeln!(s, "      cost {}", describe_cost(&report.report));
+        let _ = writeln!(s, "      cost {}", describe_cost(report));
     }
     if let Some((prims, scratch)) = shared_bytes(frame) {
         let _ = writeln!(
@@ -331,36 +318,25 @@ pub fn describe_frame(
 }
 
 /// Bytes a light's report holds of its own (the shared prim buffer aside).
-fn own_bytes(report: &LightFrameReport) -> u64 {
-    report
-        .report
-        .resources
-        .iter()
-        .filter(|r| r.resource != ResourceId::PrimBuffer)
-        .map(|r| r.bytes)
-        .sum()
+fn own_bytes(report: &FrameReport) -> u64 {
+    report.allocated_resources().map(|(_, bytes)| bytes).sum()
 }
 
 /// Bytes the lights of `frame` share: the prim buffer and the passes' scratch (the primitive maps' build,
 /// the antialiased lights' ray-trace visibility; none without a prim buffer).
 fn shared_bytes(frame: &LightsFrame) -> Option<(u64, u64)> {
-    let prims = frame.lights.iter().find_map(|r| {
-        r.report
-            .resources
-            .iter()
-            .find(|r| r.resource == ResourceId::PrimBuffer)
-    })?;
-    let scratch = frame
+    let prims = frame
         .lights
         .iter()
-        .map(|r| r.report.map_scratch_bytes)
-        .max();
-    Some((prims.bytes, scratch.unwrap_or(0)))
+        .map(|r| r.prim_buffer_bytes)
+        .find(|&bytes| bytes > 0)?;
+    let scratch = frame.lights.iter().map(|r| r.map_scratch_bytes).max();
+    Some((prims, scratch.unwrap_or(0)))
 }
 
 /// GPU ms of every pass of every light of `frame`.
 fn frame_gpu_ms(frame: &LightsFrame) -> f64 {
-    frame.lights.iter().map(|l| gpu_ms(&l.report).0).sum()
+    frame.lights.iter().map(|l| gpu_ms(l).0).sum()
 }
 
 /// Median of `v` (0 when empty).
@@ -391,7 +367,7 @@ pub fn describe_frames(frames: &[LightsFrame]) -> String {
     for f in steady {
         let mut sums: BTreeMap<String, f64> = BTreeMap::new();
         for l in &f.lights {
-            for (name, ms) in gpu_ms(&l.report).1 {
+            for (name, ms) in gpu_ms(l).1 {
                 *sums.entry(name).or_default() += ms;
             }
         }
@@ -475,7 +451,7 @@ impl From<&MapStats> for ListsJson {
             receiver_pixels: s.receiver_pixels,
             triangles_binned: s.triangles_binned,
             entries: s.entries,
-            capacity: s.capacity,
+            capacity: s.entry_capacity,
             mean_list: s.mean_list(),
             longest_list: s.longest_list,
             texels_past_capacity: s.texels_past_capacity,
@@ -636,22 +612,15 @@ pub fn render_scene_to_folder(
                     light_builds: report.light_builds,
                     frusta_recorded: report.frusta,
                     frusta_culled: report.frusta_culled,
-                    decision: report.decision.clone(),
-                    pass_status: report
-                        .report
-                        .passes
+                    decision: report.decision_reason.clone(),
+                    pass_status: hrts::PassMask::ALL
                         .iter()
-                        .map(|&(p, st)| (p.name(), status_name(st)))
+                        .map(|p| (p.name(), report.status(p).name()))
                         .collect(),
-                    resource_bytes: report
-                        .report
-                        .resources
-                        .iter()
-                        .map(|r| (r.resource.name(), r.bytes))
-                        .collect(),
-                    gpu_ms: gpu_ms(&report.report).0,
-                    pass_ms: gpu_ms(&report.report).1,
-                    lists: ListsJson::from(&report.report.stats),
+                    resource_bytes: crate::render::resource_bytes(report).collect(),
+                    gpu_ms: gpu_ms(report).0,
+                    pass_ms: gpu_ms(report).1,
+                    lists: ListsJson::from(&report.stats),
                 })
                 .collect(),
         })
@@ -694,27 +663,6 @@ mod tests {
                 "visibility_3_cart_lamp_1.png".to_owned(),
                 "visibility_3_cart_lamp_1.exr".to_owned()
             )
-        );
-    }
-
-    #[test]
-    fn status_names_are_the_c_names() {
-        assert_eq!(status_name(PassStatus::Ran), "RAN");
-        assert_eq!(
-            status_name(PassStatus::Skipped(SkipReason::UpToDate)),
-            "UP_TO_DATE"
-        );
-        assert_eq!(
-            status_name(PassStatus::Skipped(SkipReason::Shared)),
-            "SHARED"
-        );
-        assert_eq!(
-            status_name(PassStatus::Skipped(SkipReason::NotRequested)),
-            "NOT_IN_PLAN"
-        );
-        assert_eq!(
-            status_name(PassStatus::Skipped(SkipReason::Culled)),
-            "CULLED"
         );
     }
 }

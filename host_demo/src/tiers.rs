@@ -92,12 +92,12 @@ pub fn tier_matrix(device: &Device, scenes: &[(&str, View)], size: u32) -> Resul
                 .timings
                 .iter()
                 .filter(|t| t.name.starts_with("primitive map"))
-                .map(|t| t.ms)
+                .map(|t| t.milliseconds)
                 .sum();
             let path = format!(
                 "{} ({})",
                 report.binning_path.name(),
-                report.binning_path.tier().name()
+                crate::render::tier_name(&report)
             );
             rows.push(TierRow {
                 scene: (*name).to_owned(),

@@ -366,9 +366,11 @@ pub fn run_sweep(device: &Device, view: &View, scene: &str, args: &TradeoffArgs)
             bail!("{} {}: no visibility read back", m.family, m.name);
         }
         let timings = median_timings(&reports[reports.len() / 2..]);
-        let memory_bytes = reports
-            .last()
-            .map_or(0, |r| r.resources.iter().map(|r| r.bytes).sum());
+        let memory_bytes = reports.last().map_or(0, |r| {
+            crate::render::resource_bytes(r)
+                .map(|(_, bytes)| bytes)
+                .sum()
+        });
         let shaded = |v: &[f32]| shade_preview(&images.normal, v, to_light(view));
         let truth32: Vec<f32> = soft
             .visibility

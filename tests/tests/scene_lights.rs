@@ -15,16 +15,13 @@ use common::{
 };
 use glam::Vec3;
 use host_demo::accuracy::{compare_area_counts, AreaComparison};
-use host_demo::plugin::{LightFrameReport, LightsFrame, PluginRenderer};
+use host_demo::plugin::{LightsFrame, PluginRenderer};
 use host_demo::scene_plan::{
     plan_scene, scene_camera, LightDecision, NoPassReason, PlanSettings, ScenePlan,
 };
 use host_demo::scene_render::SceneRenderer;
 use host_demo::CameraMatrices;
-use passes::{
-    AreaConfig, PassId, PassStatus, PrimitiveMapConfig, ResourceId, ShadowConfig, ShadowMapConfig,
-    ShadowMode, SkipReason,
-};
+use passes::{AreaConfig, PrimitiveMapConfig, ShadowConfig, ShadowMapConfig, ShadowMode};
 use reference::{local_area_reference, reference_visibility, RefScene};
 use rhi::Device;
 use scene::{Camera, LightKind, LightSize, SceneFile, SceneLight};
@@ -130,16 +127,19 @@ fn assert_lights_match_reference(
     assert_eq!(frame.lights.len(), plugin_lights.len());
     for (light, report) in plugin_lights.iter().zip(&frame.lights) {
         let name = &plan.lights[light.scene_light].light.name;
-        let has = |r: ResourceId| report.report.resources.iter().any(|x| x.resource == r);
+        let has = |r: hrts::Resource| report.resource_bytes(r) > 0;
         let sized = light.shadowed.resolved_config().mode == ShadowMode::Hybrid;
-        assert_eq!(has(ResourceId::ShadowMap), sized, "{name}: shadow map");
-        assert_eq!(has(ResourceId::Pcss), sized, "{name}: PCSS");
-        assert!(has(ResourceId::PrimListEntries), "{name}: primitive map");
+        assert_eq!(has(hrts::Resource::ShadowMap), sized, "{name}: shadow map");
+        assert_eq!(has(hrts::Resource::Pcss), sized, "{name}: PCSS");
+        assert!(
+            has(hrts::Resource::PrimListEntries),
+            "{name}: primitive map"
+        );
         assert_eq!(
             report.frusta + report.frusta_culled,
             light.shadowed.frusta.len() as u32,
             "{name}: {}",
-            report.decision
+            report.decision_reason
         );
     }
     let hard = all_hard(&plan);
@@ -164,9 +164,9 @@ fn assert_lights_match_reference(
             .expect("a plugin light");
         let report = &frame.lights[k];
         assert_eq!(
-            report.report.stats.texels_past_capacity, 0,
+            report.stats.texels_past_capacity, 0,
             "{name}: {:?}",
-            report.report.stats
+            report.stats
         );
         let reference_light = match light.light.kind {
             LightKind::Directional { direction } => reference::Light::Directional {
@@ -190,7 +190,7 @@ fn assert_lights_match_reference(
             "{name} ({} of {} frusta recorded: {}; planned {}): {} pixels compared, {} shadowed, {} near an edge, {} mismatches",
             report.frusta,
             shadowed.frusta.len(),
-            report.decision,
+            report.decision_reason,
             plan.lights[i]
                 .shadowed()
                 .map_or("-", |s| s.resolved_config().mode.name()),
@@ -372,7 +372,7 @@ fn a_ground_that_casts_no_shadows_receives_a_shadow_cast_from_behind_the_camera(
             if ground_casts { "casting" } else { "casting nothing" },
             report.frusta,
             report.frusta_culled,
-            report.decision,
+            report.decision_reason,
             c.pixels,
             c.shadowed,
             c.near_edge,
@@ -388,7 +388,7 @@ fn a_ground_that_casts_no_shadows_receives_a_shadow_cast_from_behind_the_camera(
             (report.frusta, report.frusta_culled),
             (1, 0),
             "{}",
-            report.decision
+            report.decision_reason
         );
         assert!(c.shadowed > 1000, "{} shadowed pixels", c.shadowed);
         assert!(
@@ -584,7 +584,7 @@ fn native_point_frames(
     lamp: Vec3,
     config: ShadowConfig,
     frames: usize,
-) -> Vec<(passes::MapStats, common::VisibilityComparison)> {
+) -> Vec<(hrts::MapStats, common::VisibilityComparison)> {
     let file = closed_room(lamp);
     let camera = camera(&file);
     let mut plugin = plugin_for(device, &file);
@@ -600,12 +600,12 @@ fn native_point_frames(
             let frame = plugin
                 .render_plugin_lights(device, &matrices, &[plugin_point_light(lamp)])
                 .expect("frame");
-            let report = &frame.lights[0].report;
+            let report = &frame.lights[0];
             let (_, layers) = plugin.read_frame(device).expect("read back");
             let c = compare_with_reference(&r, &layers[0], None, None);
             println!(
                 "native point light: {} pixels, {} shadowed, {} near an edge, {} mismatches; {}; {:?}",
-                c.pixels, c.shadowed, c.near_edge, c.mismatches, frame.lights[0].decision, report.stats
+                c.pixels, c.shadowed, c.near_edge, c.mismatches, frame.lights[0].decision_reason, report.stats
             );
             assert_eq!(c.non_finite, 0);
             assert_eq!(c.mismatches, 0, "(x, y, exact, gpu): {:?}", c.examples);
@@ -629,7 +629,7 @@ fn a_native_point_light_matches_the_exact_reference() {
     assert_eq!(stats.texels_past_capacity, 0);
     assert!(stats.receiver_pixels > 0);
     assert!(
-        stats.pairs > 0 && stats.pairs <= stats.pair_capacity,
+        stats.bin_pairs > 0 && stats.bin_pairs <= stats.bin_pair_capacity,
         "{stats:?}"
     );
     assert!(c.shadowed >= 200, "{} shadowed pixels", c.shadowed);
@@ -650,11 +650,11 @@ fn a_cube_map_outgrowing_its_pairs_stays_exact_and_grows() {
     config.map.initial_pairs = 8;
     let frames = native_point_frames(&device, Vec3::new(0.15, 2.5, 0.1), config, 3);
     let (first, _) = &frames[0];
-    assert_eq!(first.pair_capacity, 8);
-    assert!(first.pairs > 8, "{first:?}");
+    assert_eq!(first.bin_pair_capacity, 8);
+    assert!(first.bin_pairs > 8, "{first:?}");
     for (stats, c) in &frames[1..] {
-        assert!(stats.pair_capacity >= stats.pairs, "{stats:?}");
-        assert_eq!(stats.pairs, first.pairs, "{stats:?}");
+        assert!(stats.bin_pair_capacity >= stats.bin_pairs, "{stats:?}");
+        assert_eq!(stats.bin_pairs, first.bin_pairs, "{stats:?}");
         assert!(c.shadowed >= 200);
     }
     assert_no_validation_errors(&device);
@@ -770,8 +770,8 @@ fn lights_that_need_nothing_get_no_pass() {
     assert_no_validation_errors(&device);
 }
 
-fn status(report: &LightFrameReport, pass: PassId) -> PassStatus {
-    report.report.status(pass).expect("every pass has a status")
+fn status(report: &hrts::FrameReport, pass: hrts::Pass) -> hrts::PassStatus {
+    report.status(pass)
 }
 
 /// The name of every plugin light of `plan`.
@@ -797,8 +797,8 @@ fn assert_only_changed_reran(
         let name = &names[k];
         let earlier = before.lights[k].light_builds;
         assert_eq!(
-            status(report, PassId::PrimBuffer),
-            PassStatus::Skipped(SkipReason::UpToDate),
+            status(report, hrts::Pass::PrimBuffer),
+            hrts::PassStatus::UpToDate,
             "{what}: {name}'s prim buffer (static geometry)"
         );
         if changed.contains(&k) {
@@ -809,14 +809,12 @@ fn assert_only_changed_reran(
             light.shadowed.resolved_config().mode,
             light.shadowed.config.static_light,
         ) {
-            (ShadowMode::Hard | ShadowMode::Area, _) => {
-                PassStatus::Skipped(SkipReason::NotRequested)
-            }
-            (_, true) => PassStatus::Skipped(SkipReason::UpToDate),
-            (_, false) => PassStatus::Ran,
+            (ShadowMode::Hard | ShadowMode::Area, _) => hrts::PassStatus::NotInPlan,
+            (_, true) => hrts::PassStatus::UpToDate,
+            (_, false) => hrts::PassStatus::Ran,
         };
         assert_eq!(
-            status(report, PassId::ShadowMap),
+            status(report, hrts::Pass::ShadowMap),
             expected,
             "{what}: {name}'s shadow map"
         );
@@ -844,7 +842,7 @@ fn changing_one_light_reruns_only_its_passes() {
     assert!(first
         .lights
         .iter()
-        .all(|l| status(l, PassId::ShadowMap) != PassStatus::Skipped(SkipReason::UpToDate)));
+        .all(|l| status(l, hrts::Pass::ShadowMap) != hrts::PassStatus::UpToDate));
     let second = render(&mut renderer, &device, &plan);
     let lamp: Vec<usize> = labels(&plan)
         .iter()
@@ -871,8 +869,8 @@ fn changing_one_light_reruns_only_its_passes() {
     let resized = render(&mut renderer, &device, &plan);
     assert_eq!(resized.lights[spot_k].light_builds, 2);
     assert_eq!(
-        status(&resized.lights[spot_k], PassId::PrimitiveMap),
-        PassStatus::Ran
+        status(&resized.lights[spot_k], hrts::Pass::PrimitiveMap),
+        hrts::PassStatus::Ran
     );
     assert_only_changed_reran(&plan, &resized, &second, &[spot_k], "spot resized");
 
@@ -896,8 +894,8 @@ fn changing_one_light_reruns_only_its_passes() {
     for &k in &lamp {
         assert_eq!(moved.lights[k].light_builds, 1, "the lamp is not rebuilt");
         assert_eq!(
-            status(&moved.lights[k], PassId::PrimitiveMap),
-            PassStatus::Ran
+            status(&moved.lights[k], hrts::Pass::PrimitiveMap),
+            hrts::PassStatus::Ran
         );
     }
     assert_only_changed_reran(&plan, &moved, &resized, &lamp, "lamp moved");
@@ -929,7 +927,7 @@ fn check_local_area(
     (centre, radius, samples): (Vec3, f32, u32),
     cone: Option<(Vec3, f32)>,
     (min_penumbra, max_unstable_percent): (usize, usize),
-) -> (AreaComparison, passes::MapStats) {
+) -> (AreaComparison, hrts::MapStats) {
     let camera = camera(file);
     let rs = RefScene::new(&file.scene);
     let params = point_light_params(file, &camera, centre);
@@ -955,7 +953,7 @@ fn check_local_area(
     });
     let base = settings(false).base;
     // The plugin's own choice of lists and BVH, then every pixel through the BVH: the same counts.
-    let mut first: Option<(AreaComparison, passes::MapStats, Vec<f32>)> = None;
+    let mut first: Option<(AreaComparison, hrts::MapStats, Vec<f32>)> = None;
     for (route, bin_budget) in [("default", base.map.bin_budget), ("BVH", 0.0)] {
         let mut config = ShadowConfig {
             mode: ShadowMode::Area,
@@ -980,13 +978,13 @@ fn check_local_area(
             );
         }
         let frame = frame.expect("two frames");
-        let report = &frame.lights[0].report;
+        let report = &frame.lights[0];
         let (_, mut layers) = plugin.read_frame(device).expect("read back");
         let c = compare_area_counts(&r, &layers[0], considered.as_deref());
         let st = report.stats;
         println!(
             "{name} ({route}): R {radius}, {samples} samples: {} px, {} unstable, {} penumbra, {} umbra, {} mismatches; {}; map {} entries, mean list {:.1}, longest {}, {} texels past capacity, {} past the limit, {} pixels walked the BVH",
-            c.pixels, c.unstable, c.penumbra, c.umbra, c.mismatches, frame.lights[0].decision,
+            c.pixels, c.unstable, c.penumbra, c.umbra, c.mismatches, frame.lights[0].decision_reason,
             st.entries, st.mean_list(), st.longest_list, st.texels_past_capacity,
             st.texels_past_limit, st.pixels_walked
         );
@@ -1001,7 +999,10 @@ fn check_local_area(
         match &first {
             None => first = Some((c, st, layers.swap_remove(0))),
             Some((_, _, default)) => {
-                assert!(st.lists_skipped && st.pixels_walked > 0, "{name}: {st:?}");
+                assert!(
+                    st.frusta_without_lists > 0 && st.pixels_walked > 0,
+                    "{name}: {st:?}"
+                );
                 assert!(
                     &layers[0] == default,
                     "{name}: the BVH's counts differ from the default route's"
@@ -1147,7 +1148,7 @@ fn native_frame(
     configs: &[ShadowConfig],
     lights: Vec<hrts::Light>,
     frames: usize,
-) -> (Vec<LightFrameReport>, Vec<Vec<f32>>) {
+) -> (Vec<hrts::FrameReport>, Vec<Vec<f32>>) {
     let mut plugin = plugin_for(device, file);
     plugin.configure_lights(device, configs).expect("configure");
     let matrices = CameraMatrices::of_camera(&camera(file), WIDTH, HEIGHT);
@@ -1232,11 +1233,11 @@ fn a_sun_fitted_by_the_plugin_shadows_as_the_hosts_matrix_does() {
         let c = compare_with_reference(&r, layer, None, None);
         println!(
             "sun, {name}: {} pixels, {} shadowed, {} near an edge, {} mismatches; {}",
-            c.pixels, c.shadowed, c.near_edge, c.mismatches, report.decision
+            c.pixels, c.shadowed, c.near_edge, c.mismatches, report.decision_reason
         );
         assert_exact_visibility(&c, 0.05);
         assert_eq!(
-            report.decision,
+            report.decision_reason,
             "directional light: its frustum holds receivers in view"
         );
     }
@@ -1279,22 +1280,28 @@ fn mode_auto_shadows_a_zero_size_sun_hard_and_a_sized_lamp_area() {
         2,
     );
     let (sun, lamp_report) = (&reports[0], &reports[1]);
-    println!("sun: {}\nlamp: {}", sun.decision, lamp_report.decision);
-    assert!(
-        sun.decision.ends_with("; auto: hard (zero-size light)"),
-        "{}",
-        sun.decision
+    println!(
+        "sun: {}\nlamp: {}",
+        sun.decision_reason, lamp_report.decision_reason
     );
     assert!(
-        lamp_report.decision.contains("cube")
-            && lamp_report.decision.ends_with("; auto: area (sized light)"),
+        sun.decision_reason
+            .ends_with("; auto: hard (zero-size light)"),
         "{}",
-        lamp_report.decision
+        sun.decision_reason
+    );
+    assert!(
+        lamp_report.decision_reason.contains("cube")
+            && lamp_report
+                .decision_reason
+                .ends_with("; auto: area (sized light)"),
+        "{}",
+        lamp_report.decision_reason
     );
     for report in &reports {
-        let has = |r: ResourceId| report.report.resources.iter().any(|x| x.resource == r);
-        assert!(has(ResourceId::RtVisibility) && !has(ResourceId::ShadowMap));
-        assert!(!has(ResourceId::RtAntialiased));
+        let has = |r: hrts::Resource| report.resource_bytes(r) > 0;
+        assert!(has(hrts::Resource::RtVisibility) && !has(hrts::Resource::ShadowMap));
+        assert!(!has(hrts::Resource::RtAntialiased));
     }
     let rs = RefScene::new(&file.scene);
     let camera = camera(&file);

@@ -29,6 +29,46 @@ impl Resource {
     }
 }
 
+impl PassStatus {
+    /// Why a pass that did not run was skipped, in words (`None` for [`PassStatus::Ran`]).
+    pub fn reason(self) -> Option<&'static str> {
+        match self {
+            Self::Ran => None,
+            Self::NotInPlan => Some("culled: no requested output depends on it"),
+            Self::UpToDate => Some("inputs unchanged since it last ran: earlier output reused"),
+            Self::Shared => {
+                Some("shared by the lights: built this frame by another light's passes")
+            }
+            Self::Culled => Some("the frustum holds no receiver in view within the light's range"),
+        }
+    }
+
+    /// The status as the C enumeration names it, without its prefix: "RAN", "UP_TO_DATE", "SHARED",
+    /// "NOT_IN_PLAN" or "CULLED".
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Ran => "RAN",
+            Self::UpToDate => "UP_TO_DATE",
+            Self::Shared => "SHARED",
+            Self::NotInPlan => "NOT_IN_PLAN",
+            Self::Culled => "CULLED",
+        }
+    }
+}
+
+impl BinningPath {
+    /// "compute", "hardware", "software", "hardware (tier-1 emulation)" or, in a request, "auto".
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Auto => "auto",
+            Self::Compute => "compute",
+            Self::Hardware => "hardware",
+            Self::Software => "software",
+            Self::EmulatedTier1 => "hardware (tier-1 emulation)",
+        }
+    }
+}
+
 /// A C enumeration whose values are 0, 1, 2, ... in the order of [`CEnum::ALL`].
 pub(crate) trait CEnum: Copy + 'static {
     /// Every value, in value order.
@@ -215,6 +255,20 @@ mod tests {
             Resource::ALL.iter().map(|r| r.name()).collect();
         assert_eq!(resources.len(), Resource::ALL.len());
         assert_eq!(Resource::PrimListEntries.name(), "prim list entries");
+    }
+
+    #[test]
+    fn pass_status_names_are_the_c_names() {
+        let header = include_str!("../../include/hrts.h");
+        for &status in PassStatus::ALL {
+            let c = format!("HRTS_PASS_STATUS_{} = {},", status.name(), status as u32);
+            assert!(header.contains(&c), "the header lacks {c}");
+            assert_eq!(status.reason().is_none(), status == PassStatus::Ran);
+        }
+        assert_eq!(
+            BinningPath::EmulatedTier1.name(),
+            "hardware (tier-1 emulation)"
+        );
     }
 
     fn values_are_indices<T: CEnum>() {

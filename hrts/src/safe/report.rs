@@ -98,6 +98,17 @@ pub struct MapStats {
     pub walks_unfinished: u32,
 }
 
+impl MapStats {
+    /// Mean list length over the texels holding a list (0 without any).
+    pub fn mean_list(&self) -> f64 {
+        if self.texels_with_list == 0 {
+            0.0
+        } else {
+            f64::from(self.entries) / f64::from(self.texels_with_list)
+        }
+    }
+}
+
 /// What one light's passes did in one frame (`hrts_get_frame_report`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameReport {
