@@ -8,6 +8,7 @@ use crate::progress::phase;
 use crate::View;
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
+use hrts::passes_bridge;
 use hrts::FrameReport;
 use passes::{PrimitiveMapConfig, ShadowConfig};
 use rhi::{Device, Format};
@@ -401,7 +402,8 @@ pub(crate) fn frames_with_layout(
 ) -> Result<(PluginRenderer, Vec<FrameReport>)> {
     let frames = frames.max(2);
     let progress = phase("frames", u64::from(frames));
-    let mut renderer = PluginRenderer::with_layout(device, view, config, layout)?;
+    let mut renderer =
+        PluginRenderer::with_layout(device, view, passes_bridge::config(&config)?, layout)?;
     let inputs = view.frame_inputs();
     let reports = (0..frames)
         .map(|_| {

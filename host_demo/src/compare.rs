@@ -10,6 +10,7 @@ use crate::FrameImages;
 use crate::{parse_vec3, View};
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
+use hrts::passes_bridge;
 use passes::{
     HybridConfig, PcssConfig, PenumbraFilter, PrimitiveMapConfig, ResourceId, ResourceSet,
     ShadowConfig, ShadowMapConfig, ShadowMode,
@@ -305,7 +306,7 @@ fn render_panel(
     let Some(first) = views.first() else {
         bail!("no view to render");
     };
-    let mut renderer = PluginRenderer::new(device, first, *config)?;
+    let mut renderer = PluginRenderer::new(device, first, passes_bridge::config(config)?)?;
     let inputs = first.frame_inputs();
     let mut reports = Vec::new();
     for _ in 0..frames.max(1) {

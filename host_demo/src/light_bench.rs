@@ -17,6 +17,7 @@ use crate::scene_render::{median, SceneRenderer};
 use crate::CameraMatrices;
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
+use hrts::passes_bridge;
 use hrts::MapStats;
 use passes::{
     directional_light_frustum, spot_light_frusta, AreaConfig, FrameInputs, Light,
@@ -323,7 +324,7 @@ fn measure_light(
     args: &BenchArgs,
 ) -> Result<LightCost> {
     let settings = PlanSettings {
-        base: ShadowConfig {
+        base: passes_bridge::config(&ShadowConfig {
             antialiasing: false,
             area: AreaConfig {
                 samples: args.area_samples,
@@ -333,7 +334,7 @@ fn measure_light(
                 ..args.map()
             },
             ..ShadowConfig::default()
-        },
+        })?,
         width: args.width,
         height: args.height,
     };
@@ -463,7 +464,10 @@ fn measure_native_points(
         config.pcss.spot_radius = radius;
         config.area.samples = args.area_samples;
     }
-    plugin.configure_lights(device, &vec![config; positions.len()])?;
+    plugin.configure_lights(
+        device,
+        &vec![passes_bridge::config(&config)?; positions.len()],
+    )?;
     let matrices = CameraMatrices::of_camera(camera, args.width, args.height);
     let lights: Vec<_> = positions
         .iter()

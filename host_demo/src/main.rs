@@ -11,7 +11,7 @@ use host_demo::render::{
 use host_demo::scene_plan::{held_still, plan_scene, scene_camera, PlanSettings};
 use host_demo::scene_render::render_scene_to_folder;
 use host_demo::{parse_vec3, View};
-use passes::{BinningRequest, FaceMode, PrimitiveMapConfig, ShadowMode};
+use hrts::{BinningPath, Faces, ShadowMode};
 use reference::RefScene;
 use rhi::Device;
 use scene::{Aabb, Camera, DirectionalLight, LightSize, Scene, SceneFile, SceneLight};
@@ -123,11 +123,11 @@ struct RenderArgs {
     map_budget_mb: u32,
     /// Faces stored: both (open geometry) or front (closed meshes only).
     #[arg(long, default_value = "both", value_parser = parse_faces)]
-    faces: FaceMode,
+    faces: Faces,
     /// Binning path of the primitive map: auto (compute), compute, hw (hardware conservative raster) or
     /// sw (geometry-shader conservative raster).
     #[arg(long, default_value = "auto", value_parser = parse_binning)]
-    binning: BinningRequest,
+    binning: BinningPath,
     /// A texel whose list would pass this many entries keeps none: its pixels walk the BVH (0: the
     /// plugin's choice by mode; moves cost, never exactness).
     #[arg(long, default_value_t = hrts::Config::default().map_list_limit)]
@@ -250,7 +250,7 @@ fn scene_setup(
     file: &SceneFile,
     (width, height): (u32, u32),
     (position, target): (Option<Vec3>, Option<Vec3>),
-    map: PrimitiveMapConfig,
+    map: hrts::Config,
     soft: &SoftShadowArgs,
 ) -> Result<(Camera, PlanSettings)> {
     if width == 0 || height == 0 {
@@ -263,7 +263,7 @@ fn scene_setup(
         position,
         target,
     )?;
-    let base = soft.shadow_config(map, world_space_scale_of(&file.scene));
+    let base = soft.config(map, world_space_scale_of(&file.scene));
     Ok((
         camera,
         PlanSettings {
@@ -281,9 +281,9 @@ fn plan(args: &PlanArgs) -> Result<()> {
         no_antialiasing: args.no_antialiasing,
         ..SoftShadowArgs::default()
     };
-    let map = PrimitiveMapConfig {
-        size: args.map_size,
-        ..PrimitiveMapConfig::default()
+    let map = hrts::Config {
+        map_size: args.map_size,
+        ..hrts::Config::default()
     };
     let (camera, settings) = scene_setup(
         &file,
@@ -499,15 +499,15 @@ fn render_closed(
 }
 
 /// The primitive map the command line asks for.
-fn map_config(args: &RenderArgs) -> PrimitiveMapConfig {
-    PrimitiveMapConfig {
-        size: args.map_size,
+fn map_config(args: &RenderArgs) -> hrts::Config {
+    hrts::Config {
+        map_size: args.map_size,
         faces: args.faces,
-        binning: args.binning,
-        entry_budget: u64::from(args.map_budget_mb) << 20,
-        list_limit: args.list_limit,
-        bin_budget: args.bin_budget,
-        ..PrimitiveMapConfig::default()
+        binning_path: args.binning,
+        map_entry_budget_kib: args.map_budget_mb.saturating_mul(1024),
+        map_list_limit: args.list_limit,
+        map_bin_budget: args.bin_budget,
+        ..hrts::Config::default()
     }
 }
 

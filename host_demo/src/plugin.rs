@@ -13,13 +13,26 @@ use crate::scene_buffers::SceneBuffers;
 use crate::{read_images, CameraMatrices, FrameImages, FrameOutput, View};
 use anyhow::{bail, Context as _, Result};
 use hrts::passes_bridge;
-use passes::{FrameInputs, Light, ResourceId, ShadowConfig};
+use passes::{FrameInputs, Light, ResourceId};
 use rhi::{
     Barrier, BufferUsage, Device, Format, GpuTimer, Image, ImageDesc, ImageUsage, MemoryLocation,
     ResourceState as S,
 };
 use scene::{Aabb, Scene};
 use std::ffi::CString;
+
+/// `config` asking for the ray trace's blocker distance when its mode traces hard rays (hard, hybrid): the
+/// demo compares blocker distances with the exact reference, and the plugin allocates them only when
+/// asked (or for the hybrid).
+pub fn with_blocker_distance(mut config: hrts::Config) -> hrts::Config {
+    if matches!(
+        config.mode,
+        hrts::ShadowMode::Hard | hrts::ShadowMode::Hybrid
+    ) {
+        config.extra_outputs = config.extra_outputs.with(hrts::Resource::BlockerDistance);
+    }
+    config
+}
 
 /// The line the demo's commands print first: the device and the plugin's API version.
 pub fn device_banner(caps: &rhi::Capabilities) -> String {
@@ -85,7 +98,7 @@ impl PluginRenderer {
     /// Uploads `view`'s scene into the demo's buffers, creates the G-buffer and the visibility image for
     /// its size, and a plugin context on `device` configured with `config` (one light), asking for the
     /// blocker distance when it traces rays (the demo compares it with the exact reference).
-    pub fn new(device: &Device, view: &View, config: impl Into<ShadowConfig>) -> Result<Self> {
+    pub fn new(device: &Device, view: &View, config: hrts::Config) -> Result<Self> {
         Self::with_layout(device, view, config, GBufferLayout::ANALYSIS)
     }
 
@@ -93,10 +106,10 @@ impl PluginRenderer {
     pub fn with_layout(
         device: &Device,
         view: &View,
-        config: impl Into<ShadowConfig>,
+        config: hrts::Config,
         layout: GBufferLayout,
     ) -> Result<Self> {
-        let config = crate::renderer::with_blocker_distance(config.into());
+        let config = with_blocker_distance(config);
         let mut renderer = Self::for_scene(device, &view.scene, view.width, view.height, layout)?;
         renderer.configure_lights(device, &[config])?;
         Ok(renderer)
@@ -186,13 +199,9 @@ impl PluginRenderer {
     /// ABI carries it; none: later frames give the plugin nothing). The plugin keeps the passes of every
     /// light whose configuration is unchanged, unless the number of lights changes. A visibility image with
     /// too few layers is replaced ([`hrts::Context::set_targets`], which rebuilds every light).
-    pub fn configure_lights(&mut self, device: &Device, configs: &[ShadowConfig]) -> Result<()> {
-        let configs = configs
-            .iter()
-            .map(passes_bridge::config)
-            .collect::<Result<Vec<_>, _>>()?;
+    pub fn configure_lights(&mut self, device: &Device, configs: &[hrts::Config]) -> Result<()> {
         if configs.is_empty() || configs == self.configured {
-            self.configured = configs;
+            self.configured = configs.to_vec();
             return Ok(());
         }
         let layers = configs.len() as u32;
@@ -221,8 +230,8 @@ impl PluginRenderer {
             unsafe { self.context.set_targets(&targets) }?;
             self.replaced_outputs.extend(self.output.replace(output));
         }
-        self.context.configure_lights(&configs)?;
-        self.configured = configs;
+        self.context.configure_lights(configs)?;
+        self.configured = configs.to_vec();
         Ok(())
     }
 

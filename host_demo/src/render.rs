@@ -6,10 +6,9 @@ use crate::output::{shade_preview, write_exr_rgba, write_exr_scalar, write_png};
 use crate::plugin::PluginRenderer;
 use crate::{focus_bounds, View};
 use anyhow::{Context, Result};
-use hrts::{FrameReport, Pass, PassStatus, Resource};
-use passes::{
-    AreaConfig, BinningRequest, FaceMode, HybridConfig, PcssConfig, PenumbraFilter,
-    PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig, ShadowMapConfig, ShadowMode,
+use hrts::{
+    BinningPath, Faces, FrameReport, Pass, PassStatus, PenumbraFilter, Resource, ResourceSet,
+    ShadowMode,
 };
 use rhi::Device;
 use scene::Scene;
@@ -76,8 +75,10 @@ impl Default for SoftShadowArgs {
 /// Options of a render besides the view.
 #[derive(Debug, Clone)]
 pub struct RenderOptions {
-    /// Primitive map configuration.
-    pub map: PrimitiveMapConfig,
+    /// The plugin configuration the primitive-map options set (`map_size`, `map_entry_budget_kib`,
+    /// `faces`, `binning_path`, `map_list_limit`, `map_bin_budget`); [`RenderOptions::soft`] sets the
+    /// rest.
+    pub map: hrts::Config,
     /// Frames rendered; timings are medians over the frames after the first.
     pub frames: u32,
     /// Shadow mode, shadow map, PCSS and hybrid settings.
@@ -99,39 +100,25 @@ pub fn world_space_scale_of(scene: &Scene) -> f32 {
 }
 
 impl SoftShadowArgs {
-    /// The configuration these options describe over the primitive map `map`, with the hybrid's WSS
-    /// `default_world_space_scale` unless `--wss` sets it; static geometry, a moving light, no extra
-    /// output.
-    pub fn shadow_config(
-        &self,
-        map: PrimitiveMapConfig,
-        default_world_space_scale: f32,
-    ) -> ShadowConfig {
-        ShadowConfig {
+    /// The configuration these options describe over the primitive-map settings of `map`, with the
+    /// hybrid's WSS `default_world_space_scale` unless `--wss` sets it; static geometry, a moving light, no
+    /// extra output.
+    pub fn config(&self, map: hrts::Config, default_world_space_scale: f32) -> hrts::Config {
+        hrts::Config {
             mode: self.mode,
             antialiasing: !self.no_antialiasing,
-            static_geometry: true,
+            dynamic_geometry: false,
             static_light: false,
-            map,
-            shadow_map: ShadowMapConfig {
-                size: self.shadow_map_size,
-                ..ShadowMapConfig::default()
-            },
-            pcss: PcssConfig {
-                angular_radius: self.angular_radius,
-                blocker_search_taps: self.search_taps,
-                pcf_taps: self.pcf_taps,
-                filter: self.filter,
-                ..PcssConfig::default()
-            },
-            hybrid: HybridConfig {
-                world_space_scale: self.wss.unwrap_or(default_world_space_scale),
-                hard_shadow_percentage: self.phs,
-            },
-            area: AreaConfig {
-                samples: self.area_samples,
-            },
-            ..ShadowConfig::default()
+            shadow_map_size: self.shadow_map_size,
+            pcss_angular_radius: self.angular_radius,
+            pcss_blocker_search_taps: self.search_taps,
+            pcss_pcf_taps: self.pcf_taps,
+            pcss_filter: self.filter,
+            hybrid_world_space_scale: self.wss.unwrap_or(default_world_space_scale),
+            hybrid_hard_shadow_percentage: self.phs,
+            area_samples: self.area_samples,
+            extra_outputs: ResourceSet::EMPTY,
+            ..map
         }
     }
 }
@@ -139,12 +126,10 @@ impl SoftShadowArgs {
 impl RenderOptions {
     /// The pipeline configuration: the plan's final output plus every intermediate the demo writes. Every
     /// frame re-renders the light-space maps (a moving light), so that their timings are medians too.
-    pub fn shadow_config(&self, view: &View) -> ShadowConfig {
-        ShadowConfig {
+    pub fn config(&self, view: &View) -> hrts::Config {
+        hrts::Config {
             extra_outputs: demo_outputs(self.soft.mode, self.occupancy_view),
-            ..self
-                .soft
-                .shadow_config(self.map, default_world_space_scale(view))
+            ..self.soft.config(self.map, default_world_space_scale(view))
         }
     }
 }
@@ -153,14 +138,15 @@ impl RenderOptions {
 /// the occupancy view if asked), the shadow-map views wherever it has a shadow map, the hybrid's parts in
 /// hybrid mode.
 fn demo_outputs(mode: ShadowMode, occupancy_view: bool) -> ResourceSet {
-    use ResourceId as R;
+    use Resource as R;
+    let of = |resources: &[Resource]| resources.iter().copied().collect::<ResourceSet>();
     let outputs = match mode {
         ShadowMode::None => ResourceSet::EMPTY,
-        ShadowMode::Hard => ResourceSet::of(&[R::RtVisibility, R::BlockerDistance]),
+        ShadowMode::Hard => of(&[R::RtVisibility, R::BlockerDistance]),
         // Auto, until resolved per light, has what hard and area shadows share.
-        ShadowMode::Area | ShadowMode::Auto => ResourceSet::of(&[R::RtVisibility]),
-        ShadowMode::Soft => ResourceSet::of(&[R::ShadowMapVisibility, R::Pcss]),
-        ShadowMode::Hybrid => ResourceSet::of(&[
+        ShadowMode::Area | ShadowMode::Auto => of(&[R::RtVisibility]),
+        ShadowMode::Soft => of(&[R::ShadowMapVisibility, R::Pcss]),
+        ShadowMode::Hybrid => of(&[
             R::RtVisibility,
             R::BlockerDistance,
             R::ShadowMapVisibility,
@@ -333,7 +319,7 @@ pub fn render_to_folder(
     out: &Path,
 ) -> Result<FrameReport> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let config = options.shadow_config(view);
+    let config = options.config(view);
     // The demo's G-buffer as engines keep one (D24S8 depth, octahedral RG16F normals); its read-back
     // rebuilds positions and world normals for the outputs below.
     let layout = GBufferLayout::compact(device);
@@ -353,7 +339,7 @@ pub fn render_to_folder(
     }
     bar.set_message("reading back and writing the outputs");
     let images = renderer.read_back(device, false).context("reading back")?;
-    let (w, h, n) = (view.width, view.height, options.map.size);
+    let (w, h, n) = (view.width, view.height, options.map.map_size);
     write_exr_rgba(&out.join("position.exr"), w, h, &images.position)?;
     write_exr_rgba(&out.join("normal.exr"), w, h, &images.normal)?;
     let scalars = [
@@ -413,8 +399,8 @@ pub fn render_to_folder(
         primitive_map: MapJson {
             size: n,
             faces: match options.map.faces {
-                FaceMode::Both => "both",
-                FaceMode::FrontOnly => "front",
+                Faces::Both => "both",
+                Faces::FrontOnly => "front",
             },
             binning_path: report.binning_path.name(),
             tier: tier_name(&report),
@@ -443,8 +429,8 @@ pub fn render_to_folder(
             angular_radius: s.angular_radius,
             blocker_search_taps: s.search_taps,
             pcf_taps: s.pcf_taps,
-            world_space_scale: config.hybrid.world_space_scale,
-            hard_shadow_percentage: config.hybrid.hard_shadow_percentage,
+            world_space_scale: config.hybrid_world_space_scale,
+            hard_shadow_percentage: config.hybrid_hard_shadow_percentage,
         },
         plan: plan_json(&report),
         frames: options.frames.max(1),
@@ -505,12 +491,12 @@ pub fn render_to_folder(
         ShadowMode::Hard => fxaa,
         ShadowMode::Area => format!(
             "{} light samples per pixel, angular radius {}",
-            config.area.samples, config.pcss.angular_radius
+            config.area_samples, config.pcss_angular_radius
         ),
         ShadowMode::Soft => soft,
         ShadowMode::Hybrid => format!(
             "{fxaa}, {soft}, WSS {:.3}, PHS {}",
-            config.hybrid.world_space_scale, config.hybrid.hard_shadow_percentage
+            config.hybrid_world_space_scale, config.hybrid_hard_shadow_percentage
         ),
         ShadowMode::Auto => "hard or area, by the light's size".to_owned(),
     };
@@ -627,12 +613,12 @@ pub fn map_bytes(report: &FrameReport) -> u64 {
 }
 
 /// Parses the binning request of the command line.
-pub fn parse_binning(s: &str) -> Result<BinningRequest, String> {
+pub fn parse_binning(s: &str) -> Result<BinningPath, String> {
     match s {
-        "auto" => Ok(BinningRequest::Auto),
-        "compute" => Ok(BinningRequest::Compute),
-        "hw" | "hardware" => Ok(BinningRequest::Hardware),
-        "sw" | "software" => Ok(BinningRequest::Software),
+        "auto" => Ok(BinningPath::Auto),
+        "compute" => Ok(BinningPath::Compute),
+        "hw" | "hardware" => Ok(BinningPath::Hardware),
+        "sw" | "software" => Ok(BinningPath::Software),
         _ => Err(format!(
             "unknown binning path '{s}' (auto, compute, hw, sw)"
         )),
@@ -640,10 +626,10 @@ pub fn parse_binning(s: &str) -> Result<BinningRequest, String> {
 }
 
 /// Parses the face mode of the command line.
-pub fn parse_faces(s: &str) -> Result<FaceMode, String> {
+pub fn parse_faces(s: &str) -> Result<Faces, String> {
     match s {
-        "both" => Ok(FaceMode::Both),
-        "front" => Ok(FaceMode::FrontOnly),
+        "both" => Ok(Faces::Both),
+        "front" => Ok(Faces::FrontOnly),
         _ => Err(format!("unknown face mode '{s}' (both, front)")),
     }
 }

@@ -8,6 +8,7 @@ use crate::plugin::PluginRenderer;
 use crate::render::{map_bytes, median_timings};
 use crate::View;
 use anyhow::{Context, Result};
+use hrts::passes_bridge;
 use passes::{
     PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig, ShadowMapConfig, ShadowMode,
 };
@@ -64,7 +65,7 @@ pub fn render_frames(
     frames: u32,
 ) -> Result<(crate::FrameImages, Vec<hrts::FrameReport>)> {
     let progress = crate::progress::phase("frames", u64::from(frames.max(2)));
-    let mut r = PluginRenderer::new(device, view, config)?;
+    let mut r = PluginRenderer::new(device, view, passes_bridge::config(&config)?)?;
     let inputs = view.frame_inputs();
     let mut reports = Vec::new();
     for _ in 0..frames.max(2) {

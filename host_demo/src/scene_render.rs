@@ -291,7 +291,7 @@ pub fn describe_frame(
                 report,
                 built_now,
                 shadowed.config.static_light,
-                !shadowed.config.static_geometry
+                shadowed.config.dynamic_geometry
             )
         );
         let resources: Vec<String> = report

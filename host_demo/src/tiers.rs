@@ -10,6 +10,7 @@ use crate::accuracy::{compare_map, fitted_light_matrix, MapComparison};
 use crate::plugin::PluginRenderer;
 use crate::View;
 use anyhow::Result;
+use hrts::passes_bridge;
 use passes::{choose_binning_path, BinningRequest, FaceMode, PrimitiveMapConfig};
 use reference::{FaceSelection, RefScene};
 use rhi::Device;
@@ -75,7 +76,8 @@ pub fn tier_matrix(device: &Device, scenes: &[(&str, View)], size: u32) -> Resul
                 bin_budget: f32::INFINITY,
                 ..PrimitiveMapConfig::default()
             };
-            let mut renderer = PluginRenderer::new(device, view, config)?;
+            let mut renderer =
+                PluginRenderer::new(device, view, passes_bridge::config(&config.into())?)?;
             let inputs = view.frame_inputs();
             let report = renderer.render(device, &inputs)?;
             let images = renderer.read_back(device, true)?;

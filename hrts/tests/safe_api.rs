@@ -37,7 +37,7 @@ fn a_headless_context_configures_takes_geometry_and_reports_errors() {
         ..Config::default()
     };
     context
-        .configure_lights(&[hard.clone(), Config::default()])
+        .configure_lights(&[hard, Config::default()])
         .expect("two lights");
     let positions = [Vec3::ZERO, Vec3::X, Vec3::Z, Vec3::new(1.0, 0.0, 1.0)];
     let draw = Draw {

@@ -10,7 +10,6 @@ use common::{
 use glam::Vec3;
 use host_demo::scene_plan::{plan_scene, PlanSettings};
 use host_demo::scene_render::SceneRenderer;
-use passes::{PrimitiveMapConfig, ShadowConfig};
 use reference::{reference_visibility, RefScene};
 use rhi::Device;
 use scene::gltf_scene::{write_scene, GltfEncoding, Quantization, QuantizedComponent};
@@ -96,13 +95,10 @@ fn write_and_load(dir: &Path, name: &str, file: &SceneFile, encoding: GltfEncodi
 fn visibilities(device: &Device, file: &SceneFile) -> Vec<Vec<f32>> {
     let camera = file.camera.expect("the scene has a camera");
     let settings = PlanSettings {
-        base: ShadowConfig {
+        base: hrts::Config {
             antialiasing: false,
-            map: PrimitiveMapConfig {
-                size: 128,
-                ..PrimitiveMapConfig::default()
-            },
-            ..ShadowConfig::default()
+            map_size: 128,
+            ..hrts::Config::default()
         },
         width: WIDTH,
         height: HEIGHT,

@@ -105,7 +105,8 @@ fn both(
 ) -> ((FrameReport, FrameImages), (hrts::FrameReport, FrameImages)) {
     let inputs = view.frame_inputs();
     let mut direct = ShadowRenderer::new(device, view, config).expect("Rust renderer");
-    let mut plugin = PluginRenderer::new(device, view, config).expect("plugin renderer");
+    let plugin_config = hrts::passes_bridge::config(&config).expect("a configuration of the C ABI");
+    let mut plugin = PluginRenderer::new(device, view, plugin_config).expect("plugin renderer");
     let mut last_direct = None;
     let mut last_plugin = None;
     for _ in 0..frames {
@@ -284,7 +285,11 @@ fn soft_and_none_modes_match() {
 fn compact_gbuffer_reads_back_as_the_analysis_one_and_shadows_exactly() {
     let device = device();
     let view = View::framed(scene::procedural_default(), 192, 108);
-    let config = PrimitiveMapConfig::default();
+    let config = hrts::Config {
+        mode: hrts::ShadowMode::Hard,
+        antialiasing: false,
+        ..hrts::Config::default()
+    };
     let layouts = [
         host_demo::gbuffer::GBufferLayout::ANALYSIS,
         host_demo::gbuffer::GBufferLayout::compact(&device),

@@ -28,9 +28,11 @@ fn not_run(device: &Device, why: &str) -> ! {
 
 fn check(view: &View, max_near_edge_fraction: f64) {
     let device = device();
-    let config = PrimitiveMapConfig {
-        size: 256,
-        ..Default::default()
+    let config = hrts::Config {
+        mode: hrts::ShadowMode::Hard,
+        antialiasing: false,
+        map_size: 256,
+        ..hrts::Config::default()
     };
     let mut renderer = PluginRenderer::new(&device, view, config).expect("renderer");
     let inputs = view.frame_inputs();
@@ -129,6 +131,7 @@ fn area_peer_counts_equal_the_plugins_on_stable_pixels() {
             area: AreaConfig { samples },
             ..ShadowConfig::default()
         };
+        let config = hrts::passes_bridge::config(&config).expect("a configuration of the C ABI");
         let mut renderer = PluginRenderer::new(&device, &view, config).expect("renderer");
         renderer.render(&device, &inputs).expect("render");
         let ours = renderer

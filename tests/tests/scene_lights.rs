@@ -21,7 +21,7 @@ use host_demo::scene_plan::{
 };
 use host_demo::scene_render::SceneRenderer;
 use host_demo::CameraMatrices;
-use passes::{AreaConfig, PrimitiveMapConfig, ShadowConfig, ShadowMapConfig, ShadowMode};
+use hrts::{Config, ShadowMode};
 use reference::{local_area_reference, reference_visibility, RefScene};
 use rhi::Device;
 use scene::{Camera, LightKind, LightSize, SceneFile, SceneLight};
@@ -44,17 +44,11 @@ fn example() -> SceneFile {
 
 fn settings(antialiasing: bool) -> PlanSettings {
     PlanSettings {
-        base: ShadowConfig {
+        base: Config {
             antialiasing,
-            map: PrimitiveMapConfig {
-                size: 256,
-                ..PrimitiveMapConfig::default()
-            },
-            shadow_map: ShadowMapConfig {
-                size: 512,
-                ..ShadowMapConfig::default()
-            },
-            ..ShadowConfig::default()
+            map_size: 256,
+            shadow_map_size: 512,
+            ..Config::default()
         },
         width: WIDTH,
         height: HEIGHT,
@@ -101,7 +95,9 @@ fn all_hard(plan: &ScenePlan) -> ScenePlan {
         if let LightDecision::Shadowed(s) = &mut light.decision {
             // Hard shadows ignore the light's size, and take only sizes above 0 (0 is mode auto's).
             s.config.mode = ShadowMode::Hard;
-            s.config.pcss = passes::PcssConfig::default();
+            s.mode = ShadowMode::Hard;
+            s.config.pcss_angular_radius = Config::default().pcss_angular_radius;
+            s.config.pcss_spot_radius = Config::default().pcss_spot_radius;
         }
     }
     hard
@@ -582,7 +578,7 @@ fn closed_room(lamp: Vec3) -> SceneFile {
 fn native_point_frames(
     device: &Device,
     lamp: Vec3,
-    config: ShadowConfig,
+    config: Config,
     frames: usize,
 ) -> Vec<(hrts::MapStats, common::VisibilityComparison)> {
     let file = closed_room(lamp);
@@ -619,7 +615,7 @@ fn native_point_frames(
 #[test]
 fn a_native_point_light_matches_the_exact_reference() {
     let device = device();
-    let config = ShadowConfig {
+    let config = Config {
         mode: ShadowMode::Hard,
         antialiasing: false,
         ..settings(false).base
@@ -641,13 +637,13 @@ fn a_native_point_light_matches_the_exact_reference() {
 #[test]
 fn a_cube_map_outgrowing_its_pairs_stays_exact_and_grows() {
     let device = device();
-    let mut config = ShadowConfig {
+    let mut config = Config {
         mode: ShadowMode::Hard,
         antialiasing: false,
         static_light: false,
         ..settings(false).base
     };
-    config.map.initial_pairs = 8;
+    config.map_initial_pairs = 8;
     let frames = native_point_frames(&device, Vec3::new(0.15, 2.5, 0.1), config, 3);
     let (first, _) = &frames[0];
     assert_eq!(first.bin_pair_capacity, 8);
@@ -954,15 +950,15 @@ fn check_local_area(
     let base = settings(false).base;
     // The plugin's own choice of lists and BVH, then every pixel through the BVH: the same counts.
     let mut first: Option<(AreaComparison, hrts::MapStats, Vec<f32>)> = None;
-    for (route, bin_budget) in [("default", base.map.bin_budget), ("BVH", 0.0)] {
-        let mut config = ShadowConfig {
+    for (route, bin_budget) in [("default", base.map_bin_budget), ("BVH", 0.0)] {
+        let mut config = Config {
             mode: ShadowMode::Area,
             antialiasing: false,
-            area: AreaConfig { samples },
+            area_samples: samples,
             ..base
         };
-        config.map.bin_budget = bin_budget;
-        config.pcss.spot_radius = radius;
+        config.map_bin_budget = bin_budget;
+        config.pcss_spot_radius = radius;
         let mut plugin = plugin_for(device, file);
         plugin
             .configure_lights(device, &[config])
@@ -1145,7 +1141,7 @@ fn plugin_directional_light(direction: Vec3, view_proj: Option<glam::Mat4>) -> h
 fn native_frame(
     device: &Device,
     file: &SceneFile,
-    configs: &[ShadowConfig],
+    configs: &[Config],
     lights: Vec<hrts::Light>,
     frames: usize,
 ) -> (Vec<hrts::FrameReport>, Vec<Vec<f32>>) {
@@ -1201,7 +1197,7 @@ fn a_sun_fitted_by_the_plugin_shadows_as_the_hosts_matrix_does() {
     let file = open_boxes();
     let direction = sun_direction();
     let host = scene::DirectionalLight { direction }.view_proj(&file.scene.bounds());
-    let config = ShadowConfig {
+    let config = Config {
         mode: ShadowMode::Hard,
         antialiasing: false,
         ..settings(false).base
@@ -1260,14 +1256,14 @@ fn mode_auto_shadows_a_zero_size_sun_hard_and_a_sized_lamp_area() {
     let direction = sun_direction();
     let lamp = Vec3::new(0.6, 2.2, 0.9);
     let (radius, samples) = (0.2, 16);
-    let mut config = ShadowConfig {
+    let mut config = Config {
         mode: ShadowMode::Auto,
         antialiasing: false,
-        area: AreaConfig { samples },
+        area_samples: samples,
         ..settings(false).base
     };
-    config.pcss.angular_radius = 0.0;
-    config.pcss.spot_radius = radius;
+    config.pcss_angular_radius = 0.0;
+    config.pcss_spot_radius = radius;
     // The second frame: the first one's lists grow to what it needed.
     let (reports, layers) = native_frame(
         &device,

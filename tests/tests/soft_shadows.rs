@@ -444,9 +444,9 @@ fn render_and_compare_write_the_soft_shadow_outputs() {
     let _ = std::fs::remove_dir_all(&dir);
     let view = plate_and_box_view(96, 64);
     let options = host_demo::render::RenderOptions {
-        map: PrimitiveMapConfig {
-            size: 128,
-            ..PrimitiveMapConfig::default()
+        map: hrts::Config {
+            map_size: 128,
+            ..hrts::Config::default()
         },
         frames: 2,
         soft: host_demo::render::SoftShadowArgs {

@@ -23,6 +23,7 @@ use crate::plugin::PluginRenderer;
 use crate::{FrameImages, View};
 use anyhow::{anyhow, bail, Context, Result};
 use glam::{DVec3, Mat4};
+use hrts::passes_bridge;
 use passes::{
     BinningRequest, FaceMode, FrameInputs, Light, PrimitiveMapConfig, DEFAULT_ENTRY_BUDGET,
     GUARD_VALUE, GUARD_WORDS,
@@ -346,8 +347,13 @@ fn measure(
         },
         _ => config,
     };
-    let mut renderer = PluginRenderer::with_layout(device, &view, config, layout)
-        .context("creating the renderer")?;
+    let mut renderer = PluginRenderer::with_layout(
+        device,
+        &view,
+        passes_bridge::config(&config.into())?,
+        layout,
+    )
+    .context("creating the renderer")?;
     let mut report = renderer.render(device, &inputs).context("rendering")?;
     if report.stats.texels_past_capacity > 0 && case.map.overflow == Overflow::Forbidden {
         // The lists grew to what this frame needed: the next frame, as an engine's would, fits.

@@ -42,8 +42,8 @@
 
 use anyhow::{bail, Result};
 use glam::{DVec4, Vec3};
+use hrts::{Config, Faces, ShadowMode};
 use hrts::{SpotFrustum, HRTS_MAX_LIGHTS};
-use passes::{FaceMode, ShadowConfig, ShadowMode};
 use scene::{Camera, LightKind, LightSize, SceneFile, SceneLight};
 use std::fmt::Write as _;
 
@@ -52,8 +52,8 @@ use std::fmt::Write as _;
 pub struct PlanSettings {
     /// The configuration every shadowed light starts from: primitive map, shadow map size, PCSS taps and
     /// filter, hybrid blend, antialiasing. The plan sets mode auto, the light size, `static_light` and
-    /// `static_geometry` (and both faces in the primitive map of spot and point lights).
-    pub base: ShadowConfig,
+    /// `dynamic_geometry` (and both faces in the primitive map of spot and point lights).
+    pub base: Config,
     /// Frame width in pixels (with the height, the aspect of the camera's frustum).
     pub width: u32,
     /// Frame height in pixels.
@@ -90,7 +90,9 @@ impl NoPassReason {
 #[derive(Debug, Clone, PartialEq)]
 pub struct ShadowedLight {
     /// The light's configuration as the plugin is given it (mode auto, and the light's size).
-    pub config: ShadowConfig,
+    pub config: Config,
+    /// The mode the plugin runs for the light: auto resolved by the light's size ([`hrts::LightPlan::mode`]).
+    pub mode: ShadowMode,
     /// The passes of the light's plan, as the plugin plans them ([`hrts::LightPlan::passes`]) for the
     /// configuration it resolves ([`ShadowedLight::resolved_config`]).
     pub passes: hrts::PassMask,
@@ -110,9 +112,12 @@ impl ShadowedLight {
     }
 
     /// The configuration the plugin builds the light's passes with: mode auto resolved by the light's size
-    /// ([`ShadowConfig::resolved`], as the plugin resolves it).
-    pub fn resolved_config(&self) -> ShadowConfig {
-        self.config.resolved(self.is_directional())
+    /// ([`ShadowedLight::mode`]).
+    pub fn resolved_config(&self) -> Config {
+        Config {
+            mode: self.mode,
+            ..self.config
+        }
     }
 }
 
@@ -153,17 +158,17 @@ impl LightPlan {
             LightDecision::Shadowed(shadowed) => shadowed,
         };
         let config = shadowed.resolved_config();
-        let samples = config.area.samples;
+        let samples = config.area_samples;
         match (config.mode, self.light.kind) {
             (ShadowMode::Hard, _) => "hard (zero-size light: exact ray-traced hard shadows; no shadow map, no PCSS)".to_owned(),
             (ShadowMode::Area, LightKind::Directional { .. }) => format!(
                 "area (sized sun: exact soft shadows, the visible fraction of {samples} light samples within {} rad, each tested against the exact triangles; no shadow map)",
-                config.pcss.angular_radius
+                config.pcss_angular_radius
             ),
             (ShadowMode::Area, kind) => format!(
                 "area (sized {} light: exact soft shadows, the visible fraction of {samples} samples of its emitter of radius {} m, each tested against the exact triangles; no shadow map{})",
                 if kind.direction().is_some() { "spot" } else { "point" },
-                config.pcss.spot_radius,
+                config.pcss_spot_radius,
                 if shadowed.frusta.len() > 1 { ", per frustum" } else { "" }
             ),
             (mode, _) => mode.name().to_owned(),
@@ -214,7 +219,7 @@ impl ScenePlan {
     }
 
     /// The configuration of each plugin light ([`ScenePlan::plugin_lights`] order).
-    pub fn plugin_configs(&self) -> Vec<ShadowConfig> {
+    pub fn plugin_configs(&self) -> Vec<Config> {
         self.plugin_lights()
             .iter()
             .map(|l| l.shadowed.config)
@@ -281,7 +286,7 @@ impl ScenePlan {
                 .position(|l| l.scene_light == i)
                 .unwrap_or_default();
             let _ = match shadowed.frusta {
-                faces if faces == passes::CUBE_MAP_NAME => writeln!(
+                ["cube"] => writeln!(
                     s,
                     "      plugin light {index}: one cube map (its six faces built as one primitive map by the plugin; faces without a receiver in view get no grid)"
                 ),
@@ -297,20 +302,21 @@ impl ScenePlan {
             let _ = writeln!(
                 s,
                 "      config: {}, FXAA {}, static_light {}, dynamic_geometry {}, map {}², shadow map {}",
-                shadowed
-                    .config
-                    .auto_reason(shadowed.is_directional())
-                    .map_or_else(|| format!("mode {}", c.mode.name()), str::to_owned),
+                match (shadowed.config.mode, c.mode) {
+                    (ShadowMode::Auto, ShadowMode::Area) => "auto: area (sized light)".to_owned(),
+                    (ShadowMode::Auto, _) => "auto: hard (zero-size light)".to_owned(),
+                    (_, mode) => format!("mode {}", mode.name()),
+                },
                 if shadowed.passes.contains(hrts::Pass::Fxaa) {
                     "on"
                 } else {
                     "off"
                 },
                 c.static_light,
-                !c.static_geometry,
-                c.map.size,
+                c.dynamic_geometry,
+                c.map_size,
                 if shadowed.resources.contains(hrts::Resource::ShadowMap) {
-                    format!("{0}x{0}", c.shadow_map.size)
+                    format!("{0}x{0}", c.shadow_map_size)
                 } else {
                     "none".to_owned()
                 }
@@ -421,18 +427,13 @@ pub fn plan_scene(file: &SceneFile, camera: &Camera, settings: &PlanSettings) ->
     let dynamic_geometry = !moving_objects.is_empty();
     let aspect = settings.width as f32 / settings.height as f32;
     let receivers_in_view = receivers_in_view(file, camera, aspect);
-    let candidates: Vec<Result<(hrts::Light, ShadowConfig), NoPassReason>> = file
+    let candidates: Vec<Result<(hrts::Light, Config), NoPassReason>> = file
         .lights
         .iter()
         .map(|light| candidate(light, receivers_in_view, settings, dynamic_geometry))
         .collect();
-    let (plugin_lights, configs): (Vec<hrts::Light>, Vec<hrts::Config>) = candidates
-        .iter()
-        .flatten()
-        .map(|(light, config)| Ok((*light, hrts::passes_bridge::config(config)?)))
-        .collect::<Result<Vec<_>>>()?
-        .into_iter()
-        .unzip();
+    let (plugin_lights, configs): (Vec<hrts::Light>, Vec<Config>) =
+        candidates.iter().flatten().copied().unzip();
     let casters = file.scene.objects_bounds(&file.shadow_casters);
     let view = hrts::PlanView {
         view: camera.view(),
@@ -461,7 +462,7 @@ pub fn plan_scene(file: &SceneFile, camera: &Camera, settings: &PlanSettings) ->
                     Some(p) if p.decision == hrts::LightDecision::OutOfView => {
                         LightDecision::NoPass(NoPassReason::OutOfView)
                     }
-                    Some(p) => shadowed(light, config, plugin_light, &p),
+                    Some(p) => shadowed(config, plugin_light, &p),
                     None => bail!("the plugin planned fewer lights than it was given"),
                 },
             };
@@ -512,7 +513,7 @@ fn candidate(
     receivers_in_view: usize,
     settings: &PlanSettings,
     dynamic_geometry: bool,
-) -> Result<(hrts::Light, ShadowConfig), NoPassReason> {
+) -> Result<(hrts::Light, Config), NoPassReason> {
     if !light.casts_shadows {
         return Err(NoPassReason::CastsNoShadows);
     }
@@ -550,50 +551,34 @@ fn candidate(
 
 /// A light's configuration: the settings' base, mode auto with the light's size (the plugin chooses by
 /// the size: hard shadows for no size, exact soft shadows (area) for a size), and its flags.
-fn light_config(
-    light: &SceneLight,
-    settings: &PlanSettings,
-    dynamic_geometry: bool,
-) -> ShadowConfig {
+fn light_config(light: &SceneLight, settings: &PlanSettings, dynamic_geometry: bool) -> Config {
     let mut config = settings.base;
-    config.static_geometry = !dynamic_geometry;
+    config.dynamic_geometry = dynamic_geometry;
     config.static_light = light.is_static;
     config.mode = ShadowMode::Auto;
     let directional = matches!(light.kind, LightKind::Directional { .. });
     match light.size {
-        LightSize::Zero if directional => config.pcss.angular_radius = 0.0,
-        LightSize::Zero => config.pcss.spot_radius = 0.0,
-        LightSize::AngularRadius(a) => config.pcss.angular_radius = a,
-        LightSize::Radius(r) => config.pcss.spot_radius = r,
+        LightSize::Zero if directional => config.pcss_angular_radius = 0.0,
+        LightSize::Zero => config.pcss_spot_radius = 0.0,
+        LightSize::AngularRadius(a) => config.pcss_angular_radius = a,
+        LightSize::Radius(r) => config.pcss_spot_radius = r,
     }
     if !directional {
         // A front-only primitive map needs a directional light.
-        config.map.faces = FaceMode::Both;
+        config.faces = Faces::Both;
     }
     config
 }
 
 /// A light the plugin shadows as it planned it (`plan`).
-fn shadowed(
-    light: &SceneLight,
-    config: ShadowConfig,
-    plugin_light: hrts::Light,
-    plan: &hrts::LightPlan,
-) -> LightDecision {
-    let directional = matches!(light.kind, LightKind::Directional { .. });
-    let resolved = config.resolved(directional);
-    let frusta = (plan.frusta + plan.frusta_culled) as usize;
+fn shadowed(config: Config, plugin_light: hrts::Light, plan: &hrts::LightPlan) -> LightDecision {
     LightDecision::Shadowed(Box::new(ShadowedLight {
         config,
+        mode: plan.mode,
         passes: plan.passes,
         resources: plan.resources,
         light: plugin_light,
-        frusta: if matches!(light.kind, LightKind::Point { .. }) && resolved.shadows_point_as_cube()
-        {
-            &passes::CUBE_MAP_NAME
-        } else {
-            passes::frustum_names(frusta)
-        },
+        frusta: plan.frustum_names,
     }))
 }
 
@@ -671,7 +656,7 @@ mod tests {
 
     fn settings() -> PlanSettings {
         PlanSettings {
-            base: ShadowConfig::default(),
+            base: Config::default(),
             width: 160,
             height: 120,
         }
@@ -693,7 +678,7 @@ mod tests {
         let s = p.shadowed().expect("shadowed");
         // Given in mode auto with no size: the plugin resolves hard shadows.
         assert_eq!(s.config.mode, ShadowMode::Auto);
-        assert_eq!(s.config.pcss.angular_radius, 0.0);
+        assert_eq!(s.config.pcss_angular_radius, 0.0);
         assert_eq!(s.resolved_config().mode, ShadowMode::Hard);
         assert_eq!(s.frusta, ["whole"]);
         // No matrix: the plugin fits the sun's frustum to the scene's bounds.
@@ -728,7 +713,7 @@ mod tests {
         let s = p.shadowed().expect("shadowed");
         assert_eq!(s.config.mode, ShadowMode::Auto);
         assert_eq!(s.resolved_config().mode, ShadowMode::Area);
-        assert_eq!(s.config.pcss.angular_radius, 0.03);
+        assert_eq!(s.config.pcss_angular_radius, 0.03);
         assert!(s.passes.contains(Pass::RayTrace) && !s.passes.contains(Pass::ShadowMap));
         assert!(p.describe_decision().starts_with("area"));
         let p = only(ground_and_box(vec![spot(
@@ -739,9 +724,9 @@ mod tests {
         )]));
         let s = p.shadowed().expect("shadowed");
         assert_eq!(s.resolved_config().mode, ShadowMode::Area);
-        assert_eq!(s.config.pcss.spot_radius, 0.05);
+        assert_eq!(s.config.pcss_spot_radius, 0.05);
         assert!(p.describe_decision().starts_with("area (sized spot light"));
-        assert_eq!(s.config.map.faces, FaceMode::Both);
+        assert_eq!(s.config.faces, Faces::Both);
         // A fitted spot light: no matrix; the plugin fits one frustum to its cone and range.
         assert_eq!(s.frusta, ["whole"]);
         assert_eq!(
@@ -846,7 +831,7 @@ mod tests {
         // Area shadows of a point light: its six faces as one cube map.
         assert_eq!(s.frusta, ["cube"]);
         assert_eq!(s.resolved_config().mode, ShadowMode::Area);
-        assert_eq!(s.config.pcss.spot_radius, 0.1);
+        assert_eq!(s.config.pcss_spot_radius, 0.1);
         assert!(p.describe_decision().starts_with("area (sized point light"));
         // A zero-size lamp: no emitter radius, which the plugin resolves to hard shadows (one cube map).
         let small = light(
@@ -860,7 +845,7 @@ mod tests {
         let p = only(ground_and_box(vec![small]));
         let s = p.shadowed().expect("shadowed");
         assert_eq!(
-            (s.config.mode, s.config.pcss.spot_radius),
+            (s.config.mode, s.config.pcss_spot_radius),
             (ShadowMode::Auto, 0.0)
         );
         assert_eq!(s.resolved_config().mode, ShadowMode::Hard);
@@ -901,19 +886,19 @@ mod tests {
         let configs = p.plugin_configs();
         assert_eq!(configs.len(), 2);
         assert!(configs[0].static_light && !configs[1].static_light);
-        assert!(configs.iter().all(|c| c.static_geometry));
+        assert!(configs.iter().all(|c| !c.dynamic_geometry));
         file.static_objects[1] = false;
         let p = plan(&file);
         assert!(p.dynamic_geometry);
         assert_eq!(p.moving_objects, ["box"]);
-        assert!(p.plugin_configs().iter().all(|c| !c.static_geometry));
+        assert!(p.plugin_configs().iter().all(|c| c.dynamic_geometry));
         assert!(p.describe().contains("dynamic (not static: box)"));
         let p = plan(&held_still(&file));
         assert!(!p.dynamic_geometry);
         assert!(p
             .plugin_configs()
             .iter()
-            .all(|c| c.static_geometry && c.static_light));
+            .all(|c| !c.dynamic_geometry && c.static_light));
     }
 
     #[test]

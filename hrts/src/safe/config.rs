@@ -22,7 +22,7 @@ use crate::types::HrtsConfig;
 /// assert_eq!(Config::default().mode, ShadowMode::Hybrid);
 /// assert_ne!(config, Config::default());
 /// ```
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Config {
     /// What the plugin computes; the frame plan runs only the passes it needs (default hybrid).
     pub mode: ShadowMode,
@@ -111,7 +111,7 @@ impl Default for Config {
 
 impl Config {
     /// The C configuration.
-    pub(crate) fn to_c(&self) -> HrtsConfig {
+    pub(crate) fn to_c(self) -> HrtsConfig {
         HrtsConfig {
             struct_size: size_of::<HrtsConfig>() as u32,
             mode: self.mode as u32,

@@ -200,7 +200,7 @@ impl Context {
     /// recorded so far completed.
     pub fn configure_lights(&self, configs: &[Config]) -> Result<()> {
         const CALL: &str = "hrts_configure_lights";
-        let c: Vec<HrtsConfig> = configs.iter().map(Config::to_c).collect();
+        let c: Vec<HrtsConfig> = configs.iter().copied().map(Config::to_c).collect();
         let light_count = count(CALL, "configurations", c.len())?;
         // SAFETY: a live context; `c` holds `light_count` valid configurations.
         check(CALL, unsafe {

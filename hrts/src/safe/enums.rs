@@ -29,6 +29,26 @@ impl Resource {
     }
 }
 
+impl ShadowMode {
+    /// "none", "hard", "soft", "hybrid", "area" or "auto".
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::None => "none",
+            Self::Hard => "hard",
+            Self::Soft => "soft",
+            Self::Hybrid => "hybrid",
+            Self::Area => "area",
+            Self::Auto => "auto",
+        }
+    }
+
+    /// Whether the mode traces shadow rays through the primitive map (hard, hybrid and area, and so
+    /// auto).
+    pub fn traces_rays(self) -> bool {
+        matches!(self, Self::Hard | Self::Hybrid | Self::Area | Self::Auto)
+    }
+}
+
 impl PassStatus {
     /// Why a pass that did not run was skipped, in words (`None` for [`PassStatus::Ran`]).
     pub fn reason(self) -> Option<&'static str> {

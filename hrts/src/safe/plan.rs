@@ -41,6 +41,10 @@ pub struct LightPlan {
     /// The resources of its plan (held by the light or shared by the context's lights); none when out of
     /// view.
     pub resources: ResourceSet,
+    /// The names of the frusta it is planned through (shadowed and skipped), as reports name them: "cube"
+    /// for a point light shadowed as one cube map, its faces ("+X" ... "-Z") for one shadowed face by face,
+    /// a wide spot light's faces ("front", "right", "left", "up", "down"), else "whole".
+    pub frustum_names: &'static [&'static str],
 }
 
 /// Plans `lights` (configured by `configs`, one per light) for `view` without a context or a device
@@ -76,7 +80,7 @@ pub fn plan_lights(
     view: &PlanView,
 ) -> Result<Vec<LightPlan>> {
     const CALL: &str = "hrts_plan_lights";
-    let c_configs: Vec<_> = configs.iter().map(Config::to_c).collect();
+    let c_configs: Vec<_> = configs.iter().copied().map(Config::to_c).collect();
     let c_lights: Vec<_> = lights.iter().map(|l| l.to_c()).collect();
     if c_configs.len() != c_lights.len() {
         return Err(super::error::Error::new(
@@ -132,7 +136,9 @@ pub fn plan_lights(
     })?;
     plans
         .iter()
-        .map(|p| {
+        .zip(lights)
+        .map(|(p, light)| {
+            let frusta = (p.frusta + p.frusta_culled) as usize;
             Ok(LightPlan {
                 decision: decode(CALL, "decision", p.decision)?,
                 frusta: p.frusta,
@@ -141,6 +147,11 @@ pub fn plan_lights(
                 reason: c_chars(&p.decision_reason),
                 passes: PassMask::from_bits(CALL, "passes", p.passes)?,
                 resources: ResourceSet::from_bits(CALL, "resources", p.resources)?,
+                frustum_names: match light {
+                    _ if frusta == 0 => &[],
+                    Light::Point { .. } if frusta == 1 => &passes::CUBE_MAP_NAME,
+                    _ => passes::frustum_names(frusta),
+                },
             })
         })
         .collect()
