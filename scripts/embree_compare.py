@@ -23,8 +23,8 @@ One thread: embreex creates its device with rtcNewDevice(NULL) and offers no con
 loads Embree: TBB, and with it Embree, then sizes its thread pool to that one CPU. The number of OS
 threads of the process after the build is printed as a check (1 expected).
 
-Inputs, in the folder given (all written by `host_demo render --dump-rays`, see
-host_demo/src/ray_dump.rs):
+Inputs, in the folder given (all written by `hrts_lab ray-dump`, see
+lab/src/ray_dump.rs):
   triangles.f32     f32 LE, 9 per triangle (frame coordinates: world minus the frame origin)
   rays.f32          f32 LE, 8 per ray: ox oy oz dx dy dz t_max pixel (pixel = y * width + x)
   ray_near_edge.u8  optional, 1 byte per ray: 1 where the exact reference is ambiguous
@@ -38,9 +38,9 @@ use a virtual environment, e.g. in the git-ignored .dev/ folder:
 
 How to run
 ----------
-  # 1. Render a frame with the ray trace (mode hard or hybrid) and dump its rays:
-  cargo run --release -p host_demo -- render --obj ../shared/models/02_stanford_bunny_69k.obj \\
-      --mode hard --no-antialiasing --no-occupancy --out out/bunny --dump-rays
+  # 1. Render a frame's hard shadow and dump its rays:
+  cargo run --release -p hrts_lab -- ray-dump --obj ../shared/models/02_stanford_bunny_69k.obj \\
+      --out out/bunny
   # 2. Time Embree on the same rays and compare:
   .dev/embree-venv/bin/python scripts/embree_compare.py out/bunny
   # options: --model NAME (default: the folder's name), --runs N (default 5), --cpu K (the CPU to
@@ -75,7 +75,7 @@ def parse_args():
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
-    parser.add_argument("dir", type=Path, help="output folder of `host_demo render --dump-rays`")
+    parser.add_argument("dir", type=Path, help="output folder of `hrts_lab ray-dump`")
     parser.add_argument("--model", help="model name in the table (default: the folder's name)")
     parser.add_argument("--runs", type=int, default=5, help="timed runs; medians are reported (default 5)")
     parser.add_argument(
@@ -114,7 +114,7 @@ def os_threads():
 def load_inputs(folder, np):
     for name in ("triangles.f32", "rays.f32", "rays.json", "frame.json", "rt_visibility.exr"):
         if not (folder / name).is_file():
-            hint = " (render with --dump-rays)" if name.endswith((".f32", "rays.json")) else ""
+            hint = " (write it with hrts_lab ray-dump)" if name.endswith((".f32", "rays.json")) else ""
             if name == "rt_visibility.exr":
                 hint = " (render with --mode hard or hybrid)"
             fail(f"{folder / name} is missing{hint}")

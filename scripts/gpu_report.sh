@@ -6,37 +6,38 @@
 #
 # Writes into $OUT (default out/gpu): each report's output (NAME.txt) and progress (NAME.log), the render's frame.json
 # and preview, and benchmarks.md, the assembled page (device, driver, commit and date in its header; the
-# tables as the tools print them, nothing written by hand). HRTS_BIN names a prebuilt host_demo,
+# tables as the tools print them, nothing written by hand). HRTS_BIN_DIR names the folder of prebuilt
+# host_demo and hrts_lab (default target/release),
 # HRTS_MODELS the models folder, HRTS_COMMIT the commit measured (default: git's HEAD, if there is one),
 # HRTS_RAW_DIR where the page's readers find the raw outputs (a link in its header).
 # Arguments name the sections to run (default: all; "none" only assembles the page from $OUT): a run
 # longer than one session's command limit splits into calls on the same machine, assembled at the end.
 set -uo pipefail
-bin=${HRTS_BIN:-target/release/host_demo}
+bins=${HRTS_BIN_DIR:-target/release}
 out=${OUT:-out/gpu}
 commit=${HRTS_COMMIT:-$(git rev-parse --short HEAD 2>/dev/null || echo unknown)}
 selected=" ${*:-all} "
 mkdir -p "$out"
 status=0
-# name|title|arguments of host_demo (DIR: a temporary folder for the render's outputs)
+# name|title|program|its arguments (DIR: a temporary folder for the render's outputs)
 sections=(
-    "render|A frame of the built-in scene (hybrid, 1920×1080)|render --width 1920 --height 1080 --frames 30 --out DIR"
-    "bench|Hard and hybrid shadows on every model, against the ray-tracing pipeline|bench --frames 30 --no-reference"
-    "lights_hard|Hard shadows of each kind of light inside two buildings, and 16 point lights at once|bench --lights --point-lights 16 --frames 20"
-    "lights_hard_64|64 point lights at once, with their memory and the per-pass split|bench --lights --point-lights 64 --frames 20"
-    "lights_area|Exact soft shadows of sized lights, from 0.25 % to 8 % of the scene's extent, against the ray-tracing pipeline at equal samples|bench --lights --emitter-size 0.0025,0.01,0.02,0.04,0.08 --frames 10"
-    "lights_area_16|16 sized point lights at once (0.25 % of the extent)|bench --lights --point-lights 16 --emitter-size 0.0025 --frames 10"
-    "area|Exact soft shadows of a sized sun against PCSS with an 8K shadow map|bench --area --frames 10 --no-reference"
-    "tiers|The binning matrix: every binning path against exact binning|tiers"
+    "render|A frame of the built-in scene (hybrid, 1920×1080)|host_demo|render --width 1920 --height 1080 --frames 30 --out DIR"
+    "bench|Hard and hybrid shadows on every model, against the ray-tracing pipeline|hrts_lab|bench --frames 30 --no-reference"
+    "lights_hard|Hard shadows of each kind of light inside two buildings, and 16 point lights at once|hrts_lab|bench --lights --point-lights 16 --frames 20"
+    "lights_hard_64|64 point lights at once, with their memory and the per-pass split|hrts_lab|bench --lights --point-lights 64 --frames 20"
+    "lights_area|Exact soft shadows of sized lights, from 0.25 % to 8 % of the scene's extent, against the ray-tracing pipeline at equal samples|hrts_lab|bench --lights --emitter-size 0.0025,0.01,0.02,0.04,0.08 --frames 10"
+    "lights_area_16|16 sized point lights at once (0.25 % of the extent)|hrts_lab|bench --lights --point-lights 16 --emitter-size 0.0025 --frames 10"
+    "area|Exact soft shadows of a sized sun against PCSS with an 8K shadow map|hrts_lab|bench --area --frames 10 --no-reference"
+    "tiers|The binning matrix: every binning path against exact binning|hrts_lab|tiers"
 )
 for s in "${sections[@]}"; do
-    IFS='|' read -r name title command <<<"$s"
+    IFS='|' read -r name title program command <<<"$s"
     [[ $selected == *" all "* || $selected == *" $name "* ]] || continue
-    echo "== $name: host_demo $command"
+    echo "== $name: $program $command"
     dir=$(mktemp -d)
     start=$SECONDS
     # shellcheck disable=SC2086 # the arguments are words
-    "$bin" ${command//DIR/$dir} >"$out/$name.txt" 2>"$out/$name.log" || {
+    "$bins/$program" ${command//DIR/$dir} >"$out/$name.txt" 2>"$out/$name.log" || {
         status=1
         echo "   FAILED: $(tail -n 3 "$out/$name.log")"
     }
@@ -55,12 +56,12 @@ device=$(grep -h '^Device:' "$out"/*.txt 2>/dev/null | head -n 1 | sed 's/^Devic
     echo "timestamps, medians over frames after the first)."
     [ -n "${HRTS_RAW_DIR:-}" ] && echo "Each output as written, with its progress log: [$HRTS_RAW_DIR]($HRTS_RAW_DIR)."
     for s in "${sections[@]}"; do
-        IFS='|' read -r name title command <<<"$s"
+        IFS='|' read -r name title program command <<<"$s"
         [ -s "$out/$name.txt" ] || continue
         echo
         echo "## $title"
         echo
-        echo "\`host_demo $command\`"
+        echo "\`$program $command\`"
         echo
         cat "$out/$name.txt"
     done

@@ -10,13 +10,8 @@
 //! light gets and through which frusta; [`scene_render`] renders them through the plugin and reports per
 //! light what ran, what was kept and why; [`shading`] sums the lights into the shaded image.
 
-pub mod accuracy;
-pub mod area_bench;
-pub mod bench;
-mod bench_models;
-pub mod compare;
+pub mod cli;
 pub mod gbuffer;
-pub mod hardcases;
 pub mod images;
 pub mod interior;
 
@@ -27,22 +22,16 @@ pub mod limits {
     /// Largest primitive map size N (texel coordinates are packed in 16 bits).
     pub const MAP_SIZE: u32 = u16::MAX as u32;
 }
-pub mod light_bench;
 pub mod load_report;
 pub mod output;
-pub mod peer;
 pub mod plugin;
 pub mod progress;
-pub mod ray_dump;
 pub mod render;
 pub mod renderer;
-pub mod report;
 pub mod scene_buffers;
 pub mod scene_plan;
 pub mod scene_render;
 pub mod shading;
-pub mod tiers;
-pub mod tradeoff;
 
 use glam::{DVec3, Mat4, Vec3};
 use passes::{Draw, FrameInputs, Geometry, Light, PassError};

@@ -14,8 +14,7 @@ use host_demo::{parse_vec3, View};
 use hrts::{BinningPath, Faces, ShadowMode};
 use reference::RefScene;
 use rhi::Device;
-use scene::{Aabb, Camera, DirectionalLight, LightSize, Scene, SceneFile, SceneLight};
-use std::any::TypeId;
+use scene::{Camera, DirectionalLight, LightSize, Scene, SceneFile, SceneLight};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -54,35 +53,6 @@ enum Command {
     /// What loading a glTF scene costs: load time and peak resident memory; or write generated test scenes
     /// (float, meshopt, quantized + meshopt) to measure it on.
     LoadReport(host_demo::load_report::LoadReportArgs),
-    /// Run the hard numerical cases against the exact reference and print a table; fails if any case fails.
-    Hardcases(host_demo::hardcases::HardcasesArgs),
-    /// The talk's side-by-sides on one view (shadow map 3K/8K, ray traced with primitive maps 1K/256, PCSS
-    /// 3K, hybrid standard and shrinking, the lerp factor): labelled composite PNG, the individual pictures
-    /// and a caption file.
-    Compare(host_demo::compare::CompareArgs),
-    /// The talk's timing tables (~10K/65K/240K triangles, 1920x1080, shadow map 3072², primitive map 1024²
-    /// fitted to the receivers, lists of their own length) next to its GTX 980 column, and every model of
-    /// the models folder: GPU timestamps, medians over frames. With --lights: local lights inside scenes.
-    Bench {
-        #[command(flatten)]
-        args: host_demo::bench::BenchArgs,
-        /// Also write the Markdown tables to this file.
-        #[arg(long)]
-        out: Option<PathBuf>,
-    },
-    /// What accuracy costs in time: shadow maps and primitive maps of growing size against the exact
-    /// reference, with GPU times and memory (Markdown).
-    Accuracy(host_demo::report::AccuracyArgs),
-    /// What accuracy costs in time for soft shadows: every method and setting against a ground-truth soft
-    /// shadow, with GPU time and memory; CSV, JSON, a Pareto plot and error maps.
-    Tradeoff(host_demo::tradeoff::TradeoffArgs),
-    /// The conservative-raster tier matrix: every raster path of the device against exact binning (Markdown).
-    Tiers {
-        /// Folder with the test models (default: `HRTS_MODELS`, else `../shared/models` beside the
-        /// checkout).
-        #[arg(long)]
-        models: Option<PathBuf>,
-    },
 }
 
 #[derive(clap::Args)]
@@ -90,7 +60,7 @@ struct RenderArgs {
     /// glTF 2.0 scene (.gltf or .glb) whose lights (KHR_lights_punctual) decide the shadows: renders every
     /// light, writes the shaded image, each light's visibility (PNG and EXR) and scene_report.json, and
     /// prints the plan and each frame's per-light report.
-    #[arg(long, conflicts_with_all = ["obj", "no_ground", "light_dir", "dump_rays", "mode", "angular_radius"])]
+    #[arg(long, conflicts_with_all = ["obj", "no_ground", "light_dir", "mode", "angular_radius"])]
     scene: Option<PathBuf>,
     /// OBJ file to load (default: the built-in procedural scene). A closed model (a room) is seen from
     /// inside and lit by a point light below its ceiling, rendered as --scene renders a scene's lights.
@@ -113,7 +83,7 @@ struct RenderArgs {
     #[arg(long, value_parser = parse_vec3)]
     light_dir: Option<Vec3>,
     #[command(flatten)]
-    camera: CameraArgs,
+    camera: host_demo::cli::CameraArgs,
     /// Primitive map size N: texels per side of the light-space grid fitted to the visible receivers (moves
     /// cost, never exactness).
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::MAP_SIZE)))]
@@ -140,10 +110,6 @@ struct RenderArgs {
     /// second frame's report shows what was kept).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
     frames: u32,
-    /// Also write the frame's shadow rays and triangles (rays.f32, triangles.f32, rays.json) for
-    /// scripts/embree_compare.py.
-    #[arg(long)]
-    dump_rays: bool,
     /// Skip the primitive map's occupancy view (occupancy.png), a debug image: the frame as an engine
     /// runs it (the map's statistics are gathered anyway).
     #[arg(long)]
@@ -155,18 +121,6 @@ struct RenderArgs {
     still: bool,
     #[command(flatten)]
     soft: SoftShadowArgs,
-}
-
-/// Where the camera is, when not framed automatically (or, with `--scene`, taken from the file).
-#[derive(clap::Args)]
-struct CameraArgs {
-    /// Camera position "x,y,z" (default: the scene file's camera, else framed automatically: from
-    /// outside, or inside a closed model, in a corner at eye height looking across the room).
-    #[arg(long, value_parser = parse_vec3)]
-    camera_pos: Option<Vec3>,
-    /// Camera target "x,y,z" (default: the scene file's camera's, else the scene centre).
-    #[arg(long, value_parser = parse_vec3)]
-    camera_target: Option<Vec3>,
 }
 
 #[derive(clap::Args)]
@@ -181,7 +135,7 @@ struct PlanArgs {
     #[arg(long, default_value_t = 720, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
     height: u32,
     #[command(flatten)]
-    camera: CameraArgs,
+    camera: host_demo::cli::CameraArgs,
     /// Primitive map size N.
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::MAP_SIZE)))]
     map_size: u32,
@@ -215,36 +169,6 @@ fn load_scene(path: &Path, still: bool) -> Result<SceneFile> {
     Ok(file)
 }
 
-/// `camera` moved to `position` and looking at `target` where given (the target defaults to the centre
-/// of `bounds` when only the position is given).
-fn camera_with(
-    camera: Camera,
-    bounds: &Aabb,
-    position: Option<Vec3>,
-    target: Option<Vec3>,
-) -> Result<Camera> {
-    if position.is_none() && target.is_none() {
-        return Ok(camera);
-    }
-    let position = position.unwrap_or(camera.position);
-    let target = target.unwrap_or(bounds.center());
-    if (position - target).length() == 0.0 {
-        bail!("camera position and target coincide");
-    }
-    let forward = (target - position).normalize();
-    let up = if forward.cross(Vec3::Y).length() < 1e-3 {
-        Vec3::Z
-    } else {
-        Vec3::Y
-    };
-    Ok(Camera {
-        position,
-        target,
-        up,
-        ..camera
-    })
-}
-
 /// The camera and plan settings of a scene for a `width` x `height` frame.
 fn scene_setup(
     file: &SceneFile,
@@ -257,7 +181,7 @@ fn scene_setup(
         bail!("--width and --height must be positive");
     }
     let aspect = width as f32 / height as f32;
-    let camera = camera_with(
+    let camera = host_demo::cli::camera_with(
         scene_camera(file, aspect),
         &file.scene.bounds(),
         position,
@@ -385,7 +309,7 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
         view.light =
             DirectionalLight::new(d).context("--light-dir must be a non-zero finite vector")?;
     }
-    view.camera = camera_with(
+    view.camera = host_demo::cli::camera_with(
         view.camera,
         &view.scene.bounds(),
         args.camera.camera_pos,
@@ -399,13 +323,6 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
         occupancy_view: !args.no_occupancy,
     };
     render_to_folder(&device, &view, &options, &args.out)?;
-    if args.dump_rays {
-        let bar = host_demo::progress(1, "ray dump");
-        bar.set_message("the frame's shadow rays");
-        let dump = host_demo::ray_dump::write_ray_dump(&view, &view.frame_inputs(), &args.out)?;
-        drop(bar);
-        println!("ray dump: {dump:?}");
-    }
     host_demo::check_validation(&device)
 }
 
@@ -455,12 +372,6 @@ fn closed_interior(model: &Scene, args: &RenderArgs) -> Result<Option<Interior>>
                 ),
                 ShadowMode::None => light.casts_shadows = false,
                 ShadowMode::Hard | ShadowMode::Hybrid => {}
-            }
-            if args.dump_rays {
-                bail!(
-                    "--dump-rays writes a sun's shadow rays: pass --light-dir to light the closed scene \
-                     with a sun"
-                );
             }
             let size = match light.size {
                 LightSize::Radius(r) => format!("a sphere of radius {r:.3}"),
@@ -519,37 +430,7 @@ fn device(cli: &Cli) -> Result<Device> {
 /// The command line of [`Cli`], where every option of numbers takes negative ones as people type them
 /// (`--camera-pos -5,2,3`, not only `--camera-pos=-5,2,3`).
 fn command() -> clap::Command {
-    negative_numbers(Cli::command())
-}
-
-/// `command` and its subcommands with negative values allowed on the options of numbers: an option of
-/// one number takes a negative number (`allow_negative_numbers`); a vector or a list of numbers, whose
-/// value is no number as a whole, takes a value that begins with a hyphen (`allow_hyphen_values`), so
-/// that such an option followed by another flag takes the flag as its value and fails to parse it.
-fn negative_numbers(command: clap::Command) -> clap::Command {
-    command
-        .mut_args(|arg| {
-            let value = arg.get_value_parser().type_id();
-            let number = [
-                TypeId::of::<u32>(),
-                TypeId::of::<u64>(),
-                TypeId::of::<i32>(),
-                TypeId::of::<i64>(),
-                TypeId::of::<usize>(),
-                TypeId::of::<f32>(),
-                TypeId::of::<f64>(),
-            ]
-            .into_iter()
-            .any(|t| value == t);
-            if value == TypeId::of::<Vec3>() || (number && arg.get_value_delimiter().is_some()) {
-                arg.allow_hyphen_values(true)
-            } else if number {
-                arg.allow_negative_numbers(true)
-            } else {
-                arg
-            }
-        })
-        .mut_subcommands(negative_numbers)
+    host_demo::cli::negative_numbers(Cli::command())
 }
 
 fn main() -> ExitCode {
@@ -563,39 +444,6 @@ fn main() -> ExitCode {
             .map_err(anyhow::Error::from)
             .map(|()| println!("example scene written to {}", out.display())),
         Command::LoadReport(args) => host_demo::load_report::run_cli(args),
-        Command::Hardcases(args) => {
-            host_demo::hardcases::run_cli(cli.device.clone(), cli.validation, args)
-        }
-        Command::Compare(args) => {
-            host_demo::compare::run_cli(cli.device.clone(), cli.validation, args)
-        }
-        Command::Bench { args, out } => {
-            host_demo::bench::run_cli(cli.device.clone(), cli.validation, args, out.as_deref())
-        }
-        Command::Tradeoff(args) => {
-            device(&cli).and_then(|d| host_demo::tradeoff::run_cli(&d, args))
-        }
-        Command::Accuracy(args) => device(&cli).and_then(|d| {
-            println!("{}", host_demo::report::run_report(&d, args)?);
-            Ok(())
-        }),
-        Command::Tiers { models } => device(&cli).and_then(|d| {
-            let models = match models {
-                Some(dir) => dir.clone(),
-                None => scene::models_dir().map_err(anyhow::Error::msg)?,
-            };
-            let rows = host_demo::tiers::tier_matrix(
-                &d,
-                &host_demo::tiers::standard_scenes(&models)?,
-                256,
-            )?;
-            println!("{}", host_demo::tiers::markdown(&d, &rows));
-            if rows.iter().all(|r| r.passed()) {
-                Ok(())
-            } else {
-                bail!("a binning path missed triangles of the exact conservative set")
-            }
-        }),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -611,52 +459,11 @@ mod tests {
     use super::*;
     use clap::error::ErrorKind;
 
-    /// Every option of numbers of every subcommand takes a negative value as a separate argument
-    /// (`--flag -1`, a vector `-1,-2,-3`, a list `-1,2`): it is parsed as the option's value (and then
-    /// accepted, or refused by the option's own check), never as an unknown argument.
+    /// Every option of numbers of every subcommand takes a negative value as a separate argument.
     #[test]
     fn every_option_of_numbers_takes_negative_values() {
-        let root = command();
-        let mut checked = Vec::new();
-        for sub in root.get_subcommands() {
-            for arg in sub.get_arguments() {
-                let Some(long) = arg.get_long() else { continue };
-                let value = if !arg.is_allow_hyphen_values_set() {
-                    if !arg.is_allow_negative_numbers_set() {
-                        continue;
-                    }
-                    "-1"
-                } else if arg.get_value_parser().type_id() == TypeId::of::<Vec3>() {
-                    "-1,-2,-3"
-                } else {
-                    "-1,2"
-                };
-                let flag = format!("--{long}");
-                let parsed =
-                    command().try_get_matches_from(["host_demo", sub.get_name(), &flag, value]);
-                match parsed {
-                    Ok(m) => {
-                        let raw: Vec<_> = m
-                            .subcommand_matches(sub.get_name())
-                            .and_then(|m| m.get_raw(arg.get_id().as_str()))
-                            .map(|r| r.map(|v| v.to_string_lossy().into_owned()).collect())
-                            .unwrap_or_default();
-                        assert_eq!(raw.join(","), value, "{} {flag} {value}", sub.get_name());
-                    }
-                    Err(e) => assert!(
-                        matches!(
-                            e.kind(),
-                            ErrorKind::ValueValidation
-                                | ErrorKind::MissingRequiredArgument
-                                | ErrorKind::InvalidValue
-                        ) && !e.to_string().contains("unexpected argument"),
-                        "{} {flag} {value}: {e}",
-                        sub.get_name()
-                    ),
-                }
-                checked.push(format!("{} {flag}", sub.get_name()));
-            }
-        }
+        let checked =
+            host_demo::cli::check_negative_numbers(command).unwrap_or_else(|e| panic!("{e}"));
         for expected in [
             "render --camera-pos",
             "render --camera-target",
@@ -666,13 +473,6 @@ mod tests {
             "render --width",
             "plan --camera-pos",
             "plan --camera-target",
-            "compare --camera-pos",
-            "compare --camera-target",
-            "compare --close-up-pos",
-            "compare --close-up-target",
-            "bench --emitter-size",
-            "bench --angular-radius",
-            "tradeoff --angular-radius",
         ] {
             assert!(
                 checked.iter().any(|c| c == expected),

@@ -53,7 +53,7 @@ fn host_demo(args: &[&str]) -> String {
 }
 
 /// Every file `render` writes by default (hybrid: every image) is listed in docs/demo.md under "`--out` receives:", and
-/// every file listed there is written (the `--dump-rays` files aside); every key the list names exists
+/// every file listed there is written; every key the list names exists
 /// in `frame.json`.
 #[test]
 fn the_demo_guide_lists_what_render_writes() {
@@ -135,20 +135,6 @@ fn the_default_light_angle_is_quoted_from_the_code() {
         guide.contains(&format!("slanted about {angle}° from vertical")),
         "docs/demo.md lacks 'slanted about {angle}° from vertical'"
     );
-}
-
-/// The sizes the help quotes for `bench` are the defaults of the code.
-#[test]
-fn bench_help_quotes_the_default_sizes() {
-    let help = host_demo(&["--help"]).replace('\n', " ");
-    let map = passes::PrimitiveMapConfig::default().size;
-    let shadow_map = passes::ShadowMapConfig::default().size;
-    for figure in [
-        format!("primitive map {map}²"),
-        format!("shadow map {shadow_map}²"),
-    ] {
-        assert!(help.contains(&figure), "host_demo --help lacks '{figure}'");
-    }
 }
 
 /// The Markdown files a reader meets: README.md, CHANGELOG.md, examples' READMEs and everything under docs/.
@@ -326,10 +312,10 @@ fn help_of(exe: &Path, args: &[&str]) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
-/// wgpu_host's executable beside host_demo's, built for the same profile the way the README builds
-/// everything (`cargo build --workspace --all-targets`: the features `cargo test --workspace` resolves,
-/// so nothing is compiled again).
-fn wgpu_host_binary(host_demo: &Path) -> PathBuf {
+/// The workspace's executable `name` beside host_demo's (wgpu_host's, the lab's), built for the same
+/// profile the way the README builds everything (`cargo build --workspace --all-targets`: the features
+/// `cargo test --workspace` resolves, so nothing is compiled again).
+fn workspace_binary(host_demo: &Path, name: &str) -> PathBuf {
     let dir = host_demo.parent().expect("target/<profile>");
     let mut cargo = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
     cargo.args(["build", "--workspace", "--all-targets"]);
@@ -350,7 +336,7 @@ fn wgpu_host_binary(host_demo: &Path) -> PathBuf {
         status.success(),
         "cargo build --workspace --all-targets failed"
     );
-    dir.join("wgpu_host")
+    dir.join(name)
 }
 
 /// The `--flags` of a command line, up to its end (a `#` comment ends it too).
@@ -371,17 +357,33 @@ fn flags_in(words: &[&str]) -> Vec<String> {
 #[test]
 fn every_flag_the_readme_and_docs_name_exists() {
     let host_demo = PathBuf::from(env!("CARGO_BIN_EXE_host_demo"));
-    let wgpu_host = wgpu_host_binary(&host_demo);
-    let (global, subcommands) = parse_help(&help_of(&host_demo, &[]));
-    assert!(
-        subcommands.contains(&"render".to_owned()),
-        "{subcommands:?}"
-    );
-    let mut known: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
-    for sub in subcommands.iter().filter(|s| *s != "help") {
-        let (flags, _) = parse_help(&help_of(&host_demo, &[sub]));
-        known.insert(sub.clone(), flags.union(&global).cloned().collect());
+    let wgpu_host = workspace_binary(&host_demo, "wgpu_host");
+    // Per binary with subcommands, the flags of each; the binaries' subcommand names differ, so a span
+    // that starts with one (`render --mode area`, `bench --lights`) names its binary.
+    let mut by_binary: BTreeMap<&str, BTreeMap<String, BTreeSet<String>>> = BTreeMap::new();
+    for (name, exe, first) in [
+        ("host_demo", host_demo.clone(), "render"),
+        (
+            "hrts_lab",
+            workspace_binary(&host_demo, "hrts_lab"),
+            "bench",
+        ),
+    ] {
+        let (global, subcommands) = parse_help(&help_of(&exe, &[]));
+        assert!(
+            subcommands.contains(&first.to_owned()),
+            "{name}: {subcommands:?}"
+        );
+        let known = by_binary.entry(name).or_default();
+        for sub in subcommands.iter().filter(|s| *s != "help") {
+            let (flags, _) = parse_help(&help_of(&exe, &[sub]));
+            known.insert(sub.clone(), flags.union(&global).cloned().collect());
+        }
     }
+    let known: BTreeMap<String, BTreeSet<String>> = by_binary
+        .values()
+        .flat_map(|subs| subs.iter().map(|(k, v)| (k.clone(), v.clone())))
+        .collect();
     let (wgpu_flags, _) = parse_help(&help_of(&wgpu_host, &[]));
     let mut checked = 0;
     let mut unknown = Vec::new();
@@ -407,12 +409,15 @@ fn every_flag_the_readme_and_docs_name_exists() {
             let mut i = 0;
             while i < words.len() {
                 let w = words[i].trim_start_matches("./");
-                let (flags_known, name, rest) = if w == "host_demo" || w.ends_with("/host_demo") {
+                let binary = by_binary
+                    .iter()
+                    .find(|(name, _)| w == **name || w.ends_with(&format!("/{name}")));
+                let (flags_known, name, rest) = if let Some((_, subs)) = binary {
                     let mut j = i + 1;
                     if words.get(j) == Some(&"--") {
                         j += 1;
                     }
-                    match words.get(j).and_then(|s| known.get(*s)) {
+                    match words.get(j).and_then(|s| subs.get(*s)) {
                         Some(flags) => (flags, words[j], j + 1),
                         None => {
                             i += 1;

@@ -12,8 +12,8 @@ use common::{
     assert_exact_area, assert_no_validation_errors, axis_boxes, device, plate_and_box_view, GROUND,
 };
 use glam::Vec3;
-use host_demo::accuracy::{compare_area, AreaComparison};
 use host_demo::{FrameImages, View};
+use hrts_lab::accuracy::{compare_area, AreaComparison};
 use passes::{
     AreaConfig, BinningRequest, FaceMode, FrameReport, PcssConfig, PrimitiveMapConfig,
     ShadowConfig, ShadowMode,
@@ -77,7 +77,7 @@ fn check(
     c
 }
 
-/// The hard case `name` of family `f`, framed as `host_demo hardcases` frames it at the test size, checked
+/// The hard case `name` of family `f`, framed as `hrts_lab hardcases` frames it at the test size, checked
 /// with a light of `angular_radius` and `samples` samples (at least 20 stable penumbra pixels).
 fn check_hard_case(f: Family, name: &str, (angular_radius, samples): (f32, u32)) {
     let case: HardCase = family(f, &common::models())

@@ -1,5 +1,5 @@
 //! The hard numerical cases of `scene::hard_cases`, one test per family, run through
-//! `host_demo::hardcases::run_cases` — the code behind `host_demo hardcases` — so that the table and the
+//! `hrts_lab::hardcases::run_cases` — the code behind `hrts_lab hardcases` — so that the table and the
 //! tests cannot drift apart.
 //!
 //! Every rendered case must have, with Vulkan validation on:
@@ -19,7 +19,7 @@ mod common;
 
 use common::{assert_no_validation_errors, device, models};
 use host_demo::gbuffer::GBufferLayout;
-use host_demo::hardcases::{run_cases, table, Outcome};
+use hrts_lab::hardcases::{run_cases, table, Outcome};
 use rhi::Device;
 use scene::hard_cases::{family, Expectation, Family};
 
@@ -179,7 +179,7 @@ fn overflow_keeps_the_guard_layer_and_exact_visibility() {
 /// The families where the engine's normal decides most (which side of a grazing light a receiver faces,
 /// where a ray leaves a surface touching another), with the plugin reading each normal target engines keep
 /// instead of RGBA32F: quantized and octahedral normals, in world and view space. (The whole suite for every
-/// encoding: `host_demo hardcases --normals NAME`, docs/hardcases_normal_encodings_lavapipe.txt.)
+/// encoding: `hrts_lab hardcases --normals NAME`, docs/hardcases_normal_encodings_lavapipe.txt.)
 #[test]
 fn grazing_and_contact_cases_hold_with_every_normal_encoding() {
     let device = device();

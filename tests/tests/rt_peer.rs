@@ -1,4 +1,4 @@
-//! The ray-tracing-pipeline peer (`host_demo::peer`) traces the primitive-map ray trace's shadow rays
+//! The ray-tracing-pipeline peer (`hrts_lab::peer`) traces the primitive-map ray trace's shadow rays
 //! through acceleration structures the driver builds and the GPU's ray-tracing pipeline. Its visibility
 //! equals the exact f64 reference on every pixel whose exact shadow ray does not pass within a tiny
 //! tolerance of a triangle edge; those near-edge pixels are counted and bounded.
@@ -9,9 +9,9 @@
 mod common;
 
 use common::*;
-use host_demo::peer::{run_area_peer, run_peer};
 use host_demo::plugin::PluginRenderer;
 use host_demo::{FrameImages, View};
+use hrts_lab::peer::{run_area_peer, run_peer};
 use passes::{AreaConfig, PassError, PcssConfig, PrimitiveMapConfig, ShadowConfig, ShadowMode};
 use reference::RefScene;
 use rhi::Device;

@@ -14,7 +14,6 @@ use common::{
     compare_with_reference, device, scene_visibility_params,
 };
 use glam::Vec3;
-use host_demo::accuracy::{compare_area_counts, AreaComparison};
 use host_demo::plugin::{LightsFrame, PluginRenderer};
 use host_demo::scene_plan::{
     plan_scene, scene_camera, LightDecision, NoPassReason, PlanSettings, ScenePlan,
@@ -22,6 +21,7 @@ use host_demo::scene_plan::{
 use host_demo::scene_render::SceneRenderer;
 use host_demo::CameraMatrices;
 use hrts::{Config, ShadowMode};
+use hrts_lab::accuracy::{compare_area_counts, AreaComparison};
 use reference::{local_area_reference, reference_visibility, RefScene};
 use rhi::Device;
 use scene::{Camera, LightKind, LightSize, SceneFile, SceneLight};

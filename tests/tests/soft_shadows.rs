@@ -479,7 +479,7 @@ fn render_and_compare_write_the_soft_shadow_outputs() {
         assert!(json.contains(row), "gpu_ms lacks {row}");
     }
     assert!(json.contains("\"total_bytes\""));
-    let compare = host_demo::compare::CompareArgs {
+    let compare = hrts_lab::compare::CompareArgs {
         out: dir.join("compare"),
         width: 64,
         height: 40,
@@ -489,7 +489,7 @@ fn render_and_compare_write_the_soft_shadow_outputs() {
         close_up_target: None,
         frames: 1,
     };
-    host_demo::compare::compare_to_folder(&device, &compare).expect("compare");
+    hrts_lab::compare::compare_to_folder(&device, &compare).expect("compare");
     for f in [
         "compare.png",
         "caption.txt",

@@ -6,7 +6,7 @@
 mod common;
 
 use common::*;
-use host_demo::tiers::{available_requests, markdown, standard_scenes, tier_matrix};
+use hrts_lab::tiers::{available_requests, markdown, standard_scenes, tier_matrix};
 use passes::BinningRequest;
 
 #[test]

@@ -1,4 +1,4 @@
-//! `host_demo tradeoff` on a contact-hardening scene (a plate high above the ground and a box standing on
+//! `hrts_lab tradeoff` on a contact-hardening scene (a plate high above the ground and a box standing on
 //! it), on lavapipe: the numbers are checked, never the timings. The ground-truth soft shadow converges;
 //! soft shadows beat hard ones against it; the hybrid beats the hard shadow it starts from; more PCSS taps
 //! and the standard penumbra move PCSS towards the truth; area shadows at 64 samples beat every other
@@ -8,7 +8,7 @@
 mod common;
 
 use common::*;
-use host_demo::tradeoff::{run_sweep, TradeoffArgs};
+use hrts_lab::tradeoff::{run_sweep, TradeoffArgs};
 use reference::{reference_visibility, soft_visibility, AreaLight, RefScene, SoftParams};
 
 fn args(out: std::path::PathBuf, strata: u32) -> TradeoffArgs {

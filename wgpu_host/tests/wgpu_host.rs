@@ -3,9 +3,9 @@
 //! against the exact CPU reference (mismatches as counts).
 
 use glam::{Mat4, Vec3};
-use host_demo::accuracy::{compare_with_reference, scene_visibility_params};
 use host_demo::View;
 use hrts::{FrameReport, ShadowMode};
+use hrts_lab::accuracy::{compare_with_reference, scene_visibility_params};
 use passes::PrimitiveMapConfig;
 use reference::{reference_visibility, Light, PixelClass, RefScene, VisibilityReference};
 use scene::{Camera, DirectionalLight, Scene};

@@ -5,8 +5,8 @@
 #![allow(dead_code, unused_imports)]
 
 use glam::Vec3;
-pub use host_demo::accuracy::*;
 use host_demo::{FrameImages, View};
+pub use hrts_lab::accuracy::*;
 use passes::{FrameReport, PrimitiveMapConfig};
 use rhi::{Device, DeviceDesc};
 use scene::{Camera, DirectionalLight, Scene};

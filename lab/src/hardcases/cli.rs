@@ -1,13 +1,13 @@
-//! The `host_demo hardcases` subcommand: its arguments, the run, and the outcome table.
+//! The `hrts_lab hardcases` subcommand: its arguments, the run, and the outcome table.
 
 use super::{run_cases, Outcome};
-use crate::gbuffer::GBufferLayout;
 use anyhow::{bail, Result};
+use host_demo::gbuffer::GBufferLayout;
 use scene::hard_cases::{Family, HardCase};
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// Arguments of `host_demo hardcases`.
+/// Arguments of `hrts_lab hardcases`.
 #[derive(Debug, clap::Args)]
 pub struct HardcasesArgs {
     /// Print the table as Markdown (for the README).
@@ -47,7 +47,7 @@ pub fn run_cli(
     args: &HardcasesArgs,
 ) -> Result<()> {
     let validation = validation || rhi::DeviceDesc::from_env().validation;
-    let device = crate::open_device(device_filter, validation)?;
+    let device = host_demo::open_device(device_filter, validation)?;
     let families = if args.family.is_empty() {
         Family::ALL.to_vec()
     } else {

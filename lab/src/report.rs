@@ -1,13 +1,13 @@
-//! `host_demo accuracy`: what accuracy costs in time. For one view, the classic shadow map at growing
+//! `hrts_lab accuracy`: what accuracy costs in time. For one view, the classic shadow map at growing
 //! sizes and the ray-traced primitive map at growing N, each with its GPU time, memory, and
 //! the pixels it gets wrong against the exact f64 reference (near-edge pixels counted apart).
 
 use crate::accuracy::{compare_visibility_to, view_reference};
 use crate::bench_models::median_of;
-use crate::plugin::PluginRenderer;
-use crate::render::{map_bytes, median_timings};
-use crate::View;
 use anyhow::{Context, Result};
+use host_demo::plugin::PluginRenderer;
+use host_demo::render::{map_bytes, median_timings};
+use host_demo::View;
 use hrts::passes_bridge;
 use passes::{
     PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig, ShadowMapConfig, ShadowMode,
@@ -24,10 +24,10 @@ pub struct AccuracyArgs {
     #[arg(long)]
     pub obj: Option<PathBuf>,
     /// Frame width.
-    #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
+    #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
     pub width: u32,
     /// Frame height.
-    #[arg(long, default_value_t = 360, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
+    #[arg(long, default_value_t = 360, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
     pub height: u32,
     /// Frames per configuration (timings are medians over all but the first).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
@@ -48,7 +48,7 @@ fn render(
     config: ShadowConfig,
     frames: u32,
 ) -> Result<(
-    crate::FrameImages,
+    host_demo::FrameImages,
     std::collections::BTreeMap<String, f64>,
     u64,
 )> {
@@ -63,8 +63,8 @@ pub fn render_frames(
     view: &View,
     config: ShadowConfig,
     frames: u32,
-) -> Result<(crate::FrameImages, Vec<hrts::FrameReport>)> {
-    let progress = crate::progress::phase("frames", u64::from(frames.max(2)));
+) -> Result<(host_demo::FrameImages, Vec<hrts::FrameReport>)> {
+    let progress = host_demo::progress::phase("frames", u64::from(frames.max(2)));
     let mut r = PluginRenderer::new(device, view, passes_bridge::config(&config)?)?;
     let inputs = view.frame_inputs();
     let mut reports = Vec::new();
@@ -99,7 +99,7 @@ pub fn model_view(
 
 /// Builds the report as Markdown.
 pub fn run_report(device: &Device, args: &AccuracyArgs) -> Result<String> {
-    let bar = crate::progress(8, "accuracy");
+    let bar = host_demo::progress(8, "accuracy");
     bar.set_message("the exact reference");
     let (view, label) = model_view(args.obj.as_deref(), args.width, args.height)?;
     // One reference for every configuration: the same view.

@@ -1,4 +1,4 @@
-//! `host_demo bench --lights`: what each kind of light costs inside whole scenes. The shared Sponza and
+//! `hrts_lab bench --lights`: what each kind of light costs inside whole scenes. The shared Sponza and
 //! Conference models, seen from inside, each with one light at a time: the sun, a spot light inside and a
 //! point light at three positions inside, planned as `render --scene` plans a glTF scene and drawn through
 //! the plugin's C ABI (a point light given as a point light: the plugin builds its cube faces as one map);
@@ -10,13 +10,13 @@
 //! traced by the ray-tracing-pipeline peer at equal samples (trace only).
 
 use crate::bench_models::{keep_only, models_folder, BenchArgs};
-use crate::gbuffer::GBufferLayout;
-use crate::plugin::{LightsFrame, PluginRenderer};
-use crate::scene_plan::{plan_scene, PlanSettings};
-use crate::scene_render::{median, SceneRenderer};
-use crate::CameraMatrices;
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
+use host_demo::gbuffer::GBufferLayout;
+use host_demo::plugin::{LightsFrame, PluginRenderer};
+use host_demo::scene_plan::{plan_scene, PlanSettings};
+use host_demo::scene_render::{median, SceneRenderer};
+use host_demo::CameraMatrices;
 use hrts::passes_bridge;
 use hrts::MapStats;
 use passes::{
@@ -339,7 +339,7 @@ fn measure_light(
         height: args.height,
     };
     let plan = plan_scene(file, camera, &settings)?;
-    let progress = crate::progress::phase("frames", u64::from(args.frames.max(2)));
+    let progress = host_demo::progress::phase("frames", u64::from(args.frames.max(2)));
     let mut renderer = SceneRenderer::new(device, file, args.width, args.height)?;
     renderer.set_output_format(args.output_format());
     if !args.copied_output {
@@ -437,7 +437,7 @@ fn measure_native_points(
     args: &BenchArgs,
     emitter_radius: Option<f32>,
 ) -> Result<LightCost> {
-    let progress = crate::progress::phase("frames", u64::from(args.frames.max(2)));
+    let progress = host_demo::progress::phase("frames", u64::from(args.frames.max(2)));
     let mut plugin = PluginRenderer::for_scene_casters(
         device,
         &file.scene,
@@ -568,7 +568,7 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
         .iter()
         .map(|s| (2 + s.points.len() + usize::from(args.point_lights > 0)) * sizes.len())
         .sum();
-    let bar = crate::progress(total as u64, "bench --lights");
+    let bar = host_demo::progress(total as u64, "bench --lights");
     let mut sizes_line = String::new();
     let mut per_pass = String::from(
         "\nPer pass (median ms over the same frames, summed over the light's frusta):\n\n",

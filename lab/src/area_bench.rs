@@ -1,4 +1,4 @@
-//! `host_demo bench --area`: what exact soft shadows cost, per model of the benchmark. Area shadows at
+//! `hrts_lab bench --area`: what exact soft shadows cost, per model of the benchmark. Area shadows at
 //! `--area-samples` light samples against PCSS with an 8K shadow map (the most accurate PCSS setting of
 //! `tradeoff` on the held-out models), with the primitive map's lists and memory; then how the cost grows
 //! with the light's size and with the samples.
@@ -7,9 +7,9 @@
 
 use crate::accuracy::compare_area;
 use crate::bench_models::{frames_of, median_of, view_of, BenchArgs, BenchModel};
-use crate::render::{map_bytes, median_timings};
-use crate::View;
 use anyhow::{Context, Result};
+use host_demo::render::{map_bytes, median_timings};
+use host_demo::View;
 use hrts::FrameReport;
 use passes::{AreaConfig, PcssConfig, PenumbraFilter, ShadowConfig, ShadowMapConfig, ShadowMode};
 use reference::RefScene;
@@ -65,7 +65,7 @@ fn run(
     view: &View,
     config: ShadowConfig,
     frames: u32,
-) -> Result<(crate::plugin::PluginRenderer, Run)> {
+) -> Result<(host_demo::plugin::PluginRenderer, Run)> {
     let (renderer, reports) = frames_of(device, view, config, frames)?;
     let times = median_timings(&reports);
     let report = reports.last().cloned().context("no frame")?;
@@ -83,7 +83,7 @@ fn area_ms(r: &Run) -> (f64, f64) {
 /// (`None` on a device without ray tracing).
 fn peer_trace_ms(
     device: &Device,
-    renderer: &crate::plugin::PluginRenderer,
+    renderer: &host_demo::plugin::PluginRenderer,
     view: &View,
     angular_radius: f32,
     samples: u32,
@@ -132,7 +132,7 @@ pub(crate) fn run_area_bench(
          |---|---:|---:|---:|---:|---:|---:|---:|\n",
         RADII[0], RADII[1], RADII[2], SAMPLES[0], SAMPLES[1], SAMPLES[2], SAMPLES[3]
     );
-    let bar = crate::progress(
+    let bar = host_demo::progress(
         models.len() as u64 * (2 + (RADII.len() + SAMPLES.len()) as u64),
         "bench --area",
     );

@@ -22,9 +22,9 @@
 //! needs no `t_min` and no receiver exclusion.
 
 use crate::accuracy::{absolute_tolerance, tolerance_per_distance};
-use crate::View;
 use anyhow::{bail, Context, Result};
 use glam::{DVec3, DVec4};
+use host_demo::View;
 use passes::ray_trace::{RAY_OFFSET_FLOAT_BOUND, RAY_OFFSET_PIXELS};
 use passes::FrameInputs;
 use reference::{reference_visibility_with_progress, PixelClass, RefScene, VisibilityParams};
@@ -206,7 +206,7 @@ fn shadow_rays(rs: &RefScene, view: &View, inputs: &FrameInputs, origin: DVec3) 
         tolerance_per_distance: tolerance_per_distance(view),
         pixel_tolerance: 1.0 / 128.0,
     };
-    let rows = crate::progress::phase("CPU reference", u64::from(view.height));
+    let rows = host_demo::progress::phase("CPU reference", u64::from(view.height));
     let reference = reference_visibility_with_progress(rs, &params, &|| rows.inc(1));
     drop(rows);
     let camera = inputs.camera_position.as_dvec3() - origin;

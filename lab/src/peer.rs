@@ -5,9 +5,9 @@
 //! For area shadows ([`run_area_peer`]) each of a pixel's light samples is its own ray: the same samples
 //! as the plugin's area trace, so equal samples give equal answers.
 
-use crate::plugin::PluginRenderer;
-use crate::{read_images, upload_scene, FrameImages, FrameOutput};
 use anyhow::{Context as _, Result};
+use host_demo::plugin::PluginRenderer;
+use host_demo::{read_images, upload_scene, FrameImages, FrameOutput};
 use passes::gpu_types::{AreaSamples, RayTraceConstants};
 use passes::prim_buffer::PrimBufferPass;
 use passes::rt_peer::{area_peer_constants, shadow_ray_constants, RtPeerPass};
@@ -94,7 +94,7 @@ fn run(
         .world_normal()
         .context("the ray-tracing peer reads the analysis G-buffer's world normals")?;
     let frames = frames.max(2);
-    let progress = crate::progress::phase("RT peer frames", u64::from(frames));
+    let progress = host_demo::progress::phase("RT peer frames", u64::from(frames));
     let new = if area.is_some() {
         RtPeerPass::new_area
     } else {

@@ -1,15 +1,15 @@
-//! `host_demo compare`: the talk's side-by-sides on one view — shadow map 3K and 8K, ray traced
+//! `hrts_lab compare`: the talk's side-by-sides on one view — shadow map 3K and 8K, ray traced
 //! 1K×1K×64 and ×32, PCSS, and the hybrid with the standard and the shrinking penumbra filter — as
 //! individual pictures, one labelled composite and a caption file that states every setting.
 
-use crate::images::{lerp_factor_preview, write_png_compact, Canvas};
-use crate::output::{shade_preview, write_png};
-use crate::plugin::PluginRenderer;
-use crate::render::{default_world_space_scale, median_timings};
-use crate::FrameImages;
-use crate::{parse_vec3, View};
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
+use host_demo::images::{lerp_factor_preview, write_png_compact, Canvas};
+use host_demo::output::{shade_preview, write_png};
+use host_demo::plugin::PluginRenderer;
+use host_demo::render::{default_world_space_scale, median_timings};
+use host_demo::FrameImages;
+use host_demo::{parse_vec3, View};
 use hrts::passes_bridge;
 use passes::{
     HybridConfig, PcssConfig, PenumbraFilter, PrimitiveMapConfig, ResourceId, ResourceSet,
@@ -21,17 +21,17 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-/// Options of `host_demo compare`.
+/// Options of `hrts_lab compare`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct CompareArgs {
     /// Output folder (individual pictures, compare.png, caption.txt).
     #[arg(long, default_value = "compare")]
     pub out: PathBuf,
     /// Width of each panel in pixels.
-    #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
+    #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
     pub width: u32,
     /// Height of each panel in pixels.
-    #[arg(long, default_value_t = 270, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
+    #[arg(long, default_value_t = 270, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
     pub height: u32,
     /// Camera position "x,y,z" (default: a close-up of the character, the fence and the sphere).
     #[arg(long, value_parser = parse_vec3)]
@@ -202,9 +202,9 @@ pub fn run_cli(device_filter: Option<String>, validation: bool, args: &CompareAr
     if args.width == 0 || args.height == 0 {
         bail!("--width and --height must be positive");
     }
-    let device = crate::open_device(device_filter, validation)?;
+    let device = host_demo::open_device(device_filter, validation)?;
     compare_to_folder(&device, args)?;
-    crate::check_validation(&device)
+    host_demo::check_validation(&device)
 }
 
 /// Renders every panel of the procedural scene and writes the pictures, the composite and the caption.
@@ -234,7 +234,7 @@ pub fn compare_to_folder(device: &Device, args: &CompareArgs) -> Result<()> {
     let mut caption = String::new();
     let _ = writeln!(
         caption,
-        "host_demo compare: procedural scene ({} triangles), {w}x{h} per picture, directional light {:?}; \
+        "hrts_lab compare: procedural scene ({} triangles), {w}x{h} per picture, directional light {:?}; \
          overview camera {:?} -> {:?} (top of each panel), close-up {:?} -> {:?} (below it). Previews are \
          Lambert x visibility.\nDevice: {} ({}). GPU times (overview) are medians over {} frames after \
          the first; on a CPU device they are relative only.\n",

@@ -2,12 +2,12 @@
 //! run chooses (`--models`, `--obj`, `--only`), their views, and the frames rendered of them. `bench`,
 //! `bench --area` and `bench --lights` share them.
 
-use crate::gbuffer::GBufferLayout;
-use crate::plugin::PluginRenderer;
-use crate::progress::phase;
-use crate::View;
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
+use host_demo::gbuffer::GBufferLayout;
+use host_demo::plugin::PluginRenderer;
+use host_demo::progress::phase;
+use host_demo::View;
 use hrts::passes_bridge;
 use hrts::FrameReport;
 use passes::{PrimitiveMapConfig, ShadowConfig};
@@ -31,10 +31,10 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..))]
     pub frames: u32,
     /// Frame width.
-    #[arg(long, default_value_t = 1920, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
+    #[arg(long, default_value_t = 1920, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
     pub width: u32,
     /// Frame height.
-    #[arg(long, default_value_t = 1080, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
+    #[arg(long, default_value_t = 1080, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
     pub height: u32,
     /// Only the models whose name (the path in the models folder, or the file as given to --obj; with
     /// --lights, the scene's file) contains one of these (comma-separated; default all). One that matches

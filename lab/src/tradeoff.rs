@@ -1,4 +1,4 @@
-//! `host_demo tradeoff`: what accuracy costs in time, for the shadows users see. Every method and setting
+//! `hrts_lab tradeoff`: what accuracy costs in time, for the shadows users see. Every method and setting
 //! the plugin offers (classic shadow maps, PCF, PCSS, ray-traced hard shadows, the hybrid, area shadows)
 //! renders one view through the C ABI. Each result is compared with a ground-truth soft shadow: the visible fraction of the
 //! light's extent per pixel, integrated on the CPU by stratified Monte Carlo over the exact f64 scene
@@ -6,12 +6,12 @@
 //! writes CSV, JSON, an error-against-time plot with the Pareto front marked, and a strip of error maps.
 
 use crate::accuracy::{view_reference, visibility_params};
-use crate::images::{write_png_compact, Canvas};
-use crate::output::shade_preview;
-use crate::render::median_timings;
 use crate::report::{model_view, render_frames};
-use crate::View;
 use anyhow::{bail, Context, Result};
+use host_demo::images::{write_png_compact, Canvas};
+use host_demo::output::shade_preview;
+use host_demo::render::median_timings;
+use host_demo::View;
 use passes::{
     AreaConfig, HybridConfig, PcssConfig, PenumbraFilter, PrimitiveMapConfig, ResourceId,
     ResourceSet, ShadowConfig, ShadowMapConfig, ShadowMode,
@@ -23,7 +23,7 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Options of `host_demo tradeoff`.
+/// Options of `hrts_lab tradeoff`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct TradeoffArgs {
     /// OBJ model, a ground plane added (default: the Stanford bunny of the models folder).
@@ -33,10 +33,10 @@ pub struct TradeoffArgs {
     #[arg(long)]
     pub builtin: bool,
     /// Frame width.
-    #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
+    #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
     pub width: u32,
     /// Frame height.
-    #[arg(long, default_value_t = 360, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
+    #[arg(long, default_value_t = 360, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
     pub height: u32,
     /// Frames per method. Timings are medians over the second half: the first half lets a GPU that idled
     /// while the method's pipelines were created reach its clocks again.
@@ -315,9 +315,9 @@ pub struct Sweep {
 
 /// Renders every method of [`methods`] on `view` and measures it against the ground truth.
 pub fn run_sweep(device: &Device, view: &View, scene: &str, args: &TradeoffArgs) -> Result<Sweep> {
-    let wss = crate::render::default_world_space_scale(view);
+    let wss = host_demo::render::default_world_space_scale(view);
     let methods = methods(args.angular_radius, wss);
-    let bar = crate::progress(methods.len() as u64 + 1, "tradeoff");
+    let bar = host_demo::progress(methods.len() as u64 + 1, "tradeoff");
     bar.set_message("ground truth");
     let rs = RefScene::new(&view.scene);
     let params = visibility_params(view);
@@ -327,7 +327,7 @@ pub fn run_sweep(device: &Device, view: &View, scene: &str, args: &TradeoffArgs)
         direction: view.frame_inputs().light.direction().as_dvec3(),
         angular_radius: f64::from(args.angular_radius),
     };
-    let rows = crate::progress::phase(
+    let rows = host_demo::progress::phase(
         format!("soft shadows, {}² samples", args.strata),
         u64::from(view.height),
     );
@@ -367,7 +367,7 @@ pub fn run_sweep(device: &Device, view: &View, scene: &str, args: &TradeoffArgs)
         }
         let timings = median_timings(&reports[reports.len() / 2..]);
         let memory_bytes = reports.last().map_or(0, |r| {
-            crate::render::resource_bytes(r)
+            host_demo::render::resource_bytes(r)
                 .map(|(_, bytes)| bytes)
                 .sum()
         });
@@ -675,7 +675,7 @@ fn downscale(pixels: &[[u8; 4]], width: u32, height: u32, scale: u32) -> Vec<[u8
         .collect()
 }
 
-/// `host_demo tradeoff`: loads the model, runs the sweep, writes the outputs and prints the table.
+/// `hrts_lab tradeoff`: loads the model, runs the sweep, writes the outputs and prints the table.
 pub fn run_cli(device: &Device, args: &TradeoffArgs) -> Result<()> {
     let (view, label) = if args.builtin {
         (

@@ -1,4 +1,4 @@
-//! `host_demo bench`: what the exact shadow costs, per model, with default settings.
+//! `hrts_lab bench`: what the exact shadow costs, per model, with default settings.
 //! - The talk's timing tables for its three models (~10K, ~65K, ~240K triangles on a ground plane):
 //!   primitive map with each binning path (compute, hardware and software conservative raster), ray
 //!   trace, PCSS, PCSS + ray trace, FXAA, next to the talk's GTX 980 column.
@@ -14,12 +14,12 @@ pub use crate::bench_models::BenchArgs;
 use crate::bench_models::{
     chosen_models, frames_of, frames_with_layout, median_of, view_of, BenchModel, TALK_ROWS,
 };
-use crate::gbuffer::GBufferLayout;
 use crate::peer::run_peer;
-use crate::progress::phase;
-use crate::render::{map_bytes, median_timings};
-use crate::View;
 use anyhow::{Context, Result};
+use host_demo::gbuffer::GBufferLayout;
+use host_demo::progress::phase;
+use host_demo::render::{map_bytes, median_timings};
+use host_demo::View;
 use hrts::FrameReport;
 use passes::{BinningRequest, PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig};
 use reference::RefScene;
@@ -71,7 +71,7 @@ fn measure(device: &Device, model: &BenchModel, args: &BenchArgs) -> Result<Meas
         let run = run_peer(device, &renderer, &view.scene, &inputs, args.frames)?;
         let wrong = match &reference {
             Some(r) => {
-                let images = crate::FrameImages {
+                let images = host_demo::FrameImages {
                     visibility: run.visibility,
                     ..renderer.read_back(device, false)?
                 };
@@ -182,7 +182,7 @@ fn scene_row(m: &Measured) -> String {
 /// Measures `models` and returns the Markdown tables.
 fn run_bench(device: &Device, args: &BenchArgs, models: &[BenchModel]) -> Result<String> {
     let caps = device.capabilities();
-    let bar = crate::progress(models.len() as u64, "bench");
+    let bar = host_demo::progress(models.len() as u64, "bench");
     let mut measured = Vec::new();
     for model in models {
         bar.set_message(&model.name);
@@ -243,7 +243,7 @@ fn run_gbuffer_bench(device: &Device, args: &BenchArgs, models: &[BenchModel]) -
         compact.depth,
         compact.normal,
     );
-    let bar = crate::progress(models.len() as u64 * 2, "bench --gbuffer");
+    let bar = host_demo::progress(models.len() as u64 * 2, "bench --gbuffer");
     for model in models {
         bar.set_message(&model.name);
         let view = view_of(model, args)?;
@@ -264,7 +264,7 @@ fn run_gbuffer_bench(device: &Device, args: &BenchArgs, models: &[BenchModel]) -
             let plugin: f64 = times
                 .iter()
                 .filter(|(k, _)| {
-                    k.as_str() != "gbuffer" && k.as_str() != crate::plugin::SCREEN_SPACE_WALL
+                    k.as_str() != "gbuffer" && k.as_str() != host_demo::plugin::SCREEN_SPACE_WALL
                 })
                 .fold(0.0, |total, (_, v)| total + v);
             out.push_str(&format!(
@@ -291,7 +291,7 @@ fn run_gbuffer_bench(device: &Device, args: &BenchArgs, models: &[BenchModel]) -
 /// configuration measured does not pay for a GPU still clocking up (seen on an H100: the first light 4x
 /// slower than the same light measured later).
 fn warm_up(device: &Device, args: &BenchArgs) -> Result<()> {
-    let bar = crate::progress(1, "bench warm-up");
+    let bar = host_demo::progress(1, "bench warm-up");
     bar.set_message(format!(
         "the built-in scene at {}×{}",
         args.width, args.height
@@ -320,7 +320,7 @@ pub fn run_cli(
     } else {
         Work::Models(chosen_models(args)?)
     };
-    let device = crate::open_device(device_filter, validation)?;
+    let device = host_demo::open_device(device_filter, validation)?;
     warm_up(&device, args)?;
     let tables = match &work {
         Work::Lights(scenes) => crate::light_bench::run_light_bench(&device, args, scenes)?,
@@ -334,7 +334,7 @@ pub fn run_cli(
     if let Some(path) = out {
         std::fs::write(path, &tables).with_context(|| format!("writing {}", path.display()))?;
     }
-    crate::check_validation(&device)
+    host_demo::check_validation(&device)
 }
 
 /// What `bench` measures.

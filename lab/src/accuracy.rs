@@ -1,8 +1,8 @@
 //! Accuracy of a rendered frame against the exact CPU reference, as counts: primitive-map texel lists
 //! against exact conservative binning, and ray-traced visibility against exact visibility.
 
-use crate::{CameraMatrices, FrameImages, View};
 use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
+use host_demo::{CameraMatrices, FrameImages, View};
 use passes::{PrimitiveMapConfig, GUARD_WORDS};
 use reference::{
     conservative_texel_sets, overlaps_texel_with_margin, reference_visibility_with_progress,
@@ -204,9 +204,9 @@ pub fn compare_visibility(
 }
 
 /// The exact reference of `view` ([`visibility_params`]); its rows are counted as the phase "CPU
-/// reference" of the run's progress ([`crate::progress::phase`]).
+/// reference" of the run's progress ([`host_demo::progress::phase`]).
 pub fn view_reference(rs: &RefScene, view: &View) -> VisibilityReference {
-    let rows = crate::progress::phase("CPU reference", u64::from(view.height));
+    let rows = host_demo::progress::phase("CPU reference", u64::from(view.height));
     reference_visibility_with_progress(rs, &visibility_params(view), &|| rows.inc(1))
 }
 
@@ -331,7 +331,7 @@ pub fn compare_area(
             .iter()
             .map(|w| w.as_dvec3())
             .collect();
-    let rows = crate::progress::phase(
+    let rows = host_demo::progress::phase(
         format!("CPU reference ({samples} samples)"),
         u64::from(view.height) * directions.len() as u64,
     );

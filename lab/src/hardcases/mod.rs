@@ -1,4 +1,4 @@
-//! `host_demo hardcases`: runs every [hard case](scene::hard_cases) on a device and measures it.
+//! `hrts_lab hardcases`: runs every [hard case](scene::hard_cases) on a device and measures it.
 //!
 //! Per case: the frame is rendered once (G-buffer, primitive map, ray trace) and read back; visibility is
 //! compared with the exact f64 reference (pixels whose exact shadow ray passes within a tolerance of an
@@ -17,12 +17,12 @@
 //! cannot drift apart.
 
 use crate::accuracy::{compare_map, compare_visibility, fitted_light_matrix};
-use crate::gbuffer::GBufferLayout;
-use crate::output::write_png;
-use crate::plugin::PluginRenderer;
-use crate::{FrameImages, View};
 use anyhow::{anyhow, bail, Context, Result};
 use glam::{DVec3, Mat4};
+use host_demo::gbuffer::GBufferLayout;
+use host_demo::output::write_png;
+use host_demo::plugin::PluginRenderer;
+use host_demo::{FrameImages, View};
 use hrts::passes_bridge;
 use passes::{
     BinningRequest, FaceMode, FrameInputs, Light, PrimitiveMapConfig, DEFAULT_ENTRY_BUDGET,
@@ -245,7 +245,7 @@ pub fn run_cases(
     previews: Option<&Path>,
 ) -> Vec<Outcome> {
     let mut bases = HashMap::new();
-    let bar = crate::progress(cases.len() as u64, "hard cases");
+    let bar = host_demo::progress(cases.len() as u64, "hard cases");
     let outcomes = cases
         .iter()
         .map(|c| {

@@ -7,9 +7,9 @@
 //! no path may drop any (nothing is excused).
 
 use crate::accuracy::{compare_map, fitted_light_matrix, MapComparison};
-use crate::plugin::PluginRenderer;
-use crate::View;
 use anyhow::Result;
+use host_demo::plugin::PluginRenderer;
+use host_demo::View;
 use hrts::passes_bridge;
 use passes::{choose_binning_path, BinningRequest, FaceMode, PrimitiveMapConfig};
 use reference::{FaceSelection, RefScene};
@@ -99,7 +99,7 @@ pub fn tier_matrix(device: &Device, scenes: &[(&str, View)], size: u32) -> Resul
             let path = format!(
                 "{} ({})",
                 report.binning_path.name(),
-                crate::render::tier_name(&report)
+                host_demo::render::tier_name(&report)
             );
             rows.push(TierRow {
                 scene: (*name).to_owned(),

@@ -1,0 +1,139 @@
+//! What the command lines of `host_demo` and `hrts_lab` share: the camera options, negative numbers as
+//! people type them (`--camera-pos -5,2,3`, not only `--camera-pos=-5,2,3`), and the check of it.
+
+use crate::parse_vec3;
+use anyhow::{bail, Result};
+use glam::Vec3;
+use scene::{Aabb, Camera};
+use std::any::TypeId;
+
+/// Where the camera is, when not framed automatically (or, with `--scene`, taken from the file).
+#[derive(Debug, Clone, clap::Args)]
+pub struct CameraArgs {
+    /// Camera position "x,y,z" (default: the scene file's camera, else framed automatically: from
+    /// outside, or inside a closed model, in a corner at eye height looking across the room).
+    #[arg(long, value_parser = parse_vec3)]
+    pub camera_pos: Option<Vec3>,
+    /// Camera target "x,y,z" (default: the scene file's camera's, else the scene centre).
+    #[arg(long, value_parser = parse_vec3)]
+    pub camera_target: Option<Vec3>,
+}
+
+impl CameraArgs {
+    /// `camera` moved as these options say ([`camera_with`]).
+    pub fn apply(&self, camera: Camera, bounds: &Aabb) -> Result<Camera> {
+        camera_with(camera, bounds, self.camera_pos, self.camera_target)
+    }
+}
+
+/// `camera` moved to `position` and looking at `target` where given (the target defaults to the centre
+/// of `bounds` when only the position is given).
+pub fn camera_with(
+    camera: Camera,
+    bounds: &Aabb,
+    position: Option<Vec3>,
+    target: Option<Vec3>,
+) -> Result<Camera> {
+    if position.is_none() && target.is_none() {
+        return Ok(camera);
+    }
+    let position = position.unwrap_or(camera.position);
+    let target = target.unwrap_or(bounds.center());
+    if (position - target).length() == 0.0 {
+        bail!("camera position and target coincide");
+    }
+    let forward = (target - position).normalize();
+    let up = if forward.cross(Vec3::Y).length() < 1e-3 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    };
+    Ok(Camera {
+        position,
+        target,
+        up,
+        ..camera
+    })
+}
+
+/// `command` and its subcommands with negative values allowed on the options of numbers: an option of
+/// one number takes a negative number (`allow_negative_numbers`); a vector or a list of numbers, whose
+/// value is no number as a whole, takes a value that begins with a hyphen (`allow_hyphen_values`), so
+/// that such an option followed by another flag takes the flag as its value and fails to parse it.
+pub fn negative_numbers(command: clap::Command) -> clap::Command {
+    command
+        .mut_args(|arg| {
+            let value = arg.get_value_parser().type_id();
+            let number = [
+                TypeId::of::<u32>(),
+                TypeId::of::<u64>(),
+                TypeId::of::<i32>(),
+                TypeId::of::<i64>(),
+                TypeId::of::<usize>(),
+                TypeId::of::<f32>(),
+                TypeId::of::<f64>(),
+            ]
+            .into_iter()
+            .any(|t| value == t);
+            if value == TypeId::of::<Vec3>() || (number && arg.get_value_delimiter().is_some()) {
+                arg.allow_hyphen_values(true)
+            } else if number {
+                arg.allow_negative_numbers(true)
+            } else {
+                arg
+            }
+        })
+        .mut_subcommands(negative_numbers)
+}
+
+/// Checks that every option of numbers of every subcommand of `command()` (a command built with
+/// [`negative_numbers`]) takes a negative value as a separate argument (`--flag -1`, a vector
+/// `-1,-2,-3`, a list `-1,2`): it is parsed as the option's value (and then accepted, or refused by the
+/// option's own check), never as an unknown argument. Returns the options checked ("render
+/// --camera-pos", ...), or the first that failed.
+pub fn check_negative_numbers(
+    command: impl Fn() -> clap::Command,
+) -> std::result::Result<Vec<String>, String> {
+    use clap::error::ErrorKind;
+    let root = command();
+    let mut checked = Vec::new();
+    for sub in root.get_subcommands() {
+        for arg in sub.get_arguments() {
+            let Some(long) = arg.get_long() else { continue };
+            let value = if !arg.is_allow_hyphen_values_set() {
+                if !arg.is_allow_negative_numbers_set() {
+                    continue;
+                }
+                "-1"
+            } else if arg.get_value_parser().type_id() == TypeId::of::<Vec3>() {
+                "-1,-2,-3"
+            } else {
+                "-1,2"
+            };
+            let flag = format!("--{long}");
+            let case = format!("{} {flag} {value}", sub.get_name());
+            match command().try_get_matches_from([root.get_name(), sub.get_name(), &flag, value]) {
+                Ok(m) => {
+                    let raw: Vec<_> = m
+                        .subcommand_matches(sub.get_name())
+                        .and_then(|m| m.get_raw(arg.get_id().as_str()))
+                        .map(|r| r.map(|v| v.to_string_lossy().into_owned()).collect())
+                        .unwrap_or_default();
+                    if raw.join(",") != value {
+                        return Err(format!("{case}: parsed as {raw:?}"));
+                    }
+                }
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        ErrorKind::ValueValidation
+                            | ErrorKind::MissingRequiredArgument
+                            | ErrorKind::InvalidValue
+                    ) && !e.to_string().contains("unexpected argument") => {}
+                Err(e) => return Err(format!("{case}: {e}")),
+            }
+            checked.push(format!("{} {flag}", sub.get_name()));
+        }
+    }
+    Ok(checked)
+}
