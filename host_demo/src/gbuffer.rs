@@ -10,10 +10,9 @@ use crate::{shader, CameraMatrices, FrameImages};
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, Mat3, Mat4, Vec4};
 use hrts::{NormalEncoding, NormalSpace};
-use passes::PassError;
 use rhi::{
     BindGroup, BindingKind, ColorTarget, DepthState, DepthTarget, Device, Encoder, Format,
-    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, ImageUsage, Resource,
+    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, ImageUsage, Resource, RhiError,
 };
 
 /// Push constants of the G-buffer (`gbuffer_push.glsl`).
@@ -35,18 +34,18 @@ const _: () = assert!(std::mem::size_of::<GBufferPush>() == 144);
 impl GBufferPush {
     /// The constants of `camera` for vertices relative to `origin` (f32) and a G-buffer of `layout`: the
     /// view-projection of coordinates relative to the camera, composed in f64 as the plugin composes its own
-    /// (`passes::camera_in_frame`), so that the G-buffer and the plugin agree on every pixel's ray.
+    /// (`camera_in_frame` of the passes), so that the G-buffer and the plugin agree on every pixel's ray.
     pub fn for_camera(
         camera: &CameraMatrices,
         origin: DVec3,
         layout: &GBufferLayout,
-    ) -> Result<Self, PassError> {
+    ) -> Result<Self, RhiError> {
         let relative_view =
             camera.view.as_dmat4() * DMat4::from_translation(camera.position.as_dvec3());
         let view_proj_rel = (camera.proj.as_dmat4() * relative_view).as_mat4();
         let camera_frame = (camera.position.as_dvec3() - origin).as_vec3();
         if !view_proj_rel.is_finite() || !camera_frame.is_finite() {
-            return Err(PassError::InvalidConfig(
+            return Err(RhiError::InvalidArgument(
                 "camera matrices are not finite".into(),
             ));
         }
@@ -232,10 +231,10 @@ impl GBufferTargets {
         width: u32,
         height: u32,
         layout: GBufferLayout,
-    ) -> Result<Self, PassError> {
+    ) -> Result<Self, RhiError> {
         for format in [layout.depth, layout.normal] {
             if !device.can_render(format) || !device.can_sample(format) {
-                return Err(PassError::InvalidConfig(format!(
+                return Err(RhiError::InvalidArgument(format!(
                     "the device cannot render to and sample {format:?} for the G-buffer"
                 )));
             }
@@ -250,7 +249,7 @@ impl GBufferTargets {
         };
         let analysis = layout
             .analysis
-            .then(|| -> Result<_, PassError> {
+            .then(|| -> Result<_, RhiError> {
                 Ok(AnalysisTargets {
                     position: device
                         .create_image(&color("gbuffer position", Format::Rgba32Float))?,
@@ -311,7 +310,7 @@ impl GBufferPass {
         device: &Device,
         scene: &SceneBuffers,
         layout: &GBufferLayout,
-    ) -> Result<Self, PassError> {
+    ) -> Result<Self, RhiError> {
         let pipeline = device.create_graphics_pipeline(&GraphicsPipelineDesc {
             name: "gbuffer",
             vertex: &shader("gbuffer.vert")?,
@@ -346,7 +345,7 @@ impl GBufferPass {
         targets: &GBufferTargets,
         push: &GBufferPush,
         scene: &SceneBuffers,
-    ) -> Result<(), PassError> {
+    ) -> Result<(), RhiError> {
         enc.begin_pass("gbuffer");
         let colors: Vec<ColorTarget<'_>> = targets
             .colors()
@@ -386,7 +385,7 @@ pub fn decode_compact(
     (width, height): (u32, u32),
     normal: &[u8],
     depth: &[u8],
-) -> Result<FrameImages, PassError> {
+) -> Result<FrameImages, RhiError> {
     let pixels = width as usize * height as usize;
     if layout.normal != Format::Rg16Float
         || layout.normal_encoding != NormalEncoding::Octahedral
@@ -394,7 +393,7 @@ pub fn decode_compact(
         || normal.len() != pixels * 4
         || depth.len() != pixels * 4
     {
-        return Err(PassError::InvalidConfig(format!(
+        return Err(RhiError::InvalidArgument(format!(
             "a compact G-buffer read back holds RG16F octahedral view-space normals, not {layout:?}"
         )));
     }

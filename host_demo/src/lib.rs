@@ -1,10 +1,12 @@
-//! The standalone demo host as a library: scene setup shared by the `host_demo` binary and the
-//! integration tests, so that what the tests check is what the demo shows.
+//! The standalone demo host as a library: scene setup shared by the `host_demo` binary, the lab
+//! (`hrts_lab`) and the integration tests, so that what the tests check is what the demo shows.
 //!
-//! The demo's own G-buffer ([`gbuffer`], shaders in `host_demo/shaders/` embedded at build time) lives
-//! here, not in the shipped `passes` library: an engine brings its own G-buffer. (The frame that drives
-//! one `passes::ShadowPipeline` directly, which the tests compare the plugin with, is the `test_support`
-//! crate's.)
+//! The demo is an engine in miniature on the plugin's public API ([`hrts`]): its own device (through
+//! `rhi`, as an engine has its own), scene buffers ([`scene_buffers`]) and G-buffer ([`gbuffer`], shaders
+//! in `host_demo/shaders/` embedded at build time), and the plugin driven through the safe Rust API over
+//! the C ABI ([`plugin`]). It names nothing of the passes: the tools that look inside them are the lab's,
+//! and the frame that drives one pipeline of the passes directly, which the tests compare the plugin
+//! with, is the `test_support` crate's.
 //!
 //! A glTF scene's lights decide its shadows: [`scene_plan`] derives, without a GPU, which shadow each
 //! light gets and through which frusta; [`scene_render`] renders them through the plugin and reports per
@@ -34,7 +36,6 @@ pub mod scene_render;
 pub mod shading;
 
 use glam::{DVec3, Mat4, Vec3};
-use passes::{Draw, FrameInputs, Geometry, Light, PassError};
 use rhi::Device;
 use scene::{Aabb, Camera, DirectionalLight, Scene};
 
@@ -46,8 +47,9 @@ mod shaders {
 }
 
 /// SPIR-V words of the demo's embedded shader `name` (file name in `host_demo/shaders/`).
-pub fn shader(name: &str) -> Result<Vec<u32>, PassError> {
-    passes::embedded_shader(shaders::ALL, name)
+pub fn shader(name: &str) -> Result<Vec<u32>, rhi::RhiError> {
+    shaders::spirv(name)
+        .ok_or_else(|| rhi::RhiError::InvalidArgument(format!("no embedded shader named {name}")))
 }
 
 /// A scene with its camera and light, ready to render.
@@ -80,52 +82,24 @@ impl View {
         }
     }
 
-    /// Camera and light matrices of the frame.
-    pub fn frame_inputs(&self) -> FrameInputs {
-        let bounds = self.scene.bounds();
-        let aspect = self.width as f32 / self.height as f32;
-        FrameInputs {
-            view: self.camera.view(),
-            proj: self.camera.proj(aspect),
-            camera_position: self.camera.position,
-            light: Light::Directional {
-                direction: self.light.direction,
-                view_proj: self.light.view_proj(&bounds),
-            },
-        }
+    /// The camera of the frame.
+    pub fn camera_matrices(&self) -> CameraMatrices {
+        CameraMatrices::of_camera(&self.camera, self.width, self.height)
     }
 
-    /// Uploads the scene ([`upload_scene`]).
-    pub fn upload(&self, device: &Device) -> Result<Geometry, PassError> {
-        upload_scene(device, &self.scene)
+    /// The light as the plugin takes it: the directional light with its matrix fitted to the scene's
+    /// bounds.
+    pub fn plugin_light(&self) -> hrts::Light {
+        hrts::Light::Directional {
+            direction: self.light.direction,
+            view_proj: Some(self.light.view_proj(&self.scene.bounds())),
+        }
     }
 
     /// The frame origin of the scene ([`frame_origin`]).
     pub fn frame_origin(&self) -> DVec3 {
         frame_origin(&self.scene)
     }
-}
-
-/// Uploads `scene`: one draw per object, identity transforms, frame origin at the centre of its bounds.
-pub fn upload_scene(device: &Device, scene: &Scene) -> Result<Geometry, PassError> {
-    let positions: Vec<f32> = scene.positions.iter().flat_map(|p| p.to_array()).collect();
-    let draws: Vec<Draw> = scene
-        .objects
-        .iter()
-        .map(|o| Draw {
-            first_index: o.first_triangle * 3,
-            index_count: o.triangle_count * 3,
-            model: Mat4::IDENTITY,
-            base_vertex: 0,
-        })
-        .collect();
-    Geometry::upload(
-        device,
-        &positions,
-        &scene.indices,
-        &draws,
-        frame_origin(scene),
-    )
 }
 
 /// The frame origin of `scene`: the centre of its bounds in f32, as the plugin derives it from the bounds
@@ -152,15 +126,6 @@ impl CameraMatrices {
             view: camera.view(),
             proj: camera.proj(width as f32 / height.max(1) as f32),
             position: camera.position,
-        }
-    }
-
-    /// The camera of `inputs`.
-    pub fn of_frame(inputs: &FrameInputs) -> Self {
-        Self {
-            view: inputs.view,
-            proj: inputs.proj,
-            position: inputs.camera_position,
         }
     }
 }

@@ -12,8 +12,6 @@ use crate::gbuffer::{GBufferLayout, GBufferPass, GBufferPush, GBufferTargets};
 use crate::scene_buffers::SceneBuffers;
 use crate::{read_images, CameraMatrices, FrameImages, FrameOutput, View};
 use anyhow::{bail, Context as _, Result};
-use hrts::passes_bridge;
-use passes::{FrameInputs, Light, ResourceId};
 use rhi::{
     Barrier, BufferUsage, Device, Format, GpuTimer, Image, ImageDesc, ImageUsage, MemoryLocation,
     ResourceState as S,
@@ -252,9 +250,13 @@ impl PluginRenderer {
 
     /// Renders one frame of one light ([`PluginRenderer::render_lights`]) and returns the plugin's report
     /// plus the G-buffer's GPU time and [`SCREEN_SPACE_WALL`].
-    pub fn render(&mut self, device: &Device, inputs: &FrameInputs) -> Result<hrts::FrameReport> {
-        let frame =
-            self.render_lights(device, &CameraMatrices::of_frame(inputs), &[inputs.light])?;
+    pub fn render_light(
+        &mut self,
+        device: &Device,
+        camera: &CameraMatrices,
+        light: hrts::Light,
+    ) -> Result<hrts::FrameReport> {
+        let frame = self.render_lights(device, camera, &[light])?;
         let Some(mut report) = frame.lights.into_iter().next() else {
             bail!("the frame reported no light");
         };
@@ -263,25 +265,13 @@ impl PluginRenderer {
     }
 
     /// Renders one frame and waits for it, in two submissions: the plugin's light-space passes and the
-    /// demo's G-buffer; then
-    /// the plugin's screen-space passes (primitive map, ray trace, soft shadows) and output copy. `lights`
-    /// holds one light per configured light (none: the plugin records nothing). Returns the plugin's
-    /// report of each light, the G-buffer's GPU time and, with lights, [`SCREEN_SPACE_WALL`]: the host's
-    /// wall clock of the second submission (what a CPU device such as lavapipe spends on it: its
-    /// timestamps do not see compute work).
+    /// demo's G-buffer; then the plugin's screen-space passes (primitive map, ray trace, soft shadows) and
+    /// output copy. `lights` holds one light per configured light, as the plugin takes it (point lights,
+    /// spot lights whose frusta the plugin fits, directional lights fitted to the casters; none: the
+    /// plugin records nothing). Returns the plugin's report of each light, the G-buffer's GPU time and,
+    /// with lights, [`SCREEN_SPACE_WALL`]: the host's wall clock of the second submission (what a CPU
+    /// device such as lavapipe spends on it: its timestamps do not see compute work).
     pub fn render_lights(
-        &mut self,
-        device: &Device,
-        camera: &CameraMatrices,
-        lights: &[Light],
-    ) -> Result<LightsFrame> {
-        let lights: Vec<hrts::Light> = lights.iter().map(plugin_light).collect();
-        self.render_plugin_lights(device, camera, &lights)
-    }
-
-    /// [`render_lights`](Self::render_lights) with the lights as the plugin takes them (point lights, spot
-    /// lights whose frusta the plugin fits, directional lights fitted to the casters).
-    pub fn render_plugin_lights(
         &mut self,
         device: &Device,
         camera: &CameraMatrices,
@@ -450,21 +440,19 @@ impl PluginRenderer {
         }
         frame.output = layers.swap_remove(light as usize);
         let origin = self.scene.origin();
-        let mut sources: Vec<(Destination, ResourceId)> = FrameOutput::PIPELINE
+        let mut sources: Vec<(Destination, hrts::Resource)> = FrameOutput::PIPELINE
             .iter()
-            .map(|&(output, id)| (Destination::Image(output), id))
+            .map(|&(output, resource)| (Destination::Image(output), resource))
             .collect();
-        sources.push((Destination::ListOffsets, ResourceId::PrimListOffsets));
+        sources.push((Destination::ListOffsets, hrts::Resource::PrimListOffsets));
         if with_entries {
-            sources.push((Destination::ListEntries, ResourceId::PrimListEntries));
+            sources.push((Destination::ListEntries, hrts::Resource::PrimListEntries));
         }
         let mut wanted = Vec::new();
-        for &(output, id) in &sources {
-            let resource =
-                passes_bridge::resource(id).context("a read-back resource has no C value")?;
+        for &(output, resource) in &sources {
             if let Some(info) = self.context.resource_info(light, resource)? {
                 let buffer = device.create_buffer(
-                    id.name(),
+                    resource.name(),
                     info.bytes,
                     BufferUsage::COPY_DST,
                     MemoryLocation::GpuToCpu,
@@ -497,9 +485,7 @@ impl PluginRenderer {
                 Destination::Image(image) => frame.insert(image, bytes, origin),
                 Destination::ListOffsets => {
                     let packed: Vec<u32> = bytemuck::pod_collect_to_vec(bytes);
-                    frame.list_offsets =
-                        passes::unpack_list_offsets(&packed, passes::packed_texels(packed.len()))
-                            .map_err(anyhow::Error::msg)?;
+                    frame.list_offsets = hrts::unpack_list_offsets(&packed)?;
                 }
                 Destination::ListEntries => {
                     frame.list_entries = bytemuck::pod_collect_to_vec(bytes)
@@ -567,30 +553,6 @@ fn create_context(device: &Device) -> Result<hrts::Context> {
     // SAFETY: the handles are the demo's live device, as it was created; it outlives the context (the
     // renderer that holds it borrows nothing but is dropped before the demo's device by every caller).
     Ok(unsafe { hrts::Context::adopt(&vulkan, 0) }?)
-}
-
-/// The plugin's light of `light`.
-fn plugin_light(light: &Light) -> hrts::Light {
-    match *light {
-        Light::Directional {
-            direction,
-            view_proj,
-        } => hrts::Light::Directional {
-            direction,
-            view_proj: Some(view_proj),
-        },
-        Light::Spot {
-            position,
-            direction,
-            view_proj,
-        } => hrts::Light::Spot {
-            position,
-            direction,
-            frustum: hrts::SpotFrustum::Given(view_proj),
-            range: None,
-        },
-        Light::Point { position, range } => hrts::Light::Point { position, range },
-    }
 }
 
 /// Frame `frame_index` of `camera` with `lights`; depth and normal are sampled

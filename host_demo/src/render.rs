@@ -330,11 +330,16 @@ pub fn render_to_folder(
     let mut renderer = PluginRenderer::with_layout(device, view, config, layout)
         .context("creating the shadow passes")?;
     bar.inc(1);
-    let inputs = view.frame_inputs();
+    let camera = view.camera_matrices();
+    let light = view.plugin_light();
     let mut reports = Vec::new();
     for frame in 1..=frames {
         bar.set_message(format!("frame {frame} of {frames}"));
-        reports.push(renderer.render(device, &inputs).context("rendering")?);
+        reports.push(
+            renderer
+                .render_light(device, &camera, light)
+                .context("rendering")?,
+        );
         bar.inc(1);
     }
     bar.set_message("reading back and writing the outputs");
@@ -387,14 +392,14 @@ pub fn render_to_folder(
         height: h,
         triangles: view.scene.triangle_count(),
         camera: CameraJson {
-            view: inputs.view.to_cols_array(),
-            proj: inputs.proj.to_cols_array(),
-            position: inputs.camera_position.to_array(),
+            view: camera.view.to_cols_array(),
+            proj: camera.proj.to_cols_array(),
+            position: camera.position.to_array(),
         },
         light: LightJson {
-            r#type: inputs.light.kind_name(),
-            direction: inputs.light.direction().to_array(),
-            view_proj: inputs.light.view_proj().to_cols_array(),
+            r#type: "directional",
+            direction: view.light.direction.to_array(),
+            view_proj: view.light.view_proj(&view.scene.bounds()).to_cols_array(),
         },
         primitive_map: MapJson {
             size: n,

@@ -3,8 +3,8 @@
 
 use crate::gbuffer::GBufferTargets;
 use glam::DVec3;
-use passes::{PassError, ResourceId, ShadowConfig, ShadowMode};
-use rhi::{Barrier, BufferUsage, Device, Image, MemoryLocation, ResourceState as S};
+use hrts::Resource;
+use rhi::{Barrier, BufferUsage, Device, Image, MemoryLocation, ResourceState as S, RhiError};
 
 /// Everything the frame produced, read back to the host. Row-major, y = 0 at the top. Outputs the plan
 /// did not produce are empty.
@@ -18,12 +18,12 @@ pub struct FrameImages {
     pub depth: Vec<f32>,
     /// Ray-traced visibility (1 = lit).
     pub visibility: Vec<f32>,
-    /// Blocker distance (see [`passes::ray_trace::RayTracePass::blocker_distance`]).
+    /// Blocker distance (`HRTS_RESOURCE_BLOCKER_DISTANCE`).
     pub blocker_distance: Vec<f32>,
     /// Occupancy view, N×N RGBA8.
     pub occupancy: Vec<[u8; 4]>,
     /// Primitive map list offsets, unpacked: texel t's list is `list_entries[list_offsets.range(t)]`.
-    pub list_offsets: passes::ListOffsets,
+    pub list_offsets: hrts::ListOffsets,
     /// Primitive map list entries (triangle indices); empty unless requested.
     pub list_entries: Vec<u32>,
     /// Classic single-tap shadow-map visibility.
@@ -36,7 +36,7 @@ pub struct FrameImages {
     pub lerp_factor: Vec<f32>,
     /// Hybrid visibility.
     pub hybrid: Vec<f32>,
-    /// The pipeline's final output ([`ShadowPipeline::output`]).
+    /// The final output: the layer of the light in the output image.
     pub output: Vec<f32>,
 }
 
@@ -81,7 +81,7 @@ impl GBufferTargets {
 
 /// Copies `images` (each in the given state, restored afterwards) into host buffers, waits, and returns
 /// their bytes (all layers, tightly packed). An image listed twice is read twice.
-pub fn read_images(device: &Device, images: &[(&Image, S)]) -> Result<Vec<Vec<u8>>, PassError> {
+pub fn read_images(device: &Device, images: &[(&Image, S)]) -> Result<Vec<Vec<u8>>, RhiError> {
     let buffers = images
         .iter()
         .map(|(img, _)| {
@@ -131,16 +131,6 @@ pub fn read_images(device: &Device, images: &[(&Image, S)]) -> Result<Vec<Vec<u8
     buffers.iter().map(|b| Ok(b.read()?.to_vec())).collect()
 }
 
-/// `config` asking for the ray trace's blocker distance when its mode traces rays (hard, hybrid): the
-/// demo compares blocker distances with the exact reference, and the plugin allocates them only when
-/// asked (or for the hybrid).
-pub fn with_blocker_distance(mut config: ShadowConfig) -> ShadowConfig {
-    if matches!(config.mode, ShadowMode::Hard | ShadowMode::Hybrid) {
-        config.extra_outputs = config.extra_outputs.with(ResourceId::BlockerDistance);
-    }
-    config
-}
-
 /// Where a read-back image goes in [`FrameImages`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FrameOutput {
@@ -172,15 +162,15 @@ pub enum FrameOutput {
 
 impl FrameOutput {
     /// The pipeline resources read back into [`FrameImages`].
-    pub const PIPELINE: [(FrameOutput, ResourceId); 8] = [
-        (Self::Visibility, ResourceId::RtVisibility),
-        (Self::BlockerDistance, ResourceId::BlockerDistance),
-        (Self::Occupancy, ResourceId::Occupancy),
-        (Self::ShadowMapVisibility, ResourceId::ShadowMapVisibility),
-        (Self::Pcss, ResourceId::Pcss),
-        (Self::Antialiased, ResourceId::RtAntialiased),
-        (Self::LerpFactor, ResourceId::LerpFactor),
-        (Self::Hybrid, ResourceId::Hybrid),
+    pub const PIPELINE: [(FrameOutput, Resource); 8] = [
+        (Self::Visibility, Resource::RtVisibility),
+        (Self::BlockerDistance, Resource::BlockerDistance),
+        (Self::Occupancy, Resource::Occupancy),
+        (Self::ShadowMapVisibility, Resource::ShadowMapVisibility),
+        (Self::Pcss, Resource::Pcss),
+        (Self::Antialiased, Resource::RtAntialiased),
+        (Self::LerpFactor, Resource::LerpFactor),
+        (Self::Hybrid, Resource::Hybrid),
     ];
 }
 

@@ -87,7 +87,7 @@ impl SceneRenderer {
     ) -> Result<LightsFrame> {
         self.plugin
             .configure_lights(device, &plan.plugin_configs())?;
-        self.plugin.render_plugin_lights(
+        self.plugin.render_lights(
             device,
             &CameraMatrices::of_camera(camera, self.width, self.height),
             &plan.plugin_frame_lights(),

@@ -1,7 +1,6 @@
-//! Conversions between the safe API's types and the `passes` crate's, for Rust hosts that still hold
-//! `passes` types: host_demo's configurations and reports, which it shares with the frame it renders
-//! through the Rust passes directly. A host on the plugin's public API needs none of them; they go when
-//! host_demo holds the plugin's own types.
+//! Conversions between the safe API's types and the `passes` crate's, for the code that drives the passes
+//! directly beside the plugin: the lab's tools and the tests that compare the plugin with the passes. A
+//! host on the plugin's public API (the demo, an engine) needs none of them.
 
 use crate::convert;
 use crate::safe::{Config, Error, NormalEncoding, NormalSpace, Resource, Result};
@@ -18,12 +17,6 @@ pub fn config(config: &passes::ShadowConfig) -> Result<Config> {
 /// The pipeline resource of a plugin resource.
 pub fn resource_id(resource: Resource) -> passes::ResourceId {
     convert::RESOURCES[resource as usize]
-}
-
-/// The plugin resource of a pipeline resource, if the C ABI names it.
-pub fn resource(id: passes::ResourceId) -> Option<Resource> {
-    let value = convert::resource_index(id).ok()?;
-    crate::safe::decode("hrts::passes_bridge::resource", "resource", value).ok()
 }
 
 /// How the passes read an engine normal image of `encoding` in `space`, as the C ABI converts them.

@@ -7,6 +7,7 @@
 
 use crate::accuracy::compare_area;
 use crate::bench_models::{frames_of, median_of, view_of, BenchArgs, BenchModel};
+use crate::frames::ViewInputs;
 use anyhow::{Context, Result};
 use host_demo::render::{map_bytes, median_timings};
 use host_demo::View;

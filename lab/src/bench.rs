@@ -14,6 +14,7 @@ pub use crate::bench_models::BenchArgs;
 use crate::bench_models::{
     chosen_models, frames_of, frames_with_layout, median_of, view_of, BenchModel, TALK_ROWS,
 };
+use crate::frames::{PluginFrames, ViewInputs};
 use crate::peer::run_peer;
 use anyhow::{Context, Result};
 use host_demo::gbuffer::GBufferLayout;

@@ -2,6 +2,7 @@
 //! run chooses (`--models`, `--obj`, `--only`), their views, and the frames rendered of them. `bench`,
 //! `bench --area` and `bench --lights` share them.
 
+use crate::frames::{PluginFrames, ViewInputs};
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
 use host_demo::gbuffer::GBufferLayout;

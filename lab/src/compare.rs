@@ -2,6 +2,7 @@
 //! 1K×1K×64 and ×32, PCSS, and the hybrid with the standard and the shrinking penumbra filter — as
 //! individual pictures, one labelled composite and a caption file that states every setting.
 
+use crate::frames::{PluginFrames, ViewInputs};
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
 use host_demo::images::{lerp_factor_preview, write_png_compact, Canvas};

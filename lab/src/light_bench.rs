@@ -478,7 +478,7 @@ fn measure_native_points(
         .collect();
     let mut frames = Vec::new();
     for _ in 0..args.frames.max(2) {
-        frames.push(plugin.render_plugin_lights(device, &matrices, &lights)?);
+        frames.push(plugin.render_lights(device, &matrices, &lights)?);
         progress.inc(1);
     }
     drop(progress);

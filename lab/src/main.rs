@@ -7,6 +7,7 @@ use glam::Vec3;
 use host_demo::cli::CameraArgs;
 use host_demo::render::{render_to_folder, RenderOptions, SoftShadowArgs};
 use host_demo::{parse_vec3, View};
+use hrts_lab::frames::ViewInputs;
 use rhi::Device;
 use scene::DirectionalLight;
 use std::path::PathBuf;

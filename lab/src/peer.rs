@@ -5,9 +5,10 @@
 //! For area shadows ([`run_area_peer`]) each of a pixel's light samples is its own ray: the same samples
 //! as the plugin's area trace, so equal samples give equal answers.
 
+use crate::frames::upload_scene;
 use anyhow::{Context as _, Result};
 use host_demo::plugin::PluginRenderer;
-use host_demo::{read_images, upload_scene, FrameImages, FrameOutput};
+use host_demo::{read_images, FrameImages, FrameOutput};
 use passes::gpu_types::{AreaSamples, RayTraceConstants};
 use passes::prim_buffer::PrimBufferPass;
 use passes::rt_peer::{area_peer_constants, shadow_ray_constants, RtPeerPass};

@@ -289,6 +289,7 @@ fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::frames::ViewInputs;
     use glam::Vec3;
     use reference::intersect_watertight;
     use scene::{MeshBuilder, Scene};

@@ -4,6 +4,7 @@
 
 use crate::accuracy::{compare_visibility_to, view_reference};
 use crate::bench_models::median_of;
+use crate::frames::{PluginFrames, ViewInputs};
 use anyhow::{Context, Result};
 use host_demo::plugin::PluginRenderer;
 use host_demo::render::{map_bytes, median_timings};

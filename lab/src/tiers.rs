@@ -7,6 +7,7 @@
 //! no path may drop any (nothing is excused).
 
 use crate::accuracy::{compare_map, fitted_light_matrix, MapComparison};
+use crate::frames::{PluginFrames, ViewInputs};
 use anyhow::Result;
 use host_demo::plugin::PluginRenderer;
 use host_demo::View;

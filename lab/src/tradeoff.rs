@@ -6,6 +6,7 @@
 //! writes CSV, JSON, an error-against-time plot with the Pareto front marked, and a strip of error maps.
 
 use crate::accuracy::{view_reference, visibility_params};
+use crate::frames::ViewInputs;
 use crate::report::{model_view, render_frames};
 use anyhow::{bail, Context, Result};
 use host_demo::images::{write_png_compact, Canvas};

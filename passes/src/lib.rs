@@ -58,4 +58,4 @@ pub use shadow_pipeline::{
 pub use surface::{NormalEncoding, NormalSpace, SurfaceInput};
 pub use view_cull::{Casters, ViewVolume};
 
-pub use shaders::{embedded_shader, shader, shader_names};
+pub use shaders::{shader, shader_names};

@@ -10,7 +10,8 @@ mod compiled {
 
 /// SPIR-V words of the embedded shader `name` (file name in `shaders/`).
 pub fn shader(name: &str) -> Result<Vec<u32>, PassError> {
-    embedded_shader(compiled::ALL, name)
+    compiled::spirv(name)
+        .ok_or_else(|| PassError::InvalidConfig(format!("no embedded shader named {name}")))
 }
 
 /// The name of the module of shader `name` that writes its final visibility into an image of `format`:
@@ -25,16 +26,6 @@ pub fn output_variant(name: &str, format: Format) -> Result<String, PassError> {
             "{name} writes its visibility into R32_SFLOAT, R16_SFLOAT or R8_UNORM images, not {other:?}"
         ))),
     }
-}
-
-/// SPIR-V words of shader `name` in a table of embedded modules (as `shader_build` writes them).
-pub fn embedded_shader(table: &[(&str, &[u8])], name: &str) -> Result<Vec<u32>, PassError> {
-    let bytes = table
-        .iter()
-        .find(|(n, _)| *n == name)
-        .map(|(_, b)| *b)
-        .ok_or_else(|| PassError::InvalidConfig(format!("no embedded shader named {name}")))?;
-    Ok(bytemuck::pod_collect_to_vec(bytes))
 }
 
 /// Names of all embedded shader modules.

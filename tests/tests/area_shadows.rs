@@ -14,6 +14,7 @@ use common::{
 use glam::Vec3;
 use host_demo::{FrameImages, View};
 use hrts_lab::accuracy::{compare_area, AreaComparison};
+use hrts_lab::frames::ViewInputs;
 use passes::{
     AreaConfig, BinningRequest, FaceMode, FrameReport, PcssConfig, PrimitiveMapConfig,
     ShadowConfig, ShadowMode,

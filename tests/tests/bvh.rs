@@ -13,7 +13,6 @@ mod common;
 
 use common::*;
 use glam::Vec3;
-use host_demo::renderer::with_blocker_distance;
 use host_demo::{FrameImages, View};
 use passes::bvh::{BvhNode, BVH_LEAF};
 use passes::gpu_types::GpuTriangle;
@@ -23,6 +22,7 @@ use passes::{
 };
 use reference::RefScene;
 use rhi::{Barrier, Buffer, BufferUsage, Device, MemoryLocation, ResourceState as S};
+use test_support::with_blocker_distance;
 use test_support::ShadowRenderer;
 
 /// Copies `buffer` to the host.

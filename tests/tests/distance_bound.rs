@@ -45,7 +45,7 @@ impl Query {
 
 /// `distance_below` of every query, on the device.
 fn bounds_on_device(device: &Device, queries: &[Query]) -> Vec<f32> {
-    let spirv = passes::embedded_shader(shaders::ALL, "distance_bound_probe.comp").expect("probe");
+    let spirv = shaders::spirv("distance_bound_probe.comp").expect("probe");
     let pipeline = device
         .create_compute_pipeline(
             "distance bound probe",

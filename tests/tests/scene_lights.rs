@@ -594,7 +594,7 @@ fn native_point_frames(
     (0..frames)
         .map(|_| {
             let frame = plugin
-                .render_plugin_lights(device, &matrices, &[plugin_point_light(lamp)])
+                .render_lights(device, &matrices, &[plugin_point_light(lamp)])
                 .expect("frame");
             let report = &frame.lights[0];
             let (_, layers) = plugin.read_frame(device).expect("read back");
@@ -969,7 +969,7 @@ fn check_local_area(
         for _ in 0..2 {
             frame = Some(
                 plugin
-                    .render_plugin_lights(device, &matrices, &[light])
+                    .render_lights(device, &matrices, &[light])
                     .expect("frame"),
             );
         }
@@ -1151,7 +1151,7 @@ fn native_frame(
     let mut reports = Vec::new();
     for _ in 0..frames {
         reports = plugin
-            .render_plugin_lights(device, &matrices, &lights)
+            .render_lights(device, &matrices, &lights)
             .expect("frame")
             .lights;
     }

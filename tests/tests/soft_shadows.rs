@@ -11,6 +11,7 @@ use common::{
 };
 use glam::{Mat4, Vec3};
 use host_demo::{FrameImages, View};
+use hrts_lab::frames::ViewInputs;
 use passes::hybrid::{blend, lerp_factor};
 use passes::{
     BinningRequest, FrameReport, HybridConfig, Light, PassId, PassStatus, PcssConfig,

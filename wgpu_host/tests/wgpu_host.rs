@@ -6,6 +6,7 @@ use glam::{Mat4, Vec3};
 use host_demo::View;
 use hrts::{FrameReport, ShadowMode};
 use hrts_lab::accuracy::{compare_with_reference, scene_visibility_params};
+use hrts_lab::frames::ViewInputs;
 use passes::PrimitiveMapConfig;
 use reference::{reference_visibility, Light, PixelClass, RefScene, VisibilityReference};
 use scene::{Camera, DirectionalLight, Scene};

@@ -10,9 +10,9 @@
 //!   nothing;
 //! - every other light is given in mode **auto** with its size: its angular radius (directional) as
 //!   `pcss_angular_radius`, its radius (spot, point) as `pcss_spot_radius`, 0 for a zero-size light. The
-//!   plugin chooses ([`ShadowConfig::resolved`]): a **zero-size** light gets exact ray-traced hard
+//!   plugin chooses ([`hrts::LightPlan::mode`]): a **zero-size** light gets exact ray-traced hard
 //!   shadows (mode hard: no shadow map and no PCSS are allocated), a **sized** light exact soft shadows
-//!   (mode area). The plan describes the passes of the mode the plugin resolves, by the same function.
+//!   (mode area). The plan describes the passes of the mode the plugin resolves, as the plugin plans them.
 //!
 //! A shadowed light is one light of the plugin, given as a light, without a matrix:
 //! - a directional light by its direction (`HRTS_LIGHT_TYPE_DIRECTIONAL` with no matrix): the plugin

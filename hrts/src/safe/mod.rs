@@ -24,7 +24,6 @@ mod report;
 
 pub use config::Config;
 pub use context::{Context, HeadlessOptions, VulkanDevice};
-pub(crate) use enums::decode;
 pub use enums::{
     BinningPath, Faces, IndexType, LightDecision, NormalEncoding, NormalSpace, Pass, PassMask,
     PassStatus, PenumbraFilter, Resource, ResourceSet, ShadowMode,
@@ -33,7 +32,10 @@ pub use error::{Error, Result};
 pub use frame::{Frame, Light, MeshVertices, ResourceReadback, SpotFrustum, TargetImage, Targets};
 pub use geometry::{Bounds, CpuGeometry, Draw, VulkanMesh};
 pub use plan::{plan_lights, LightPlan, PlanView};
-pub use report::{Capabilities, FrameReport, MapStats, MemoryStats, PassTiming, ResourceInfo};
+pub use report::{
+    unpack_list_offsets, Capabilities, FrameReport, ListOffsets, MapStats, MemoryStats, PassTiming,
+    ResourceInfo,
+};
 
 use crate::types::{HrtsMemoryStats, HRTS_API_VERSION};
 

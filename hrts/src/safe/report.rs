@@ -248,3 +248,27 @@ pub struct MemoryStats {
     /// GPU bytes allocated by the plugin and not freed (not what the Vulkan driver keeps internally).
     pub gpu_bytes: u64,
 }
+
+/// A primitive map's list offsets, unpacked from a read-back of
+/// [`Resource::PrimListOffsets`](crate::Resource::PrimListOffsets) ([`unpack_list_offsets`]): texel `t`'s
+/// list is `entries[range(t)]` of a read-back of [`Resource::PrimListEntries`](crate::Resource::PrimListEntries).
+pub use passes::ListOffsets;
+
+/// Unpacks a read-back of [`Resource::PrimListOffsets`] (its `u32` words, the packed groups `hrts.h`
+/// describes) into every texel's list bounds, and whether its list was kept.
+///
+/// ```
+/// // One group of 16 texels whose lists hold nothing, and the final group: no entries.
+/// let offsets = hrts::unpack_list_offsets(&[0; 18])?;
+/// assert_eq!((offsets.total(), offsets.range(3)), (0, Some(0..0)));
+/// # Ok::<(), hrts::Error>(())
+/// ```
+pub fn unpack_list_offsets(words: &[u32]) -> Result<ListOffsets> {
+    passes::unpack_list_offsets(words, passes::packed_texels(words.len())).map_err(|message| {
+        super::error::Error::new(
+            "hrts::unpack_list_offsets",
+            HrtsResult::ErrorInvalidArgument,
+            message,
+        )
+    })
+}

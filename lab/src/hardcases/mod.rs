@@ -17,6 +17,7 @@
 //! cannot drift apart.
 
 use crate::accuracy::{compare_map, compare_visibility, fitted_light_matrix};
+use crate::frames::{PluginFrames, ViewInputs};
 use anyhow::{anyhow, bail, Context, Result};
 use glam::{DVec3, Mat4};
 use host_demo::gbuffer::GBufferLayout;

@@ -1,6 +1,6 @@
 //! For build scripts: compiles every GLSL shader of a folder to SPIR-V with the glslang crate (Vulkan 1.3,
 //! SPIR-V 1.6) and writes `$OUT_DIR/shaders.rs`, a table `ALL: &[(&str, &[u8])]` of the modules by file
-//! name, for `include!`. A shader that does not compile fails the build with glslang's message.
+//! name and `spirv(name)`, a module's words, for `include!`. A shader that does not compile fails the build with glslang's message.
 //!
 //! A shader whose source or includes name [`OUTPUT_FORMAT`] (the format qualifier of the image its final
 //! visibility goes into, `r32f` unless defined) is also compiled once per [`OUTPUT_FORMAT_VARIANTS`] value,
@@ -121,7 +121,19 @@ pub fn embed_shaders(dir: &Path, include_dirs: &[PathBuf]) {
             ));
         }
     }
-    table.push_str("];\n");
+    table.push_str(concat!(
+        "];\n\n",
+        "/// The SPIR-V words of the embedded module `name` (a file name), if there is one.\n",
+        "pub fn spirv(name: &str) -> Option<Vec<u32>> {\n",
+        "    let (_, bytes) = ALL.iter().find(|(n, _)| *n == name)?;\n",
+        "    Some(\n",
+        "        bytes\n",
+        "            .chunks_exact(4)\n",
+        "            .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))\n",
+        "            .collect(),\n",
+        "    )\n",
+        "}\n",
+    ));
     std::fs::write(out.join("shaders.rs"), table).expect("write shader table");
 }
 

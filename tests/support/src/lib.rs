@@ -4,12 +4,12 @@
 //! frames with it; the demo itself drives the plugin through its public API only.
 
 use host_demo::gbuffer::{GBufferLayout, GBufferPass, GBufferPush, GBufferTargets};
-use host_demo::renderer::with_blocker_distance;
 use host_demo::scene_buffers::SceneBuffers;
-use host_demo::{read_images, CameraMatrices, FrameImages, FrameOutput, View};
+use host_demo::{read_images, FrameImages, FrameOutput, View};
+use hrts_lab::frames::ViewInputs;
 use passes::{
     FrameInputs, FrameReport, PassError, PassId, ResourceId, ShadowConfig, ShadowInputs,
-    ShadowPipeline,
+    ShadowMode, ShadowPipeline,
 };
 use rhi::{Barrier, Buffer, BufferUsage, Device, Image, MemoryLocation, ResourceState as S};
 
@@ -72,7 +72,7 @@ impl ShadowRenderer {
         inputs: &FrameInputs,
     ) -> Result<FrameReport, PassError> {
         let push = GBufferPush::for_camera(
-            &CameraMatrices::of_frame(inputs),
+            &hrts_lab::frames::camera_of(inputs),
             self.scene.origin(),
             &self.targets.layout,
         )?;
@@ -87,9 +87,7 @@ impl ShadowRenderer {
             let (prim_buffer, rest) = PassId::ALL.split_at(1);
             pipeline.record_passes(enc, prim_buffer).map_err(into_rhi)?;
             enc.barriers(&targets.to_render());
-            gbuffer
-                .record(enc, targets, &push, scene)
-                .map_err(into_rhi)?;
+            gbuffer.record(enc, targets, &push, scene)?;
             enc.barriers(&[
                 Barrier::Image {
                     image: &targets.normal,
@@ -112,7 +110,8 @@ impl ShadowRenderer {
         let p = &self.pipeline;
         let mut wanted = self.targets.outputs();
         wanted.extend(FrameOutput::PIPELINE.iter().filter_map(|&(output, r)| {
-            p.image(r).map(|image| (image, S::UnorderedAccess, output))
+            p.image(hrts::passes_bridge::resource_id(r))
+                .map(|image| (image, S::UnorderedAccess, output))
         }));
         wanted.push((p.output(), S::UnorderedAccess, FrameOutput::Output));
         let images: Vec<(&Image, S)> = wanted.iter().map(|&(i, s, _)| (i, s)).collect();
@@ -177,4 +176,14 @@ fn into_rhi(e: PassError) -> rhi::RhiError {
         PassError::Rhi(r) => r,
         other => rhi::RhiError::InvalidArgument(other.to_string()),
     }
+}
+
+/// `config` asking for the ray trace's blocker distance when its mode traces rays (hard, hybrid): the
+/// tests compare blocker distances with the exact reference, and the plugin allocates them only when
+/// asked (or for the hybrid).
+pub fn with_blocker_distance(mut config: ShadowConfig) -> ShadowConfig {
+    if matches!(config.mode, ShadowMode::Hard | ShadowMode::Hybrid) {
+        config.extra_outputs = config.extra_outputs.with(ResourceId::BlockerDistance);
+    }
+    config
 }

@@ -7,6 +7,7 @@
 use glam::Vec3;
 use host_demo::{FrameImages, View};
 pub use hrts_lab::accuracy::*;
+pub use hrts_lab::frames::{PluginFrames, ViewInputs};
 use passes::{FrameReport, PrimitiveMapConfig};
 use rhi::{Device, DeviceDesc};
 use scene::{Camera, DirectionalLight, Scene};
