@@ -1,11 +1,32 @@
-//! What the command lines of `host_demo` and `hrts_lab` share: the camera options, negative numbers as
-//! people type them (`--camera-pos -5,2,3`, not only `--camera-pos=-5,2,3`), and the check of it.
+//! What the command lines of `host_demo` and `hrts_lab` share: how a program runs, the camera options,
+//! negative numbers as people type them (`--camera-pos -5,2,3`, not only `--camera-pos=-5,2,3`), and
+//! the check of it.
 
 use crate::parse_vec3;
 use anyhow::{bail, Result};
 use glam::Vec3;
 use scene::{Aabb, Camera};
 use std::any::TypeId;
+use std::process::ExitCode;
+
+/// Runs a program: logging from `RUST_LOG` (warnings by default), its command line `command()` parsed
+/// into `C` (clap's message and exit code on bad arguments), then `run`, whose error is printed as
+/// `error: ...` with exit code 1.
+pub fn main_of<C: clap::FromArgMatches>(
+    command: impl Fn() -> clap::Command,
+    run: impl FnOnce(&C) -> Result<()>,
+) -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let cli = C::from_arg_matches(&command().get_matches())
+        .unwrap_or_else(|e| e.format(&mut command()).exit());
+    match run(&cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
 
 /// Where the camera is, when not framed automatically (or, with `--scene`, taken from the file).
 #[derive(Debug, Clone, clap::Args)]

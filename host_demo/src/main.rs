@@ -1,7 +1,7 @@
 //! `host_demo`: the standalone demo of hybrid ray-traced shadows.
 
 use anyhow::{bail, Context, Result};
-use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use glam::Vec3;
 use host_demo::interior::Enclosure;
 use host_demo::render::{
@@ -434,30 +434,21 @@ fn command() -> clap::Command {
 }
 
 fn main() -> ExitCode {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    let cli = Cli::from_arg_matches(&command().get_matches())
-        .unwrap_or_else(|e| e.format(&mut command()).exit());
-    let result = match &cli.command {
-        Command::Render(args) => render(&cli, args),
+    host_demo::cli::main_of(command, |cli: &Cli| match &cli.command {
+        Command::Render(args) => render(cli, args),
         Command::Plan(args) => plan(args),
         Command::ExampleScene { out } => scene::gltf_scene::write_example_scene(out)
             .map_err(anyhow::Error::from)
             .map(|()| println!("example scene written to {}", out.display())),
         Command::LoadReport(args) => host_demo::load_report::run_cli(args),
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
-        }
-    }
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use clap::error::ErrorKind;
+    use clap::FromArgMatches;
 
     /// Every option of numbers of every subcommand takes a negative value as a separate argument.
     #[test]

@@ -1,21 +1,14 @@
 //! The demo binary as a user runs it: bad input fails with a clear message and a non-zero exit (never a
 //! panic); a render on lavapipe writes every promised output with validation on.
 
+mod common;
+
+use common::{assert_clean_failure, temp_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("hrts-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
-
 fn host_demo(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_host_demo"))
-        .args(args)
-        .output()
-        .expect("host_demo runs")
+    common::run(env!("CARGO_BIN_EXE_host_demo"), args)
 }
 
 fn render_obj(dir: &Path, obj_text: &str) -> (Output, String) {
@@ -35,17 +28,6 @@ fn render_obj(dir: &Path, obj_text: &str) -> (Output, String) {
     ]);
     let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
     (output, stderr)
-}
-
-fn assert_clean_failure(output: &Output, stderr: &str, expect: &str) {
-    assert!(
-        !output.status.success(),
-        "expected failure, stderr: {stderr}"
-    );
-    assert_eq!(output.status.code(), Some(1), "stderr: {stderr}");
-    assert!(!stderr.contains("panicked"), "panicked: {stderr}");
-    assert!(stderr.starts_with("error: "), "stderr: {stderr}");
-    assert!(stderr.contains(expect), "expected '{expect}' in: {stderr}");
 }
 
 #[test]
@@ -391,30 +373,20 @@ fn scene_render_reports_what_each_light_ran_and_kept() {
 /// Options out of range are refused before any GPU work, naming the flag, the value and the range.
 #[test]
 fn out_of_range_options_name_the_flag_and_the_range() {
-    for (args, flag, range) in [
-        (&["render", "--frames", "0"][..], "--frames", "1.."),
-        (
-            &["render", "--map-budget-mb", "0"][..],
-            "--map-budget-mb",
-            "1..",
-        ),
-        (
-            &["render", "--map-size", "0"][..],
-            "--map-size",
-            "1..=65535",
-        ),
-        (&["render", "--width", "0"][..], "--width", "1..=16384"),
-        (&["render", "--width", "-5"][..], "--width", "1..=16384"),
-    ] {
-        let output = host_demo(args);
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        assert!(!output.status.success(), "{args:?} accepted");
-        assert!(!stderr.contains("panicked"), "{stderr}");
-        assert!(
-            stderr.contains(flag) && stderr.contains(range),
-            "{args:?}: {stderr}"
-        );
-    }
+    common::assert_out_of_range_refused(
+        env!("CARGO_BIN_EXE_host_demo"),
+        &[
+            (&["render", "--frames", "0"], "--frames", "1.."),
+            (
+                &["render", "--map-budget-mb", "0"],
+                "--map-budget-mb",
+                "1..",
+            ),
+            (&["render", "--map-size", "0"], "--map-size", "1..=65535"),
+            (&["render", "--width", "0"], "--width", "1..=16384"),
+            (&["render", "--width", "-5"], "--width", "1..=16384"),
+        ],
+    );
 }
 
 /// Vector options take negative numbers as people type them (`--camera-pos -5,2,3`, not only

@@ -405,7 +405,6 @@ fn taps(value: u32, field: &str) -> ApiResult<u32> {
     }
 }
 
-/// `HrtsShadowMode` values and the modes they name (both directions use this one table).
 /// The `HrtsShadowMode` value of `mode`.
 pub(crate) fn mode_to_c(mode: ShadowMode) -> u32 {
     MODES
@@ -414,6 +413,15 @@ pub(crate) fn mode_to_c(mode: ShadowMode) -> u32 {
         .map_or(HrtsShadowMode::Auto as u32, |(c, _)| *c)
 }
 
+/// The passes' mode of `mode`.
+pub(crate) fn mode_from_c(mode: HrtsShadowMode) -> ShadowMode {
+    MODES
+        .iter()
+        .find(|(c, _)| *c == mode as u32)
+        .map_or(ShadowMode::Auto, |&(_, m)| m)
+}
+
+/// `HrtsShadowMode` values and the modes they name (both directions use this one table).
 const MODES: [(u32, ShadowMode); 6] = [
     (HrtsShadowMode::None as u32, ShadowMode::None),
     (HrtsShadowMode::Hard as u32, ShadowMode::Hard),

@@ -2,7 +2,7 @@
 //! side-by-sides, the conservative-raster tier matrix and ray dumps.
 
 use anyhow::{bail, Context, Result};
-use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use glam::Vec3;
 use host_demo::cli::CameraArgs;
 use host_demo::render::{render_to_folder, RenderOptions, SoftShadowArgs};
@@ -171,16 +171,7 @@ fn run(cli: &Cli) -> Result<()> {
 }
 
 fn main() -> ExitCode {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    let cli = Cli::from_arg_matches(&command().get_matches())
-        .unwrap_or_else(|e| e.format(&mut command()).exit());
-    match run(&cli) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
-        }
-    }
+    host_demo::cli::main_of(command, run)
 }
 
 #[cfg(test)]

@@ -2,32 +2,15 @@
 //! options take negative numbers; `bench` takes the user's own models and, off a terminal, never stays
 //! silent; `ray-dump` writes the rays `scripts/embree_compare.py` reads.
 
+#[path = "../../host_demo/tests/common/mod.rs"]
+mod common;
+
+use common::{assert_clean_failure, temp_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("hrts-lab-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
-
 fn hrts_lab(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hrts_lab"))
-        .args(args)
-        .output()
-        .expect("hrts_lab runs")
-}
-
-fn assert_clean_failure(output: &Output, stderr: &str, expect: &str) {
-    assert!(
-        !output.status.success(),
-        "expected failure, stderr: {stderr}"
-    );
-    assert_eq!(output.status.code(), Some(1), "stderr: {stderr}");
-    assert!(!stderr.contains("panicked"), "panicked: {stderr}");
-    assert!(stderr.starts_with("error: "), "stderr: {stderr}");
-    assert!(stderr.contains(expect), "expected '{expect}' in: {stderr}");
+    common::run(env!("CARGO_BIN_EXE_hrts_lab"), args)
 }
 
 /// A unit cube as six quads (12 triangles) in `dir`.
@@ -44,25 +27,15 @@ fn cube_obj(dir: &Path) -> PathBuf {
 
 #[test]
 fn out_of_range_options_name_the_flag_and_the_range() {
-    for (args, flag, range) in [
-        (&["tradeoff", "--strata", "-2"][..], "--strata", "1.."),
-        (&["bench", "--frames", "0"][..], "--frames", "1.."),
-        (
-            &["tradeoff", "--height", "99999"][..],
-            "--height",
-            "1..=16384",
-        ),
-        (&["ray-dump", "--width", "0"][..], "--width", "1..=16384"),
-    ] {
-        let output = hrts_lab(args);
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        assert!(!output.status.success(), "{args:?} accepted");
-        assert!(!stderr.contains("panicked"), "{stderr}");
-        assert!(
-            stderr.contains(flag) && stderr.contains(range),
-            "{args:?}: {stderr}"
-        );
-    }
+    common::assert_out_of_range_refused(
+        env!("CARGO_BIN_EXE_hrts_lab"),
+        &[
+            (&["tradeoff", "--strata", "-2"], "--strata", "1.."),
+            (&["bench", "--frames", "0"], "--frames", "1.."),
+            (&["tradeoff", "--height", "99999"], "--height", "1..=16384"),
+            (&["ray-dump", "--width", "0"], "--width", "1..=16384"),
+        ],
+    );
 }
 
 /// Vector options take negative numbers as people type them, each value reaching the view.

@@ -32,35 +32,28 @@ impl Resource {
 impl ShadowMode {
     /// "none", "hard", "soft", "hybrid", "area" or "auto".
     pub fn name(self) -> &'static str {
-        match self {
-            Self::None => "none",
-            Self::Hard => "hard",
-            Self::Soft => "soft",
-            Self::Hybrid => "hybrid",
-            Self::Area => "area",
-            Self::Auto => "auto",
-        }
+        crate::convert::mode_from_c(self).name()
     }
 
     /// Whether the mode traces shadow rays through the primitive map (hard, hybrid and area, and so
     /// auto).
     pub fn traces_rays(self) -> bool {
-        matches!(self, Self::Hard | Self::Hybrid | Self::Area | Self::Auto)
+        crate::convert::mode_from_c(self).traces_rays()
     }
 }
 
 impl PassStatus {
     /// Why a pass that did not run was skipped, in words (`None` for [`PassStatus::Ran`]).
     pub fn reason(self) -> Option<&'static str> {
-        match self {
-            Self::Ran => None,
-            Self::NotInPlan => Some("culled: no requested output depends on it"),
-            Self::UpToDate => Some("inputs unchanged since it last ran: earlier output reused"),
-            Self::Shared => {
-                Some("shared by the lights: built this frame by another light's passes")
-            }
-            Self::Culled => Some("the frustum holds no receiver in view within the light's range"),
-        }
+        use passes::SkipReason as R;
+        let skipped = match self {
+            Self::Ran => return None,
+            Self::NotInPlan => R::NotRequested,
+            Self::UpToDate => R::UpToDate,
+            Self::Shared => R::Shared,
+            Self::Culled => R::Culled,
+        };
+        Some(skipped.describe())
     }
 
     /// The status as the C enumeration names it, without its prefix: "RAN", "UP_TO_DATE", "SHARED",
