@@ -5,7 +5,7 @@
 //! must hold besides agreement with the exact reference ([`Check`]s that are decided analytically from the
 //! receiver positions, so that they do not depend on the reference's tolerance classification).
 //!
-//! The renderer that runs them (the `host_demo hardcases` subcommand and the `hard_cases` integration
+//! The renderer that runs them (the `hrts_lab hardcases` subcommand and the `hard_cases` integration
 //! test) lives outside this crate; this module knows nothing about GPUs.
 //!
 //! Families ([`Family`]), one submodule each:
