@@ -28,6 +28,17 @@ pub fn main_of<C: clap::FromArgMatches>(
     }
 }
 
+/// The size of the frame rendered.
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct FrameSizeArgs {
+    /// Frame width in pixels.
+    #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
+    pub width: u32,
+    /// Frame height in pixels.
+    #[arg(long, default_value_t = 720, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::limits::FRAME_SIDE)))]
+    pub height: u32,
+}
+
 /// Where the camera is, when not framed automatically (or, with `--scene`, taken from the file).
 #[derive(Debug, Clone, clap::Args)]
 pub struct CameraArgs {

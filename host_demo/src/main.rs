@@ -72,12 +72,8 @@ struct RenderArgs {
     /// Output folder.
     #[arg(long, default_value = "out")]
     out: PathBuf,
-    /// Frame width in pixels.
-    #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
-    width: u32,
-    /// Frame height in pixels.
-    #[arg(long, default_value_t = 720, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
-    height: u32,
+    #[command(flatten)]
+    size: host_demo::cli::FrameSizeArgs,
     /// Direction the light travels, "x,y,z" (default: slanted, about 34° from vertical; inside a closed
     /// model, a point light below its ceiling).
     #[arg(long, value_parser = parse_vec3)]
@@ -128,12 +124,8 @@ struct PlanArgs {
     /// glTF 2.0 scene (.gltf or .glb).
     #[arg(long)]
     scene: PathBuf,
-    /// Frame width in pixels (with the height, the aspect of the camera's view).
-    #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
-    width: u32,
-    /// Frame height in pixels.
-    #[arg(long, default_value_t = 720, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
-    height: u32,
+    #[command(flatten)]
+    size: host_demo::cli::FrameSizeArgs,
     #[command(flatten)]
     camera: host_demo::cli::CameraArgs,
     /// Primitive map size N.
@@ -211,7 +203,7 @@ fn plan(args: &PlanArgs) -> Result<()> {
     };
     let (camera, settings) = scene_setup(
         &file,
-        (args.width, args.height),
+        (args.size.width, args.size.height),
         (args.camera.camera_pos, args.camera.camera_target),
         map,
         &soft,
@@ -222,8 +214,8 @@ fn plan(args: &PlanArgs) -> Result<()> {
         "scene {}: {} triangles, {}x{} px, camera {}",
         args.scene.display(),
         file.scene.triangle_count(),
-        args.width,
-        args.height,
+        args.size.width,
+        args.size.height,
         match (
             &file.camera,
             args.camera.camera_pos.or(args.camera.camera_target)
@@ -249,7 +241,7 @@ fn render_scene(cli: &Cli, args: &RenderArgs, path: &Path) -> Result<()> {
 fn render_scene_file(cli: &Cli, args: &RenderArgs, file: &SceneFile, path: &Path) -> Result<()> {
     let (camera, settings) = scene_setup(
         file,
-        (args.width, args.height),
+        (args.size.width, args.size.height),
         (args.camera.camera_pos, args.camera.camera_target),
         map_config(args),
         &args.soft,
@@ -301,7 +293,7 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
         }
         None => scene::procedural_default(),
     };
-    let mut view = View::framed(scene, args.width, args.height);
+    let mut view = View::framed(scene, args.size.width, args.size.height);
     if let Some(camera) = interior_camera {
         view.camera = camera;
     }
@@ -341,7 +333,7 @@ fn closed_interior(model: &Scene, args: &RenderArgs) -> Result<Option<Interior>>
         ShadowMode::Hybrid | ShadowMode::Area => args.soft.angular_radius,
         _ => 0.0,
     };
-    let aspect = args.width as f32 / args.height as f32;
+    let aspect = args.size.width as f32 / args.size.height as f32;
     let inside = (
         enclosure.interior_camera(&reference, aspect),
         enclosure.interior_light(&reference, angular_radius),

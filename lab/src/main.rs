@@ -77,12 +77,8 @@ struct RayDumpArgs {
     /// Output folder.
     #[arg(long, default_value = "out")]
     out: PathBuf,
-    /// Frame width in pixels.
-    #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
-    width: u32,
-    /// Frame height in pixels.
-    #[arg(long, default_value_t = 720, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]
-    height: u32,
+    #[command(flatten)]
+    size: host_demo::cli::FrameSizeArgs,
     /// Direction the sun's light travels, "x,y,z" (default: slanted, about 34° from vertical).
     #[arg(long, value_parser = parse_vec3)]
     light_dir: Option<Vec3>,
@@ -100,7 +96,7 @@ fn ray_dump(device: &Device, args: &RayDumpArgs) -> Result<()> {
         Some(path) => scene::load_obj(path)?.with_ground_plane(),
         None => scene::procedural_default(),
     };
-    let mut view = View::framed(scene, args.width, args.height);
+    let mut view = View::framed(scene, args.size.width, args.size.height);
     if let Some(d) = args.light_dir {
         view.light =
             DirectionalLight::new(d).context("--light-dir must be a non-zero finite vector")?;
