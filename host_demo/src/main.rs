@@ -2,18 +2,18 @@
 
 use anyhow::{bail, Context, Result};
 use clap::{CommandFactory, Parser, Subcommand};
+use demo_engine::{Device, View};
 use glam::Vec3;
 use host_demo::interior::Enclosure;
+use host_demo::parse_vec3;
 use host_demo::render::{
     parse_binning, parse_faces, render_to_folder, world_space_scale_of, RenderOptions,
     SoftShadowArgs,
 };
 use host_demo::scene_plan::{held_still, plan_scene, scene_camera, PlanSettings};
 use host_demo::scene_render::render_scene_to_folder;
-use host_demo::{parse_vec3, View};
 use hrts::{BinningPath, Faces, ShadowMode};
 use reference::RefScene;
-use rhi::Device;
 use scene::{Camera, DirectionalLight, LightSize, Scene, SceneFile, SceneLight};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -256,7 +256,7 @@ fn render_scene_file(cli: &Cli, args: &RenderArgs, file: &SceneFile, path: &Path
         args.frames,
         &args.out,
     )?;
-    host_demo::check_validation(&device)
+    demo_engine::check_validation(&device)
 }
 
 fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
@@ -315,7 +315,7 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
         occupancy_view: !args.no_occupancy,
     };
     render_to_folder(&device, &view, &options, &args.out)?;
-    host_demo::check_validation(&device)
+    demo_engine::check_validation(&device)
 }
 
 /// The camera and light inside a closed model, as `render --obj` places them by default.
@@ -416,7 +416,7 @@ fn map_config(args: &RenderArgs) -> hrts::Config {
 
 /// The device chosen by the global options.
 fn device(cli: &Cli) -> Result<Device> {
-    host_demo::open_device(cli.device.clone(), cli.validation)
+    demo_engine::open_device(cli.device.clone(), cli.validation)
 }
 
 /// The command line of [`Cli`], where every option of numbers takes negative ones as people type them

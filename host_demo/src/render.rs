@@ -1,16 +1,15 @@
 //! `host_demo render`: one view of a scene through every pass its plan runs, written to a folder.
 
-use crate::gbuffer::GBufferLayout;
 use crate::images::lerp_factor_preview;
 use crate::output::{shade_preview, write_exr_rgba, write_exr_scalar, write_png};
-use crate::plugin::PluginRenderer;
-use crate::{focus_bounds, View};
 use anyhow::{Context, Result};
+use demo_engine::gbuffer::GBufferLayout;
+use demo_engine::plugin::PluginRenderer;
+use demo_engine::{focus_bounds, Device, View};
 use hrts::{
     BinningPath, Faces, FrameReport, Pass, PassStatus, PenumbraFilter, Resource, ResourceSet,
     ShadowMode,
 };
-use rhi::Device;
 use scene::Scene;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -243,6 +242,18 @@ struct DeviceJson {
     device_type: String,
 }
 
+impl DeviceJson {
+    fn of(device: &Device) -> Self {
+        let d = demo_engine::DeviceSummary::of(device);
+        Self {
+            name: d.name,
+            driver: d.driver,
+            api_version: d.api_version,
+            device_type: d.device_type,
+        }
+    }
+}
+
 #[derive(Serialize)]
 struct FrameJson {
     width: u32,
@@ -384,7 +395,6 @@ pub fn render_to_folder(
     let report = reports.last().cloned().context("no frame rendered")?;
     let mut timings = median_timings(&reports);
     let notes = add_derived_rows(&mut timings);
-    let caps = device.capabilities();
     let stats = report.stats;
     let s = &options.soft;
     let json = FrameJson {
@@ -441,12 +451,7 @@ pub fn render_to_folder(
         frames: options.frames.max(1),
         gpu_ms: timings.clone(),
         gpu_ms_notes: notes.clone(),
-        device: DeviceJson {
-            name: caps.device_name.clone(),
-            driver: caps.driver.clone(),
-            api_version: caps.api_version.clone(),
-            device_type: caps.device_type.clone(),
-        },
+        device: DeviceJson::of(device),
     };
     let text = serde_json::to_string_pretty(&json)?;
     std::fs::write(out.join("frame.json"), text)
@@ -454,7 +459,7 @@ pub fn render_to_folder(
     bar.inc(1);
     bar.finish_and_clear();
 
-    println!("{}", crate::plugin::device_banner(caps));
+    println!("{}", demo_engine::plugin::device_banner(device));
     if report.status(Pass::PrimitiveMap) == PassStatus::NotInPlan {
         println!(
             "scene: {} triangles, {}x{} px; no primitive map (the plan does not need one)",

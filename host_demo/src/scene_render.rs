@@ -3,16 +3,15 @@
 //! light's visibility, and per frame and light what ran, what was culled or reused and why, and the
 //! memory it holds.
 
-use crate::gbuffer::GBufferLayout;
 use crate::output::{write_exr_rgba, write_exr_scalar, write_png};
-use crate::plugin::{LightsFrame, PluginRenderer};
 use crate::scene_plan::{plan_scene, PlanSettings, ScenePlan};
 use crate::shading::{shade, tone_map};
-use crate::{CameraMatrices, FrameImages};
 use anyhow::{Context, Result};
+use demo_engine::gbuffer::GBufferLayout;
+use demo_engine::plugin::{LightsFrame, PluginRenderer};
+use demo_engine::{CameraMatrices, Device, FrameImages};
 use glam::Vec3;
 use hrts::{FrameReport, MapStats, Pass, PassStatus};
-use rhi::{Device, Format};
 use scene::{Camera, SceneFile};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -67,14 +66,15 @@ impl SceneRenderer {
         self.plugin.write_outputs_directly();
     }
 
-    /// The visibility image's format ([`PluginRenderer::set_output_format`]); call before the first frame.
-    pub fn set_output_format(&mut self, format: Format) {
-        self.plugin.set_output_format(format);
-    }
-
     /// The plugin driver.
     pub fn plugin(&self) -> &PluginRenderer {
         &self.plugin
+    }
+
+    /// The plugin driver, to set what it draws into before the first frame (such as
+    /// [`PluginRenderer::set_output_format`]).
+    pub fn plugin_mut(&mut self) -> &mut PluginRenderer {
+        &mut self.plugin
     }
 
     /// Renders one frame of `plan` seen through `camera`: configures the plugin with the plan's lights
@@ -520,8 +520,7 @@ pub fn render_scene_to_folder(
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let plan = plan_scene(file, camera, settings)
         .with_context(|| format!("planning {}", source.display()))?;
-    let caps = device.capabilities();
-    println!("{}", crate::plugin::device_banner(caps));
+    println!("{}", demo_engine::plugin::device_banner(device));
     println!(
         "scene {}: {} triangles, {}x{} px",
         source.display(),

@@ -1,8 +1,8 @@
 //! Accuracy of a rendered frame against the exact CPU reference, as counts: primitive-map texel lists
 //! against exact conservative binning, and ray-traced visibility against exact visibility.
 
+use demo_engine::{CameraMatrices, FrameImages, View};
 use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
-use host_demo::{CameraMatrices, FrameImages, View};
 use passes::{PrimitiveMapConfig, GUARD_WORDS};
 use reference::{
     conservative_texel_sets, overlaps_texel_with_margin, reference_visibility_with_progress,

@@ -9,8 +9,8 @@ use crate::accuracy::compare_area;
 use crate::bench_models::{frames_of, median_of, view_of, BenchArgs, BenchModel};
 use crate::frames::ViewInputs;
 use anyhow::{Context, Result};
+use demo_engine::View;
 use host_demo::render::{map_bytes, median_timings};
-use host_demo::View;
 use hrts::FrameReport;
 use passes::{AreaConfig, PcssConfig, PenumbraFilter, ShadowConfig, ShadowMapConfig, ShadowMode};
 use reference::RefScene;
@@ -66,7 +66,7 @@ fn run(
     view: &View,
     config: ShadowConfig,
     frames: u32,
-) -> Result<(host_demo::plugin::PluginRenderer, Run)> {
+) -> Result<(demo_engine::plugin::PluginRenderer, Run)> {
     let (renderer, reports) = frames_of(device, view, config, frames)?;
     let times = median_timings(&reports);
     let report = reports.last().cloned().context("no frame")?;
@@ -84,7 +84,7 @@ fn area_ms(r: &Run) -> (f64, f64) {
 /// (`None` on a device without ray tracing).
 fn peer_trace_ms(
     device: &Device,
-    renderer: &host_demo::plugin::PluginRenderer,
+    renderer: &demo_engine::plugin::PluginRenderer,
     view: &View,
     angular_radius: f32,
     samples: u32,

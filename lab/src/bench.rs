@@ -17,10 +17,10 @@ use crate::bench_models::{
 use crate::frames::{PluginFrames, ViewInputs};
 use crate::peer::run_peer;
 use anyhow::{Context, Result};
-use host_demo::gbuffer::GBufferLayout;
+use demo_engine::gbuffer::GBufferLayout;
+use demo_engine::View;
 use host_demo::progress::phase;
 use host_demo::render::{map_bytes, median_timings};
-use host_demo::View;
 use hrts::FrameReport;
 use passes::{BinningRequest, PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig};
 use reference::RefScene;
@@ -72,7 +72,7 @@ fn measure(device: &Device, model: &BenchModel, args: &BenchArgs) -> Result<Meas
         let run = run_peer(device, &renderer, &view.scene, &inputs, args.frames)?;
         let wrong = match &reference {
             Some(r) => {
-                let images = host_demo::FrameImages {
+                let images = demo_engine::FrameImages {
                     visibility: run.visibility,
                     ..renderer.read_back(device, false)?
                 };
@@ -265,7 +265,7 @@ fn run_gbuffer_bench(device: &Device, args: &BenchArgs, models: &[BenchModel]) -
             let plugin: f64 = times
                 .iter()
                 .filter(|(k, _)| {
-                    k.as_str() != "gbuffer" && k.as_str() != host_demo::plugin::SCREEN_SPACE_WALL
+                    k.as_str() != "gbuffer" && k.as_str() != demo_engine::plugin::SCREEN_SPACE_WALL
                 })
                 .fold(0.0, |total, (_, v)| total + v);
             out.push_str(&format!(
@@ -321,7 +321,7 @@ pub fn run_cli(
     } else {
         Work::Models(chosen_models(args)?)
     };
-    let device = host_demo::open_device(device_filter, validation)?;
+    let device = demo_engine::open_device(device_filter, validation)?;
     warm_up(&device, args)?;
     let tables = match &work {
         Work::Lights(scenes) => crate::light_bench::run_light_bench(&device, args, scenes)?,
@@ -335,7 +335,7 @@ pub fn run_cli(
     if let Some(path) = out {
         std::fs::write(path, &tables).with_context(|| format!("writing {}", path.display()))?;
     }
-    host_demo::check_validation(&device)
+    demo_engine::check_validation(&device)
 }
 
 /// What `bench` measures.

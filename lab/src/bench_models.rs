@@ -4,11 +4,11 @@
 
 use crate::frames::{PluginFrames, ViewInputs};
 use anyhow::{bail, Context, Result};
+use demo_engine::gbuffer::GBufferLayout;
+use demo_engine::plugin::PluginRenderer;
+use demo_engine::View;
 use glam::Vec3;
-use host_demo::gbuffer::GBufferLayout;
-use host_demo::plugin::PluginRenderer;
 use host_demo::progress::phase;
-use host_demo::View;
 use hrts::passes_bridge;
 use hrts::FrameReport;
 use passes::{PrimitiveMapConfig, ShadowConfig};

@@ -4,13 +4,14 @@
 
 use crate::frames::{PluginFrames, ViewInputs};
 use anyhow::{bail, Context, Result};
+use demo_engine::plugin::PluginRenderer;
+use demo_engine::FrameImages;
+use demo_engine::View;
 use glam::Vec3;
 use host_demo::images::{lerp_factor_preview, write_png_compact, Canvas};
 use host_demo::output::{shade_preview, write_png};
-use host_demo::plugin::PluginRenderer;
+use host_demo::parse_vec3;
 use host_demo::render::{default_world_space_scale, median_timings};
-use host_demo::FrameImages;
-use host_demo::{parse_vec3, View};
 use hrts::passes_bridge;
 use passes::{
     HybridConfig, PcssConfig, PenumbraFilter, PrimitiveMapConfig, ResourceId, ResourceSet,
@@ -203,9 +204,9 @@ pub fn run_cli(device_filter: Option<String>, validation: bool, args: &CompareAr
     if args.width == 0 || args.height == 0 {
         bail!("--width and --height must be positive");
     }
-    let device = host_demo::open_device(device_filter, validation)?;
+    let device = demo_engine::open_device(device_filter, validation)?;
     compare_to_folder(&device, args)?;
-    host_demo::check_validation(&device)
+    demo_engine::check_validation(&device)
 }
 
 /// Renders every panel of the procedural scene and writes the pictures, the composite and the caption.

@@ -4,9 +4,9 @@
 //! ([`View::camera_matrices`], [`View::plugin_light`], [`PluginRenderer::render_light`]).
 
 use anyhow::Result;
+use demo_engine::plugin::PluginRenderer;
+use demo_engine::{frame_origin, CameraMatrices, View};
 use glam::Mat4;
-use host_demo::plugin::PluginRenderer;
-use host_demo::{frame_origin, CameraMatrices, View};
 use passes::{Draw, FrameInputs, Geometry, Light, PassError};
 use rhi::Device;
 use scene::Scene;

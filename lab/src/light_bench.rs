@@ -11,12 +11,12 @@
 
 use crate::bench_models::{keep_only, models_folder, BenchArgs};
 use anyhow::{bail, Context, Result};
+use demo_engine::gbuffer::GBufferLayout;
+use demo_engine::plugin::{LightsFrame, PluginRenderer};
+use demo_engine::CameraMatrices;
 use glam::Vec3;
-use host_demo::gbuffer::GBufferLayout;
-use host_demo::plugin::{LightsFrame, PluginRenderer};
 use host_demo::scene_plan::{plan_scene, PlanSettings};
 use host_demo::scene_render::{median, SceneRenderer};
-use host_demo::CameraMatrices;
 use hrts::passes_bridge;
 use hrts::MapStats;
 use passes::{
@@ -341,7 +341,9 @@ fn measure_light(
     let plan = plan_scene(file, camera, &settings)?;
     let progress = host_demo::progress::phase("frames", u64::from(args.frames.max(2)));
     let mut renderer = SceneRenderer::new(device, file, args.width, args.height)?;
-    renderer.set_output_format(args.output_format());
+    renderer
+        .plugin_mut()
+        .set_output_format(args.output_format());
     if !args.copied_output {
         renderer.write_outputs_directly();
     }

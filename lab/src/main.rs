@@ -3,10 +3,11 @@
 
 use anyhow::{bail, Context, Result};
 use clap::{CommandFactory, Parser, Subcommand};
+use demo_engine::View;
 use glam::Vec3;
 use host_demo::cli::CameraArgs;
+use host_demo::parse_vec3;
 use host_demo::render::{render_to_folder, RenderOptions, SoftShadowArgs};
-use host_demo::{parse_vec3, View};
 use hrts_lab::frames::ViewInputs;
 use rhi::Device;
 use scene::DirectionalLight;
@@ -127,7 +128,7 @@ fn command() -> clap::Command {
 }
 
 fn run(cli: &Cli) -> Result<()> {
-    let device = || host_demo::open_device(cli.device.clone(), cli.validation);
+    let device = || demo_engine::open_device(cli.device.clone(), cli.validation);
     match &cli.command {
         Command::Hardcases(args) => {
             hrts_lab::hardcases::run_cli(cli.device.clone(), cli.validation, args)
@@ -161,7 +162,7 @@ fn run(cli: &Cli) -> Result<()> {
         Command::RayDump(args) => {
             let d = device()?;
             ray_dump(&d, args)?;
-            host_demo::check_validation(&d)
+            demo_engine::check_validation(&d)
         }
     }
 }

@@ -7,8 +7,8 @@
 
 use crate::frames::upload_scene;
 use anyhow::{Context as _, Result};
-use host_demo::plugin::PluginRenderer;
-use host_demo::{read_images, FrameImages, FrameOutput};
+use demo_engine::plugin::PluginRenderer;
+use demo_engine::{read_images, FrameImages, FrameOutput};
 use passes::gpu_types::{AreaSamples, RayTraceConstants};
 use passes::prim_buffer::PrimBufferPass;
 use passes::rt_peer::{area_peer_constants, shadow_ray_constants, RtPeerPass};

@@ -23,8 +23,8 @@
 
 use crate::accuracy::{absolute_tolerance, tolerance_per_distance};
 use anyhow::{bail, Context, Result};
+use demo_engine::View;
 use glam::{DVec3, DVec4};
-use host_demo::View;
 use passes::ray_trace::{RAY_OFFSET_FLOAT_BOUND, RAY_OFFSET_PIXELS};
 use passes::FrameInputs;
 use reference::{reference_visibility_with_progress, PixelClass, RefScene, VisibilityParams};

@@ -6,9 +6,9 @@ use crate::accuracy::{compare_visibility_to, view_reference};
 use crate::bench_models::median_of;
 use crate::frames::{PluginFrames, ViewInputs};
 use anyhow::{Context, Result};
-use host_demo::plugin::PluginRenderer;
+use demo_engine::plugin::PluginRenderer;
+use demo_engine::View;
 use host_demo::render::{map_bytes, median_timings};
-use host_demo::View;
 use hrts::passes_bridge;
 use passes::{
     PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig, ShadowMapConfig, ShadowMode,
@@ -49,7 +49,7 @@ fn render(
     config: ShadowConfig,
     frames: u32,
 ) -> Result<(
-    host_demo::FrameImages,
+    demo_engine::FrameImages,
     std::collections::BTreeMap<String, f64>,
     u64,
 )> {
@@ -64,7 +64,7 @@ pub fn render_frames(
     view: &View,
     config: ShadowConfig,
     frames: u32,
-) -> Result<(host_demo::FrameImages, Vec<hrts::FrameReport>)> {
+) -> Result<(demo_engine::FrameImages, Vec<hrts::FrameReport>)> {
     let progress = host_demo::progress::phase("frames", u64::from(frames.max(2)));
     let mut r = PluginRenderer::new(device, view, passes_bridge::config(&config)?)?;
     let inputs = view.frame_inputs();

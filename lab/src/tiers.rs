@@ -9,8 +9,8 @@
 use crate::accuracy::{compare_map, fitted_light_matrix, MapComparison};
 use crate::frames::{PluginFrames, ViewInputs};
 use anyhow::Result;
-use host_demo::plugin::PluginRenderer;
-use host_demo::View;
+use demo_engine::plugin::PluginRenderer;
+use demo_engine::View;
 use hrts::passes_bridge;
 use passes::{choose_binning_path, BinningRequest, FaceMode, PrimitiveMapConfig};
 use reference::{FaceSelection, RefScene};

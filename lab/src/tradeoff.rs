@@ -9,10 +9,10 @@ use crate::accuracy::{view_reference, visibility_params};
 use crate::frames::ViewInputs;
 use crate::report::{model_view, render_frames};
 use anyhow::{bail, Context, Result};
+use demo_engine::View;
 use host_demo::images::{write_png_compact, Canvas};
 use host_demo::output::shade_preview;
 use host_demo::render::median_timings;
-use host_demo::View;
 use passes::{
     AreaConfig, HybridConfig, PcssConfig, PenumbraFilter, PrimitiveMapConfig, ResourceId,
     ResourceSet, ShadowConfig, ShadowMapConfig, ShadowMode,

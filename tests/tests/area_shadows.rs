@@ -11,8 +11,8 @@ mod common;
 use common::{
     assert_exact_area, assert_no_validation_errors, axis_boxes, device, plate_and_box_view, GROUND,
 };
+use demo_engine::{FrameImages, View};
 use glam::Vec3;
-use host_demo::{FrameImages, View};
 use hrts_lab::accuracy::{compare_area, AreaComparison};
 use hrts_lab::frames::ViewInputs;
 use passes::{

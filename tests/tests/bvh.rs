@@ -12,8 +12,8 @@
 mod common;
 
 use common::*;
+use demo_engine::{FrameImages, View};
 use glam::Vec3;
-use host_demo::{FrameImages, View};
 use passes::bvh::{BvhNode, BVH_LEAF};
 use passes::gpu_types::GpuTriangle;
 use passes::{

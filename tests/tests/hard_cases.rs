@@ -18,7 +18,7 @@
 mod common;
 
 use common::{assert_no_validation_errors, device, models};
-use host_demo::gbuffer::GBufferLayout;
+use demo_engine::gbuffer::GBufferLayout;
 use hrts_lab::hardcases::{run_cases, table, Outcome};
 use rhi::Device;
 use scene::hard_cases::{family, Expectation, Family};
@@ -183,7 +183,7 @@ fn overflow_keeps_the_guard_layer_and_exact_visibility() {
 #[test]
 fn grazing_and_contact_cases_hold_with_every_normal_encoding() {
     let device = device();
-    for (name, ..) in host_demo::gbuffer::NORMAL_TARGETS.iter().skip(1) {
+    for (name, ..) in demo_engine::gbuffer::NORMAL_TARGETS.iter().skip(1) {
         let layout = GBufferLayout::analysis_with(name).expect("a named normal target");
         for f in [Family::Grazing, Family::Contact, Family::Coplanar] {
             println!("normals {name}, {}", f.name());

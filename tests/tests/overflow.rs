@@ -6,7 +6,7 @@
 mod common;
 
 use common::*;
-use host_demo::{FrameImages, View};
+use demo_engine::{FrameImages, View};
 use passes::{
     FrameInputs, PrimitiveMapConfig, ResourceId, ResourceSet, ShadowConfig, GUARD_VALUE,
     GUARD_WORDS, MIN_ENTRY_BUDGET,

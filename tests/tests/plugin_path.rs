@@ -1,12 +1,12 @@
-//! The demo drives the plugin through its C ABI (`host_demo::plugin::PluginRenderer`). Its frames equal,
+//! The demo drives the plugin through its C ABI (`demo_engine::plugin::PluginRenderer`). Its frames equal,
 //! bit for bit, the frames of the Rust passes driven directly (`test_support::ShadowRenderer`), for every
 //! output both produce, and its report says the same: what the demo shows is what integrators get.
 
 mod common;
 
 use common::*;
-use host_demo::plugin::PluginRenderer;
-use host_demo::{FrameImages, View};
+use demo_engine::plugin::PluginRenderer;
+use demo_engine::{FrameImages, View};
 use passes::{
     BinningRequest, FrameReport, PassId, PassStatus, PrimitiveMapConfig, ResourceId, ResourceSet,
     ShadowConfig, ShadowMode, SkipReason,
@@ -291,8 +291,8 @@ fn compact_gbuffer_reads_back_as_the_analysis_one_and_shadows_exactly() {
         ..hrts::Config::default()
     };
     let layouts = [
-        host_demo::gbuffer::GBufferLayout::ANALYSIS,
-        host_demo::gbuffer::GBufferLayout::compact(&device),
+        demo_engine::gbuffer::GBufferLayout::ANALYSIS,
+        demo_engine::gbuffer::GBufferLayout::compact(&device),
     ];
     let images: Vec<FrameImages> = layouts
         .iter()

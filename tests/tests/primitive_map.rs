@@ -6,7 +6,7 @@
 mod common;
 
 use common::*;
-use host_demo::View;
+use demo_engine::View;
 use passes::{choose_binning_path, BinningRequest, FaceMode, PrimitiveMapConfig};
 use reference::{FaceSelection, RefScene};
 

@@ -9,8 +9,8 @@
 mod common;
 
 use common::*;
-use host_demo::plugin::PluginRenderer;
-use host_demo::{FrameImages, View};
+use demo_engine::plugin::PluginRenderer;
+use demo_engine::{FrameImages, View};
 use hrts_lab::peer::{run_area_peer, run_peer};
 use passes::{AreaConfig, PassError, PcssConfig, PrimitiveMapConfig, ShadowConfig, ShadowMode};
 use reference::RefScene;

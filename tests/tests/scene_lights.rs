@@ -13,13 +13,13 @@ use common::{
     assert_exact_area, assert_exact_visibility, assert_no_validation_errors,
     compare_with_reference, device, scene_visibility_params,
 };
+use demo_engine::plugin::{LightsFrame, PluginRenderer};
+use demo_engine::CameraMatrices;
 use glam::Vec3;
-use host_demo::plugin::{LightsFrame, PluginRenderer};
 use host_demo::scene_plan::{
     plan_scene, scene_camera, LightDecision, NoPassReason, PlanSettings, ScenePlan,
 };
 use host_demo::scene_render::SceneRenderer;
-use host_demo::CameraMatrices;
 use hrts::{Config, ShadowMode};
 use hrts_lab::accuracy::{compare_area_counts, AreaComparison};
 use reference::{local_area_reference, reference_visibility, RefScene};
@@ -1371,7 +1371,7 @@ fn plugin_for(device: &Device, file: &SceneFile) -> PluginRenderer {
         &file.scene,
         WIDTH,
         HEIGHT,
-        host_demo::gbuffer::GBufferLayout::ANALYSIS,
+        demo_engine::gbuffer::GBufferLayout::ANALYSIS,
     )
     .expect("plugin")
 }

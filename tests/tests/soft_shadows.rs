@@ -9,8 +9,8 @@ use common::{
     absolute_tolerance, assert_no_validation_errors, device, plate_and_box_view,
     tolerance_per_distance,
 };
+use demo_engine::{FrameImages, View};
 use glam::{Mat4, Vec3};
-use host_demo::{FrameImages, View};
 use hrts_lab::frames::ViewInputs;
 use passes::hybrid::{blend, lerp_factor};
 use passes::{

@@ -2,8 +2,8 @@
 //! same scene and light, under every convention the renderer may pick, and with instances that move, all
 //! against the exact CPU reference (mismatches as counts).
 
+use demo_engine::View;
 use glam::{Mat4, Vec3};
-use host_demo::View;
 use hrts::{FrameReport, ShadowMode};
 use hrts_lab::accuracy::{compare_with_reference, scene_visibility_params};
 use hrts_lab::frames::ViewInputs;

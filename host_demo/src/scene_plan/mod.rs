@@ -385,7 +385,7 @@ pub fn held_still(file: &SceneFile) -> SceneFile {
 /// every scene.
 pub fn scene_camera(file: &SceneFile, aspect: f32) -> Camera {
     file.camera
-        .unwrap_or_else(|| Camera::frame(&crate::focus_bounds(&file.scene), aspect))
+        .unwrap_or_else(|| Camera::frame(&demo_engine::focus_bounds(&file.scene), aspect))
 }
 
 /// Derives the plan of `file` seen through `camera`.

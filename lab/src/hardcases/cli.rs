@@ -2,7 +2,7 @@
 
 use super::{run_cases, Outcome};
 use anyhow::{bail, Result};
-use host_demo::gbuffer::GBufferLayout;
+use demo_engine::gbuffer::GBufferLayout;
 use scene::hard_cases::{Family, HardCase};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -47,7 +47,7 @@ pub fn run_cli(
     args: &HardcasesArgs,
 ) -> Result<()> {
     let validation = validation || rhi::DeviceDesc::from_env().validation;
-    let device = host_demo::open_device(device_filter, validation)?;
+    let device = demo_engine::open_device(device_filter, validation)?;
     let families = if args.family.is_empty() {
         Family::ALL.to_vec()
     } else {

@@ -19,11 +19,11 @@
 use crate::accuracy::{compare_map, compare_visibility, fitted_light_matrix};
 use crate::frames::{PluginFrames, ViewInputs};
 use anyhow::{anyhow, bail, Context, Result};
+use demo_engine::gbuffer::GBufferLayout;
+use demo_engine::plugin::PluginRenderer;
+use demo_engine::{FrameImages, View};
 use glam::{DVec3, Mat4};
-use host_demo::gbuffer::GBufferLayout;
 use host_demo::output::write_png;
-use host_demo::plugin::PluginRenderer;
-use host_demo::{FrameImages, View};
 use hrts::passes_bridge;
 use passes::{
     BinningRequest, FaceMode, FrameInputs, Light, PrimitiveMapConfig, DEFAULT_ENTRY_BUDGET,

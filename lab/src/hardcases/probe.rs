@@ -2,8 +2,8 @@
 //! margin of the checks at each receiver.
 
 use crate::accuracy::absolute_tolerance;
+use demo_engine::{FrameImages, View};
 use glam::{DMat4, DVec2, DVec3};
-use host_demo::{FrameImages, View};
 use passes::FrameInputs;
 use reference::{certainly_blocked, contact_shadow_start};
 use scene::hard_cases::Solid;

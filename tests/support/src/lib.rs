@@ -3,9 +3,9 @@
 //! every output its plan produced. The integration tests and wgpu_host's tests compare the plugin's C ABI
 //! frames with it; the demo itself drives the plugin through its public API only.
 
-use host_demo::gbuffer::{GBufferLayout, GBufferPass, GBufferPush, GBufferTargets};
-use host_demo::scene_buffers::SceneBuffers;
-use host_demo::{read_images, FrameImages, FrameOutput, View};
+use demo_engine::gbuffer::{GBufferLayout, GBufferPass, GBufferPush, GBufferTargets};
+use demo_engine::scene_buffers::SceneBuffers;
+use demo_engine::{read_images, FrameImages, FrameOutput, View};
 use hrts_lab::frames::ViewInputs;
 use passes::{
     FrameInputs, FrameReport, PassError, PassId, ResourceId, ShadowConfig, ShadowInputs,

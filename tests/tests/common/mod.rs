@@ -4,8 +4,8 @@
 // Each test binary uses only part of the harness.
 #![allow(dead_code, unused_imports)]
 
+use demo_engine::{FrameImages, View};
 use glam::Vec3;
-use host_demo::{FrameImages, View};
 pub use hrts_lab::accuracy::*;
 pub use hrts_lab::frames::{PluginFrames, ViewInputs};
 use passes::{FrameReport, PrimitiveMapConfig};

@@ -3,7 +3,7 @@
 //!
 //! Reads: the scene's index and vertex buffers ([`SceneBuffers`]). Writes: the targets of its [`GBufferLayout`]. Shaders: `gbuffer.vert`
 //! and `gbuffer.frag` (analysis), `gbuffer_encoded.frag` (analysis and an encoded normal target),
-//! `gbuffer_compact.frag` (depth and the encoded normal alone) in `host_demo/shaders/`.
+//! `gbuffer_compact.frag` (depth and the encoded normal alone) in `demo_engine/shaders/`.
 
 use crate::scene_buffers::SceneBuffers;
 use crate::{shader, CameraMatrices, FrameImages};

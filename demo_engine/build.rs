@@ -1,5 +1,5 @@
-//! Compiles the demo's GLSL shaders in `shaders/` (the G-buffer) to SPIR-V and embeds the modules (see
-//! `shader_build`). Includes resolve in `shaders/`: the demo's shaders read its own buffers alone.
+//! Compiles the engine's GLSL shaders in `shaders/` (the G-buffer) to SPIR-V and embeds the modules (see
+//! `shader_build`). Includes resolve in `shaders/`: the engine's shaders read its own buffers alone.
 
 fn main() {
     let manifest = std::path::PathBuf::from(

@@ -1,4 +1,4 @@
-// The scene's meshes as the demo keeps them (host_demo::scene_buffers): tightly packed f32 world positions
+// The scene's meshes as the demo keeps them (demo_engine::scene_buffers): tightly packed f32 world positions
 // (drawn through its u32 index buffer) and an f32 xyz unit normal per triangle. Needs the includer's `pc`
 // (GBufferPush).
 layout(set = 0, binding = 0) readonly buffer Positions { float positions[]; };

@@ -33,7 +33,8 @@ pub fn with_blocker_distance(mut config: hrts::Config) -> hrts::Config {
 }
 
 /// The line the demo's commands print first: the device and the plugin's API version.
-pub fn device_banner(caps: &rhi::Capabilities) -> String {
+pub fn device_banner(device: &Device) -> String {
+    let caps = device.capabilities();
     format!(
         "device: {} ({}, {}); shadows through the plugin's C ABI, {}",
         caps.device_name,

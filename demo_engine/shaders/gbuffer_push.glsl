@@ -1,4 +1,4 @@
-// Mirrors host_demo::gbuffer::GBufferPush (144 bytes).
+// Mirrors demo_engine::gbuffer::GBufferPush (144 bytes).
 struct GBufferPush {
     mat4 view_proj_rel;     // proj * view with the camera at the origin
     vec4 camera_pos;        // xyz: camera in frame coordinates, w: the engine normal's code (gbuffer_surface.glsl)
