@@ -1,7 +1,6 @@
 //! What the demo reads back of a frame: the G-buffer and the plugin's outputs ([`FrameImages`]), and the
 //! read-back itself.
 
-use crate::gbuffer::GBufferTargets;
 use glam::DVec3;
 use hrts::Resource;
 use rhi::{Barrier, BufferUsage, Device, Image, MemoryLocation, ResourceState as S, RhiError};
@@ -38,45 +37,6 @@ pub struct FrameImages {
     pub hybrid: Vec<f32>,
     /// The final output: the layer of the light in the output image.
     pub output: Vec<f32>,
-}
-
-impl GBufferTargets {
-    /// The G-buffer images read back, their state after a frame, and where they go in [`FrameImages`]:
-    /// the analysis targets and the depth (none for a compact G-buffer).
-    pub fn outputs(&self) -> Vec<(&Image, S, FrameOutput)> {
-        let (Some(position), Some(normal)) = (self.position(), self.world_normal()) else {
-            return Vec::new();
-        };
-        let normal_state = if std::ptr::eq(normal, &self.normal) {
-            S::ShaderResource
-        } else {
-            S::RenderTarget
-        };
-        vec![
-            (position, S::RenderTarget, FrameOutput::Position),
-            (normal, normal_state, FrameOutput::Normal),
-            (&self.depth, S::ShaderResource, FrameOutput::Depth),
-        ]
-    }
-
-    /// Barriers taking every target from undefined contents to its rendering state.
-    pub fn to_render(&self) -> Vec<Barrier<'_>> {
-        let mut barriers: Vec<Barrier<'_>> = self
-            .colors()
-            .into_iter()
-            .map(|image| Barrier::Image {
-                image,
-                before: S::Undefined,
-                after: S::RenderTarget,
-            })
-            .collect();
-        barriers.push(Barrier::Image {
-            image: &self.depth,
-            before: S::Undefined,
-            after: S::DepthWrite,
-        });
-        barriers
-    }
 }
 
 /// Copies `images` (each in the given state, restored afterwards) into host buffers, waits, and returns

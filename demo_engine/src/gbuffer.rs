@@ -5,15 +5,27 @@
 //! and `gbuffer.frag` (analysis), `gbuffer_encoded.frag` (analysis and an encoded normal target),
 //! `gbuffer_compact.frag` (depth and the encoded normal alone) in `demo_engine/shaders/`.
 
+use crate::frame_images::{FrameImages, FrameOutput};
 use crate::scene_buffers::SceneBuffers;
-use crate::{shader, CameraMatrices, FrameImages};
+use crate::view::CameraMatrices;
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, Mat3, Mat4, Vec4};
 use hrts::{NormalEncoding, NormalSpace};
 use rhi::{
-    BindGroup, BindingKind, ColorTarget, DepthState, DepthTarget, Device, Encoder, Format,
-    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, ImageUsage, Resource, RhiError,
+    Barrier, BindGroup, BindingKind, ColorTarget, DepthState, DepthTarget, Device, Encoder, Format,
+    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, ImageUsage, Resource,
+    ResourceState as S, RhiError,
 };
+
+mod shaders {
+    include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
+}
+
+/// SPIR-V words of the engine's embedded shader `name` (file name in `demo_engine/shaders/`).
+fn shader(name: &str) -> Result<Vec<u32>, RhiError> {
+    shaders::spirv(name)
+        .ok_or_else(|| RhiError::InvalidArgument(format!("no embedded shader named {name}")))
+}
 
 /// Push constants of the G-buffer (`gbuffer_push.glsl`).
 #[repr(C)]
@@ -296,6 +308,43 @@ impl GBufferTargets {
             .as_ref()
             .map(|a| a.normal.as_ref().unwrap_or(&self.normal))
     }
+
+    /// The G-buffer images read back, their state after a frame, and where they go in [`FrameImages`]:
+    /// the analysis targets and the depth (none for a compact G-buffer).
+    pub fn outputs(&self) -> Vec<(&Image, S, FrameOutput)> {
+        let (Some(position), Some(normal)) = (self.position(), self.world_normal()) else {
+            return Vec::new();
+        };
+        let normal_state = if std::ptr::eq(normal, &self.normal) {
+            S::ShaderResource
+        } else {
+            S::RenderTarget
+        };
+        vec![
+            (position, S::RenderTarget, FrameOutput::Position),
+            (normal, normal_state, FrameOutput::Normal),
+            (&self.depth, S::ShaderResource, FrameOutput::Depth),
+        ]
+    }
+
+    /// Barriers taking every target from undefined contents to its rendering state.
+    pub fn to_render(&self) -> Vec<Barrier<'_>> {
+        let mut barriers: Vec<Barrier<'_>> = self
+            .colors()
+            .into_iter()
+            .map(|image| Barrier::Image {
+                image,
+                before: S::Undefined,
+                after: S::RenderTarget,
+            })
+            .collect();
+        barriers.push(Barrier::Image {
+            image: &self.depth,
+            before: S::Undefined,
+            after: S::DepthWrite,
+        });
+        barriers
+    }
 }
 
 /// The G-buffer pass over the scene's buffers.
@@ -436,4 +485,29 @@ pub fn decode_compact(
     }
     frame.depth = depth;
     Ok(frame)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_demo_shader_is_embedded_spirv() {
+        let names: Vec<&str> = shaders::ALL.iter().map(|(n, _)| *n).collect();
+        assert_eq!(
+            names,
+            [
+                "gbuffer.frag",
+                "gbuffer.vert",
+                "gbuffer_compact.frag",
+                "gbuffer_encoded.frag"
+            ]
+        );
+        for n in names {
+            let words = shader(n).unwrap();
+            assert!(words.len() > 5, "{n} is too short for a SPIR-V module");
+            assert_eq!(words[0], 0x0723_0203, "{n} lacks the SPIR-V magic number");
+        }
+        assert!(shader("gbuffer.comp").is_err());
+    }
 }

@@ -32,23 +32,6 @@ pub fn with_blocker_distance(mut config: hrts::Config) -> hrts::Config {
     config
 }
 
-/// The line the demo's commands print first: the device and the plugin's API version.
-pub fn device_banner(device: &Device) -> String {
-    let caps = device.capabilities();
-    format!(
-        "device: {} ({}, {}); shadows through the plugin's C ABI, {}",
-        caps.device_name,
-        caps.device_type,
-        caps.driver,
-        api_version()
-    )
-}
-
-/// "libhrts API major.minor.patch", as the loaded library reports it.
-pub fn api_version() -> String {
-    format!("libhrts API {}", hrts::api_version())
-}
-
 /// What a frame of several lights did.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LightsFrame {
@@ -154,14 +137,14 @@ impl PluginRenderer {
             bail!("no object of the scene casts shadows: the plugin needs at least one caster");
         }
         let scene = SceneBuffers::upload(device, scene).context("uploading the scene")?;
-        let gbuffer = GBufferPass::new(device, &scene, &layout)?;
-        let targets = GBufferTargets::new(device, width, height, layout)?;
-        let context = create_context(device)?;
         let draws = scene.caster_draws(casters);
-        let mesh = scene.plugin_mesh(&draws, &bounds);
+        let mesh = scene.plugin_mesh(&draws, plugin_bounds(&bounds));
+        let context = create_context(device)?;
         // SAFETY: the buffers are the demo device's, of their sizes; they live as long as the renderer,
         // which drops the context first.
         unsafe { context.set_geometry_vulkan(&[mesh]) }?;
+        let gbuffer = GBufferPass::new(device, &scene, &layout)?;
+        let targets = GBufferTargets::new(device, width, height, layout)?;
         Ok(Self {
             context,
             scene,
@@ -523,7 +506,7 @@ fn target_image(image: &Image) -> hrts::TargetImage {
 }
 
 /// The plugin's bounds of `bounds`.
-pub(crate) fn plugin_bounds(bounds: &Aabb) -> hrts::Bounds {
+fn plugin_bounds(bounds: &Aabb) -> hrts::Bounds {
     hrts::Bounds {
         min: bounds.min,
         max: bounds.max,

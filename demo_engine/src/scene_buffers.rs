@@ -6,7 +6,7 @@
 use anyhow::{Context as _, Result};
 use glam::{DVec3, Vec3};
 use rhi::{Buffer, BufferUsage, Device};
-use scene::{Aabb, Scene};
+use scene::Scene;
 
 /// The scene's vertex, index and normal buffers, its draws and its frame origin.
 pub struct SceneBuffers {
@@ -109,7 +109,11 @@ impl SceneBuffers {
     /// The scene as the plugin takes it: one mesh of these buffers with `draws`
     /// ([`SceneBuffers::caster_draws`]), bounded by `bounds` (which enclose them; the plugin's frame origin
     /// is their centre).
-    pub fn plugin_mesh<'a>(&self, draws: &'a [hrts::Draw], bounds: &Aabb) -> hrts::VulkanMesh<'a> {
+    pub fn plugin_mesh<'a>(
+        &self,
+        draws: &'a [hrts::Draw],
+        bounds: hrts::Bounds,
+    ) -> hrts::VulkanMesh<'a> {
         hrts::VulkanMesh {
             vertex_buffer: self.vertices.raw_handle(),
             vertex_buffer_size: self.vertices.size(),
@@ -122,7 +126,7 @@ impl SceneBuffers {
             index_type: hrts::IndexType::Uint32,
             index_count: self.index_count,
             draws,
-            bounds: crate::plugin::plugin_bounds(bounds),
+            bounds,
             vertex_format: 0,
             position_scale: Vec3::ZERO,
             position_offset: Vec3::ZERO,

@@ -24,6 +24,7 @@ pub mod load_report;
 pub mod output;
 pub mod progress;
 pub mod render;
+pub mod report_text;
 pub mod scene_plan;
 pub mod scene_render;
 pub mod shading;

@@ -10,7 +10,7 @@ use host_demo::render::{
     parse_binning, parse_faces, render_to_folder, world_space_scale_of, RenderOptions,
     SoftShadowArgs,
 };
-use host_demo::scene_plan::{held_still, plan_scene, scene_camera, PlanSettings};
+use host_demo::scene_plan::{held_still, plan_view, PlanSettings};
 use host_demo::scene_render::render_scene_to_folder;
 use hrts::{BinningPath, Faces, ShadowMode};
 use reference::RefScene;
@@ -161,33 +161,21 @@ fn load_scene(path: &Path, still: bool) -> Result<SceneFile> {
     Ok(file)
 }
 
-/// The camera and plan settings of a scene for a `width` x `height` frame.
-fn scene_setup(
+/// The plan settings of `file` for a `width` x `height` frame, with the command line's configuration.
+fn scene_settings(
     file: &SceneFile,
     (width, height): (u32, u32),
-    (position, target): (Option<Vec3>, Option<Vec3>),
     map: hrts::Config,
     soft: &SoftShadowArgs,
-) -> Result<(Camera, PlanSettings)> {
+) -> Result<PlanSettings> {
     if width == 0 || height == 0 {
         bail!("--width and --height must be positive");
     }
-    let aspect = width as f32 / height as f32;
-    let camera = host_demo::cli::camera_with(
-        scene_camera(file, aspect),
-        &file.scene.bounds(),
-        position,
-        target,
-    )?;
-    let base = soft.config(map, world_space_scale_of(&file.scene));
-    Ok((
-        camera,
-        PlanSettings {
-            base,
-            width,
-            height,
-        },
-    ))
+    Ok(PlanSettings {
+        base: soft.config(map, world_space_scale_of(&file.scene)),
+        width,
+        height,
+    })
 }
 
 fn plan(args: &PlanArgs) -> Result<()> {
@@ -201,15 +189,14 @@ fn plan(args: &PlanArgs) -> Result<()> {
         map_size: args.map_size,
         ..hrts::Config::default()
     };
-    let (camera, settings) = scene_setup(
+    let settings = scene_settings(&file, (args.size.width, args.size.height), map, &soft)?;
+    let (_, plan) = plan_view(
         &file,
-        (args.size.width, args.size.height),
-        (args.camera.camera_pos, args.camera.camera_target),
-        map,
-        &soft,
-    )?;
-    let plan = plan_scene(&file, &camera, &settings)
-        .with_context(|| format!("planning {}", args.scene.display()))?;
+        &settings,
+        args.camera.camera_pos,
+        args.camera.camera_target,
+    )
+    .with_context(|| format!("planning {}", args.scene.display()))?;
     println!(
         "scene {}: {} triangles, {}x{} px, camera {}",
         args.scene.display(),
@@ -239,20 +226,26 @@ fn render_scene(cli: &Cli, args: &RenderArgs, path: &Path) -> Result<()> {
 
 /// Renders `file` (read from `path`) as `render --scene` does, with the command line's view and settings.
 fn render_scene_file(cli: &Cli, args: &RenderArgs, file: &SceneFile, path: &Path) -> Result<()> {
-    let (camera, settings) = scene_setup(
+    let settings = scene_settings(
         file,
         (args.size.width, args.size.height),
-        (args.camera.camera_pos, args.camera.camera_target),
         map_config(args),
         &args.soft,
     )?;
+    let (camera, plan) = plan_view(
+        file,
+        &settings,
+        args.camera.camera_pos,
+        args.camera.camera_target,
+    )
+    .with_context(|| format!("planning {}", path.display()))?;
     let device = device(cli)?;
     render_scene_to_folder(
         &device,
         file,
         path,
-        &camera,
-        &settings,
+        (&camera, &plan),
+        (settings.width, settings.height),
         args.frames,
         &args.out,
     )?;

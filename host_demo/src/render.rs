@@ -2,6 +2,7 @@
 
 use crate::images::lerp_factor_preview;
 use crate::output::{shade_preview, write_exr_rgba, write_exr_scalar, write_png};
+use crate::report_text::{resource_bytes, routes_line, tier_name};
 use anyhow::{Context, Result};
 use demo_engine::gbuffer::GBufferLayout;
 use demo_engine::plugin::PluginRenderer;
@@ -459,7 +460,7 @@ pub fn render_to_folder(
     bar.inc(1);
     bar.finish_and_clear();
 
-    println!("{}", demo_engine::plugin::device_banner(device));
+    println!("{}", demo_engine::device::device_banner(device));
     if report.status(Pass::PrimitiveMap) == PassStatus::NotInPlan {
         println!(
             "scene: {} triangles, {}x{} px; no primitive map (the plan does not need one)",
@@ -485,7 +486,7 @@ pub fn render_to_folder(
             stats.longest_list,
             map_bytes(&report) as f64 / f64::from(1 << 20)
         );
-        println!("{}", crate::scene_render::routes_line(&stats, &timings));
+        println!("{}", routes_line(&stats, &timings));
     }
     // Only the settings of the passes the mode runs.
     let fxaa = format!("FXAA {}", if s.no_antialiasing { "off" } else { "on" });
@@ -552,27 +553,6 @@ fn plan_passes(report: &FrameReport) -> impl Iterator<Item = (Pass, PassStatus)>
         .iter()
         .filter(|&p| p != Pass::OutputCopy)
         .map(|p| (p, report.status(p)))
-}
-
-/// The bytes of each resource the light's passes use, by name: the prim buffer its context's lights share
-/// first, then those the plugin allocated for the light.
-pub fn resource_bytes(report: &FrameReport) -> impl Iterator<Item = (&'static str, u64)> + '_ {
-    let prims = (report.prim_buffer_bytes > 0).then_some(("prim buffer", report.prim_buffer_bytes));
-    prims.into_iter().chain(
-        report
-            .allocated_resources()
-            .map(|(resource, bytes)| (resource.name(), bytes)),
-    )
-}
-
-/// The conservative-raster tier the light's binning used: "none", "tier1", "tier2" or "tier3".
-pub fn tier_name(report: &FrameReport) -> &'static str {
-    match report.tier {
-        0 => "none",
-        1 => "tier1",
-        2 => "tier2",
-        _ => "tier3",
-    }
 }
 
 /// Prints which passes ran in the last frame, which were skipped and why, and the memory of each

@@ -4,7 +4,8 @@
 //! memory it holds.
 
 use crate::output::{write_exr_rgba, write_exr_scalar, write_png};
-use crate::scene_plan::{plan_scene, PlanSettings, ScenePlan};
+use crate::report_text::{resource_bytes, routes_line};
+use crate::scene_plan::ScenePlan;
 use crate::shading::{shade, tone_map};
 use anyhow::{Context, Result};
 use demo_engine::gbuffer::GBufferLayout;
@@ -189,41 +190,6 @@ fn describe_cost(report: &FrameReport) -> String {
         st.mean_list(),
         st.longest_list,
         routes_line(st, &per_pass)
-    )
-}
-
-/// Where a frame's pixels found their triangles, and what the trace cost (`ms`: GPU ms by pass name):
-/// how many walked the BVH rather than a list, and why (no list built this frame: its bin items passed the
-/// budget; texels past the list limit or the entry capacity).
-pub fn routes_line(st: &MapStats, ms: &std::collections::BTreeMap<String, f64>) -> String {
-    let trace = ms.get("ray trace").copied().unwrap_or(0.0);
-    if st.pixels_walked == 0 {
-        return format!(
-            "every pixel walked its texel's list (trace {trace:.3} ms); {} bin items",
-            st.bin_items
-        );
-    }
-    let why = if st.frusta_without_lists > 0 {
-        format!(
-            "no list built: {} bin items passed the bin budget",
-            st.bin_items
-        )
-    } else {
-        format!(
-            "{} texels past the list limit, {} past the entry capacity of {} (the lists grow to fit the next \
-             frame)",
-            st.texels_past_limit, st.texels_past_capacity, st.entry_capacity
-        )
-    };
-    format!(
-        "{} of {} pixels walked the BVH ({why}); trace {trace:.3} ms in all{}",
-        st.pixels_walked,
-        st.receiver_pixels,
-        if st.walks_unfinished > 0 {
-            format!(", {} WALKS UNFINISHED", st.walks_unfinished)
-        } else {
-            String::new()
-        }
     )
 }
 
@@ -504,50 +470,47 @@ pub fn visibility_file_names(index: usize, name: &str) -> (String, String) {
     (format!("{stem}.png"), format!("{stem}.exr"))
 }
 
-/// Plans `file` (from `source`, for messages) seen through `camera`, renders `frames` frames, prints
-/// the plan and each frame's per-light report, and writes into `out`: `shaded.png` and `shaded.exr`
+/// Renders `frames` frames of `file` (from `source`, for messages) at `width` x `height` seen through
+/// `camera` as `plan` (its [`ScenePlan`] through that camera) says, prints the plan and each frame's
+/// per-light report, and writes into `out`: `shaded.png` and `shaded.exr`
 /// (linear radiance), each light's visibility (`visibility_<i>_<name>.png` and `.exr`) and
 /// `scene_report.json`.
 pub fn render_scene_to_folder(
     device: &Device,
     file: &SceneFile,
     source: &Path,
-    camera: &Camera,
-    settings: &PlanSettings,
+    (camera, plan): (&Camera, &ScenePlan),
+    (width, height): (u32, u32),
     frames: u32,
     out: &Path,
 ) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let plan = plan_scene(file, camera, settings)
-        .with_context(|| format!("planning {}", source.display()))?;
-    println!("{}", demo_engine::plugin::device_banner(device));
+    println!("{}", demo_engine::device::device_banner(device));
     println!(
         "scene {}: {} triangles, {}x{} px",
         source.display(),
         file.scene.triangle_count(),
-        settings.width,
-        settings.height
+        width,
+        height
     );
     print!("{}", plan.describe());
     // Steps: the renderer's creation, each frame, the outputs.
     let bar = crate::progress(u64::from(frames) + 2, "render");
     bar.set_message("creating the renderer");
-    let mut renderer = SceneRenderer::new(device, file, settings.width, settings.height)
-        .context("creating the renderer")?;
+    let mut renderer =
+        SceneRenderer::new(device, file, width, height).context("creating the renderer")?;
     // As an engine that gives its output storage usage: each light writes its layer, no copy.
     renderer.write_outputs_directly();
     bar.inc(1);
     let mut reports: Vec<LightsFrame> = Vec::new();
     for index in 1..=frames {
         bar.set_message(format!("frame {index} of {frames}"));
-        let frame = renderer
-            .render(device, camera, &plan)
-            .context("rendering")?;
+        let frame = renderer.render(device, camera, plan).context("rendering")?;
         bar.inc(1);
         // Every light's passes, memory and cost for the first frame (what was built) and the last (what
         // later frames kept); one line for the frames between.
         let text = if index == 1 || index == frames {
-            describe_frame(&plan, &frame, reports.last())
+            describe_frame(plan, &frame, reports.last())
         } else {
             format!(
                 "frame {}: {} lights, GPU {:.3} ms\n",
@@ -561,8 +524,8 @@ pub fn render_scene_to_folder(
     }
     bar.suspend(|| print!("{}", describe_frames(&reports)));
     bar.set_message("reading back and writing the outputs");
-    let images = renderer.read_back(device, &plan).context("reading back")?;
-    let (w, h) = (settings.width, settings.height);
+    let images = renderer.read_back(device, plan).context("reading back")?;
+    let (w, h) = (width, height);
     let radiance = shade(
         &file.lights,
         &images.visibility,
@@ -616,7 +579,7 @@ pub fn render_scene_to_folder(
                         .iter()
                         .map(|p| (p.name(), report.status(p).name()))
                         .collect(),
-                    resource_bytes: crate::render::resource_bytes(report).collect(),
+                    resource_bytes: resource_bytes(report).collect(),
                     gpu_ms: gpu_ms(report).0,
                     pass_ms: gpu_ms(report).1,
                     lists: ListsJson::from(&report.stats),

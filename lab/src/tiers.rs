@@ -100,7 +100,7 @@ pub fn tier_matrix(device: &Device, scenes: &[(&str, View)], size: u32) -> Resul
             let path = format!(
                 "{} ({})",
                 report.binning_path.name(),
-                host_demo::render::tier_name(&report)
+                host_demo::report_text::tier_name(&report)
             );
             rows.push(TierRow {
                 scene: (*name).to_owned(),

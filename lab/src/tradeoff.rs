@@ -368,7 +368,7 @@ pub fn run_sweep(device: &Device, view: &View, scene: &str, args: &TradeoffArgs)
         }
         let timings = median_timings(&reports[reports.len() / 2..]);
         let memory_bytes = reports.last().map_or(0, |r| {
-            host_demo::render::resource_bytes(r)
+            host_demo::report_text::resource_bytes(r)
                 .map(|(_, bytes)| bytes)
                 .sum()
         });

@@ -50,10 +50,11 @@ pub use primitive_map::{
     BinningRequest, FaceMode, ListOffsets, PrimitiveMapConfig, DEFAULT_ENTRY_BUDGET, GUARD_VALUE,
     GUARD_WORDS, MIN_ENTRY_BUDGET, MIN_FITTED_ENTRIES,
 };
+pub use retire::MAX_FRAMES_IN_FLIGHT;
 pub use shadow_map::ShadowMapConfig;
 pub use shadow_pipeline::{
     camera_in_frame, FitBatch, FrameInputs, FrameReport, ResourceReport, ShadowConfig,
-    ShadowInputs, ShadowPipeline, FIT_BATCH_PASS, MAX_FRAMES_IN_FLIGHT,
+    ShadowInputs, ShadowPipeline, FIT_BATCH_PASS,
 };
 pub use surface::{NormalEncoding, NormalSpace, SurfaceInput};
 pub use view_cull::{Casters, ViewVolume};

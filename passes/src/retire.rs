@@ -1,6 +1,9 @@
 //! Deferred destruction for frames in flight: GPU objects replaced while earlier frames may still use them
 //! are held until those frames completed.
 
+/// The most frames in flight a pipeline supports: how many frames' objects may be held at once.
+pub const MAX_FRAMES_IN_FLIGHT: u32 = 8;
+
 /// Objects retired at a frame, held until every frame up to that one completed on the GPU.
 pub struct RetireQueue<T> {
     held: Vec<(u64, T)>,

@@ -168,6 +168,16 @@ impl MeshBuilder {
     }
 }
 
+impl Scene {
+    /// An axis-aligned box from `min` to `max` as one object named `name`: 8 vertices, 12 triangles
+    /// counter-clockwise seen from outside (see [`MeshBuilder::add_box`]).
+    pub fn axis_box(name: &str, min: Vec3, max: Vec3) -> Scene {
+        let mut mesh = MeshBuilder::new();
+        mesh.add_box(min, max);
+        mesh.into_scene(name)
+    }
+}
+
 /// Sum of the signed volumes of the tetrahedra from the origin to every triangle (the enclosed volume
 /// of a closed, outward-wound mesh), for the crate's tests.
 #[cfg(test)]

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use crate::{error::MEMORY_PATH, Aabb, MeshBuilder, SceneError};
+use crate::{error::MEMORY_PATH, Aabb, SceneError};
 
 /// A named contiguous range of triangles (one OBJ object/group, or one procedural part).
 /// A draw call.
@@ -47,14 +47,6 @@ impl Scene {
                 triangle_count,
             }],
         }
-    }
-
-    /// An axis-aligned box from `min` to `max` as one object named `name`: 8 vertices, 12 triangles
-    /// counter-clockwise seen from outside (see [`MeshBuilder::add_box`]).
-    pub fn axis_box(name: &str, min: Vec3, max: Vec3) -> Scene {
-        let mut mesh = MeshBuilder::new();
-        mesh.add_box(min, max);
-        mesh.into_scene(name)
     }
 
     /// Number of complete triangles (`indices.len() / 3`).
@@ -231,14 +223,15 @@ impl Scene {
 /// from +Y, centred on `center` (at height `center.y`).
 pub(crate) fn ground_square(name: &str, center: Vec3, side: f32) -> Scene {
     let h = side * 0.5;
-    let mut mesh = MeshBuilder::new();
-    mesh.add_quad([
-        center + Vec3::new(-h, 0.0, -h),
-        center + Vec3::new(-h, 0.0, h),
-        center + Vec3::new(h, 0.0, h),
-        center + Vec3::new(h, 0.0, -h),
-    ]);
-    mesh.into_scene(name)
+    let corners = [(-h, -h), (-h, h), (h, h), (h, -h)];
+    Scene::single_object(
+        corners
+            .iter()
+            .map(|&(x, z)| center + Vec3::new(x, 0.0, z))
+            .collect(),
+        vec![0, 1, 2, 0, 2, 3],
+        name,
+    )
 }
 
 #[cfg(test)]

@@ -388,6 +388,29 @@ pub fn scene_camera(file: &SceneFile, aspect: f32) -> Camera {
         .unwrap_or_else(|| Camera::frame(&demo_engine::focus_bounds(&file.scene), aspect))
 }
 
+/// The camera `file` is seen through (its own, else one framing its objects; moved to `position` and
+/// looking at `target` where given) and the plan of the scene through it ([`plan_scene`]).
+///
+/// # Errors
+///
+/// A camera position equal to its target, or what [`plan_scene`] refuses.
+pub fn plan_view(
+    file: &SceneFile,
+    settings: &PlanSettings,
+    position: Option<Vec3>,
+    target: Option<Vec3>,
+) -> Result<(Camera, ScenePlan)> {
+    let aspect = settings.width as f32 / settings.height.max(1) as f32;
+    let camera = crate::cli::camera_with(
+        scene_camera(file, aspect),
+        &file.scene.bounds(),
+        position,
+        target,
+    )?;
+    let plan = plan_scene(file, &camera, settings)?;
+    Ok((camera, plan))
+}
+
 /// Derives the plan of `file` seen through `camera`.
 ///
 /// # Errors

@@ -7,6 +7,7 @@ mod lights;
 mod plan;
 pub(crate) use plan::plan_lights;
 mod report;
+mod schedule;
 mod targets;
 
 use crate::convert::{binning_path_to_c, FrameLight, LightShape};
@@ -14,15 +15,14 @@ use crate::error::{invalid, ApiError, ApiResult};
 use crate::geometry::GeometrySource;
 use crate::types::*;
 use crate::version::{major_minor, OLDEST_MINOR};
-use lights::FrameSchedule;
 use passes::retire::RetireQueue;
 use passes::{
     BinningRequest, FitBatch, MinCombine, ShadowConfig, ShadowPipeline, SharedGeometry,
     SurfaceInput,
 };
-use rhi::{Device, Image};
+use rhi::{Device, Format, Image, ImageUsage};
+use schedule::FrameSchedule;
 use std::sync::Arc;
-use targets::TargetSource;
 
 /// The passes of one light: one pipeline per frustum it is shadowed through and, for several, the
 /// minimum over their outputs.
@@ -128,6 +128,24 @@ impl Built {
             ))),
         }
     }
+}
+
+/// The engine images, as handles and shape.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) struct TargetSource {
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    pub(crate) depth: u64,
+    pub(crate) depth_format: Format,
+    pub(crate) output_format: Format,
+    /// The engine's normal image (`None`: normals derived from depth).
+    pub(crate) normal: Option<u64>,
+    pub(crate) normal_format: Format,
+    pub(crate) surface: SurfaceInput,
+    pub(crate) output: u64,
+    pub(crate) output_layers: u32,
+    /// Usage of the output image: with storage usage, lights write their layers directly.
+    pub(crate) output_usage: ImageUsage,
 }
 
 /// What reconfiguration replaced, held until the frames that used it completed.

@@ -1,7 +1,7 @@
 //! Planning lights without a context (`hrts_plan_lights`): the decision each light's frame report would
 //! give for a view, from the same conversion and culling a frame's recording runs.
 
-use super::lights::schedule;
+use super::schedule::schedule;
 use crate::convert::{
     frame_bounds, frame_inputs, mode_to_c, resource_index, shadow_config, FrameLight,
 };

@@ -1,30 +1,12 @@
 //! Targets: the engine's depth, normal and output images, checked against the device and kept as a
 //! [`TargetSource`] for the passes.
 
-use super::Context;
+use super::{Context, TargetSource};
 use crate::convert::{require_usage, surface_input};
 use crate::error::{invalid, ApiError, ApiResult};
 use crate::types::*;
-use passes::{NormalEncoding, SurfaceInput};
+use passes::NormalEncoding;
 use rhi::{Format, ImageUsage};
-
-/// The engine images, as handles and shape.
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub(crate) struct TargetSource {
-    pub(crate) width: u32,
-    pub(crate) height: u32,
-    pub(crate) depth: u64,
-    pub(crate) depth_format: Format,
-    pub(crate) output_format: Format,
-    /// The engine's normal image (`None`: normals derived from depth).
-    pub(crate) normal: Option<u64>,
-    pub(crate) normal_format: Format,
-    pub(crate) surface: SurfaceInput,
-    pub(crate) output: u64,
-    pub(crate) output_layers: u32,
-    /// Usage of the output image: with storage usage, lights write their layers directly.
-    pub(crate) output_usage: ImageUsage,
-}
 
 impl Context {
     pub(crate) fn set_targets(&mut self, t: &HrtsTargets) -> ApiResult<()> {

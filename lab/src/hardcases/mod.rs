@@ -42,11 +42,7 @@ mod probe;
 
 pub use cli::{run_cli, table, HardcasesArgs};
 use probe::Probe;
-
-/// Margin of the analytic checks, in pixel footprints at the receiver's distance from the camera: a
-/// receiver counts as certainly shadowed (or certainly in a contact shadow) only if its shadow ray passes
-/// this far inside the blocker.
-pub const MARGIN_PIXELS: f64 = 2.0;
+pub use probe::MARGIN_PIXELS;
 
 /// What one case measured.
 #[derive(Debug, Clone, Default)]

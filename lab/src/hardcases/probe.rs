@@ -9,7 +9,10 @@ use reference::{certainly_blocked, contact_shadow_start};
 use scene::hard_cases::Solid;
 use scene::Aabb;
 
-use super::MARGIN_PIXELS;
+/// Margin of the analytic checks, in pixel footprints at the receiver's distance from the camera: a
+/// receiver counts as certainly shadowed (or certainly in a contact shadow) only if its shadow ray passes
+/// this far inside the blocker.
+pub const MARGIN_PIXELS: f64 = 2.0;
 
 /// Light-facing threshold of the acne check: receivers whose normal makes a cosine above this with the
 /// direction to the light (89.99°) must be lit where nothing blocks them.

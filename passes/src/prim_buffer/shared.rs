@@ -5,7 +5,8 @@
 use super::{DrawSource, Geometry, PrimBufferPass, VertexLayout};
 use crate::bvh::SceneBvh;
 use crate::primitive_map::MapScratchPool;
-use crate::{PassError, MAX_FRAMES_IN_FLIGHT};
+use crate::retire::MAX_FRAMES_IN_FLIGHT;
+use crate::PassError;
 use glam::Mat4;
 use rhi::{BindGroup, Buffer, Device, Encoder};
 use std::collections::VecDeque;

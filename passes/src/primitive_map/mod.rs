@@ -26,13 +26,14 @@ use crate::scan::ScanPipeline;
 use crate::shaders::shader;
 use crate::PassError;
 use rhi::{
-    Barrier, BindGroup, BindingKind, Buffer, BufferUsage, ComputePipeline, Device, Encoder, Format,
+    Barrier, BindGroup, BindingKind, Buffer, BufferUsage, Device, Encoder, Format,
     GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, ImageUsage, MemoryLocation, Resource,
     ResourceState as S,
 };
 
 mod config;
 mod offsets;
+mod pipelines;
 mod scratch;
 
 pub use config::{
@@ -44,6 +45,7 @@ pub use offsets::{
     packed_offset_words, packed_texels, unpack_list_offsets, ListOffsets, OFFSET_GROUP,
     OFFSET_GROUP_OVERFLOW, OFFSET_GROUP_WORDS,
 };
+use pipelines::{Binner, MapPipelines};
 use scratch::{receiver_words, storage_buffer, BindTargets, SharedTexels, PAIR_BYTES};
 pub use scratch::{MapScratch, MapScratchPool, ScratchBindings};
 
@@ -83,24 +85,6 @@ pub struct PrimitiveMapInputs<'a> {
     pub occupancy_view: bool,
     /// Where the map takes its build scratch from (one pool per geometry).
     pub scratch: &'a MapScratchPool,
-}
-
-/// The binning pipelines of the path in use.
-pub(super) enum Binner {
-    Compute(ComputePipeline),
-    Raster(GraphicsPipeline),
-}
-
-/// The map's pipelines.
-pub(super) struct MapPipelines {
-    pub(super) fit: ComputePipeline,
-    pub(super) receivers: ComputePipeline,
-    pub(super) setup: ComputePipeline,
-    pub(super) index: ComputePipeline,
-    pub(super) scan: ScanPipeline,
-    pub(super) binner: Binner,
-    pub(super) pack: ComputePipeline,
-    pub(super) occupancy: ComputePipeline,
 }
 
 /// A phase of the fit of a primitive map's grid ([`PrimitiveMap::record_fit_phase`]), in this order.

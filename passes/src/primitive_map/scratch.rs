@@ -2,7 +2,7 @@
 //! built and traced and the lights are recorded one after another: bin triangles, tile offsets, pair
 //! owners and per-texel counts, the receiver map, and the screen-size pixel texels.
 
-use super::{Binner, MapPipelines};
+use super::pipelines::{Binner, MapPipelines};
 use crate::scan::PrefixScan;
 use crate::PassError;
 use rhi::{BindGroup, Buffer, BufferUsage, Device, MemoryLocation, Resource};

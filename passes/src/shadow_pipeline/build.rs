@@ -1,6 +1,6 @@
 //! Creating a pipeline: the passes and resources its frame plan needs.
 
-use super::{FrameSlot, ShadowConfig, ShadowInputs, ShadowPipeline, MAX_FRAMES_IN_FLIGHT};
+use super::{FrameSlot, ShadowConfig, ShadowInputs, ShadowPipeline};
 use crate::frame_plan::{
     FramePlan, HardEdge, PassId, PenumbraFilter, ResourceId, ResourceSet, ShadowMode,
 };
@@ -12,6 +12,7 @@ use crate::prim_buffer::{Geometry, SharedGeometry};
 use crate::primitive_map::{choose_binning_path, BinningPath, PrimitiveMap, PrimitiveMapInputs};
 use crate::ray_trace::{RayTraceInputs, RayTraceKind, RayTracePass};
 use crate::retire::RetireQueue;
+use crate::retire::MAX_FRAMES_IN_FLIGHT;
 use crate::screen_pass::visibility_image;
 use crate::shadow_map::ShadowMapPass;
 use crate::surface::NormalEncoding;

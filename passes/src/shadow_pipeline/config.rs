@@ -55,14 +55,11 @@ pub struct ShadowConfig {
     /// Resources to produce besides the final output (comparison views, debug images, a host G-buffer
     /// drawing the prim buffer). Empty by default.
     pub extra_outputs: ResourceSet,
-    /// The most frames recorded and not yet completed on the GPU (1..=[`MAX_FRAMES_IN_FLIGHT`], default 3):
+    /// The most frames recorded and not yet completed on the GPU (1..=[`MAX_FRAMES_IN_FLIGHT`](crate::MAX_FRAMES_IN_FLIGHT), default 3):
     /// when frame `f` is begun, every frame up to `f - frames_in_flight` has completed. Per-frame
     /// read-backs and timers are ring-buffered this deep, and replaced GPU objects are held as long.
     pub frames_in_flight: u32,
 }
-
-/// The most frames in flight a pipeline supports.
-pub const MAX_FRAMES_IN_FLIGHT: u32 = 8;
 
 impl Default for ShadowConfig {
     /// The talk's full technique: hybrid with FXAA, 1K×1K×32 primitive map, 3K shadow map, shrinking PCSS.

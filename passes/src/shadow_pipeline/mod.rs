@@ -19,7 +19,7 @@ mod record;
 mod report;
 
 pub use batch::{FitBatch, FIT_BATCH_PASS};
-pub use config::{FrameInputs, ShadowConfig, ShadowInputs, MAX_FRAMES_IN_FLIGHT};
+pub use config::{FrameInputs, ShadowConfig, ShadowInputs};
 pub use report::{FrameReport, ResourceReport};
 
 use crate::frame_plan::{FramePlan, PassId, PassStatus, ResourceId, ResourceSet};
