@@ -3,6 +3,7 @@
 
 /// The engine's GPU device: the RHI's.
 pub use rhi::Device;
+use serde::Serialize;
 
 /// Opens the device the command line asks for: a name filter (else `HRTS_DEVICE`), validation layers if
 /// `validation` (or `HRTS_VALIDATION=1`), with their synchronization validation, whose hazards count as
@@ -29,8 +30,8 @@ pub fn check_validation(device: &Device) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// What a device is, as the demo's reports name it.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// What a device is, as the demo's reports name it (`frame.json`'s `device`).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct DeviceSummary {
     /// The device's name ("llvmpipe (LLVM 19.1.7, 256 bits)", "NVIDIA H100 80GB HBM3").
     pub name: String,
@@ -57,12 +58,12 @@ impl DeviceSummary {
 
 /// The line the demo's commands print first: the device and the plugin's API version.
 pub fn device_banner(device: &Device) -> String {
-    let caps = device.capabilities();
+    let d = DeviceSummary::of(device);
     format!(
         "device: {} ({}, {}); shadows through the plugin's C ABI, {}",
-        caps.device_name,
-        caps.device_type,
-        caps.driver,
+        d.name,
+        d.device_type,
+        d.driver,
         api_version()
     )
 }

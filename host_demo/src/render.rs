@@ -6,7 +6,7 @@ use crate::report_text::{resource_bytes, routes_line, tier_name};
 use anyhow::{Context, Result};
 use demo_engine::gbuffer::GBufferLayout;
 use demo_engine::plugin::PluginRenderer;
-use demo_engine::{focus_bounds, Device, View};
+use demo_engine::{focus_bounds, Device, DeviceSummary, View};
 use hrts::{
     BinningPath, Faces, FrameReport, Pass, PassStatus, PenumbraFilter, Resource, ResourceSet,
     ShadowMode,
@@ -236,26 +236,6 @@ struct PlanJson {
 }
 
 #[derive(Serialize)]
-struct DeviceJson {
-    name: String,
-    driver: String,
-    api_version: String,
-    device_type: String,
-}
-
-impl DeviceJson {
-    fn of(device: &Device) -> Self {
-        let d = demo_engine::DeviceSummary::of(device);
-        Self {
-            name: d.name,
-            driver: d.driver,
-            api_version: d.api_version,
-            device_type: d.device_type,
-        }
-    }
-}
-
-#[derive(Serialize)]
 struct FrameJson {
     width: u32,
     height: u32,
@@ -268,7 +248,7 @@ struct FrameJson {
     frames: u32,
     gpu_ms: BTreeMap<String, f64>,
     gpu_ms_notes: BTreeMap<String, &'static str>,
-    device: DeviceJson,
+    device: DeviceSummary,
 }
 
 /// Median GPU milliseconds per pass over `reports` (the first frame alone for passes that ran once).
@@ -452,7 +432,7 @@ pub fn render_to_folder(
         frames: options.frames.max(1),
         gpu_ms: timings.clone(),
         gpu_ms_notes: notes.clone(),
-        device: DeviceJson::of(device),
+        device: DeviceSummary::of(device),
     };
     let text = serde_json::to_string_pretty(&json)?;
     std::fs::write(out.join("frame.json"), text)
