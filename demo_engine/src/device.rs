@@ -33,7 +33,7 @@ pub fn check_validation(device: &Device) -> anyhow::Result<()> {
 /// What a device is, as the demo's reports name it (`frame.json`'s `device`).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct DeviceSummary {
-    /// The device's name ("llvmpipe (LLVM 19.1.7, 256 bits)", "NVIDIA H100 80GB HBM3").
+    /// The device's name ("llvmpipe (LLVM 15.0.6, 256 bits)", "NVIDIA H100 80GB HBM3").
     pub name: String,
     /// The driver's name and version.
     pub driver: String,

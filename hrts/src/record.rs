@@ -1,8 +1,12 @@
-//! Recording into the engine's command buffers: every light's passes of a frame (whole or pass by pass),
-//! the copy of each light's visibility into the engine's output, and resource read-backs.
+//! Recording into the engine's command buffers: each frame's schedule of the lights' frusta (what is
+//! rebuilt, what is recorded), every light's passes of a frame (whole or pass by pass), the copy of each
+//! light's visibility into the engine's output, and resource read-backs.
 
-use crate::context::{Built, Context, FrameProgress, OpenFrame};
-use crate::convert::{frame_bounds, frame_inputs, pass_from_index, resource_id, FrameLight};
+use crate::context::schedule::{schedule, FrameSchedule, LightSchedule};
+use crate::context::{Built, Context, FrameProgress, OpenFrame, Retired};
+use crate::convert::{
+    frame_bounds, frame_inputs, pass_from_index, resource_id, FrameLight, LightShape,
+};
 use crate::error::{invalid, ApiError, ApiResult};
 use crate::geometry::deformed_meshes;
 use crate::types::*;
@@ -16,6 +20,68 @@ pub(crate) const DEPTH_NORMAL_READERS: u32 = 1 << HrtsPass::PrimitiveMap as u32
     | 1 << HrtsPass::RayTrace as u32
     | 1 << HrtsPass::ShadowMapTest as u32
     | 1 << HrtsPass::Pcss as u32;
+
+impl Context {
+    /// The shadow casters' bounds this frame: `frame_bounds` when the engine gave them, else the geometry's
+    /// own bounds when they hold (not when the frame `deforms` a mesh, nor for Vulkan geometry that moves).
+    pub(crate) fn scene_bounds(
+        &self,
+        frame_bounds: Option<[glam::DVec3; 2]>,
+        deforms: bool,
+    ) -> Option<[glam::DVec3; 2]> {
+        let dynamic = self.lights.iter().any(|c| !c.static_geometry);
+        frame_bounds.or_else(|| {
+            self.geometry
+                .as_ref()
+                .filter(|_| !deforms)
+                .and_then(|g| g.cull_bounds(dynamic))
+        })
+    }
+
+    /// Which frusta of each light may change a pixel in view this frame: [`schedule`] with the context's
+    /// configurations.
+    pub(crate) fn schedule(
+        &self,
+        lights: &[FrameLight],
+        bounds: Option<[glam::DVec3; 2]>,
+    ) -> Vec<LightSchedule> {
+        schedule(&self.lights, lights, bounds)
+    }
+
+    /// Keeps the schedule of frame `index` for its reports, with those of the frames in flight before it.
+    pub(crate) fn keep_schedule(&mut self, index: u64, lights: Vec<LightSchedule>) {
+        while self.schedules.len() >= self.frames_in_flight as usize {
+            self.schedules.pop_front();
+        }
+        self.schedules.push_back(FrameSchedule { index, lights });
+    }
+
+    /// Takes how each light is shadowed this frame: a light whose number of frusta changed (a spot light
+    /// turned point light, say), or whose resolved configuration did (mode auto choosing otherwise for a
+    /// light that changed kind), has its passes rebuilt.
+    pub(crate) fn set_frusta(&mut self, frusta: &[LightShape]) {
+        let mut replaced = Vec::new();
+        for (i, ((&new, old), configured)) in frusta
+            .iter()
+            .zip(&mut self.frusta)
+            .zip(&self.lights)
+            .enumerate()
+        {
+            let rebuild =
+                new.frusta != old.frusta || new.config(configured) != old.config(configured);
+            *old = new;
+            if rebuild {
+                if let Some(passes) = self.built.as_mut().and_then(|b| b.lights[i].take()) {
+                    replaced.push(passes);
+                }
+            }
+        }
+        if !replaced.is_empty() {
+            self.retire(Retired::light_passes(replaced));
+            self.progress = FrameProgress::default();
+        }
+    }
+}
 
 impl Context {
     pub(crate) fn record_passes(&mut self, f: &HrtsFrame, mask: u32) -> ApiResult<()> {

@@ -7,7 +7,7 @@ mod lights;
 mod plan;
 pub(crate) use plan::plan_lights;
 mod report;
-mod schedule;
+pub(crate) mod schedule;
 mod targets;
 
 use crate::convert::{binning_path_to_c, FrameLight, LightShape};
@@ -154,6 +154,16 @@ pub(crate) struct Retired {
     _built: Option<Built>,
 }
 
+impl Retired {
+    /// Lights' passes replaced by a rebuild.
+    pub(crate) fn light_passes(pipelines: Vec<LightPasses>) -> Self {
+        Self {
+            _pipelines: pipelines,
+            _built: None,
+        }
+    }
+}
+
 /// Where the recording of frames stands.
 #[derive(Default)]
 pub(crate) struct FrameProgress {
@@ -284,7 +294,7 @@ impl Context {
     }
 
     /// Holds `retired` until the frames recorded so far completed (drops it now if none was recorded).
-    fn retire(&mut self, retired: Retired) {
+    pub(crate) fn retire(&mut self, retired: Retired) {
         if let Some(last) = self.last_frame.max(self.readback_frame) {
             self.retired.retire(last, retired);
         }
