@@ -102,6 +102,11 @@ struct RenderArgs {
     /// (0: always the BVH; inf: always lists; moves cost, never exactness).
     #[arg(long, default_value_t = hrts::Config::default().map_bin_budget)]
     bin_budget: f32,
+    /// Area shadows: the nodes and triangles a pixel's walk of the BVH with a wide bundle of segments or
+    /// rays may visit per 64 open samples (scaled by the bundle's width) before each open sample walks its
+    /// own (0: each sample's own walk at once; 4294967295: the bundle always; moves cost, never exactness).
+    #[arg(long, default_value_t = hrts::Config::default().area_walk_budget)]
+    area_walk_budget: u32,
     /// Frames to render (timings are medians over all but the first; at least 2 with --scene, so that the
     /// second frame's report shows what was kept).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
@@ -403,6 +408,7 @@ fn map_config(args: &RenderArgs) -> hrts::Config {
         map_entry_budget_kib: args.map_budget_mb.saturating_mul(1024),
         map_list_limit: args.list_limit,
         map_bin_budget: args.bin_budget,
+        area_walk_budget: args.area_walk_budget,
         ..hrts::Config::default()
     }
 }

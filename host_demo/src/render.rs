@@ -76,8 +76,8 @@ impl Default for SoftShadowArgs {
 #[derive(Debug, Clone)]
 pub struct RenderOptions {
     /// The plugin configuration the primitive-map options set (`map_size`, `map_entry_budget_kib`,
-    /// `faces`, `binning_path`, `map_list_limit`, `map_bin_budget`); [`RenderOptions::soft`] sets the
-    /// rest.
+    /// `faces`, `binning_path`, `map_list_limit`, `map_bin_budget`, `area_walk_budget`);
+    /// [`RenderOptions::soft`] sets the rest.
     pub map: hrts::Config,
     /// Frames rendered; timings are medians over the frames after the first.
     pub frames: u32,

@@ -48,8 +48,16 @@ pub fn routes_line(st: &MapStats, ms: &BTreeMap<String, f64>) -> String {
             st.texels_past_limit, st.texels_past_capacity, st.entry_capacity
         )
     };
+    let per_sample = if st.pixels_walked_per_sample > 0 {
+        format!(
+            ", {} of them walked each area sample on its own (their bundle passed the area walk budget)",
+            st.pixels_walked_per_sample
+        )
+    } else {
+        String::new()
+    };
     format!(
-        "{} of {} pixels walked the BVH ({why}); trace {trace:.3} ms in all{}",
+        "{} of {} pixels walked the BVH ({why}{per_sample}); trace {trace:.3} ms in all{}",
         st.pixels_walked,
         st.receiver_pixels,
         if st.walks_unfinished > 0 {

@@ -630,6 +630,14 @@ typedef struct HrtsConfig {
   // BVH (default 8; infinity: always lists; 0: always the BVH). It moves cost, never exactness. API
   // 5.9: older callers get the default.
   float map_bin_budget;
+  // Area shadows: where a pixel walks the BVH with a wide bundle of segments or rays (an emitter's radius
+  // over a tenth of its distance), the nodes and triangles the bundle's walk may visit per 64 samples
+  // still open, scaled by (0.3 / width)^2 (width: radius over distance), before each open sample walks
+  // its own segment or ray (default 256; 0: each sample's own walk at once; `0xFFFFFFFF`: the bundle
+  // always). The bundle costs less where few triangles straddle it (small lights), the samples' own
+  // walks where many do (large lights). It moves cost, never exactness. API 5.10: older callers get the
+  // default.
+  uint32_t area_walk_budget;
 } HrtsConfig;
 
 // One draw of the geometry: an element of `draws`, read at `draw_stride`.
@@ -1052,6 +1060,11 @@ typedef struct HrtsFrameReport {
   uint32_t pixels_walked;
   // BVH walks that could not finish (a driver that ends long loops early): 0 on a conforming device.
   uint32_t walks_unfinished;
+  // Reserved, written 0: API 5.9's report ends with this padding, which no later field may take.
+  uint32_t reserved_5_9;
+  // Area shadows: pixels whose bundle passed `area_walk_budget`, so that each of their open samples
+  // walked the BVH on its own. API 5.10: written for callers of 5.10 and later.
+  uint32_t pixels_walked_per_sample;
 } HrtsFrameReport;
 
 // Every result, in value order.

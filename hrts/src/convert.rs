@@ -560,6 +560,7 @@ pub(crate) fn shadow_config(c: &HrtsConfig) -> ApiResult<ShadowConfig> {
     )?;
     config.pcss.validate()?;
     config.area.samples = c.area_samples;
+    config.area.bundle_walk_budget = c.area_walk_budget;
     // Mode auto gives a sized directional light area shadows.
     if mode == ShadowMode::Area || (mode == ShadowMode::Auto && config.pcss.angular_radius > 0.0) {
         config.area.validate(config.pcss.angular_radius)?;
@@ -609,6 +610,7 @@ pub(crate) fn config_to_c(config: &ShadowConfig) -> ApiResult<HrtsConfig> {
         area_samples: config.area.samples,
         map_list_limit: config.map.list_limit,
         map_bin_budget: config.map.bin_budget,
+        area_walk_budget: config.area.bundle_walk_budget,
     })
 }
 

@@ -539,6 +539,14 @@ pub struct HrtsConfig {
     /// BVH (default 8; infinity: always lists; 0: always the BVH). It moves cost, never exactness. API
     /// 5.9: older callers get the default.
     pub map_bin_budget: f32,
+    /// Area shadows: where a pixel walks the BVH with a wide bundle of segments or rays (an emitter's radius
+    /// over a tenth of its distance), the nodes and triangles the bundle's walk may visit per 64 samples
+    /// still open, scaled by (0.3 / width)^2 (width: radius over distance), before each open sample walks
+    /// its own segment or ray (default 256; 0: each sample's own walk at once; `0xFFFFFFFF`: the bundle
+    /// always). The bundle costs less where few triangles straddle it (small lights), the samples' own
+    /// walks where many do (large lights). It moves cost, never exactness. API 5.10: older callers get the
+    /// default.
+    pub area_walk_budget: u32,
 }
 
 /// One draw of the geometry: an element of `draws`, read at `draw_stride`.
@@ -955,6 +963,11 @@ pub struct HrtsFrameReport {
     pub pixels_walked: u32,
     /// BVH walks that could not finish (a driver that ends long loops early): 0 on a conforming device.
     pub walks_unfinished: u32,
+    /// Reserved, written 0: API 5.9's report ends with this padding, which no later field may take.
+    pub reserved_5_9: u32,
+    /// Area shadows: pixels whose bundle passed `area_walk_budget`, so that each of their open samples
+    /// walked the BVH on its own. API 5.10: written for callers of 5.10 and later.
+    pub pixels_walked_per_sample: u32,
 }
 
 /// What the plugin would do with one light in a view, decided without a context or a device

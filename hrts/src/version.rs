@@ -74,21 +74,21 @@ versions! {
     HrtsFrame => [(240, 1), (256, 8)] versioned;
     HrtsResourceInfo => [(32, 1)] versioned;
     HrtsResourceReadback => [(48, 1)] versioned;
-    HrtsFrameReport => [(5560, 1), (5568, 4), (5592, 9)] versioned;
+    HrtsFrameReport => [(5560, 1), (5568, 4), (5592, 9), (5600, 10)] versioned;
     HrtsLightPlan => [(156, 10)] versioned;
     HrtsDraw => [(76, 1)];
     HrtsLight => [(100, 1)];
     HrtsMeshVertices => [(32, 1)];
 }
 
-// SAFETY: as for the structs above; 104, 108 and 112 end where `map_initial_pairs`, `area_samples` and
-// `map_list_limit` begin.
+// SAFETY: as for the structs above; 104, 108, 112 and 120 end where `map_initial_pairs`, `area_samples`,
+// `map_list_limit` and `area_walk_budget` begin.
 unsafe impl Versions for HrtsConfig {
-    const SIZES: &'static [(usize, u32)] = &[(104, 1), (108, 4), (112, 5), (120, 9)];
+    const SIZES: &'static [(usize, u32)] = &[(104, 1), (108, 4), (112, 5), (120, 9), (124, 10)];
 
     /// A configuration of 5.1 to 5.3 gets `map_initial_pairs` 0 (automatic); one of 5.1 to 5.4
-    /// `area_samples` 64; one of 5.1 to 5.8 the default list limit and bin budget: the defaults of
-    /// `hrts_config_defaults`.
+    /// `area_samples` 64; one of 5.1 to 5.8 the default list limit and bin budget; one of 5.1 to 5.9 the
+    /// default area walk budget: the defaults of `hrts_config_defaults`.
     fn defaults() -> Self {
         // SAFETY: every field is an integer or a float: all zeros is valid.
         let mut config: Self = unsafe { std::mem::zeroed() };
@@ -96,12 +96,13 @@ unsafe impl Versions for HrtsConfig {
         config.area_samples = defaults.area.samples;
         config.map_list_limit = defaults.map.list_limit;
         config.map_bin_budget = defaults.map.bin_budget;
+        config.area_walk_budget = defaults.area.bundle_walk_budget;
         config
     }
 }
 // SAFETY: as above; the first field is `struct_size: u32`.
 unsafe impl Versioned for HrtsConfig {}
-const _: () = assert!(HrtsConfig::SIZES[3].0 == size_of::<HrtsConfig>());
+const _: () = assert!(HrtsConfig::SIZES[4].0 == size_of::<HrtsConfig>());
 
 // The fields of each version lie past the sizes of the versions before it, never in their padding.
 const _: () = {
@@ -113,6 +114,8 @@ const _: () = {
     assert!(offset_of!(HrtsConfig, area_samples) == 108);
     assert!(offset_of!(HrtsConfig, map_list_limit) == 112);
     assert!(offset_of!(HrtsFrameReport, texels_past_limit) == 5568);
+    assert!(offset_of!(HrtsFrameReport, pixels_walked_per_sample) == 5592);
+    assert!(offset_of!(HrtsConfig, area_walk_budget) == 120);
 };
 
 /// The name of `T` in the C header.

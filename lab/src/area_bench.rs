@@ -12,7 +12,7 @@ use anyhow::{Context, Result};
 use demo_engine::View;
 use host_demo::render::{map_bytes, median_timings};
 use hrts::FrameReport;
-use passes::{AreaConfig, PcssConfig, PenumbraFilter, ShadowConfig, ShadowMapConfig, ShadowMode};
+use passes::{PcssConfig, PenumbraFilter, ShadowConfig, ShadowMapConfig, ShadowMode};
 use reference::RefScene;
 use rhi::Device;
 use std::collections::BTreeMap;
@@ -33,7 +33,7 @@ fn area_config(args: &BenchArgs, angular_radius: f32, samples: u32) -> ShadowCon
             angular_radius,
             ..PcssConfig::default()
         },
-        area: AreaConfig { samples },
+        area: args.area(samples),
         ..ShadowConfig::default()
     }
 }

@@ -11,7 +11,7 @@ use glam::Vec3;
 use host_demo::progress::phase;
 use hrts::passes_bridge;
 use hrts::FrameReport;
-use passes::{PrimitiveMapConfig, ShadowConfig};
+use passes::{AreaConfig, PrimitiveMapConfig, ShadowConfig};
 use rhi::{Device, Format};
 use scene::{Camera, DirectionalLight};
 use std::collections::BTreeMap;
@@ -83,6 +83,11 @@ pub struct BenchArgs {
     /// (0: always the BVH; inf: always lists).
     #[arg(long, default_value_t = hrts::Config::default().map_bin_budget)]
     pub bin_budget: f32,
+    /// Area shadows: the nodes and triangles a pixel's walk of the BVH with a wide bundle of segments or
+    /// rays may visit per 64 open samples (scaled by the bundle's width) before each open sample walks its
+    /// own (0: each sample's own walk at once; 4294967295: the bundle always).
+    #[arg(long, default_value_t = hrts::Config::default().area_walk_budget)]
+    pub area_walk_budget: u32,
     /// With --lights: give the plugin an R32F output without storage usage, as an engine whose output the
     /// lights cannot write: each light's layer is copied in ("output copy" in the per-pass split). Default:
     /// a storage output each light writes directly.
@@ -115,6 +120,14 @@ impl BenchArgs {
 
     /// The primitive map the benchmark's configurations take: the default with the given list limit and
     /// bin budget (and, for --lights, N).
+    /// The area settings of these options, with `samples` light samples per pixel.
+    pub fn area(&self, samples: u32) -> AreaConfig {
+        AreaConfig {
+            samples,
+            bundle_walk_budget: self.area_walk_budget,
+        }
+    }
+
     pub fn map(&self) -> PrimitiveMapConfig {
         PrimitiveMapConfig {
             list_limit: self.list_limit,

@@ -20,8 +20,8 @@ use host_demo::scene_render::{median, SceneRenderer};
 use hrts::passes_bridge;
 use hrts::MapStats;
 use passes::{
-    directional_light_frustum, spot_light_frusta, AreaConfig, FrameInputs, Light,
-    PrimitiveMapConfig, ShadowConfig, ShadowMode,
+    directional_light_frustum, spot_light_frusta, FrameInputs, Light, PrimitiveMapConfig,
+    ShadowConfig, ShadowMode,
 };
 use rhi::Device;
 use scene::{Aabb, Camera, LightKind, LightSize, Scene, SceneFile, SceneLight};
@@ -200,8 +200,9 @@ struct LightCost {
     max_ms: f64,
     map_ms: f64,
     trace_ms: f64,
-    /// The ray-tracing-pipeline peer's trace-only ms at equal samples (sized lights with one frustum).
-    peer_ms: Option<f64>,
+    /// The ray-tracing-pipeline peer's trace-only ms at equal samples (sized lights with one frustum), and
+    /// the pixels whose visible sample count differs between it and the plugin.
+    peer: Option<PeerCost>,
     bytes: u64,
     entries: u64,
     mean_list: f64,
@@ -226,6 +227,8 @@ struct Routes {
     past_limit: u64,
     /// Pixels that walked the BVH.
     walked: u64,
+    /// Area shadows: pixels whose bundle passed its walk budget, their samples walked one by one.
+    per_sample: u64,
 }
 
 impl Routes {
@@ -235,6 +238,7 @@ impl Routes {
             skipped: r.skipped + u32::from(st.frusta_without_lists > 0),
             past_limit: r.past_limit + u64::from(st.texels_past_limit),
             walked: r.walked + u64::from(st.pixels_walked),
+            per_sample: r.per_sample + u64::from(st.pixels_walked_per_sample),
         })
     }
 }
@@ -283,9 +287,28 @@ fn medians(frames: &[LightsFrame]) -> (f64, f64, f64) {
     )
 }
 
+/// What the ray-tracing-pipeline peer cost, and how its answer compares with the plugin's.
+struct PeerCost {
+    /// Trace-only GPU ms at equal samples.
+    trace_ms: f64,
+    /// Pixels whose visible sample count differs from the plugin's layer. Both test the same segments;
+    /// they may differ only where a segment passes within rounding of a triangle's edge or plane.
+    differing: usize,
+}
+
+/// The pixels of two visibility images of `samples` samples whose visible counts differ.
+fn differing_counts(a: &[f32], b: &[f32], samples: u32) -> usize {
+    let count = |v: f32| (v * samples as f32).round() as i64;
+    a.iter()
+        .zip(b)
+        .filter(|(x, y)| count(**x) != count(**y))
+        .count()
+}
+
 /// The peer's trace-only ms for `light` of size `size` (angular radius or emitter radius) on the frame
-/// `plugin` last rendered through `camera` (`None` without ray tracing or without a light for it).
-fn peer_ms(
+/// `plugin` last rendered through `camera`, and the pixels where it differs from the plugin's layer of
+/// that frame (`None` without ray tracing or without a light for it).
+fn peer_cost(
     device: &Device,
     plugin: &PluginRenderer,
     scene: &Scene,
@@ -293,10 +316,12 @@ fn peer_ms(
     light: Option<Light>,
     size: f32,
     args: &BenchArgs,
-) -> Result<Option<f64>> {
+) -> Result<Option<PeerCost>> {
     let Some(light) = light.filter(|_| device.capabilities().ray_tracing_pipeline) else {
         return Ok(None);
     };
+    let (_, layers) = plugin.read_frame(device)?;
+    let layer = layers.first().context("the light's layer")?;
     let m = CameraMatrices::of_camera(camera, args.width, args.height);
     let inputs = FrameInputs {
         view: m.view,
@@ -313,7 +338,10 @@ fn peer_ms(
         args.area_samples,
         args.frames,
     )?;
-    Ok(Some(run.trace_ms))
+    Ok(Some(PeerCost {
+        trace_ms: run.trace_ms,
+        differing: differing_counts(&run.visibility, layer, args.area_samples),
+    }))
 }
 
 fn measure_light(
@@ -326,9 +354,7 @@ fn measure_light(
     let settings = PlanSettings {
         base: passes_bridge::config(&ShadowConfig {
             antialiasing: false,
-            area: AreaConfig {
-                samples: args.area_samples,
-            },
+            area: args.area(args.area_samples),
             map: PrimitiveMapConfig {
                 size: args.map_size,
                 ..args.map()
@@ -357,8 +383,8 @@ fn measure_light(
     let max_ms = slowest(&frames);
     let last = frames.last().context("no frame rendered")?;
     let reports = &last.lights;
-    let peer_ms = match peer {
-        Some((light, size)) => peer_ms(
+    let peer = match peer {
+        Some((light, size)) => peer_cost(
             device,
             renderer.plugin(),
             &file.scene,
@@ -381,7 +407,7 @@ fn measure_light(
         max_ms,
         map_ms,
         trace_ms,
-        peer_ms,
+        peer,
         routes: Routes::of(reports.iter().map(|r| &r.stats)),
         bytes: reports
             .iter()
@@ -464,7 +490,7 @@ fn measure_native_points(
     if let Some(radius) = emitter_radius {
         config.mode = ShadowMode::Area;
         config.pcss.spot_radius = radius;
-        config.area.samples = args.area_samples;
+        config.area = args.area(args.area_samples);
     }
     plugin.configure_lights(
         device,
@@ -498,7 +524,7 @@ fn measure_native_points(
         max_ms,
         map_ms,
         trace_ms,
-        peer_ms: None,
+        peer: None,
         routes: Routes::of(last.lights.iter().map(|l| &l.stats)),
         bytes: last
             .lights
@@ -538,8 +564,9 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
          included; memory = the light's own resources ({}; the build scratch shared by all lights is listed \
          below); frusta = recorded / built (the plugin skips those holding no receiver in view).\n\n\
          | scene | light | emitter | frusta | GPU ms | max ms | × sun | map ms | ray trace ms | RT peer trace ms | \
-         MiB | entries | mean list | longest | bin items | lists | past limit | past capacity | BVH pixels |\n\
-         |---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|\n",
+         MiB | entries | mean list | longest | bin items | lists | past limit | past capacity | BVH pixels | \
+         per-sample pixels | ≠ peer |\n\
+         |---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|\n",
         caps.device_name,
         caps.driver,
         args.width,
@@ -695,7 +722,7 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
             for c in &costs {
                 let _ = writeln!(
                     out,
-                    "| {} | {} | {size_cell} | {} / {} | {:.3} | {:.3} | {:.1} | {:.3} | {:.3} | {} | {:.1} | {} | {:.1} | {} | {} | {} | {} | {} | {} |",
+                    "| {} | {} | {size_cell} | {} / {} | {:.3} | {:.3} | {:.1} | {:.3} | {:.3} | {} | {:.1} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} |",
                     scene_case.file.trim_end_matches(".obj"),
                     c.name,
                     c.frusta.0,
@@ -705,7 +732,9 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
                     if sun_ms > 0.0 { c.gpu_ms / sun_ms } else { 0.0 },
                     c.map_ms,
                     c.trace_ms,
-                    c.peer_ms.map_or("—".to_owned(), |ms| format!("{ms:.3}")),
+                    c.peer
+                        .as_ref()
+                        .map_or("—".to_owned(), |p| format!("{:.3}", p.trace_ms)),
                     c.bytes as f64 / f64::from(1 << 20),
                     c.entries,
                     c.mean_list,
@@ -719,6 +748,10 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
                     c.routes.past_limit,
                     c.past_capacity,
                     c.routes.walked,
+                    c.routes.per_sample,
+                    c.peer
+                        .as_ref()
+                        .map_or("—".to_owned(), |p| p.differing.to_string()),
                 );
                 let passes: Vec<String> = c
                     .passes
@@ -740,7 +773,10 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
     out.push_str(
         "\n× sun: against the first size's sun. lists: built, or BVH when the frame's bin items passed the \
          bin budget and every pixel walked the BVH; past limit: texels whose list passed the list limit (they \
-         walk the BVH); BVH pixels: pixels that walked the BVH. RT peer: the same samples of every pixel as \
+         walk the BVH); BVH pixels: pixels that walked the BVH; per-sample pixels: those of them whose \
+         bundle of segments or rays passed its walk budget, each open sample then walking its own; ≠ peer: pixels \
+         whose visible sample count differs from the peer's (the same segments: they may differ only where \
+         one passes within rounding of a triangle's edge or plane). RT peer: the same samples of every pixel as \
          any-hit rays through the driver's ray-tracing pipeline, trace only (— for hard shadows, a spot \
          light of several frusta, several lights at once, or a device without ray tracing).\n",
     );

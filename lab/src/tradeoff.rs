@@ -217,7 +217,10 @@ pub fn methods(angular_radius: f32, wss: f32) -> Vec<Method> {
                 mode: ShadowMode::Area,
                 map: PrimitiveMapConfig::default(),
                 pcss: pcss(PenumbraFilter::Standard, 16, 32),
-                area: AreaConfig { samples },
+                area: AreaConfig {
+                    samples,
+                    ..AreaConfig::default()
+                },
                 ..base
             },
             output: Output::Final,

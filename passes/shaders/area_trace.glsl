@@ -23,7 +23,9 @@
 // A sample towards which the receiver's normal does not face is blocked, as the reference has it.
 // Where the map holds no complete list for the pixel (trace_route.glsl), it walks the BVH over the prim
 // buffer (bvh_traverse.glsl) with the bundle of its segments or rays, and tests each triangle met exactly as
-// a list entry: the same answer, bit for bit. Either way a pixel stops once every sample is blocked.
+// a list entry: the same answer, bit for bit. A wide bundle that meets many triangles gives up past a
+// budget, and each of its open samples walks its own segment or ray (walk_sample): again the same answer.
+// Either way a pixel stops once every sample is blocked.
 #include "triangle.glsl"
 #include "ray_trace_constants.glsl"
 #include "map_state.glsl"
@@ -196,6 +198,16 @@ uint quick(uint index) {
     return UNDECIDED;
 }
 
+// Whether the sample of offsets (a local light) or direction `w` meets the triangle quick() looked at
+// last: the per-sample test every decision of the trace agrees with.
+bool sample_hit(vec3 w) {
+    return local ? line_a.x + w.x * line_a.y + w.y * line_a.z >= 0.0
+                   && line_b.x + w.x * line_b.y + w.y * line_b.z >= 0.0
+                   && line_c.x + w.x * line_c.y + w.y * line_c.z >= 0.0
+                   && line_p.x + w.x * line_p.y + w.y * line_p.z > 0.0
+                 : dot(line_a, w) >= 0.0 && dot(line_b, w) >= 0.0 && dot(line_c, w) >= 0.0;
+}
+
 // Decides the samples still open against the triangle quick() left undecided: the edge table decides most
 // samples of its lines at once (a local light's four lines in the unit disc), and the samples still open
 // that it is uncertain about are tested one by one (of `reach`, those whose segment or ray may meet the
@@ -222,14 +234,7 @@ void resolve(uvec4 reach) {
         while (bits != 0u) {
             uint bit = findLSB(bits);
             bits &= bits - 1u;
-            vec3 w = sample_dirs[word * 32u + bit];
-            bool hit = local
-                ? line_a.x + w.x * line_a.y + w.y * line_a.z >= 0.0
-                  && line_b.x + w.x * line_b.y + w.y * line_b.z >= 0.0
-                  && line_c.x + w.x * line_c.y + w.y * line_c.z >= 0.0
-                  && line_p.x + w.x * line_p.y + w.y * line_p.z > 0.0
-                : dot(line_a, w) >= 0.0 && dot(line_b, w) >= 0.0 && dot(line_c, w) >= 0.0;
-            if (hit) {
+            if (sample_hit(sample_dirs[word * 32u + bit])) {
                 blocked[word] |= 1u << bit;
             }
         }
@@ -256,6 +261,76 @@ void bvh_visit(uint index, uvec4 reach) {
 bool bvh_done() {
     return all_blocked();
 }
+
+// One sample's own segment (a spot or point light) or ray (a directional light) from the origin, walked
+// through the BVH alone: `offsets`, the sample's unit-disc offsets or direction (sample_dirs), `d` the
+// segment's or ray's direction, `t_end` its end. Each triangle met is decided for every sample at once
+// where quick() can, else for this sample by its own test, exactly as resolve() would decide it. False when
+// the walk could not finish (never on a conforming device).
+bool walk_sample(uvec4 bit, vec3 offsets, vec3 d, float t_end) {
+    float big = max(max(abs(d.x), abs(d.y)), abs(d.z)) + (local ? length(disc_u) : 0.0);
+    bvh_set_cone(origin, d, 1e-4 * big, t_end);
+    uint stack[BVH_STACK];
+    uint sp = 0u;
+    uint node = 0u;
+    for (uint round = 0u; round < 65535u; ++round) {
+        for (uint step = 0u; step < 64u; ++step) {
+            BvhNode nd = bvh_nodes[node];
+            uint children[2] = uint[2](floatBitsToUint(nd.left_lo.w), floatBitsToUint(nd.right_lo.w));
+            float t_left, t_right;
+            bool met[2] = bool[2](bvh_cone_meets(nd.left_lo.xyz, nd.left_hi.xyz, t_left),
+                                  bvh_cone_meets(nd.right_lo.xyz, nd.right_hi.xyz, t_right));
+            for (uint c = 0u; c < 2u; ++c) {
+                if (met[c] && children[c] >= BVH_LEAF) {
+                    met[c] = false;
+                    uint q = quick(children[c] & ~BVH_LEAF);
+                    if (q == BLOCKS_ALL) {
+                        blocked = all_samples;
+                    } else if (q == UNDECIDED && sample_hit(offsets)) {
+                        // A blocker of one sample often blocks its neighbours: decide them all now.
+                        blocked |= bit;
+                        resolve(all_samples);
+                    }
+                }
+            }
+            if (any(notEqual(blocked & bit, uvec4(0u)))) {
+                return true;
+            }
+            if (met[0] && met[1]) {
+                if (sp == BVH_STACK) {
+                    return false;
+                }
+                bool left_first = t_left <= t_right;
+                stack[sp++] = left_first ? children[1] : children[0];
+                node = left_first ? children[0] : children[1];
+            } else if (met[0] || met[1]) {
+                node = met[0] ? children[0] : children[1];
+            } else if (sp > 0u) {
+                node = stack[--sp];
+            } else {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
+// Sample `bit` of word `word`'s own walk (walk_sample).
+bool walk_one(uint word, uint bit) {
+    uvec4 mask = uvec4(0u);
+    mask[word] = 1u << bit;
+    vec3 offsets = sample_dirs[word * 32u + bit];
+    vec3 d = local ? disc_c + offsets.x * disc_u + offsets.y * disc_v : offsets;
+    return walk_sample(mask, offsets, d, local ? 1.0 : 1.0 / 0.0);
+}
+
+// A bundle whose emitter's radius passes this share of its distance (a directional light: its angular
+// bound) is wide: its walk may give up for its samples' own walks.
+const float WIDE_BUNDLE = 0.1;
+// The width at which a wide bundle's walk budget is the configured one; it grows with the inverse square
+// of the width below it (a narrower bundle meets fewer triangles that its samples' walks would miss) and
+// shrinks above it.
+const float BUDGET_WIDTH = 0.3;
 
 // The projection of the BVH walk's boxes (bvh_box_samples) onto the samples' plane: a corner c maps to
 // depth ((c - o).axis_u, (c - o).axis_v) / (c - o).normal - plane_offset, for corners in front of the
@@ -343,7 +418,36 @@ void walk_bvh() {
         plane_offset = vec2(0.0);
         plane_margin = 1e-4 * samples.center.w;
     }
-    count_walk(bvh_walk(k.misc.y, all_samples));
+    bvh_walk_start(all_samples);
+    // A wide bundle (an emitter large for its distance) meets many triangles that no sample's own segment
+    // comes near. Its walk visits at most `k.misc.z` nodes and triangles per 64 open samples, scaled by
+    // (BUDGET_WIDTH / width)^2, about what the samples' own walks would cost; past them each open sample
+    // still undecided walks its own segment or ray, so that a pixel costs at most about twice the cheaper
+    // way. The answer is the same either way, bit for bit. (`k.misc.z` 0: each sample's own walk at once;
+    // 0xFFFFFFFF: the bundle always.)
+    float width = local ? length(disc_u) / max(length(disc_c), 1e-30) : samples.center.w;
+    uint budget = 0xFFFFFFFFu;
+    if (k.misc.z == 0u) {
+        budget = 0u;
+    } else if (width > WIDE_BUNDLE && k.misc.z != 0xFFFFFFFFu) {
+        uvec4 open = all_samples & ~blocked;
+        uint open_count = bitCount(open.x) + bitCount(open.y) + bitCount(open.z) + bitCount(open.w);
+        float scale = min(BUDGET_WIDTH * BUDGET_WIDTH / (width * width), 64.0);
+        budget = uint(min(float(k.misc.z) * scale * float(open_count) / 64.0, 4.0e9));
+    }
+    bool finished = bvh_walk_resume(k.misc.y, budget);
+    if (finished && bvh_over_budget) {
+        count_sample_walks();
+        for (uint w = 0u; w < 4u && finished; ++w) {
+            for (uint bits = all_samples[w] & ~blocked[w]; bits != 0u && finished; bits &= bits - 1u) {
+                uint bit = findLSB(bits);
+                if ((blocked[w] & (1u << bit)) == 0u) {
+                    finished = walk_one(w, bit);
+                }
+            }
+        }
+    }
+    count_walk(finished);
 }
 
 void main() {

@@ -25,7 +25,9 @@ struct MapState {
                         // the BVH, z: texels whose list passed the list limit (walked through the BVH),
                         // w: unused
     uvec4 walks;        // first state only, written by the trace: x: pixels that walked the BVH, y: walks
-                        // that could not finish (never on a conforming device), zw: unused
+                        // that could not finish (never on a conforming device), z: area trace: pixels
+                        // whose bundle passed its walk budget, their open samples walked one by one,
+                        // w: unused
 };
 
 // The texel index of texel `t` of the grid whose state's `grid` is `grid`.

@@ -12,7 +12,9 @@ struct RayTraceConstants {
     vec4 offset;                // x: radians per pixel, y: offset in pixels, z: relative float bound of |P|,
                                 // w: one step of a normalized depth format (0 for float depth)
     uvec4 misc;                 // x: 1 = front-only map, y: triangles in the prim buffer,
-                                // z: 1 = store the blocker distance (ray trace), w unused
+                                // z: ray trace: 1 = store the blocker distance; area trace: the bundle's
+                                // walk budget per 64 open samples (passes::area::AreaConfig), w: area
+                                // trace: light samples per pixel
     vec4 light_pos;             // spot light: xyz position in frame coordinates, w = 1; directional: w = 0
     mat4 view_to_world;         // the camera's rotation, view to world (for view-space normals)
     uvec4 surface_mode;         // the engine's normal: see engine_surface.glsl

@@ -27,3 +27,11 @@ void count_walk(bool finished) {
         }
     }
 }
+
+// Counts a pixel of the area trace whose bundle gave up and whose open samples walked the BVH one by one.
+void count_sample_walks() {
+    uint count = subgroupAdd(1u);
+    if (subgroupElect()) {
+        atomicAdd(ms.walks.z, count);
+    }
+}

@@ -123,8 +123,9 @@ pub struct RayTraceConstants {
     /// x: radians per pixel, y: ray-origin offset in pixels, z: relative float bound of |P|, w: one step of
     /// a normalized depth format (0 for float depth).
     pub offset: Vec4,
-    /// x: front-only map flag, y: triangles in the prim buffer, z: 1 = the ray trace stores the blocker
-    /// distance.
+    /// x: front-only map flag, y: triangles in the prim buffer, z: the ray trace: 1 = it stores the blocker
+    /// distance; the area trace: the bundle's walk budget ([`crate::area::AreaConfig::bundle_walk_budget`]),
+    /// w: the area trace's light samples per pixel.
     pub misc: UVec4,
     /// Spot light: position in frame coordinates (xyz), w = 1; directional light: w = 0.
     pub light_pos: Vec4,
@@ -165,7 +166,8 @@ pub struct MapState {
     /// every pixel walks the BVH), z: texels whose list passed the list limit (walked through the BVH).
     pub routes: UVec4,
     /// First state only, written by the trace: x: pixels that walked the BVH, y: walks that could not
-    /// finish (never on a conforming device).
+    /// finish (never on a conforming device), z: the area trace's pixels whose bundle passed its walk
+    /// budget ([`crate::area::AreaConfig::bundle_walk_budget`]).
     pub walks: UVec4,
 }
 
@@ -220,6 +222,10 @@ pub struct MapStats {
     pub pixels_walked: u32,
     /// BVH walks that could not finish (never on a conforming device: a failure the tests check for).
     pub walks_unfinished: u32,
+    /// Area shadows: pixels whose bundle of segments or rays passed its walk budget
+    /// ([`crate::area::AreaConfig::bundle_walk_budget`]), so that each of their open samples walked the
+    /// BVH on its own (the same answer, for less than the bundle's wide walk).
+    pub pixels_walked_per_sample: u32,
     /// A point light's (triangle, face) pairs kept by the setup (0 for a light of one frustum). Past the
     /// pairs the map held (`pair_capacity`), the frame traced every ray exhaustively (exact, slower), and
     /// the map grows for the next.
@@ -247,6 +253,7 @@ impl MapStats {
             lists_skipped: s.routes.y != 0,
             pixels_walked: s.walks.x,
             walks_unfinished: s.walks.y,
+            pixels_walked_per_sample: s.walks.z,
             pairs: s.grid.z,
             pair_capacity: s.grid.w,
         }

@@ -300,7 +300,9 @@ impl RayTracePass {
         samples: Option<&AreaSamples>,
     ) -> Result<(), PassError> {
         let mut constants = *constants;
-        constants.misc.z = u32::from(self.blocker_distance.is_some());
+        if samples.is_none() {
+            constants.misc.z = u32::from(self.blocker_distance.is_some());
+        }
         enc.update_buffer(&self.constants, 0, bytemuck::bytes_of(&constants))?;
         match (&self.samples, samples) {
             (Some((buffer, _, _)), Some(samples)) => {

@@ -308,7 +308,11 @@ pub fn area_peer_constants(
     size: f32,
     samples: u32,
 ) -> Result<(RayTraceConstants, AreaSamples), PassError> {
-    crate::AreaConfig { samples }.validate_samples()?;
+    crate::AreaConfig {
+        samples,
+        ..crate::AreaConfig::default()
+    }
+    .validate_samples()?;
     let mut constants = shadow_ray_constants(inputs, origin, width, height)?;
     let direction = constants.light_dir.truncate();
     let area = if inputs.light.position().is_some() {

@@ -43,7 +43,10 @@ fn area_config(angular_radius: f32, samples: u32, faces: FaceMode) -> ShadowConf
             angular_radius,
             ..PcssConfig::default()
         },
-        area: AreaConfig { samples },
+        area: AreaConfig {
+            samples,
+            ..AreaConfig::default()
+        },
         ..ShadowConfig::default()
     }
 }

@@ -271,31 +271,47 @@ fn area_shadows_through_the_bvh_equal_the_lists_bit_for_bit() {
     };
     // 64 samples: masks of two words, against the lists bit for bit.
     // (Finer samples leave fewer pixels stable against the reference: 36 penumbra pixels at 64.)
+    // Each route walks the BVH with the whole bundle of a pixel's segments, then with each sample's own.
+    let walks = [("bundle", u32::MAX), ("each sample", 0)];
     for (samples, min_penumbra) in [(32, 50), (64, 30)] {
         let mut first: Option<Vec<f32>> = None;
         for (name, map) in routes(map) {
-            let config = ShadowConfig {
-                mode: ShadowMode::Area,
-                antialiasing: false,
-                map,
-                pcss: PcssConfig {
-                    angular_radius: radius,
-                    ..PcssConfig::default()
-                },
-                area: AreaConfig { samples },
-                ..ShadowConfig::default()
-            };
-            let (report, images) = render_with(&device, &view, config);
-            assert_route(name, &report);
-            let c = compare_area(&rs, &view, radius, samples, &images.output);
-            println!("{name}, {samples} samples: {c:?}, {:?}", report.stats);
-            assert_exact_area(name, &c, min_penumbra, 25);
-            match &first {
-                None => first = Some(images.output),
-                Some(lists) => assert!(
-                    &images.output == lists,
-                    "{name}, {samples} samples: area counts differ from the lists'"
-                ),
+            for (walk, bundle_walk_budget) in walks {
+                let config = ShadowConfig {
+                    mode: ShadowMode::Area,
+                    antialiasing: false,
+                    map,
+                    pcss: PcssConfig {
+                        angular_radius: radius,
+                        ..PcssConfig::default()
+                    },
+                    area: AreaConfig {
+                        samples,
+                        bundle_walk_budget,
+                    },
+                    ..ShadowConfig::default()
+                };
+                let (report, images) = render_with(&device, &view, config);
+                assert_route(name, &report);
+                let st = report.stats;
+                let per_sample = st.pixels_walked_per_sample;
+                match (walk, st.pixels_walked) {
+                    ("bundle", _) | (_, 0) => assert_eq!(per_sample, 0, "{name}, {walk}: {st:?}"),
+                    _ => assert!(
+                        per_sample > 0 && per_sample <= st.pixels_walked,
+                        "{name}, {walk}: {st:?}"
+                    ),
+                }
+                let c = compare_area(&rs, &view, radius, samples, &images.output);
+                println!("{name}, {walk}, {samples} samples: {c:?}, {st:?}");
+                assert_exact_area(name, &c, min_penumbra, 25);
+                match &first {
+                    None => first = Some(images.output),
+                    Some(lists) => assert!(
+                        &images.output == lists,
+                        "{name}, {walk}, {samples} samples: area counts differ from the lists'"
+                    ),
+                }
             }
         }
     }

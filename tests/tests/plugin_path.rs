@@ -144,6 +144,7 @@ fn direct_stats(r: &FrameReport) -> hrts::MapStats {
         frusta_without_lists: u32::from(st.lists_skipped),
         pixels_walked: st.pixels_walked,
         walks_unfinished: st.walks_unfinished,
+        pixels_walked_per_sample: st.pixels_walked_per_sample,
     }
 }
 

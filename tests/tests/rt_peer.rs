@@ -128,7 +128,10 @@ fn area_peer_counts_equal_the_plugins_on_stable_pixels() {
                 angular_radius: radius,
                 ..PcssConfig::default()
             },
-            area: AreaConfig { samples },
+            area: AreaConfig {
+                samples,
+                ..AreaConfig::default()
+            },
             ..ShadowConfig::default()
         };
         let config = hrts::passes_bridge::config(&config).expect("a configuration of the C ABI");

@@ -948,9 +948,17 @@ fn check_local_area(
             .collect()
     });
     let base = settings(false).base;
-    // The plugin's own choice of lists and BVH, then every pixel through the BVH: the same counts.
+    // The plugin's own choice of lists and BVH, then every pixel through the BVH: with the whole bundle of
+    // its segments, with each sample's own, and with the bundle giving up after one step (wide bundles
+    // then weigh one sample's walk against the bundle's): the same counts.
     let mut first: Option<(AreaComparison, hrts::MapStats, Vec<f32>)> = None;
-    for (route, bin_budget) in [("default", base.map_bin_budget), ("BVH", 0.0)] {
+    let routes = [
+        ("default", base.map_bin_budget, base.area_walk_budget),
+        ("BVH", 0.0, u32::MAX),
+        ("BVH, each sample", 0.0, 0),
+        ("BVH, bundle of one step", 0.0, 1),
+    ];
+    for (route, bin_budget, area_walk_budget) in routes {
         let mut config = Config {
             mode: ShadowMode::Area,
             antialiasing: false,
@@ -958,6 +966,7 @@ fn check_local_area(
             ..base
         };
         config.map_bin_budget = bin_budget;
+        config.area_walk_budget = area_walk_budget;
         config.pcss_spot_radius = radius;
         let mut plugin = plugin_for(device, file);
         plugin
@@ -979,10 +988,10 @@ fn check_local_area(
         let c = compare_area_counts(&r, &layers[0], considered.as_deref());
         let st = report.stats;
         println!(
-            "{name} ({route}): R {radius}, {samples} samples: {} px, {} unstable, {} penumbra, {} umbra, {} mismatches; {}; map {} entries, mean list {:.1}, longest {}, {} texels past capacity, {} past the limit, {} pixels walked the BVH",
+            "{name} ({route}): R {radius}, {samples} samples: {} px, {} unstable, {} penumbra, {} umbra, {} mismatches; {}; map {} entries, mean list {:.1}, longest {}, {} texels past capacity, {} past the limit, {} pixels walked the BVH, {} of them each sample",
             c.pixels, c.unstable, c.penumbra, c.umbra, c.mismatches, frame.lights[0].decision_reason,
             st.entries, st.mean_list(), st.longest_list, st.texels_past_capacity,
-            st.texels_past_limit, st.pixels_walked
+            st.texels_past_limit, st.pixels_walked, st.pixels_walked_per_sample
         );
         assert_exact_area(
             &format!("{name} ({route})"),
@@ -999,6 +1008,11 @@ fn check_local_area(
                     st.frusta_without_lists > 0 && st.pixels_walked > 0,
                     "{name}: {st:?}"
                 );
+                match area_walk_budget {
+                    u32::MAX => assert_eq!(st.pixels_walked_per_sample, 0, "{name}: {st:?}"),
+                    0 => assert!(st.pixels_walked_per_sample > 0, "{name}: {st:?}"),
+                    _ => {}
+                }
                 assert!(
                     &layers[0] == default,
                     "{name}: the BVH's counts differ from the default route's"

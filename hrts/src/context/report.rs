@@ -74,6 +74,7 @@ impl Context {
         out.frusta_without_lists = sum(|r| u32::from(r.stats.lists_skipped));
         out.pixels_walked = sum(|r| r.stats.pixels_walked);
         out.walks_unfinished = sum(|r| r.stats.walks_unfinished);
+        out.pixels_walked_per_sample = sum(|r| r.stats.pixels_walked_per_sample);
         out.map_to_texels = reports
             .first()
             .map_or([0.0; 16], |r| r.map_to_texels.to_cols_array());

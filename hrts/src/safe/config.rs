@@ -89,6 +89,11 @@ pub struct Config {
     /// Bin items per pixel with a shadow ray past which a frame walks the BVH instead of building lists
     /// (default 8; infinity: always lists; 0: always the BVH).
     pub map_bin_budget: f32,
+    /// Area shadows: the nodes and triangles a pixel's walk of the BVH with a wide bundle of segments or
+    /// rays may visit per 64 open samples (scaled by the bundle's width), before each open sample walks
+    /// its own (default 256; 0: each sample's own walk at once; `u32::MAX`: the bundle always). It moves
+    /// cost, never exactness.
+    pub area_walk_budget: u32,
 }
 
 impl Default for Config {
@@ -143,6 +148,7 @@ impl Config {
             area_samples: self.area_samples,
             map_list_limit: self.map_list_limit,
             map_bin_budget: self.map_bin_budget,
+            area_walk_budget: self.area_walk_budget,
         }
     }
 
@@ -178,6 +184,7 @@ impl Config {
             area_samples: c.area_samples,
             map_list_limit: c.map_list_limit,
             map_bin_budget: c.map_bin_budget,
+            area_walk_budget: c.area_walk_budget,
         })
     }
 }

@@ -96,6 +96,9 @@ pub struct MapStats {
     pub pixels_walked: u32,
     /// BVH walks that could not finish (0 on a conforming device).
     pub walks_unfinished: u32,
+    /// Area shadows: pixels whose bundle passed the configuration's `area_walk_budget`, so that each of
+    /// their open samples walked the BVH on its own.
+    pub pixels_walked_per_sample: u32,
 }
 
 impl MapStats {
@@ -211,6 +214,7 @@ impl FrameReport {
                 frusta_without_lists: r.frusta_without_lists,
                 pixels_walked: r.pixels_walked,
                 walks_unfinished: r.walks_unfinished,
+                pixels_walked_per_sample: r.pixels_walked_per_sample,
             },
             map_to_texels: Mat4::from_cols_array(&r.map_to_texels),
             light_builds: r.light_builds,

@@ -107,7 +107,11 @@ impl ShadowPipeline {
                 misc: UVec4::new(
                     front_only,
                     self.geometry().triangle_count(),
-                    0,
+                    if area {
+                        self.config.area.bundle_walk_budget
+                    } else {
+                        0
+                    },
                     if area { samples } else { 0 },
                 ),
                 light_pos: light.position.map_or(Vec4::ZERO, |p| p.extend(1.0)),
