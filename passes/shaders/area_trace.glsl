@@ -265,12 +265,12 @@ bool bvh_done() {
 // One sample's own segment (a spot or point light) or ray (a directional light) from the origin, walked
 // through the BVH alone: `offsets`, the sample's unit-disc offsets or direction (sample_dirs), `d` the
 // segment's or ray's direction, `t_end` its end. Each triangle met is decided for every sample at once
-// where quick() can, else for this sample by its own test, exactly as resolve() would decide it. False when
-// the walk could not finish (never on a conforming device).
+// where quick() can, else for this sample by its own test, exactly as resolve() would decide it; one that
+// blocks the sample is then resolved for all the others. It takes over the stack of the bundle's walk,
+// which has given up. False when the walk could not finish (never on a conforming device).
 bool walk_sample(uvec4 bit, vec3 offsets, vec3 d, float t_end) {
     float big = max(max(abs(d.x), abs(d.y)), abs(d.z)) + (local ? length(disc_u) : 0.0);
     bvh_set_cone(origin, d, 1e-4 * big, t_end);
-    uint stack[BVH_STACK];
     uint sp = 0u;
     uint node = 0u;
     for (uint round = 0u; round < 65535u; ++round) {
@@ -301,12 +301,12 @@ bool walk_sample(uvec4 bit, vec3 offsets, vec3 d, float t_end) {
                     return false;
                 }
                 bool left_first = t_left <= t_right;
-                stack[sp++] = left_first ? children[1] : children[0];
+                bvh_stack[sp++] = left_first ? children[1] : children[0];
                 node = left_first ? children[0] : children[1];
             } else if (met[0] || met[1]) {
                 node = met[0] ? children[0] : children[1];
             } else if (sp > 0u) {
-                node = stack[--sp];
+                node = bvh_stack[--sp];
             } else {
                 return true;
             }
@@ -418,7 +418,6 @@ void walk_bvh() {
         plane_offset = vec2(0.0);
         plane_margin = 1e-4 * samples.center.w;
     }
-    bvh_walk_start(all_samples);
     // A wide bundle (an emitter large for its distance) meets many triangles that no sample's own segment
     // comes near. Its walk visits at most `k.misc.z` nodes and triangles per 64 open samples, scaled by
     // (BUDGET_WIDTH / width)^2, about what the samples' own walks would cost; past them each open sample
@@ -435,7 +434,7 @@ void walk_bvh() {
         float scale = min(BUDGET_WIDTH * BUDGET_WIDTH / (width * width), 64.0);
         budget = uint(min(float(k.misc.z) * scale * float(open_count) / 64.0, 4.0e9));
     }
-    bool finished = bvh_walk_resume(k.misc.y, budget);
+    bool finished = bvh_walk(k.misc.y, all_samples, budget);
     if (finished && bvh_over_budget) {
         count_sample_walks();
         for (uint w = 0u; w < 4u && finished; ++w) {

@@ -102,48 +102,37 @@ uint bvh_stack[BVH_STACK];
 #ifdef BVH_MASKED
 uvec4 bvh_stack_samples[BVH_STACK];
 #endif
-// The walk in progress: the node it visits next (with its samples), the nodes stacked, whether nodes are
-// left, and whether its last call stopped at its step budget (bvh_walk_resume goes on from there).
-uint bvh_node;
-uvec4 bvh_node_samples;
-uint bvh_sp;
-bool bvh_walking;
+// Whether the last walk stopped at its step budget.
 bool bvh_over_budget;
 
-// Starts a walk of the hierarchy for `samples` (the hard trace's one ray: any non-zero mask).
-void bvh_walk_start(uvec4 samples) {
-    bvh_node = 0u;
-    bvh_node_samples = samples;
-    bvh_sp = 0u;
-    bvh_walking = true;
+// Walks the hierarchy over `triangles` triangles for `samples` (the hard trace's one ray: any non-zero
+// mask) until the includer is done, no node is left, or it has visited `budget` nodes and leaves
+// (bvh_over_budget); false when the walk could not finish (never on a conforming device: the stack cannot
+// overflow and the rounds cover every node; the caller counts it).
+bool bvh_walk(uint triangles, uvec4 samples, uint budget) {
     bvh_over_budget = false;
-}
-
-// Goes on with the walk over `triangles` triangles until the includer is done, no node is left, or it has
-// visited `budget` nodes and leaves more (bvh_over_budget: a later call goes on where it stopped); false
-// when the walk could not finish (never on a conforming device: the stack cannot overflow and the rounds
-// cover every node; the caller counts it).
-bool bvh_walk_resume(uint triangles, uint budget) {
-    bvh_over_budget = false;
-    if (triangles == 0u || bvh_done()) {
-        bvh_walking = false;
+    if (triangles == 0u) {
         return true;
     }
+    uint sp = 0u;
+    uint node = 0u;
+    uvec4 node_samples = samples;
+    bool walking = true;
     uint spent = 0u;
     // Rounds of 64 steps: llvmpipe (lavapipe) ends any one loop after 65535 iterations.
-    for (uint round = 0u; round < 65535u && bvh_walking; ++round) {
-        for (uint step = 0u; step < 64u && bvh_walking; ++step) {
+    for (uint round = 0u; round < 65535u && walking; ++round) {
+        for (uint step = 0u; step < 64u && walking; ++step) {
             if (spent >= budget) {
                 bvh_over_budget = true;
                 return true;
             }
-            BvhNode nd = bvh_nodes[bvh_node];
+            BvhNode nd = bvh_nodes[node];
             uint left_child = floatBitsToUint(nd.left_lo.w);
             uint right_child = floatBitsToUint(nd.right_lo.w);
             float t_left, t_right;
-            uvec4 left = bvh_child(nd.left_lo.xyz, nd.left_hi.xyz, bvh_node_samples, left_child >= BVH_LEAF,
+            uvec4 left = bvh_child(nd.left_lo.xyz, nd.left_hi.xyz, node_samples, left_child >= BVH_LEAF,
                                    t_left);
-            uvec4 right = bvh_child(nd.right_lo.xyz, nd.right_hi.xyz, bvh_node_samples,
+            uvec4 right = bvh_child(nd.right_lo.xyz, nd.right_hi.xyz, node_samples,
                                     right_child >= BVH_LEAF, t_right);
             uint leaves[2];
             uvec4 leaf_samples[2];
@@ -162,43 +151,36 @@ bool bvh_walk_resume(uint triangles, uint budget) {
                 bvh_visit(leaves[i], leaf_samples[i]);
             }
             if (bvh_done()) {
-                bvh_walking = false;
                 return true;
             }
             spent += 1u + count;
             bool go_left = any(notEqual(left, uvec4(0u)));
             bool go_right = any(notEqual(right, uvec4(0u)));
             if (go_left && go_right) {
-                if (bvh_sp == BVH_STACK) {
+                if (sp == BVH_STACK) {
                     return false;
                 }
                 bool left_first = t_left <= t_right;
-                bvh_stack[bvh_sp] = left_first ? right_child : left_child;
+                bvh_stack[sp] = left_first ? right_child : left_child;
 #ifdef BVH_MASKED
-                bvh_stack_samples[bvh_sp] = left_first ? right : left;
+                bvh_stack_samples[sp] = left_first ? right : left;
 #endif
-                ++bvh_sp;
-                bvh_node = left_first ? left_child : right_child;
-                bvh_node_samples = left_first ? left : right;
+                ++sp;
+                node = left_first ? left_child : right_child;
+                node_samples = left_first ? left : right;
             } else if (go_left || go_right) {
-                bvh_node = go_left ? left_child : right_child;
-                bvh_node_samples = go_left ? left : right;
-            } else if (bvh_sp > 0u) {
-                --bvh_sp;
-                bvh_node = bvh_stack[bvh_sp];
+                node = go_left ? left_child : right_child;
+                node_samples = go_left ? left : right;
+            } else if (sp > 0u) {
+                --sp;
+                node = bvh_stack[sp];
 #ifdef BVH_MASKED
-                bvh_node_samples = bvh_stack_samples[bvh_sp];
+                node_samples = bvh_stack_samples[sp];
 #endif
             } else {
-                bvh_walking = false;
+                walking = false;
             }
         }
     }
-    return !bvh_walking;
-}
-
-// Walks the hierarchy over `triangles` triangles for `samples` to its end (bvh_walk_resume).
-bool bvh_walk(uint triangles, uvec4 samples) {
-    bvh_walk_start(samples);
-    return bvh_walk_resume(triangles, 0xFFFFFFFFu);
+    return !walking;
 }

@@ -186,7 +186,7 @@ void main() {
         walk_first_hit = first_hit;
         walk_t_max = t_max;
         bvh_set_cone(o, dir, 0.0, t_max);
-        count_walk(bvh_walk(k.misc.y, uvec4(1u, 0u, 0u, 0u)));
+        count_walk(bvh_walk(k.misc.y, uvec4(1u, 0u, 0u, 0u), 0xFFFFFFFFu));
         nearest = walk_nearest;
     }
     if (nearest < t_max) {
