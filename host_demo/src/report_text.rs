@@ -50,14 +50,14 @@ pub fn routes_line(st: &MapStats, ms: &BTreeMap<String, f64>) -> String {
     };
     let per_sample = if st.pixels_walked_per_sample > 0 {
         format!(
-            ", {} of them walked each area sample on its own (their bundle passed the area walk budget)",
+            ", {} of them each light sample's segment or ray on its own (past the area walk budget)",
             st.pixels_walked_per_sample
         )
     } else {
         String::new()
     };
     format!(
-        "{} of {} pixels walked the BVH ({why}{per_sample}); trace {trace:.3} ms in all{}",
+        "{} of {} pixels walked the BVH ({why}){per_sample}; trace {trace:.3} ms in all{}",
         st.pixels_walked,
         st.receiver_pixels,
         if st.walks_unfinished > 0 {
