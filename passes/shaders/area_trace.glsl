@@ -267,7 +267,10 @@ bool bvh_done() {
 // segment's or ray's direction, `t_end` its end. Each triangle met is decided for every sample at once
 // where quick() can, else for this sample by its own test, exactly as resolve() would decide it; one that
 // blocks the sample is then resolved for all the others. It takes over the stack of the bundle's walk,
-// which has given up. False when the walk could not finish (never on a conforming device).
+// which has given up. It is a loop of its own rather than bvh_walk: that walk's per-node sample masks (a
+// box projection per child, a mask per stacked node) cost more than they save for one sample: walking
+// the samples through it made 8 % lights about 1.2x slower on an H100. False when the walk could not
+// finish (never on a conforming device).
 bool walk_sample(uvec4 bit, vec3 offsets, vec3 d, float t_end) {
     float big = max(max(abs(d.x), abs(d.y)), abs(d.z)) + (local ? length(disc_u) : 0.0);
     bvh_set_cone(origin, d, 1e-4 * big, t_end);
