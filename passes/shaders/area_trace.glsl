@@ -63,6 +63,12 @@ vec3 origin;
 // A spot or point light (the emitter's disc), else a directional light (a cone): the includer's
 // LOCAL_LIGHT, so that each variant holds the code of its own lights only.
 const bool local = LOCAL_LIGHT != 0;
+// Whether a wide bundle's open samples may walk one by one (walk_sample): the includer's SAMPLE_WALKS, 0 for
+// the variant of the directional lights whose bundle is never wide (their angular bound at most
+// WIDE_BUNDLE), which leaves the per-sample walk's code and registers out.
+#ifndef SAMPLE_WALKS
+#define SAMPLE_WALKS 1
+#endif
 // The light's edge table's first cell: a directional light's, then a local light's.
 const uint table_base = local ? EDGE_ANGLES * EDGE_OFFSETS : 0u;
 uint sample_count;
@@ -262,6 +268,7 @@ bool bvh_done() {
     return all_blocked();
 }
 
+#if SAMPLE_WALKS
 // One sample's own segment (a spot or point light) or ray (a directional light) from the origin, walked
 // through the BVH alone: `offsets`, the sample's unit-disc offsets or direction (sample_dirs), `d` the
 // segment's or ray's direction, `t_end` its end. Each triangle met is decided for every sample at once
@@ -326,9 +333,10 @@ bool walk_one(uint word, uint bit) {
     vec3 d = local ? disc_c + offsets.x * disc_u + offsets.y * disc_v : offsets;
     return walk_sample(mask, offsets, d, local ? 1.0 : 1.0 / 0.0);
 }
+#endif
 
 // A bundle whose emitter's radius passes this share of its distance (a directional light: its angular
-// bound) is wide: its walk may give up for its samples' own walks.
+// bound) is wide: its walk may give up for its samples' own walks (passes::area::WIDE_BUNDLE).
 const float WIDE_BUNDLE = 0.1;
 // The width at which a wide bundle's walk budget is the configured one; it grows with the inverse square
 // of the width below it (a narrower bundle meets fewer triangles that its samples' walks would miss) and
@@ -429,7 +437,9 @@ void walk_bvh() {
     // 0xFFFFFFFF: the bundle always.)
     float width = local ? length(disc_u) / max(length(disc_c), 1e-30) : samples.center.w;
     uint budget = 0xFFFFFFFFu;
-    if (k.misc.z == 0u) {
+    if (SAMPLE_WALKS == 0) {
+        budget = 0xFFFFFFFFu;   // a directional light never wide, with a budget: its bundle walks to the end
+    } else if (k.misc.z == 0u) {
         budget = 0u;
     } else if (width > WIDE_BUNDLE && k.misc.z != 0xFFFFFFFFu) {
         uvec4 open = all_samples & ~blocked;
@@ -438,6 +448,7 @@ void walk_bvh() {
         budget = uint(min(float(k.misc.z) * scale * float(open_count) / 64.0, 4.0e9));
     }
     bool finished = bvh_walk(k.misc.y, all_samples, budget);
+#if SAMPLE_WALKS
     if (finished && bvh_over_budget) {
         count_sample_walks();
         for (uint w = 0u; w < 4u && finished; ++w) {
@@ -449,6 +460,7 @@ void walk_bvh() {
             }
         }
     }
+#endif
     count_walk(finished);
 }
 

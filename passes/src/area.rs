@@ -35,6 +35,11 @@ pub const DEFAULT_AREA_SAMPLES: u32 = 64;
 /// [`AreaConfig::bundle_walk_budget`] by default.
 pub const DEFAULT_BUNDLE_WALK_BUDGET: u32 = 256;
 
+/// A pixel's bundle of segments or rays is wide when its emitter's radius over its distance (a directional
+/// light: its angular bound) passes this: only a wide bundle's walk of the BVH may give up for its samples'
+/// own walks ([`AreaConfig::bundle_walk_budget`]; `WIDE_BUNDLE` in `area_trace.glsl`).
+pub const WIDE_BUNDLE: f32 = 0.1;
+
 /// Settings of the area mode. The light's size is the one PCSS and the hybrid use
 /// ([`PcssConfig::angular_radius`](crate::PcssConfig::angular_radius)): every mode shadows the same light.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -523,6 +528,23 @@ pub fn local_sample_bands(samples: u32) -> SampleBands {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The trace's variant without the samples' own walks is chosen by [`WIDE_BUNDLE`]: the shader must
+    /// call the same bundles wide.
+    #[test]
+    fn the_trace_calls_the_same_bundles_wide() {
+        let source = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/shaders/area_trace.glsl"
+        ))
+        .expect("area_trace.glsl");
+        let value = source
+            .lines()
+            .find_map(|l| l.strip_prefix("const float WIDE_BUNDLE = "))
+            .and_then(|v| v.strip_suffix(';'))
+            .expect("area_trace.glsl defines WIDE_BUNDLE");
+        assert_eq!(value.parse::<f32>(), Ok(WIDE_BUNDLE));
+    }
 
     #[test]
     fn sample_bands_hold_every_sample_of_a_rectangle() {

@@ -10,7 +10,9 @@
 //! and its BVH, constants (and the light samples, area shadows). Writes: visibility, blocker distance (hard
 //! rays only), the count of the walks in the map's state.
 
-use crate::area::{area_edge_table, area_sample_bands, local_area_edge_table, local_sample_bands};
+use crate::area::{
+    area_edge_table, area_sample_bands, local_area_edge_table, local_sample_bands, WIDE_BUNDLE,
+};
 use crate::gpu_types::{constant_buffer, AreaSamples, RayTraceConstants};
 use crate::primitive_map::PrimitiveMap;
 use crate::shaders::{output_variant, shader};
@@ -74,6 +76,10 @@ pub struct RayTracePass {
     /// An area trace's pipeline and bind group for spot lights, beside the directional one (a point light's
     /// cube map has the local variant as its one pipeline).
     local: Option<(ComputePipeline, BindGroup)>,
+    /// An area trace's pipeline and bind group for the directional lights whose bundle is never wide (their
+    /// angular bound at most [`WIDE_BUNDLE`]): without the samples' own walks, whose code and registers slow
+    /// every pixel.
+    narrow: Option<(ComputePipeline, BindGroup)>,
     constants: Buffer,
     /// The area trace's light samples, its edge tables and its sample bands (area shadows only).
     samples: Option<(Buffer, Buffer, Buffer)>,
@@ -222,23 +228,34 @@ impl RayTracePass {
             0,
         )?;
         let group = device.create_bind_group(pipeline.layout(), &resources)?;
-        let local = match kind {
-            RayTraceKind::Area { .. } if !cube => {
-                let pipeline = device.create_compute_pipeline(
+        let variant = |name: &str, shader_name: &str| -> Result<_, PassError> {
+            let pipeline = device.create_compute_pipeline(
+                name,
+                &shader(&output_variant(shader_name, format)?)?,
+                &kinds,
+                0,
+            )?;
+            let group = device.create_bind_group(pipeline.layout(), &resources)?;
+            Ok((pipeline, group))
+        };
+        let (local, narrow) = match kind {
+            RayTraceKind::Area { .. } if !cube => (
+                Some(variant(
                     "area trace (spot and point lights)",
-                    &shader(&output_variant("area_trace_local.comp", format)?)?,
-                    &kinds,
-                    0,
-                )?;
-                let group = device.create_bind_group(pipeline.layout(), &resources)?;
-                Some((pipeline, group))
-            }
-            _ => None,
+                    "area_trace_local.comp",
+                )?),
+                Some(variant(
+                    "area trace (directional lights, never wide)",
+                    "area_trace_narrow.comp",
+                )?),
+            ),
+            _ => (None, None),
         };
         Ok(Self {
             pipeline,
             group,
             local,
+            narrow,
             constants,
             samples,
             visibility,
@@ -278,15 +295,19 @@ impl RayTracePass {
         resource: Resource<'_>,
     ) -> Result<Vec<BindGroup>, PassError> {
         let main = device.rebound(self.pipeline.layout(), &self.group, binding, resource)?;
-        let local = match &self.local {
-            Some((pipeline, group)) => {
-                Some(device.rebound(pipeline.layout(), group, binding, resource)?)
-            }
-            None => None,
+        let rebound = |variant: &Option<(ComputePipeline, BindGroup)>| match variant {
+            Some((pipeline, group)) => device
+                .rebound(pipeline.layout(), group, binding, resource)
+                .map(Some),
+            None => Ok(None),
         };
+        let local = rebound(&self.local)?;
+        let narrow = rebound(&self.narrow)?;
         let mut old = vec![std::mem::replace(&mut self.group, main)];
-        if let (Some((_, group)), Some(new)) = (&mut self.local, local) {
-            old.push(std::mem::replace(group, new));
+        for (variant, new) in [(&mut self.local, local), (&mut self.narrow, narrow)] {
+            if let (Some((_, group)), Some(new)) = (variant, new) {
+                old.push(std::mem::replace(group, new));
+            }
         }
         Ok(old)
     }
@@ -329,9 +350,14 @@ impl RayTracePass {
             constants.dims.y.div_ceil(8),
             1,
         ];
-        // An area trace of a spot or point light (the constants' light position) takes its own variant.
-        let (pipeline, group) = match &self.local {
-            Some((pipeline, group)) if constants.light_pos.w != 0.0 => (pipeline, group),
+        // An area trace of a spot or point light (the constants' light position) takes its own variant; one
+        // of a directional light whose bundle is never wide, with a walk budget, the variant without the
+        // samples' own walks (it gives the same answer: such a bundle never gives up).
+        let never_wide =
+            samples.is_some_and(|s| s.center.w <= WIDE_BUNDLE) && constants.misc.z != 0;
+        let (pipeline, group) = match (&self.local, &self.narrow) {
+            (Some((pipeline, group)), _) if constants.light_pos.w != 0.0 => (pipeline, group),
+            (_, Some((pipeline, group))) if never_wide => (pipeline, group),
             _ => (&self.pipeline, &self.group),
         };
         enc.dispatch(pipeline, group, &[], groups)?;

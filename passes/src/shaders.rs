@@ -52,6 +52,7 @@ mod tests {
             "ray_trace.comp",
             "area_trace.comp",
             "area_trace_local.comp",
+            "area_trace_narrow.comp",
             "pcss.comp",
             "pcss_rt.comp",
             "hybrid_blend.comp",

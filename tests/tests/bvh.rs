@@ -14,6 +14,7 @@ mod common;
 use common::*;
 use demo_engine::{FrameImages, View};
 use glam::Vec3;
+use passes::area::{DEFAULT_BUNDLE_WALK_BUDGET, WIDE_BUNDLE};
 use passes::bvh::{BvhNode, BVH_LEAF};
 use passes::gpu_types::GpuTriangle;
 use passes::{
@@ -263,7 +264,6 @@ fn area_shadows_through_the_bvh_equal_the_lists_bit_for_bit() {
     let device = device();
     let view = plate_and_box_view(96, 72);
     let rs = RefScene::new(&view.scene);
-    let radius = 0.1;
     let map = PrimitiveMapConfig {
         size: 128,
         binning: BinningRequest::Compute,
@@ -271,9 +271,15 @@ fn area_shadows_through_the_bvh_equal_the_lists_bit_for_bit() {
     };
     // 64 samples: masks of two words, against the lists bit for bit.
     // (Finer samples leave fewer pixels stable against the reference: 36 penumbra pixels at 64.)
-    // Each route walks the BVH with the whole bundle of a pixel's segments, then with each sample's own.
-    let walks = [("bundle", u32::MAX), ("each sample", 0)];
-    for (samples, min_penumbra) in [(32, 50), (64, 30)] {
+    // Each route walks the BVH with the whole bundle of a pixel's segments, then with each sample's own;
+    // a sun of 0.09 rad, never wide, also with the default budget (the trace's variant without the
+    // samples' own walks).
+    let walks = [
+        ("bundle", u32::MAX),
+        ("each sample", 0),
+        ("default", DEFAULT_BUNDLE_WALK_BUDGET),
+    ];
+    for (radius, samples, min_penumbra) in [(0.1, 32, 50), (0.1, 64, 30), (0.09, 64, 25)] {
         let mut first: Option<Vec<f32>> = None;
         for (name, map) in routes(map) {
             for (walk, bundle_walk_budget) in walks {
@@ -297,19 +303,24 @@ fn area_shadows_through_the_bvh_equal_the_lists_bit_for_bit() {
                 let per_sample = st.pixels_walked_per_sample;
                 match (walk, st.pixels_walked) {
                     ("bundle", _) | (_, 0) => assert_eq!(per_sample, 0, "{name}, {walk}: {st:?}"),
+                    // Only a sun past WIDE_BUNDLE may give up its bundle.
+                    ("default", _) => assert!(
+                        radius > WIDE_BUNDLE || per_sample == 0,
+                        "{name}, {walk}: {st:?}"
+                    ),
                     _ => assert!(
                         per_sample > 0 && per_sample <= st.pixels_walked,
                         "{name}, {walk}: {st:?}"
                     ),
                 }
                 let c = compare_area(&rs, &view, radius, samples, &images.output);
-                println!("{name}, {walk}, {samples} samples: {c:?}, {st:?}");
+                println!("{name}, {walk}, {radius} rad, {samples} samples: {c:?}, {st:?}");
                 assert_exact_area(name, &c, min_penumbra, 25);
                 match &first {
                     None => first = Some(images.output),
                     Some(lists) => assert!(
                         &images.output == lists,
-                        "{name}, {walk}, {samples} samples: area counts differ from the lists'"
+                        "{name}, {walk}, {radius} rad, {samples} samples: area counts differ from the lists'"
                     ),
                 }
             }
