@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The benchmark tables of docs/benchmarks.md, generated from one run on a machine with a GPU (the device
-# tool's H100): the hybrid over every model with the ray-tracing-pipeline peer, local lights hard and
+# tool's H100 or H200): the hybrid over every model with the ray-tracing-pipeline peer, local lights hard and
 # sized (the emitter's radius a share of the scene's extent) with the peer at equal samples, 16 and 64
 # lights at once, area shadows against PCSS 8K, the binning matrix, and a 1080p render of the built-in scene.
 #
