@@ -23,6 +23,7 @@ pub(crate) fn device(info: &HrtsContextCreateInfo) -> ApiResult<Device> {
             validation: info.enable_validation != 0,
             synchronization_validation: false,
             device_filter: filter,
+            ..rhi::DeviceDesc::from_env()
         })?);
     }
     let v = &crate::version::read(info.vulkan, "vulkan")?;

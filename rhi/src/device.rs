@@ -5,6 +5,7 @@ use crate::caps::{
 };
 use crate::conv::Format;
 use crate::error::{Result, RhiError, VkResultExt};
+use crate::pipeline_stats::{self, PipelineStatistics, StatisticsCapture};
 use crate::rt_device::{ray_tracing_missing, RayTracingDevice, RayTracingFeatures};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
@@ -37,21 +38,29 @@ pub struct DeviceDesc {
     pub synchronization_validation: bool,
     /// Only accept devices whose name contains this (case-insensitive), e.g. "llvmpipe" or "NVIDIA".
     pub device_filter: Option<String>,
+    /// Enable `VK_KHR_pipeline_executable_properties` where the device offers it, and capture what the
+    /// driver says of every pipeline created (registers, spills, instructions, as it names them):
+    /// [`Device::pipeline_statistics`], and logged under the target `hrts::pipeline_statistics`.
+    pub pipeline_statistics: bool,
 }
 
 impl DeviceDesc {
-    /// Reads `HRTS_VALIDATION` (1/true enables validation) and `HRTS_DEVICE` (device-name filter).
+    /// Reads `HRTS_VALIDATION` (1/true enables validation), `HRTS_DEVICE` (device-name filter) and
+    /// `HRTS_PIPELINE_STATISTICS` (1/true captures the pipelines' statistics).
     pub fn from_env() -> Self {
-        let validation = std::env::var("HRTS_VALIDATION")
-            .map(|v| matches!(v.as_str(), "1" | "true" | "yes" | "on"))
-            .unwrap_or(false);
         let device_filter = std::env::var("HRTS_DEVICE").ok().filter(|s| !s.is_empty());
         Self {
-            validation,
+            validation: env_flag("HRTS_VALIDATION"),
             synchronization_validation: false,
             device_filter,
+            pipeline_statistics: env_flag("HRTS_PIPELINE_STATISTICS"),
         }
     }
+}
+
+/// Whether the environment variable `name` is 1, true, yes or on.
+fn env_flag(name: &str) -> bool {
+    std::env::var(name).is_ok_and(|v| matches!(v.as_str(), "1" | "true" | "yes" | "on"))
 }
 
 /// How synchronization validation was enabled on a device's instance.
@@ -167,6 +176,8 @@ pub(crate) struct Shared {
     pub(crate) nearest_sampler: vk::Sampler,
     /// Acceleration structures and ray-tracing pipelines, or why they are unavailable.
     pub(crate) ray_tracing: std::result::Result<RayTracingDevice, String>,
+    /// The pipelines' statistics, when asked for and offered.
+    pub(crate) pipeline_statistics: Option<StatisticsCapture>,
     messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     validation: Arc<ValidationLog>,
     sync_validation: Option<SyncValidation>,
@@ -431,6 +442,17 @@ impl Device {
             |name| has_extension(&exts, name),
             ray_tracing_features(&instance, chosen.pd, &exts),
         );
+        let statistics = desc.pipeline_statistics
+            && has_extension(&exts, pipeline_stats::EXTENSION)
+            && pipeline_executable_info(&instance, chosen.pd);
+        if statistics {
+            enable.push(pipeline_stats::EXTENSION);
+        } else if desc.pipeline_statistics {
+            log::warn!(
+                "pipeline statistics unavailable: the device lacks {}",
+                pipeline_stats::EXTENSION.to_string_lossy()
+            );
+        }
         let ray_tracing = rt_missing.is_empty();
         if ray_tracing {
             enable.extend(RayTracingDevice::EXTENSIONS);
@@ -458,6 +480,8 @@ impl Device {
             .acceleration_structure(true);
         let mut f_rt_pipeline =
             vk::PhysicalDeviceRayTracingPipelineFeaturesKHR::default().ray_tracing_pipeline(true);
+        let mut f_statistics = vk::PhysicalDevicePipelineExecutablePropertiesFeaturesKHR::default()
+            .pipeline_executable_info(true);
         let priorities = [1.0f32];
         let queue_info = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(chosen.family)
@@ -473,6 +497,9 @@ impl Device {
                 .push_next(&mut f12)
                 .push_next(&mut f_accel)
                 .push_next(&mut f_rt_pipeline);
+        }
+        if statistics {
+            dinfo = dinfo.push_next(&mut f_statistics);
         }
         // SAFETY: the chained structs outlive the call; features were checked during selection.
         let device = match unsafe { instance.create_device(chosen.pd, &dinfo, None) } {
@@ -506,6 +533,7 @@ impl Device {
             validation,
             sync_validation,
             owned: true,
+            pipeline_statistics: statistics,
             ray_tracing: if ray_tracing {
                 Ok(())
             } else {
@@ -560,6 +588,13 @@ impl Device {
             .fragment_stores_and_atomics(f.fragment_stores_and_atomics)
             .depth_clamp(f.depth_clamp)
             .shader_float64(f.shader_float64);
+        // The engine enabled the extension and HRTS_PIPELINE_STATISTICS asks for the capture (which also
+        // needs the extension's pipelineExecutableInfo feature, enabled by the engine).
+        let pipeline_statistics = env_flag("HRTS_PIPELINE_STATISTICS")
+            && desc
+                .enabled_extensions
+                .iter()
+                .any(|e| e.as_bytes() == pipeline_stats::EXTENSION.to_bytes());
         Self::from_parts(PartsDesc {
             entry,
             instance,
@@ -575,6 +610,7 @@ impl Device {
             validation: Arc::new(ValidationLog::default()),
             sync_validation: None,
             owned: false,
+            pipeline_statistics,
             ray_tracing: Err(
                 "an adopted device (the RHI cannot tell whether the engine enabled bufferDeviceAddress, \
                  accelerationStructure and rayTracingPipeline)"
@@ -632,6 +668,9 @@ impl Device {
         let ray_tracing = p
             .ray_tracing
             .map(|()| RayTracingDevice::new(&p.instance, &p.device, p.physical));
+        let pipeline_statistics = p
+            .pipeline_statistics
+            .then(|| StatisticsCapture::new(&p.instance, &p.device));
         let shared = Arc::new(Shared {
             entry: p.entry,
             instance: p.instance,
@@ -652,6 +691,7 @@ impl Device {
             debug_utils,
             nearest_sampler,
             ray_tracing,
+            pipeline_statistics,
             messenger: p.messenger,
             validation: p.validation,
             sync_validation: p.sync_validation,
@@ -692,6 +732,15 @@ impl Device {
     /// The device's capabilities.
     pub fn capabilities(&self) -> &Capabilities {
         &self.shared.caps
+    }
+
+    /// What the driver said of every pipeline created so far on this device, where it was created with
+    /// [`DeviceDesc::pipeline_statistics`] and offers them; `None` where it does not capture them.
+    pub fn pipeline_statistics(&self) -> Option<Vec<PipelineStatistics>> {
+        self.shared
+            .pipeline_statistics
+            .as_ref()
+            .map(StatisticsCapture::recorded)
     }
 
     /// Whether optimally tiled images of `format` can be sampled (depth formats through their depth
@@ -812,8 +861,20 @@ struct PartsDesc {
     validation: Arc<ValidationLog>,
     sync_validation: Option<SyncValidation>,
     owned: bool,
+    /// Whether the device was created with `VK_KHR_pipeline_executable_properties` and its
+    /// `pipelineExecutableInfo` feature, and the pipelines' statistics are asked for.
+    pipeline_statistics: bool,
     /// Ok if the device was created with ray tracing enabled, else what is missing.
     ray_tracing: std::result::Result<(), String>,
+}
+
+/// Whether `pd` supports `pipelineExecutableInfo` (it offers `VK_KHR_pipeline_executable_properties`).
+fn pipeline_executable_info(instance: &ash::Instance, pd: vk::PhysicalDevice) -> bool {
+    let mut f = vk::PhysicalDevicePipelineExecutablePropertiesFeaturesKHR::default();
+    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f);
+    // SAFETY: `pd` belongs to `instance`; the chained struct outlives the call.
+    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+    f.pipeline_executable_info == vk::TRUE
 }
 
 /// The ray-tracing features `pd` supports (queried only for the extensions it has).

@@ -5,7 +5,7 @@
 //! Layers, lowest first: a module uses (`crate::…`) only modules of the layers below it (a test checks):
 //! 1. `error`, `conv`
 //! 2. `caps`
-//! 3. `rt_device`
+//! 3. `rt_device`, `pipeline_stats`
 //! 4. `device`
 //! 5. `resources`
 //! 6. `accel`
@@ -20,6 +20,7 @@ mod device;
 mod encoder;
 mod error;
 mod pipeline;
+mod pipeline_stats;
 mod raytracing;
 mod resources;
 mod rt_device;
@@ -37,6 +38,7 @@ pub use pipeline::{
     BindGroup, BindingKind, ComputePipeline, DepthState, GraphicsPipeline, GraphicsPipelineDesc,
     PipelineLayout, Resource,
 };
+pub use pipeline_stats::PipelineStatistics;
 pub use raytracing::{RayTracingPipeline, RayTracingPipelineDesc, TriangleGeometry};
 pub use resources::{
     live_gpu_allocation_bytes, Buffer, BufferUsage, Image, ImageDesc, ImageUsage, MemoryLocation,
@@ -104,6 +106,6 @@ mod layering {
             }
             checked += 1;
         }
-        assert_eq!(checked, 10);
+        assert_eq!(checked, 11);
     }
 }

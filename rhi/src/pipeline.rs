@@ -214,7 +214,8 @@ impl Device {
             .name(c"main");
         let info = vk::ComputePipelineCreateInfo::default()
             .stage(stage)
-            .layout(layout.raw);
+            .layout(layout.raw)
+            .flags(self.statistics_flags());
         // SAFETY: valid module and layout.
         let raw = unsafe {
             self.shared
@@ -226,6 +227,9 @@ impl Device {
             result: e,
         })?[0];
         self.set_name(vk::ObjectType::PIPELINE, ash::vk::Handle::as_raw(raw), name);
+        if let Some(capture) = &self.shared.pipeline_statistics {
+            capture.record(name, raw);
+        }
         Ok(ComputePipeline { layout, raw })
     }
 
@@ -329,6 +333,7 @@ impl Device {
             .color_blend_state(&blend)
             .dynamic_state(&dynamic)
             .layout(layout.raw)
+            .flags(self.statistics_flags())
             .push_next(&mut rendering);
         // SAFETY: every referenced struct and module outlives the call.
         let raw = unsafe {
@@ -345,7 +350,19 @@ impl Device {
             ash::vk::Handle::as_raw(raw),
             desc.name,
         );
+        if let Some(capture) = &self.shared.pipeline_statistics {
+            capture.record(desc.name, raw);
+        }
         Ok(GraphicsPipeline { layout, raw })
+    }
+
+    /// The creation flags that capture a pipeline's statistics, where the device does.
+    fn statistics_flags(&self) -> vk::PipelineCreateFlags {
+        if self.shared.pipeline_statistics.is_some() {
+            vk::PipelineCreateFlags::CAPTURE_STATISTICS_KHR
+        } else {
+            vk::PipelineCreateFlags::empty()
+        }
     }
 
     /// Binds `resources` (in binding order) to a new descriptor set of `layout`.

@@ -1,0 +1,75 @@
+//! What the driver says each pipeline costs (`rhi::DeviceDesc::pipeline_statistics`,
+//! `VK_KHR_pipeline_executable_properties`): where the device offers the extension (NVIDIA's driver does;
+//! Mesa 25.0's lavapipe does not), every trace pipeline of a frame reports its statistics; where it does
+//! not, or where nobody asked, none is captured and the frame is the same.
+
+mod common;
+
+use common::{assert_no_validation_errors, plate_and_box_view, ViewInputs};
+use passes::{PcssConfig, ShadowConfig, ShadowMode};
+use rhi::{Device, DeviceDesc};
+use test_support::ShadowRenderer;
+
+/// A device with validation, capturing the pipelines' statistics if `capture`.
+fn device_capturing(capture: bool) -> Device {
+    let desc = DeviceDesc {
+        validation: true,
+        pipeline_statistics: capture,
+        ..DeviceDesc::from_env()
+    };
+    Device::new_headless(&desc).expect("device")
+}
+
+/// Renders one frame of area shadows of a sun (the trace and its variants, the map's passes).
+fn render_area_frame(device: &Device) {
+    let view = plate_and_box_view(64, 48);
+    let config = ShadowConfig {
+        mode: ShadowMode::Area,
+        pcss: PcssConfig {
+            angular_radius: 0.05,
+            ..PcssConfig::default()
+        },
+        ..ShadowConfig::default()
+    };
+    let mut r = ShadowRenderer::new(device, &view, config).expect("renderer");
+    r.render(device, &view.frame_inputs()).expect("render");
+}
+
+#[test]
+fn every_pipeline_of_a_frame_reports_what_it_costs() {
+    let device = device_capturing(true);
+    render_area_frame(&device);
+    let Some(statistics) = device.pipeline_statistics() else {
+        println!(
+            "{} does not offer VK_KHR_pipeline_executable_properties: nothing captured",
+            device.capabilities().device_name
+        );
+        assert_no_validation_errors(&device);
+        return;
+    };
+    for s in &statistics {
+        println!("{} [{}]: {:?}", s.pipeline, s.executable, s.values);
+    }
+    for name in [
+        "area trace (directional lights, never wide)",
+        "area trace (directional lights)",
+        "area trace (spot and point lights)",
+        "bvh build",
+    ] {
+        let found: Vec<_> = statistics.iter().filter(|s| s.pipeline == name).collect();
+        assert!(!found.is_empty(), "no statistics for {name}");
+        assert!(
+            found.iter().all(|s| !s.values.is_empty()),
+            "{name} reports no value: {found:?}"
+        );
+    }
+    assert_no_validation_errors(&device);
+}
+
+#[test]
+fn a_device_not_asked_captures_nothing() {
+    let device = device_capturing(false);
+    render_area_frame(&device);
+    assert!(device.pipeline_statistics().is_none());
+    assert_no_validation_errors(&device);
+}
