@@ -221,13 +221,6 @@ impl RayTracePass {
             RayTraceKind::Hard { .. } => ("ray trace", "ray_trace.comp"),
         };
         let format = visibility.format();
-        let pipeline = device.create_compute_pipeline(
-            name,
-            &shader(&output_variant(shader_name, format)?)?,
-            &kinds,
-            0,
-        )?;
-        let group = device.create_bind_group(pipeline.layout(), &resources)?;
         let variant = |name: &str, shader_name: &str| -> Result<_, PassError> {
             let pipeline = device.create_compute_pipeline(
                 name,
@@ -238,6 +231,7 @@ impl RayTracePass {
             let group = device.create_bind_group(pipeline.layout(), &resources)?;
             Ok((pipeline, group))
         };
+        let (pipeline, group) = variant(name, shader_name)?;
         let (local, narrow) = match kind {
             RayTraceKind::Area { .. } if !cube => (
                 Some(variant(
