@@ -35,18 +35,20 @@ fn render_area_frame(device: &Device) {
     r.render(device, &view.frame_inputs()).expect("render");
 }
 
+/// Asked for, the statistics are none where the device does not offer the extension, and otherwise hold
+/// every trace pipeline of the frame with the values the driver gives; either way the frame renders and
+/// validation stays silent.
 #[test]
-fn every_pipeline_of_a_frame_reports_what_it_costs() {
+fn pipelines_report_what_they_cost_where_the_device_offers_it() {
     let device = device_capturing(true);
     render_area_frame(&device);
+    assert_no_validation_errors(&device);
+    let name = &device.capabilities().device_name;
     let Some(statistics) = device.pipeline_statistics() else {
-        println!(
-            "{} does not offer VK_KHR_pipeline_executable_properties: nothing captured",
-            device.capabilities().device_name
-        );
-        assert_no_validation_errors(&device);
+        println!("pipeline statistics on {name}: none (VK_KHR_pipeline_executable_properties not offered)");
         return;
     };
+    println!("pipeline statistics on {name}:");
     for s in &statistics {
         println!("{} [{}]: {:?}", s.pipeline, s.executable, s.values);
     }
@@ -63,7 +65,6 @@ fn every_pipeline_of_a_frame_reports_what_it_costs() {
             "{name} reports no value: {found:?}"
         );
     }
-    assert_no_validation_errors(&device);
 }
 
 #[test]
