@@ -5,7 +5,9 @@ use crate::caps::{
 };
 use crate::conv::Format;
 use crate::error::{Result, RhiError, VkResultExt};
-use crate::pipeline_stats::{self, PipelineStatistics, StatisticsCapture};
+use crate::pipeline_stats::{
+    self, capture_state, PipelineStatistics, StatisticsCapture, StatisticsUnavailable,
+};
 use crate::rt_device::{ray_tracing_missing, RayTracingDevice, RayTracingFeatures};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
@@ -176,8 +178,8 @@ pub(crate) struct Shared {
     pub(crate) nearest_sampler: vk::Sampler,
     /// Acceleration structures and ray-tracing pipelines, or why they are unavailable.
     pub(crate) ray_tracing: std::result::Result<RayTracingDevice, String>,
-    /// The pipelines' statistics, when asked for and offered.
-    pub(crate) pipeline_statistics: Option<StatisticsCapture>,
+    /// The pipelines' statistics, when asked for and offered; else why not.
+    pub(crate) pipeline_statistics: std::result::Result<StatisticsCapture, StatisticsUnavailable>,
     messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     validation: Arc<ValidationLog>,
     sync_validation: Option<SyncValidation>,
@@ -442,12 +444,14 @@ impl Device {
             |name| has_extension(&exts, name),
             ray_tracing_features(&instance, chosen.pd, &exts),
         );
-        let statistics = desc.pipeline_statistics
-            && has_extension(&exts, pipeline_stats::EXTENSION)
-            && pipeline_executable_info(&instance, chosen.pd);
-        if statistics {
+        let statistics = capture_state(
+            desc.pipeline_statistics,
+            has_extension(&exts, pipeline_stats::EXTENSION)
+                && pipeline_executable_info(&instance, chosen.pd),
+        );
+        if statistics.is_ok() {
             enable.push(pipeline_stats::EXTENSION);
-        } else if desc.pipeline_statistics {
+        } else if statistics == Err(StatisticsUnavailable::NotOffered) {
             log::warn!(
                 "pipeline statistics unavailable: the device lacks {}",
                 pipeline_stats::EXTENSION.to_string_lossy()
@@ -498,7 +502,7 @@ impl Device {
                 .push_next(&mut f_accel)
                 .push_next(&mut f_rt_pipeline);
         }
-        if statistics {
+        if statistics.is_ok() {
             dinfo = dinfo.push_next(&mut f_statistics);
         }
         // SAFETY: the chained structs outlive the call; features were checked during selection.
@@ -590,11 +594,12 @@ impl Device {
             .shader_float64(f.shader_float64);
         // The engine enabled the extension and HRTS_PIPELINE_STATISTICS asks for the capture (which also
         // needs the extension's pipelineExecutableInfo feature, enabled by the engine).
-        let pipeline_statistics = env_flag("HRTS_PIPELINE_STATISTICS")
-            && desc
-                .enabled_extensions
+        let pipeline_statistics = capture_state(
+            env_flag("HRTS_PIPELINE_STATISTICS"),
+            desc.enabled_extensions
                 .iter()
-                .any(|e| e.as_bytes() == pipeline_stats::EXTENSION.to_bytes());
+                .any(|e| e.as_bytes() == pipeline_stats::EXTENSION.to_bytes()),
+        );
         Self::from_parts(PartsDesc {
             entry,
             instance,
@@ -670,7 +675,7 @@ impl Device {
             .map(|()| RayTracingDevice::new(&p.instance, &p.device, p.physical));
         let pipeline_statistics = p
             .pipeline_statistics
-            .then(|| StatisticsCapture::new(&p.instance, &p.device));
+            .map(|()| StatisticsCapture::new(&p.instance, &p.device));
         let shared = Arc::new(Shared {
             entry: p.entry,
             instance: p.instance,
@@ -735,12 +740,14 @@ impl Device {
     }
 
     /// What the driver said of every pipeline created so far on this device, where it was created with
-    /// [`DeviceDesc::pipeline_statistics`] and offers them; `None` where it does not capture them.
-    pub fn pipeline_statistics(&self) -> Option<Vec<PipelineStatistics>> {
-        self.shared
-            .pipeline_statistics
-            .as_ref()
-            .map(StatisticsCapture::recorded)
+    /// [`DeviceDesc::pipeline_statistics`] and offers them; else why it captures none.
+    pub fn pipeline_statistics(
+        &self,
+    ) -> std::result::Result<Vec<PipelineStatistics>, StatisticsUnavailable> {
+        match &self.shared.pipeline_statistics {
+            Ok(capture) => Ok(capture.recorded()),
+            Err(why) => Err(*why),
+        }
     }
 
     /// Whether optimally tiled images of `format` can be sampled (depth formats through their depth
@@ -861,9 +868,9 @@ struct PartsDesc {
     validation: Arc<ValidationLog>,
     sync_validation: Option<SyncValidation>,
     owned: bool,
-    /// Whether the device was created with `VK_KHR_pipeline_executable_properties` and its
-    /// `pipelineExecutableInfo` feature, and the pipelines' statistics are asked for.
-    pipeline_statistics: bool,
+    /// Ok if the pipelines' statistics are asked for and the device was created with
+    /// `VK_KHR_pipeline_executable_properties` and its `pipelineExecutableInfo` feature, else why not.
+    pipeline_statistics: std::result::Result<(), StatisticsUnavailable>,
     /// Ok if the device was created with ray tracing enabled, else what is missing.
     ray_tracing: std::result::Result<(), String>,
 }

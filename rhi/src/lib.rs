@@ -38,7 +38,7 @@ pub use pipeline::{
     BindGroup, BindingKind, ComputePipeline, DepthState, GraphicsPipeline, GraphicsPipelineDesc,
     PipelineLayout, Resource,
 };
-pub use pipeline_stats::PipelineStatistics;
+pub use pipeline_stats::{PipelineStatistics, StatisticsUnavailable};
 pub use raytracing::{RayTracingPipeline, RayTracingPipelineDesc, TriangleGeometry};
 pub use resources::{
     live_gpu_allocation_bytes, Buffer, BufferUsage, Image, ImageDesc, ImageUsage, MemoryLocation,

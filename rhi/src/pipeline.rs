@@ -227,7 +227,7 @@ impl Device {
             result: e,
         })?[0];
         self.set_name(vk::ObjectType::PIPELINE, ash::vk::Handle::as_raw(raw), name);
-        if let Some(capture) = &self.shared.pipeline_statistics {
+        if let Ok(capture) = &self.shared.pipeline_statistics {
             capture.record(name, raw);
         }
         Ok(ComputePipeline { layout, raw })
@@ -350,7 +350,7 @@ impl Device {
             ash::vk::Handle::as_raw(raw),
             desc.name,
         );
-        if let Some(capture) = &self.shared.pipeline_statistics {
+        if let Ok(capture) = &self.shared.pipeline_statistics {
             capture.record(desc.name, raw);
         }
         Ok(GraphicsPipeline { layout, raw })
@@ -358,7 +358,7 @@ impl Device {
 
     /// The creation flags that capture a pipeline's statistics, where the device does.
     fn statistics_flags(&self) -> vk::PipelineCreateFlags {
-        if self.shared.pipeline_statistics.is_some() {
+        if self.shared.pipeline_statistics.is_ok() {
             vk::PipelineCreateFlags::CAPTURE_STATISTICS_KHR
         } else {
             vk::PipelineCreateFlags::empty()

@@ -17,6 +17,28 @@ pub struct PipelineStatistics {
     pub values: Vec<(String, String)>,
 }
 
+/// Why a device captures no pipeline statistics.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StatisticsUnavailable {
+    /// Nobody asked ([`crate::DeviceDesc::pipeline_statistics`], `HRTS_PIPELINE_STATISTICS`).
+    NotAsked,
+    /// Asked, but the device does not offer `VK_KHR_pipeline_executable_properties` with its
+    /// `pipelineExecutableInfo` feature (an adopted device: the engine did not enable the extension).
+    NotOffered,
+}
+
+/// Whether a device captures the statistics: asked for, and offered.
+pub(crate) fn capture_state(
+    asked: bool,
+    offered: bool,
+) -> std::result::Result<(), StatisticsUnavailable> {
+    match (asked, offered) {
+        (false, _) => Err(StatisticsUnavailable::NotAsked),
+        (true, false) => Err(StatisticsUnavailable::NotOffered),
+        (true, true) => Ok(()),
+    }
+}
+
 /// A device's capture of the statistics.
 pub(crate) struct StatisticsCapture {
     loader: ash::khr::pipeline_executable_properties::Device,
@@ -111,6 +133,15 @@ mod tests {
     use super::*;
     use vk::PipelineExecutableStatisticFormatKHR as F;
     use vk::PipelineExecutableStatisticValueKHR as V;
+
+    #[test]
+    fn a_capture_needs_both_the_request_and_the_offer() {
+        use StatisticsUnavailable::*;
+        assert_eq!(capture_state(false, true), Err(NotAsked));
+        assert_eq!(capture_state(false, false), Err(NotAsked));
+        assert_eq!(capture_state(true, false), Err(NotOffered));
+        assert_eq!(capture_state(true, true), Ok(()));
+    }
 
     #[test]
     fn statistics_read_the_member_their_format_names() {

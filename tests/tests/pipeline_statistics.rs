@@ -7,7 +7,7 @@ mod common;
 
 use common::{assert_no_validation_errors, plate_and_box_view, ViewInputs};
 use passes::{PcssConfig, ShadowConfig, ShadowMode};
-use rhi::{Device, DeviceDesc};
+use rhi::{Device, DeviceDesc, StatisticsUnavailable};
 use test_support::ShadowRenderer;
 
 /// A device with validation, capturing the pipelines' statistics if `capture`.
@@ -44,9 +44,13 @@ fn pipelines_report_what_they_cost_where_the_device_offers_it() {
     render_area_frame(&device);
     assert_no_validation_errors(&device);
     let name = &device.capabilities().device_name;
-    let Some(statistics) = device.pipeline_statistics() else {
-        println!("pipeline statistics on {name}: none (VK_KHR_pipeline_executable_properties not offered)");
-        return;
+    let statistics = match device.pipeline_statistics() {
+        Ok(statistics) => statistics,
+        Err(why) => {
+            assert_eq!(why, StatisticsUnavailable::NotOffered, "asked, yet {why:?}");
+            println!("pipeline statistics on {name}: none (VK_KHR_pipeline_executable_properties not offered)");
+            return;
+        }
     };
     println!("pipeline statistics on {name}:");
     for s in &statistics {
@@ -71,6 +75,9 @@ fn pipelines_report_what_they_cost_where_the_device_offers_it() {
 fn a_device_not_asked_captures_nothing() {
     let device = device_capturing(false);
     render_area_frame(&device);
-    assert!(device.pipeline_statistics().is_none());
+    assert_eq!(
+        device.pipeline_statistics().map(|s| s.len()),
+        Err(StatisticsUnavailable::NotAsked)
+    );
     assert_no_validation_errors(&device);
 }
