@@ -1234,10 +1234,13 @@ enum HrtsResult hrts_record_frame(struct HrtsContext *context, const struct Hrts
 // `HRTS_PASS_MASK_SCREEN_SPACE` after its G-buffer, in the same or a later command buffer of the same
 // queue, submitted in recording order.
 //
-// Every light's passes of the mask are recorded, light after light. A call with the `frame_index` of the
-// frame being recorded and whose lowest pass comes after the last pass recorded continues that frame (its
-// camera and lights must be the same); a call with a greater `frame_index` begins a new frame (abandoning
-// an unfinished one); any other call fails. Passes the frame does not run (not needed by the
+// Every light's passes of the mask are recorded, light after light, except where several lights build
+// their primitive maps in the call: their fits are then recorded side by side first, and their lists in
+// groups of up to four lights side by side, each group's before its lights' later passes (their reports
+// list `primitive map: fit (batched)` and `primitive map: lists (batched)`). A call with the `frame_index`
+// of the frame being recorded and whose lowest pass comes after the last pass recorded continues that
+// frame (its camera and lights must be the same); a call with a greater `frame_index` begins a new frame
+// (abandoning an unfinished one); any other call fails. Passes the frame does not run (not needed by the
 // configuration, up to date, or shared) record nothing. Within a frame, every pass that runs must be
 // recorded, in order: a call that leaves out such a pass before its last requested one fails with
 // `HRTS_RESULT_ERROR_INVALID_STATE` and records nothing (its `frame_index` counts as used: the next frame

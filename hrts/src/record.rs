@@ -189,6 +189,9 @@ impl Context {
         if self.fit_batch.is_none() {
             self.fit_batch = Some(passes::FitBatch::new(&self.device, self.frames_in_flight)?);
         }
+        if self.list_batch.is_none() {
+            self.list_batch = Some(passes::ListBatch::new(&self.device, self.frames_in_flight)?);
+        }
         let frame_index = f.frame_index;
         let (device, built) = match self.built.as_mut() {
             Some(b) => (&self.device, b),
@@ -287,38 +290,60 @@ impl Context {
         }
         // The lights' fits first, batched (each phase of every light, then one barrier), when several
         // build their maps in this call: their passes then record the lists alone.
+        let mut frame_lights = match schedule.as_mut() {
+            Some(lights) => Some(lights),
+            None => self.schedules.back_mut().map(|s| &mut s.lights),
+        };
+        let batching = reads_depth && passes.contains(&PassId::PrimitiveMap);
         let mut outcome = Ok(());
-        if let Some(batch) = self
-            .fit_batch
-            .as_mut()
-            .filter(|_| reads_depth && passes.contains(&PassId::PrimitiveMap))
-        {
+        if let Some(batch) = self.fit_batch.as_mut().filter(|_| batching) {
             let (lights, mut pipelines): (Vec<usize>, Vec<&mut passes::ShadowPipeline>) =
                 built.scheduled_mut(&recorded).unzip();
             match batch.record(&mut enc, frame_index, &mut pipelines, &passes) {
                 Ok(fitted) => {
-                    let frame_lights = match schedule.as_mut() {
-                        Some(lights) => Some(lights),
-                        None => self.schedules.back_mut().map(|s| &mut s.lights),
-                    };
-                    if let Some(frame_lights) = frame_lights {
-                        for i in fitted {
-                            if let Some(l) = frame_lights.get_mut(lights[i]) {
-                                l.fits_batched += 1;
-                            }
-                        }
-                    }
+                    count_batched(&mut frame_lights, &lights, &fitted, |l| &mut l.fits_batched)
                 }
                 Err(e) => outcome = Err(e),
             }
         }
-        for (_, pipeline) in built.scheduled_mut(&recorded) {
-            if outcome.is_err() {
-                break;
+        match self.list_batch.as_mut().filter(|_| batching) {
+            // Every light's passes before its map, then groups of lights whose maps take different scratch
+            // sets: the group's lists batched (each round of steps, then one barrier), then each light's
+            // passes from its map on.
+            Some(batch) => {
+                let (lights, mut pipelines): (Vec<usize>, Vec<&mut passes::ShadowPipeline>) =
+                    built.scheduled_mut(&recorded).unzip();
+                let (before, after): (Vec<PassId>, Vec<PassId>) = passes
+                    .iter()
+                    .partition(|&&p| (p as usize) < PassId::PrimitiveMap as usize);
+                for pipeline in pipelines.iter_mut() {
+                    outcome = outcome.and_then(|()| pipeline.record_passes(&mut enc, &before));
+                }
+                let sets: Vec<usize> = pipelines.iter().map(|p| p.scratch_set()).collect();
+                for group in passes::ListBatch::groups(&sets) {
+                    if outcome.is_err() {
+                        break;
+                    }
+                    let members = &mut pipelines[group.clone()];
+                    match batch.record(&mut enc, frame_index, members, &after) {
+                        Ok(listed) => {
+                            let listed: Vec<usize> =
+                                listed.iter().map(|i| group.start + i).collect();
+                            count_batched(&mut frame_lights, &lights, &listed, |l| {
+                                &mut l.lists_batched
+                            });
+                        }
+                        Err(e) => outcome = Err(e),
+                    }
+                    for pipeline in pipelines[group].iter_mut() {
+                        outcome = outcome.and_then(|()| pipeline.record_passes(&mut enc, &after));
+                    }
+                }
             }
-            outcome = pipeline.record_passes(&mut enc, &passes);
-            if outcome.is_err() {
-                break;
+            None => {
+                for (_, pipeline) in built.scheduled_mut(&recorded) {
+                    outcome = outcome.and_then(|()| pipeline.record_passes(&mut enc, &passes));
+                }
             }
         }
         if reads_depth {
@@ -629,6 +654,23 @@ fn record_output_layers(
     }
     enc.end_pass();
     Ok(())
+}
+
+/// Counts in each light's schedule the frusta a batch recorded: `batched` indexes `lights`, which gives
+/// each scheduled frustum's light; `counter` picks the schedule's count.
+fn count_batched(
+    frame_lights: &mut Option<&mut Vec<LightSchedule>>,
+    lights: &[usize],
+    batched: &[usize],
+    counter: impl Fn(&mut LightSchedule) -> &mut u32,
+) {
+    if let Some(frame_lights) = frame_lights {
+        for &i in batched {
+            if let Some(l) = lights.get(i).and_then(|&l| frame_lights.get_mut(l)) {
+                *counter(l) += 1;
+            }
+        }
+    }
 }
 
 #[cfg(test)]

@@ -43,7 +43,7 @@ pub use min_combine::MinCombine;
 pub use pcss::PcssConfig;
 pub use prim_buffer::{
     Draw, Geometry, IndexFormat, IndexLayout, Mesh, MeshVertices, SharedGeometry, VertexFormat,
-    VertexLayout,
+    VertexLayout, MAP_SCRATCH_SETS,
 };
 pub use primitive_map::{
     choose_binning_path, packed_offset_words, packed_texels, unpack_list_offsets, BinningPath,
@@ -53,8 +53,8 @@ pub use primitive_map::{
 pub use retire::MAX_FRAMES_IN_FLIGHT;
 pub use shadow_map::ShadowMapConfig;
 pub use shadow_pipeline::{
-    camera_in_frame, FitBatch, FrameInputs, FrameReport, ResourceReport, ShadowConfig,
-    ShadowInputs, ShadowPipeline, FIT_BATCH_PASS,
+    camera_in_frame, FitBatch, FrameInputs, FrameReport, ListBatch, ResourceReport, ShadowConfig,
+    ShadowInputs, ShadowPipeline, FIT_BATCH_PASS, LIST_BATCH_PASS,
 };
 pub use surface::{NormalEncoding, NormalSpace, SurfaceInput};
 pub use view_cull::{Casters, ViewVolume};

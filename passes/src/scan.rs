@@ -126,35 +126,62 @@ impl PrefixScan {
         pipeline: &ScanPipeline,
         cap: u32,
     ) -> Result<(), PassError> {
-        let blocks = |n: u32| u64::from(n).div_ceil(BLOCK).max(1) as u32;
-        let levels = self.levels.iter().enumerate();
-        let passes: Vec<(usize, &(BindGroup, u32), u32)> = if self.flat {
-            // The blocks' totals (mode 2), then each block from the totals before it (mode 3).
-            levels
-                .flat_map(|(i, level)| [(i, level, 2), (i, level, 3)])
-                .collect()
-        } else {
-            // Up the levels scanning each block (mode 0), then down adding the block totals (mode 1).
-            let up = levels.clone().map(|(i, level)| (i, level, 0));
-            let down = levels.rev().skip(1).map(|(i, level)| (i, level, 1));
-            up.chain(down).collect()
-        };
-        for (level, (group, n), mode) in passes {
-            let push = ScanPush {
-                n: *n,
-                mode,
-                // Only the input's values are capped (the levels above hold block totals).
-                cap: if level == 0 { cap } else { u32::MAX },
-                pad: 0,
-            };
-            enc.dispatch(
-                &pipeline.0,
-                group,
-                bytemuck::bytes_of(&push),
-                [blocks(*n), 1, 1],
-            )?;
+        for step in 0..self.steps() {
+            self.record_step(enc, pipeline, cap, step)?;
             enc.barriers(&[Barrier::Uav]);
         }
+        Ok(())
+    }
+
+    /// The dispatches the scan takes, each to be followed by a UAV barrier before the next.
+    pub fn steps(&self) -> usize {
+        if self.flat {
+            2 * self.levels.len()
+        } else {
+            2 * self.levels.len() - 1
+        }
+    }
+
+    /// Records dispatch `step` (of [`PrefixScan::steps`]) of [`PrefixScan::record_capped`] alone, without
+    /// the barrier after it: the steps of scans over different buffers may be interleaved, each round of
+    /// steps followed by one UAV barrier.
+    pub fn record_step(
+        &self,
+        enc: &mut Encoder<'_>,
+        pipeline: &ScanPipeline,
+        cap: u32,
+        step: usize,
+    ) -> Result<(), PassError> {
+        let levels = self.levels.len();
+        let (level, mode) = if self.flat {
+            // The blocks' totals (mode 2), then each block from the totals before it (mode 3).
+            (step / 2, 2 + (step % 2) as u32)
+        } else if step < levels {
+            // Up the levels scanning each block (mode 0)…
+            (step, 0)
+        } else {
+            // …then down adding the block totals (mode 1).
+            (2 * levels - 2 - step, 1)
+        };
+        let Some((group, n)) = self.levels.get(level) else {
+            return Err(PassError::InvalidConfig(format!(
+                "scan step {step} of {}",
+                self.steps()
+            )));
+        };
+        let push = ScanPush {
+            n: *n,
+            mode,
+            // Only the input's values are capped (the levels above hold block totals).
+            cap: if level == 0 { cap } else { u32::MAX },
+            pad: 0,
+        };
+        enc.dispatch(
+            &pipeline.0,
+            group,
+            bytemuck::bytes_of(&push),
+            [u64::from(*n).div_ceil(BLOCK).max(1) as u32, 1, 1],
+        )?;
         Ok(())
     }
 }

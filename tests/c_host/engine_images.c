@@ -409,15 +409,19 @@ void output_formats(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
 /* With an R32_SFLOAT output that also has STORAGE usage, each light's last pass writes its layer (no copy):
  * the visibility equals the copied one bit for bit for a sun (hard, and hybrid: the blend's output), a point
  * light (one cube map, or the minimum over its faces), and a point light and a spot light whose ranges reach
- * nothing (their layers filled with 1), recorded in one call, split as an engine splits a frame, and pass by
- * pass; the report says which lights wrote directly. Pass by pass, every light's map is built before any
- * ray trace: the lights share their pixel texels, so a ray trace whose texels a later build overwrote
- * rewrites them first ('primitive map: pixel texels'); every way equals the one-call frame bit for bit. */
+ * nothing (their layers filled with 1), and two more suns, recorded in one call, split as an engine splits a
+ * frame, and pass by pass; the report says which lights wrote directly. Pass by pass, every light's map is
+ * built before any ray trace: lights whose maps take the same scratch set share their pixel texels, so a
+ * ray trace whose texels a later build overwrote rewrites them first ('primitive map: pixel texels'); every
+ * way equals the one-call frame bit for bit. */
 void output_direct(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
-    enum { PX = W * H, N = 4 };
+    enum { PX = W * H, N = 6 };
     setup_camera(0.0);
+    /* six lights' frusta take the plugin's four scratch sets in turn: the last two suns share sets with the
+     * first lights, so pass by pass their builds overwrite those lights' pixel texels */
     Emitter lights[N] = {directional(v3(0.45, -1.0, 0.2)), point(v3(0.9, 2.3, 0.7)), point(v3(0.0, 6.0, 0.0)),
-                         fitted_spot(v3(0.0, 6.0, 0.0), v3(0.0, 7.0, 0.0), 0.5)};
+                         fitted_spot(v3(0.0, 6.0, 0.0), v3(0.0, 7.0, 0.0), 0.5), directional(v3(-0.3, -1.0, 0.4)),
+                         directional(v3(0.2, -1.0, -0.5))};
     lights[2].c.range = 2.0f;
     lights[3].c.range = 2.0f;
     set_lights(lights, N);

@@ -84,8 +84,9 @@ static int plans_differ_from_reports(HrtsContext *ctx, const HrtsCpuGeometry *g,
 /* ---------- several lights in one context ---------- */
 /* Eight lights, four directional and four spot, hard shadows, in one context sharing the prim buffer:
  * each light's layer of the output matches the exact shadow of that light; the prim buffer is built once,
- * by the first light, and shared; the lights' primitive-map fits are recorded as one batch, and each report
- * holds its light's share of the batch's time in place of its own fit. */
+ * by the first light, and shared; the lights' primitive-map fits are recorded as one batch and their lists in
+ * two (the four scratch sets in turn), each report holding its light's share of the batches' time in place
+ * of its own fit and lists; each layer equals, bit for bit, the light's alone in a context of its own. */
 void several_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
     enum { N = 8 };
     Emitter lights[N] = {
@@ -110,20 +111,24 @@ void several_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
         int mismatches = count_mismatches(vis + i * W * H, tol, &lights[i], &near_edge, &shadowed, &lit);
         HrtsFrameReport rep;
         HrtsResult r = report(ctx, first, (uint32_t)i, &rep);
-        /* one primitive-map build scratch serves every light: the same bytes in every report */
+        /* the primitive maps' build scratch sets serve every light: the same bytes in every report */
         if (i == 0) scratch = rep.map_scratch_bytes;
         CHECK(rep.map_scratch_bytes > 0 && rep.map_scratch_bytes == scratch, "light %d: map scratch %llu bytes, light 0's %llu",
               i, (unsigned long long)rep.map_scratch_bytes, (unsigned long long)scratch);
-        double batched_ms = -1.0;
-        int own_fit = 0;
+        double batched_ms = -1.0, listed_ms = -1.0;
+        int own_fit = 0, own_lists = 0;
         for (uint32_t p = 0; p < rep.pass_count; p++) {
             if (strcmp(rep.passes[p].name, "primitive map: fit (batched)") == 0) batched_ms = rep.passes[p].milliseconds;
+            if (strcmp(rep.passes[p].name, "primitive map: lists (batched)") == 0) listed_ms = rep.passes[p].milliseconds;
             own_fit += strcmp(rep.passes[p].name, "primitive map: fit") == 0;
+            own_lists += strcmp(rep.passes[p].name, "primitive map: receivers") == 0;
         }
-        printf("light %d (%s): %d lit, %d shadowed, %d near-edge, %d mismatches; prim buffer %s; batched fit %.4f ms\n", i,
-               lights[i].spot ? "spot" : "directional", lit, shadowed, near_edge, mismatches,
-               rep.pass_status[HRTS_PASS_PRIM_BUFFER] == HRTS_PASS_STATUS_RAN ? "built" : "shared", batched_ms);
+        printf("light %d (%s): %d lit, %d shadowed, %d near-edge, %d mismatches; prim buffer %s; batched fit %.4f ms, lists %.4f ms\n",
+               i, lights[i].spot ? "spot" : "directional", lit, shadowed, near_edge, mismatches,
+               rep.pass_status[HRTS_PASS_PRIM_BUFFER] == HRTS_PASS_STATUS_RAN ? "built" : "shared", batched_ms, listed_ms);
         CHECK(batched_ms > 0.0 && own_fit == 0, "light %d: batched fit %.4f ms, %d fits of its own", i, batched_ms, own_fit);
+        /* the 8 lights' maps take the 4 scratch sets in turn: two groups of 4, each light's lists in a batch */
+        CHECK(listed_ms > 0.0 && own_lists == 0, "light %d: batched lists %.4f ms, %d lists of its own", i, listed_ms, own_lists);
         CHECK(r == HRTS_RESULT_OK, "report of light %d: %s", i, hrts_last_error(ctx));
         CHECK(rep.pass_status[HRTS_PASS_PRIM_BUFFER] == (i == 0 ? HRTS_PASS_STATUS_RAN : HRTS_PASS_STATUS_SHARED),
               "light %d: prim buffer status %u", i, rep.pass_status[HRTS_PASS_PRIM_BUFFER]);
@@ -133,6 +138,18 @@ void several_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
     }
     printf("8 lights: %d shadowed px in all, %d mismatches\n", total_shadowed, total_mismatches);
     CHECK(total_mismatches == 0, "%d pixels of the 8 lights differ from the exact shadows", total_mismatches);
+    /* each light alone in a context of its own (no batch): the same layer bit for bit */
+    int differ_alone = 0;
+    for (int i = 0; i < N; i++) {
+        static float alone[W * H];
+        HrtsContext *one = hard_lights_context(vk, g, &lights[i], 1);
+        CHECK(run_frame(one, alone) == HRTS_RESULT_OK, "light %d alone: %s", i, hrts_last_error(one));
+        for (int p = 0; p < W * H; p++) differ_alone += memcmp(&alone[p], &vis[i * W * H + p], sizeof(float)) != 0;
+        CHECK(hrts_context_destroy(one) == HRTS_RESULT_OK, "destroy");
+    }
+    set_lights(lights, N);
+    printf("8 lights batched against each light alone: %d px differ\n", differ_alone);
+    CHECK(differ_alone == 0, "%d px of the batched lights differ from the lights alone", differ_alone);
     /* the next frame: static geometry, the prim buffer is up to date for every light */
     CHECK(run_frame(ctx, NULL) == HRTS_RESULT_OK, "second frame: %s", hrts_last_error(ctx));
     HrtsFrameReport rep;

@@ -42,13 +42,23 @@ impl Context {
                         normal: &built.normal,
                         surface: built.surface,
                         direct_output: layer.filter(|_| shape.frusta == 1),
+                        scratch_set: 0,
                     };
+                    // The frusta of the context's lights, in recording order, take the scratch sets in
+                    // turn: neighbours' lists can then be built side by side (`passes::ListBatch`). Sized
+                    // lights' maps all take the first set: their pair lists run to hundreds of MiB and
+                    // their ray traces, not their builds, take their time.
+                    let first_frustum: usize = self.frusta[..i].iter().map(|s| s.frusta).sum();
+                    let sized = config.mode == passes::ShadowMode::Area;
                     let frusta = (0..shape.frusta)
-                        .map(|_| {
+                        .map(|f| {
                             ShadowPipeline::with_shared_geometry(
                                 device,
                                 built.shared.clone(),
-                                &inputs,
+                                &ShadowInputs {
+                                    scratch_set: if sized { 0 } else { first_frustum + f },
+                                    ..inputs
+                                },
                                 config,
                             )
                         })

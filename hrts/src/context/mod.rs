@@ -17,7 +17,7 @@ use crate::types::*;
 use crate::version::{major_minor, OLDEST_MINOR};
 use passes::retire::RetireQueue;
 use passes::{
-    BinningRequest, FitBatch, MinCombine, ShadowConfig, ShadowPipeline, SharedGeometry,
+    BinningRequest, FitBatch, ListBatch, MinCombine, ShadowConfig, ShadowPipeline, SharedGeometry,
     SurfaceInput,
 };
 use rhi::{Device, Format, Image, ImageUsage};
@@ -208,6 +208,9 @@ pub(crate) struct Context {
     /// The lights' primitive-map fits recorded together, timed per frame in flight; created with the
     /// first recording (its GPU timers need timestamps, as the passes do).
     pub(crate) fit_batch: Option<FitBatch>,
+    /// The lights' primitive-map lists recorded together in groups over different scratch sets, timed per
+    /// frame in flight; created with the first recording.
+    pub(crate) list_batch: Option<ListBatch>,
 }
 
 impl Context {
@@ -264,6 +267,7 @@ impl Context {
             frusta: vec![LightShape::default()],
             schedules: Default::default(),
             fit_batch: None,
+            list_batch: None,
         })
     }
 

@@ -1,11 +1,15 @@
 //! Reporting: a light's frame report (statistics, timings, pass statuses, memory and decision) and the
 //! description of its resources.
 
+use super::schedule::LightSchedule;
 use super::Context;
 use crate::convert::{binning_path_to_c, resource_id, resource_index, RESOURCES};
 use crate::error::{invalid, ApiError, ApiResult};
 use crate::types::*;
-use passes::{FrameReport, PassStatus, ResourceId, ShadowPipeline, SkipReason, FIT_BATCH_PASS};
+use passes::{
+    FrameReport, PassStatus, ResourceId, ShadowPipeline, SkipReason, FIT_BATCH_PASS,
+    LIST_BATCH_PASS,
+};
 use rhi::Format;
 use rhi::PassTiming;
 
@@ -78,29 +82,47 @@ impl Context {
         out.map_to_texels = reports
             .first()
             .map_or([0.0; 16], |r| r.map_to_texels.to_cols_array());
-        // The light's share of the frame's batched fits: the batch's time over the frusta it fitted.
-        let batched_total: u32 =
-            frame_schedule.map_or(0, |s| s.lights.iter().map(|l| l.fits_batched).sum());
-        let batch_share = if schedule.fits_batched > 0 {
-            let ms = self
-                .fit_batch
-                .as_ref()
-                .ok_or_else(|| ApiError::new(HrtsResult::ErrorInternal, "no fit batch"))?
-                .milliseconds(frame_index)
-                .map_err(|e| ApiError::new(HrtsResult::ErrorInternal, e.to_string()))?
-                .ok_or_else(|| {
-                    ApiError::new(
-                        HrtsResult::NotReady,
-                        format!("frame {frame_index} has not completed on the GPU: ask after its fence signalled"),
-                    )
-                })?;
-            Some(PassTiming {
-                name: FIT_BATCH_PASS.to_owned(),
-                ms: ms * f64::from(schedule.fits_batched) / f64::from(batched_total.max(1)),
-            })
-        } else {
-            None
+        // The light's share of the frame's batched fits and lists: each batch's time over the frusta it
+        // recorded.
+        let not_ready = || {
+            ApiError::new(
+                HrtsResult::NotReady,
+                format!("frame {frame_index} has not completed on the GPU: ask after its fence signalled"),
+            )
         };
+        let internal =
+            |e: passes::PassError| ApiError::new(HrtsResult::ErrorInternal, e.to_string());
+        let share = |count: fn(&LightSchedule) -> u32,
+                     ms: Option<Result<Option<f64>, passes::PassError>>,
+                     name: &str|
+         -> ApiResult<Option<PassTiming>> {
+            if count(schedule) == 0 {
+                return Ok(None);
+            }
+            let total: u32 = frame_schedule.map_or(0, |s| s.lights.iter().map(count).sum());
+            let ms = ms
+                .ok_or_else(|| ApiError::new(HrtsResult::ErrorInternal, "no batch"))?
+                .map_err(internal)?
+                .ok_or_else(not_ready)?;
+            Ok(Some(PassTiming {
+                name: name.to_owned(),
+                ms: ms * f64::from(count(schedule)) / f64::from(total.max(1)),
+            }))
+        };
+        let fit_share = share(
+            |l| l.fits_batched,
+            self.fit_batch.as_ref().map(|b| b.milliseconds(frame_index)),
+            FIT_BATCH_PASS,
+        )?;
+        let list_share = share(
+            |l| l.lists_batched,
+            self.list_batch
+                .as_ref()
+                .map(|b| b.milliseconds(frame_index)),
+            LIST_BATCH_PASS,
+        )?;
+        let batch_share = fit_share.into_iter().chain(list_share);
+        let batch_share: Vec<PassTiming> = batch_share.collect();
         let timings: Vec<_> = batch_share
             .iter()
             .chain(reports.iter().flat_map(|r| &r.timings))

@@ -22,6 +22,9 @@ pub(crate) struct LightSchedule {
     /// How many of its frusta had their primitive-map fit recorded in the frame's batch
     /// ([`passes::FitBatch`]).
     pub(crate) fits_batched: u32,
+    /// How many of its frusta had their primitive map's lists recorded in one of the frame's list batches
+    /// ([`passes::ListBatch`]).
+    pub(crate) lists_batched: u32,
 }
 
 impl LightSchedule {
@@ -110,6 +113,7 @@ pub(crate) fn schedule(
                 kind: light.kind,
                 auto: config.auto_reason(directional),
                 fits_batched: 0,
+                lists_batched: 0,
                 recorded: light
                     .frusta
                     .iter()
@@ -158,6 +162,7 @@ mod tests {
             names: vec!["whole"],
             auto: config.auto_reason(kind == HrtsLightType::Directional),
             fits_batched: 0,
+            lists_batched: 0,
         };
         let (decision, reason) = schedule(HrtsLightType::Directional, &auto).decision();
         assert_eq!(decision, HrtsLightDecision::Shadowed);

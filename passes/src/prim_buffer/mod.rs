@@ -12,7 +12,7 @@ mod shared;
 
 pub use geometry::{Draw, Geometry, IndexFormat, IndexLayout, Mesh, VertexFormat, VertexLayout};
 pub(crate) use shared::PrimBufferClaim;
-pub use shared::{MeshVertices, SharedGeometry};
+pub use shared::{MeshVertices, SharedGeometry, MAP_SCRATCH_SETS};
 
 use crate::gpu_types::{GpuTriangle, PrimBufferPush};
 use crate::shaders::shader;

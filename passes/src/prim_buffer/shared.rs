@@ -52,6 +52,10 @@ struct FrameMesh {
     entry: usize,
 }
 
+/// The sets of build scratch the primitive maps over one geometry take in turn: up to this many lights'
+/// lists are built side by side, each set allocated once a map takes it.
+pub const MAP_SCRATCH_SETS: usize = 4;
+
 /// The scene's geometry and its prim buffer, shared by the pipelines of several lights (one context): in
 /// each frame the first light that needs the prim buffer records its build and the others read it. A
 /// build rewrites only the slots that no longer hold what the frame needs.
@@ -61,7 +65,8 @@ pub struct SharedGeometry {
     /// The hierarchy over the prim buffer, rebuilt with it.
     bvh: SceneBvh,
     state: Mutex<PrimBufferState>,
-    map_scratch: MapScratchPool,
+    /// [`MAP_SCRATCH_SETS`] sets of the maps' build scratch.
+    map_scratch: Vec<MapScratchPool>,
     /// The ray traces' visibility that each light's FXAA reads right after, shared
     /// ([`SharedGeometry::antialias_source`]); freed when no pipeline holds it any more.
     antialias_source: Mutex<std::sync::Weak<rhi::Image>>,
@@ -133,7 +138,9 @@ impl SharedGeometry {
             geometry,
             pass,
             bvh,
-            map_scratch: MapScratchPool::default(),
+            map_scratch: (0..MAP_SCRATCH_SETS)
+                .map(|_| MapScratchPool::default())
+                .collect(),
             antialias_source: Mutex::new(std::sync::Weak::new()),
         }))
     }
@@ -153,9 +160,16 @@ impl SharedGeometry {
         &self.bvh
     }
 
-    /// The build scratch the primitive maps over this geometry share (one light's map is built at a time).
-    pub fn map_scratch(&self) -> &MapScratchPool {
-        &self.map_scratch
+    /// Build scratch set `set` (modulo [`MAP_SCRATCH_SETS`]), shared by the primitive maps over this
+    /// geometry that take it: they are built one after another, while maps over different sets may be
+    /// built side by side ([`crate::ListBatch`]).
+    pub fn map_scratch(&self, set: usize) -> &MapScratchPool {
+        &self.map_scratch[set % MAP_SCRATCH_SETS]
+    }
+
+    /// GPU bytes of every scratch set allocated so far.
+    pub fn map_scratch_bytes(&self) -> u64 {
+        self.map_scratch.iter().map(MapScratchPool::bytes).sum()
     }
 
     /// The `width` x `height` `R32_SFLOAT` visibility the lights' ray traces write and their FXAA reads

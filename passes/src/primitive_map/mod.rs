@@ -114,6 +114,56 @@ impl FitPhase {
     }
 }
 
+/// A step of the lists' build ([`PrimitiveMap::record_list_step`]), in the order of
+/// [`PrimitiveMap::list_steps`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ListStep {
+    /// The receiver map, the counts and the capped bits cleared (transfers).
+    Clear,
+    /// The receivers marked in the map and each pixel's texel written.
+    Receivers,
+    /// The triangles culled, projected and split into tiles.
+    Setup,
+    /// A dispatch of the tiles' prefix scan.
+    TileScan(usize),
+    /// The bin walk's search index (compute binning).
+    SearchIndex,
+    /// The (triangle, texel) pairs counted per texel.
+    Count,
+    /// A dispatch of the counts' prefix scan.
+    OffsetScan(usize),
+    /// The scanned counts packed into the list offsets (mode 0), then the cursors of the lists not kept
+    /// (mode 1).
+    Pack(u32),
+    /// The lists filled.
+    Fill,
+}
+
+impl ListStep {
+    /// The barrier that makes the step's writes visible to the next step.
+    pub fn barrier_after(self) -> Barrier<'static> {
+        match self {
+            ListStep::Clear => Barrier::Global {
+                before: S::CopyDest,
+                after: S::UnorderedAccess,
+            },
+            _ => Barrier::Uav,
+        }
+    }
+
+    /// The timed pass this step opens, when it is the first of one.
+    fn pass_name(self, path: BinningPath) -> Option<String> {
+        match self {
+            ListStep::Clear => Some("primitive map: receivers".into()),
+            ListStep::Setup => Some("primitive map: setup".into()),
+            ListStep::Count => Some(format!("primitive map: count ({})", path.label())),
+            ListStep::OffsetScan(0) => Some("primitive map: scan".into()),
+            ListStep::Fill => Some(format!("primitive map: fill ({})", path.label())),
+            _ => None,
+        }
+    }
+}
+
 /// The primitive map's resources and passes.
 pub struct PrimitiveMap {
     config: PrimitiveMapConfig,
@@ -596,74 +646,103 @@ impl PrimitiveMap {
     }
 
     /// Records the lists' build after the fit ([`PrimitiveMap::record_fit_phase`]): the receivers marked,
-    /// the setup, the count, the scan and the fill, through the scratch the maps over one geometry share
-    /// (cleared first).
+    /// the setup, the count, the scan and the fill, through the map's scratch (cleared first), each step
+    /// followed by its barrier.
     pub fn record_lists(&mut self, enc: &mut Encoder<'_>) -> Result<(), PassError> {
+        // The scratch's last use was the previous build's storage reads (or a read-back's copy).
+        enc.barriers(&BEFORE_TRANSFER_WRITES);
+        let mut open = false;
+        for step in self.list_steps() {
+            if let Some(name) = step.pass_name(self.path) {
+                if open {
+                    enc.end_pass();
+                }
+                enc.begin_pass(&name);
+                open = true;
+            }
+            self.record_list_step(enc, step)?;
+            enc.barriers(&[step.barrier_after()]);
+        }
+        if open {
+            enc.end_pass();
+        }
+        Ok(())
+    }
+
+    /// The steps of [`PrimitiveMap::record_lists`], in order.
+    pub fn list_steps(&self) -> Vec<ListStep> {
+        let compute = matches!(self.pipes.binner, Binner::Compute(_));
+        let mut steps = vec![ListStep::Clear, ListStep::Receivers, ListStep::Setup];
+        steps.extend((0..self.bound.tile_scan.steps()).map(ListStep::TileScan));
+        steps.extend(compute.then_some(ListStep::SearchIndex));
+        steps.push(ListStep::Count);
+        steps.extend((0..self.bound.offset_scan.steps()).map(ListStep::OffsetScan));
+        steps.extend([ListStep::Pack(0), ListStep::Pack(1), ListStep::Fill]);
+        steps
+    }
+
+    /// Records one step of the lists' build ([`PrimitiveMap::list_steps`]) without the barrier after it.
+    /// The steps touch the map's own buffers and its scratch, so the steps of maps over different scratch
+    /// sets may be interleaved, each round followed by the barriers of its steps
+    /// ([`ListStep::barrier_after`]), the first preceded by [`PrimitiveMap::BEFORE_LISTS`].
+    pub fn record_list_step(
+        &mut self,
+        enc: &mut Encoder<'_>,
+        step: ListStep,
+    ) -> Result<(), PassError> {
         let push = self.fit_push()?;
         let with_mode = |mode| MapPush { mode, ..push };
-        self.pixel_texels
-            .writer
-            .store(self.id, std::sync::atomic::Ordering::Relaxed);
-        enc.begin_pass("primitive map: receivers");
-        // The shared scratch's last use was the previous build's storage reads (or a read-back's copy).
-        enc.barriers(&BEFORE_TRANSFER_WRITES);
-        enc.fill_buffer(&self.receivers, 0);
-        enc.fill_buffer(&self.bound.scratch.counts, 0);
-        enc.fill_buffer(&self.bound.scratch.capped, 0);
-        enc.barriers(&[Barrier::Global {
-            before: S::CopyDest,
-            after: S::UnorderedAccess,
-        }]);
-        self.dispatch_receivers(enc, &push, 1)?;
-        enc.barriers(&[Barrier::Uav]);
-        enc.end_pass();
-        enc.begin_pass("primitive map: setup");
-        enc.dispatch(
-            &self.pipes.setup,
-            &self.bound.setup_group,
-            bytemuck::bytes_of(&push),
-            [(self.triangles + 1).div_ceil(64), 1, 1],
-        )?;
-        enc.barriers(&[Barrier::Uav]);
-        self.bound.tile_scan.record(enc, &self.pipes.scan)?;
-        if matches!(self.pipes.binner, Binner::Compute(_)) {
-            enc.dispatch(
+        match step {
+            ListStep::Clear => {
+                self.pixel_texels
+                    .writer
+                    .store(self.id, std::sync::atomic::Ordering::Relaxed);
+                enc.fill_buffer(&self.receivers, 0);
+                enc.fill_buffer(&self.bound.scratch.counts, 0);
+                enc.fill_buffer(&self.bound.scratch.capped, 0);
+            }
+            ListStep::Receivers => self.dispatch_receivers(enc, &push, 1)?,
+            ListStep::Setup => enc.dispatch(
+                &self.pipes.setup,
+                &self.bound.setup_group,
+                bytemuck::bytes_of(&push),
+                [(self.triangles + 1).div_ceil(64), 1, 1],
+            )?,
+            ListStep::TileScan(i) => {
+                self.bound
+                    .tile_scan
+                    .record_step(enc, &self.pipes.scan, u32::MAX, i)?
+            }
+            ListStep::SearchIndex => enc.dispatch(
                 &self.pipes.index,
                 &self.bound.index_group,
                 bytemuck::bytes_of(&push),
                 [scratch::SEARCH_INDEX_WORDS.div_ceil(64) as u32, 1, 1],
-            )?;
-            enc.barriers(&[Barrier::Uav]);
+            )?,
+            ListStep::Count => self.record_bin(enc, &with_mode(0))?,
+            ListStep::OffsetScan(i) => {
+                self.bound
+                    .offset_scan
+                    .record_step(enc, &self.pipes.scan, push.list_limit, i)?
+            }
+            // The offsets and statistics, then the cursors of the lists not kept.
+            ListStep::Pack(mode) => {
+                let groups = self.config.texels().div_ceil(OFFSET_GROUP as u64) + 1;
+                enc.dispatch(
+                    &self.pipes.pack,
+                    &self.bound.pack_group,
+                    bytemuck::cast_slice(&[self.config.texels() as u32, mode]),
+                    [groups.div_ceil(64) as u32, 1, 1],
+                )?
+            }
+            ListStep::Fill => self.record_bin(enc, &with_mode(1))?,
         }
-        enc.end_pass();
-
-        let label = self.path.label();
-        enc.begin_pass(&format!("primitive map: count ({label})"));
-        self.record_bin(enc, &with_mode(0))?;
-        enc.end_pass();
-
-        enc.begin_pass("primitive map: scan");
-        self.bound
-            .offset_scan
-            .record_capped(enc, &self.pipes.scan, push.list_limit)?;
-        let groups = self.config.texels().div_ceil(OFFSET_GROUP as u64) + 1;
-        // The offsets and statistics, then the cursors of the lists not kept.
-        for mode in 0..2u32 {
-            enc.dispatch(
-                &self.pipes.pack,
-                &self.bound.pack_group,
-                bytemuck::cast_slice(&[self.config.texels() as u32, mode]),
-                [groups.div_ceil(64) as u32, 1, 1],
-            )?;
-            enc.barriers(&[Barrier::Uav]);
-        }
-        enc.end_pass();
-
-        enc.begin_pass(&format!("primitive map: fill ({label})"));
-        self.record_bin(enc, &with_mode(1))?;
-        enc.end_pass();
         Ok(())
     }
+
+    /// The barriers before the first step of a lists' build: the scratch's last use was an earlier build's
+    /// storage reads (or a read-back's copy).
+    pub const BEFORE_LISTS: [Barrier<'static>; 2] = BEFORE_TRANSFER_WRITES;
 
     /// The buffer of the pixel texels the ray trace reads (one `u32` per screen pixel).
     pub fn pixel_texels(&self) -> &Buffer {
@@ -730,7 +809,6 @@ impl PrimitiveMap {
                 enc.end_rendering();
             }
         }
-        enc.barriers(&[Barrier::Uav]);
         Ok(())
     }
 

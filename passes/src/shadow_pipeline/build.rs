@@ -133,6 +133,7 @@ impl ShadowPipeline {
         } else {
             None
         };
+        let scratch_set = inputs.scratch_set % crate::MAP_SCRATCH_SETS;
         let map = if runs(PassId::PrimitiveMap) {
             let map_inputs = PrimitiveMapInputs {
                 prims: need_prims()?,
@@ -140,7 +141,7 @@ impl ShadowPipeline {
                 depth: inputs.depth,
                 normal: inputs.normal,
                 occupancy_view: plan.resources().contains(ResourceId::Occupancy),
-                scratch: shared.map_scratch(),
+                scratch: shared.map_scratch(scratch_set),
             };
             Some(PrimitiveMap::new(device, &map_inputs, config.map)?)
         } else {
@@ -333,6 +334,7 @@ impl ShadowPipeline {
             surface_mode: inputs.surface.mode(inputs.normal.format()),
             normal_precision: inputs.surface.normal_precision(inputs.normal.format()),
             rt_shared,
+            scratch_set,
         };
         // Every resource of the plan exists (a missing one would be a bug in the wiring above).
         if let Some(r) = pipeline

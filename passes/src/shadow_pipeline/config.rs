@@ -181,6 +181,10 @@ pub struct ShadowInputs<'a> {
     /// directly, instead of an image of the pipeline's own that is then copied (none: its own). Its former
     /// contents are discarded; it is left in `UnorderedAccess` state.
     pub direct_output: Option<&'a Image>,
+    /// Which of the geometry's sets of map build scratch the primitive map takes (modulo
+    /// [`crate::MAP_SCRATCH_SETS`]): pipelines whose lists a [`crate::ListBatch`] builds side by side take
+    /// different sets; each set is allocated once a map takes it.
+    pub scratch_set: usize,
 }
 
 #[cfg(test)]

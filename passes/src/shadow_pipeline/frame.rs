@@ -233,6 +233,7 @@ impl ShadowPipeline {
             timer_started: false,
             marked: false,
             map_fitted: false,
+            map_listed: false,
         });
         Ok(())
     }

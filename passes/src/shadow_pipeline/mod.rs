@@ -18,7 +18,7 @@ mod frame;
 mod record;
 mod report;
 
-pub use batch::{FitBatch, FIT_BATCH_PASS};
+pub use batch::{FitBatch, ListBatch, FIT_BATCH_PASS, LIST_BATCH_PASS};
 pub use config::{FrameInputs, ShadowConfig, ShadowInputs};
 pub use report::{FrameReport, ResourceReport};
 
@@ -66,6 +66,9 @@ struct FrameState {
     /// Whether the primitive map's fit was recorded ahead of the pass, batched with other lights'
     /// ([`FitBatch`]): the pass then records the lists alone.
     map_fitted: bool,
+    /// Whether the primitive map's lists were recorded ahead of the pass, batched with other lights'
+    /// ([`ListBatch`]): the pass then records nothing.
+    map_listed: bool,
 }
 
 /// What the ring keeps of one frame in flight: its GPU timer, the map state read back, and its schedule.
@@ -145,6 +148,9 @@ pub struct ShadowPipeline {
     normal_precision: f32,
     /// Whether the ray trace writes the visibility the lights' FXAA share ([`ShadowPipeline::is_shared`]).
     rt_shared: bool,
+    /// The set of the geometry's map scratch this pipeline's map takes
+    /// ([`SharedGeometry::map_scratch`]).
+    scratch_set: usize,
 }
 
 impl ShadowPipeline {

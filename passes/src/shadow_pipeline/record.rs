@@ -3,7 +3,7 @@
 use super::{FrameInputs, FrameState, RetiredMap, ShadowPipeline};
 use crate::frame_plan::{PassId, PassStatus, ResourceSet};
 use crate::gpu_types::ShadowMapPush;
-use crate::primitive_map::FitPhase;
+use crate::primitive_map::{FitPhase, ListStep, PrimitiveMap};
 use crate::screen_pass::visibility_image;
 use crate::PassError;
 use rhi::{Barrier, Device, Encoder, Image, ResourceState as S};
@@ -143,6 +143,60 @@ impl ShadowPipeline {
             .as_mut()
             .ok_or_else(|| PassError::InvalidConfig("the plan has no primitive map".into()))?;
         map.record_fit_phase(enc, phase, &c.ray, &c.map, c.light.frusta())
+    }
+
+    /// The set of the geometry's build scratch this pipeline's map takes: maps over different sets may be
+    /// built side by side ([`super::ListBatch`]).
+    pub fn scratch_set(&self) -> usize {
+        self.scratch_set
+    }
+
+    /// Whether a recording of `passes` builds the primitive map's lists and they may be recorded ahead
+    /// ([`ShadowPipeline::record_map_list_step`]): the map's fit was recorded ahead
+    /// ([`ShadowPipeline::record_map_fit`]), every pass before the map's is recorded, and the lists are
+    /// not yet.
+    pub fn lists_map_in(&self, passes: &[PassId]) -> bool {
+        let map = PassId::PrimitiveMap;
+        self.map.is_some()
+            && passes.contains(&map)
+            && self.statuses[map as usize].1 == PassStatus::Ran
+            && self
+                .frame
+                .as_ref()
+                .is_some_and(|f| f.next == map as usize && f.map_fitted && !f.map_listed)
+    }
+
+    /// The steps of the lists' build of a map that [`ShadowPipeline::lists_map_in`] the call's passes.
+    pub fn map_list_steps(&self) -> Vec<ListStep> {
+        self.map
+            .as_ref()
+            .map_or_else(Vec::new, PrimitiveMap::list_steps)
+    }
+
+    /// Records `step` of the primitive map's lists ahead of its pass, which then records nothing. Every
+    /// step touches the map's own buffers and its scratch set ([`ShadowPipeline::scratch_set`]), so the
+    /// steps of lights over different sets may be interleaved, each round of steps followed by their
+    /// [`ListStep::barrier_after`] and the first preceded by [`PrimitiveMap::BEFORE_LISTS`]
+    /// ([`super::ListBatch`] does). The last step marks the lists recorded.
+    pub fn record_map_list_step(
+        &mut self,
+        enc: &mut Encoder<'_>,
+        step: ListStep,
+    ) -> Result<(), PassError> {
+        self.with_frame(|this, frame| {
+            if !frame.map_fitted || frame.map_listed {
+                return Err(PassError::InvalidConfig(
+                    "the primitive map's lists are recorded ahead only once, after its fit".into(),
+                ));
+            }
+            let map = this
+                .map
+                .as_mut()
+                .ok_or_else(|| PassError::InvalidConfig("the plan has no primitive map".into()))?;
+            map.record_list_step(enc, step)?;
+            frame.map_listed = step == ListStep::Fill;
+            Ok(())
+        })
     }
 
     /// Whether [`ShadowPipeline::record_passes`] would accept `passes` now (without recording anything).
@@ -299,6 +353,8 @@ impl ShadowPipeline {
                     sm.record(enc, &push, tris)?;
                 }
             }
+            // Recorded ahead, batched with other lights' lists, and followed by the batch's barrier.
+            PassId::PrimitiveMap if frame.map_listed => return Ok(()),
             PassId::PrimitiveMap => {
                 self.grow_map(enc.device(), frame.index)?;
                 if let Some(map) = self.map.as_mut() {
@@ -381,7 +437,7 @@ impl ShadowPipeline {
             return Ok(());
         };
         let mut retired = Vec::new();
-        let pool = self.shared.map_scratch();
+        let pool = self.shared.map_scratch(self.scratch_set);
         if let Some((entries, bindings)) =
             map.fit_entries(device, pool, self.shared.prims(), self.needed_entries)?
         {

@@ -88,7 +88,7 @@ impl ShadowPipeline {
         let map = self
             .map
             .as_ref()
-            .map_or(0, |_| self.shared.map_scratch().bytes());
+            .map_or(0, |_| self.shared.map_scratch_bytes());
         let visibility = match &self.ray {
             Some(ray) if self.rt_shared => ray.visibility.byte_size(),
             _ => 0,

@@ -49,6 +49,7 @@ impl ShadowRenderer {
             )
             .map_err(|e| PassError::InvalidConfig(e.to_string()))?,
             direct_output: None,
+            scratch_set: 0,
         };
         let pipeline = ShadowPipeline::new(device, geometry, &inputs, config)?;
         let gbuffer = GBufferPass::new(device, &scene, &targets.layout)?;
