@@ -533,16 +533,17 @@ pub unsafe extern "C" fn hrts_record_frame(
 ///
 /// Every light's passes of the mask are recorded, light after light, except where several lights build
 /// their primitive maps in the call: their fits are then recorded side by side first, and their lists in
-/// groups of up to four lights side by side, each group's before its lights' later passes (their reports
-/// list `primitive map: fit (batched)` and `primitive map: lists (batched)`). A call with the `frame_index`
-/// of the frame being recorded and whose lowest pass comes after the last pass recorded continues that
-/// frame (its camera and lights must be the same); a call with a greater `frame_index` begins a new frame
-/// (abandoning an unfinished one); any other call fails. Passes the frame does not run (not needed by the
-/// configuration, up to date, or shared) record nothing. Within a frame, every pass that runs must be
-/// recorded, in order: a call that leaves out such a pass before its last requested one fails with
-/// `HRTS_RESULT_ERROR_INVALID_STATE` and records nothing (its `frame_index` counts as used: the next frame
-/// takes a greater one). `HRTS_PASS_OUTPUT_COPY` ends the frame. Submit every command buffer the plugin
-/// recorded into: passes skipped as up to date reuse what earlier recordings wrote.
+/// groups of up to four maps (one per frustum: most lights have one) side by side, each group's before its
+/// lights' later passes (their reports list `primitive map: fit (batched)` and
+/// `primitive map: lists (batched)`). A call with the `frame_index` of the frame being recorded and whose
+/// lowest pass comes after the last pass recorded continues that frame (its camera and lights must be the
+/// same); a call with a greater `frame_index` begins a new frame (abandoning an unfinished one); any other
+/// call fails. Passes the frame does not run (not needed by the configuration, up to date, or shared)
+/// record nothing. Within a frame, every pass that runs must be recorded, in order: a call that leaves out
+/// such a pass before its last requested one fails with `HRTS_RESULT_ERROR_INVALID_STATE` and records
+/// nothing (its `frame_index` counts as used: the next frame takes a greater one). `HRTS_PASS_OUTPUT_COPY`
+/// ends the frame. Submit every command buffer the plugin recorded into: passes skipped as up to date reuse
+/// what earlier recordings wrote.
 ///
 /// Frames in flight: recording frame `f` states that every frame up to `f - frames_in_flight` has
 /// completed on the GPU; the plugin's per-frame data is ring-buffered that deep, and its constants go

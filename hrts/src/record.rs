@@ -289,7 +289,8 @@ impl Context {
             engine_inputs(&mut enc, built, f, true);
         }
         // The lights' fits first, batched (each phase of every light, then one barrier), when several
-        // build their maps in this call: their passes then record the lists alone.
+        // build their maps in this call: their passes then record the lists alone (or nothing, where a
+        // list batch below records them).
         let mut frame_lights = match schedule.as_mut() {
             Some(lights) => Some(lights),
             None => self.schedules.back_mut().map(|s| &mut s.lights),

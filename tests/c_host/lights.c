@@ -156,6 +156,24 @@ void several_lights(const HrtsVulkanDevice *vk, const HrtsCpuGeometry *g) {
     CHECK(report(ctx, next_frame - 1, 0, &rep) == HRTS_RESULT_OK &&
               rep.pass_status[HRTS_PASS_PRIM_BUFFER] == HRTS_PASS_STATUS_UP_TO_DATE,
           "second frame: prim buffer %u", rep.pass_status[HRTS_PASS_PRIM_BUFFER]);
+    /* a frame recorded with the screen-space passes alone (nothing of the light-space ones runs: the prim buffer
+     * is up to date) batches the lists as the whole frame does, and gives the same layers */
+    {
+        static float screen_only[N * W * H];
+        VkCommandBuffer cmd = begin();
+        uint64_t index = next_frame++;
+        HrtsFrame f = frame(cmd, index);
+        HrtsResult r = finish_frame(cmd, hrts_record_passes(ctx, &f, HRTS_PASS_MASK_SCREEN_SPACE), screen_only);
+        CHECK(r == HRTS_RESULT_OK, "screen-space frame: %s", hrts_last_error(ctx));
+        int listed = 0, differ = 0;
+        for (int i = 0; i < N && r == HRTS_RESULT_OK; i++) {
+            CHECK(report(ctx, index, (uint32_t)i, &rep) == HRTS_RESULT_OK, "report %d: %s", i, hrts_last_error(ctx));
+            for (uint32_t p = 0; p < rep.pass_count; p++) listed += strcmp(rep.passes[p].name, "primitive map: lists (batched)") == 0;
+        }
+        for (int p = 0; p < N * W * H; p++) differ += memcmp(&screen_only[p], &vis[p], sizeof(float)) != 0;
+        printf("screen-space passes alone: %d of %d lights' lists batched, %d px differ from the whole frame\n", listed, N, differ);
+        CHECK(listed == N && differ == 0, "screen-space frame: %d lists batched, %d px differ", listed, differ);
+    }
     /* reconfiguring one light rebuilds that light's passes only */
     HrtsConfig cfgs[N];
     for (int i = 0; i < N; i++) cfgs[i] = config(HRTS_SHADOW_MODE_HARD);

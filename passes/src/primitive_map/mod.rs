@@ -83,7 +83,7 @@ pub struct PrimitiveMapInputs<'a> {
     pub normal: &'a Image,
     /// Whether the occupancy pass draws the N×N occupancy view, besides reading back the statistics.
     pub occupancy_view: bool,
-    /// Where the map takes its build scratch from (one pool per geometry).
+    /// Where the map takes its build scratch from (one of its geometry's scratch sets).
     pub scratch: &'a MapScratchPool,
 }
 
@@ -183,11 +183,11 @@ pub struct PrimitiveMap {
     /// statistics in the first).
     pub state: Buffer,
     /// One `u32` per texel, used while the map is built: 0 where no ray origin lies, else the ordered
-    /// largest depth key of the texel's origins. Shared by the maps over the same geometry (the pool's),
+    /// largest depth key of the texel's origins. Shared by the maps of the same scratch set (the pool's),
     /// unless the map draws an occupancy view, which reads it after the build.
     receivers: std::sync::Arc<Buffer>,
     /// One `u32` per screen pixel: the texel of its ray origin (or a no-ray / outside marker). Shared by
-    /// the maps over the same geometry (the pool's): see [`PrimitiveMap::record_pixel_texels`].
+    /// the maps of the same scratch set (the pool's): see [`PrimitiveMap::record_pixel_texels`].
     pixel_texels: SharedTexels,
     /// This map's mark in the pixel texels' record of their last writer.
     id: u64,

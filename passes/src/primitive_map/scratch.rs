@@ -1,6 +1,7 @@
-//! The buffers the primitive maps over one geometry share, because each map uses them only while it is
-//! built and traced and the lights are recorded one after another: bin triangles, tile offsets, pair
-//! owners and per-texel counts, the receiver map, and the screen-size pixel texels.
+//! The buffers the primitive maps that take one scratch set of a geometry share, because each map uses
+//! them only while it is built and traced, and such maps are built one after another (maps over different
+//! sets may be built side by side): bin triangles, tile offsets, pair owners and per-texel counts, the
+//! receiver map, and the screen-size pixel texels.
 
 use super::pipelines::{Binner, MapPipelines};
 use crate::scan::PrefixScan;
@@ -40,8 +41,8 @@ pub(super) fn storage_buffer(
 }
 
 /// The buffers a map uses only while it is built (bin triangles, their tile offsets and owners, per-texel
-/// counts), shared by every map over the same geometry: the builds are recorded one after another with
-/// barriers between them (each clears the counts first), so one set serves every light and frustum.
+/// counts), shared by every map that takes the same scratch set: their builds are recorded one after
+/// another with barriers between them (each clears the counts first), so one set serves all of them.
 pub struct MapScratch {
     pub(super) bin_tris: Buffer,
     pub(super) tile_offsets: Buffer,
@@ -75,7 +76,7 @@ impl MapScratch {
     }
 }
 
-/// The scratch shared by the maps over one geometry: it grows to the largest map asked for; a map keeps
+/// One scratch set, shared by the maps that take it: it grows to the largest map asked for; a map keeps
 /// the scratch it was created with until it needs a larger one (the pool's newer, larger one serves the
 /// maps created or grown after).
 #[derive(Default)]
@@ -90,7 +91,7 @@ pub struct MapScratchPool {
     pair_list: std::sync::Mutex<Option<std::sync::Arc<Buffer>>>,
 }
 
-/// Screen-size pixel texels shared by the maps over one geometry, and which map last recorded their write.
+/// Screen-size pixel texels shared by the maps of one scratch set, and which map last recorded their write.
 #[derive(Clone)]
 pub struct SharedTexels {
     pub(super) buffer: std::sync::Arc<Buffer>,

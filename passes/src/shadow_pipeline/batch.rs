@@ -21,9 +21,9 @@ pub const FIT_BATCH_PASS: &str = "primitive map: fit (batched)";
 /// The name of the list batch's timed pass.
 pub const LIST_BATCH_PASS: &str = "primitive map: lists (batched)";
 
-/// Groups a list batch times in one frame (each group one timed pass; a frame with more leaves the rest
-/// untimed).
-const LIST_GROUPS_TIMED: u32 = 64;
+/// Groups a list batch times in one frame (each group one timed pass): as many as a context's frusta can
+/// form (64 lights of 6 frusta, in groups of at least two).
+const LIST_GROUPS_TIMED: u32 = 192;
 
 /// A GPU timer per frame in flight, with the frame that last recorded into each.
 struct BatchTimers {

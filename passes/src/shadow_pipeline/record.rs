@@ -95,14 +95,19 @@ impl ShadowPipeline {
     /// map and its fit may be recorded ahead ([`ShadowPipeline::record_map_fit`]): the pass runs this frame
     /// and is neither recorded nor fitted yet.
     pub fn fits_map_in(&self, passes: &[PassId]) -> bool {
+        self.builds_map_in(passes, |f| {
+            f.next <= PassId::PrimitiveMap as usize && !f.map_fitted
+        })
+    }
+
+    /// Whether a recording of `passes` builds the primitive map (the pass runs this frame) and the
+    /// frame's state is `ready` for a part of it recorded ahead.
+    fn builds_map_in(&self, passes: &[PassId], ready: impl Fn(&FrameState) -> bool) -> bool {
         let map = PassId::PrimitiveMap;
         self.map.is_some()
             && passes.contains(&map)
             && self.statuses[map as usize].1 == PassStatus::Ran
-            && self
-                .frame
-                .as_ref()
-                .is_some_and(|f| f.next <= map as usize && !f.map_fitted)
+            && self.frame.as_ref().is_some_and(ready)
     }
 
     /// Records `phase` of the primitive map's fit ahead of the primitive-map pass, which then records the
@@ -153,17 +158,18 @@ impl ShadowPipeline {
 
     /// Whether a recording of `passes` builds the primitive map's lists and they may be recorded ahead
     /// ([`ShadowPipeline::record_map_list_step`]): the map's fit was recorded ahead
-    /// ([`ShadowPipeline::record_map_fit`]), every pass before the map's is recorded, and the lists are
-    /// not yet.
+    /// ([`ShadowPipeline::record_map_fit`]), every pass before the map's that runs is recorded, and the
+    /// lists are not yet.
     pub fn lists_map_in(&self, passes: &[PassId]) -> bool {
-        let map = PassId::PrimitiveMap;
-        self.map.is_some()
-            && passes.contains(&map)
-            && self.statuses[map as usize].1 == PassStatus::Ran
-            && self
-                .frame
-                .as_ref()
-                .is_some_and(|f| f.next == map as usize && f.map_fitted && !f.map_listed)
+        let map = PassId::PrimitiveMap as usize;
+        self.builds_map_in(passes, |f| {
+            f.map_fitted
+                && !f.map_listed
+                && f.next <= map
+                && self.statuses[f.next..map]
+                    .iter()
+                    .all(|&(_, s)| s != PassStatus::Ran)
+        })
     }
 
     /// The steps of the lists' build of a map that [`ShadowPipeline::lists_map_in`] the call's passes.
