@@ -40,6 +40,7 @@ layout(set = 0, binding = 7) readonly buffer Prims { Triangle tris[]; };
 #include "output_format.glsl"
 layout(set = 0, binding = 8, OUTPUT_FORMAT) uniform writeonly image2D visibility;
 layout(set = 0, binding = 9, r32f) uniform writeonly image2D blocker;
+// The rays' BVH (passes::bvh): one ray per pixel.
 layout(set = 0, binding = 10) readonly buffer Bvh { BvhNode bvh_nodes[]; };
 #include "shadow_ray.glsl"
 #include "trace_route.glsl"

@@ -47,8 +47,11 @@ pub struct RayTraceInputs<'a> {
     pub map: &'a PrimitiveMap,
     /// Prim buffer.
     pub prims: &'a Buffer,
-    /// The BVH's nodes over the prim buffer ([`crate::bvh::SceneBvh::nodes`]).
+    /// The linear BVH's nodes over the prim buffer, which the area trace's bundles walk
+    /// ([`crate::bvh::SceneBvh::nodes`]).
     pub bvh: &'a Buffer,
+    /// The rays' BVH's nodes, which single rays and segments walk ([`crate::bvh::SceneBvh::ray_nodes`]).
+    pub ray_bvh: &'a Buffer,
 }
 
 /// What the ray trace computes.
@@ -206,10 +209,11 @@ impl RayTracePass {
             }
         }
         kinds.push(BindingKind::StorageBuffer);
-        resources.push(b(inputs.bvh));
         if let Some((_, _, bands)) = &samples {
-            kinds.push(BindingKind::StorageBuffer);
-            resources.push(b(bands));
+            kinds.extend([BindingKind::StorageBuffer; 2]);
+            resources.extend([b(inputs.bvh), b(bands), b(inputs.ray_bvh)]);
+        } else {
+            resources.push(b(inputs.ray_bvh));
         }
         // A point light's cube map only ever traces a local light: the local variant is its one pipeline.
         let cube = inputs.map.config().cube;

@@ -3,7 +3,8 @@
 //! The hierarchy is read back and checked on the CPU: every triangle is one leaf, every node is reached
 //! once, each child's box is exactly the bounds of its subtree's vertices, and no path is 64 deep — over a
 //! real model, over triangles whose box centres all coincide (equal Morton codes throughout), and over one
-//! and two triangles.
+//! and two triangles: the linear BVH and the rays' BVH, built by clustering (which costs less than the
+//! linear one by surface area) and as the linear one's copy (for geometry rebuilt every frame).
 //!
 //! A walk of it gives the same answer as the lists, bit for bit: the same view traced with lists only, with
 //! the BVH only (a bin budget of 0) and with short lists (a list limit of 2, the longer ones walked) gives
@@ -15,7 +16,7 @@ use common::*;
 use demo_engine::{FrameImages, View};
 use glam::Vec3;
 use passes::area::{DEFAULT_BUNDLE_WALK_BUDGET, WIDE_BUNDLE};
-use passes::bvh::{BvhNode, BVH_LEAF};
+use passes::bvh::{BvhBuilder, BvhNode, BVH_LEAF};
 use passes::gpu_types::GpuTriangle;
 use passes::{
     AreaConfig, BinningRequest, FrameReport, PcssConfig, PrimitiveMapConfig, ShadowConfig,
@@ -60,32 +61,15 @@ fn render_with(device: &Device, view: &View, config: ShadowConfig) -> (FrameRepo
     (report, r.read_back(device, false).expect("read back"))
 }
 
-/// Builds the BVH of `view`'s scene (a frame of hard shadows) and checks it against its triangles.
-fn check_hierarchy(device: &Device, view: &View) {
-    let mut r = ShadowRenderer::new(
-        device,
-        view,
-        ShadowConfig {
-            mode: ShadowMode::Hard,
-            ..ShadowConfig::default()
-        },
-    )
-    .expect("renderer");
-    r.render(device, &view.frame_inputs()).expect("render");
-    let shared = r.pipeline().shared_geometry();
-    let triangles: Vec<GpuTriangle> = read_buffer(device, shared.prims());
-    let nodes: Vec<BvhNode> = read_buffer(device, shared.bvh().nodes());
-    let n = shared.geometry().triangle_count() as usize;
-    assert_eq!(triangles.len(), n);
+/// Checks hierarchy `nodes` against `triangles`: every triangle one leaf, every node reached once, every
+/// box exact, no path 64 deep. Returns its depth and cost: the surface areas of its internal nodes' boxes
+/// over the root's (what a walk of rays in every direction visits).
+fn check_nodes(triangles: &[GpuTriangle], nodes: &[BvhNode]) -> (usize, f64) {
+    let n = triangles.len();
     let bounds = |t: &GpuTriangle| {
         let [a, b, c] = t.v.map(|v| v.truncate());
         (a.min(b).min(c), a.max(b).max(c))
     };
-    let mut leaves = vec![0u32; n];
-    let mut reached = vec![0u32; nodes.len()];
-    // (child, its box as stored in the parent, depth)
-    let mut deepest = 0;
-    let mut pending: Vec<(u32, (Vec3, Vec3), usize)> = Vec::new();
     let root = nodes[0];
     if n == 1 {
         assert_eq!(root.left_lo.w.to_bits(), BVH_LEAF);
@@ -94,9 +78,8 @@ fn check_hierarchy(device: &Device, view: &View) {
             (root.left_lo.truncate(), root.left_hi.truncate()),
             bounds(&triangles[0])
         );
-        return;
+        return (0, 1.0);
     }
-    reached[0] = 1;
     let children = |node: &BvhNode| {
         [
             (
@@ -109,10 +92,15 @@ fn check_hierarchy(device: &Device, view: &View) {
             ),
         ]
     };
+    let mut leaves = vec![0u32; n];
+    let mut reached = vec![0u32; nodes.len()];
+    reached[0] = 1;
+    // (child, its box as stored in the parent, depth)
+    let mut pending: Vec<(u32, (Vec3, Vec3), usize)> = Vec::new();
     for (child, stored) in children(&root) {
         pending.push((child, stored, 1));
     }
-    // Exact subtree bounds, computed bottom-up after the walk.
+    let mut deepest = 0;
     let mut order = Vec::new();
     while let Some((child, stored, depth)) = pending.pop() {
         deepest = deepest.max(depth);
@@ -137,19 +125,89 @@ fn check_hierarchy(device: &Device, view: &View) {
     let unreached = reached.iter().filter(|&&c| c != 1).count();
     assert_eq!(unreached, 0, "{unreached} nodes not reached exactly once");
     // Each internal node's box as its parent stores it is the union of its children's boxes.
+    let area = |(lo, hi): (Vec3, Vec3)| {
+        let d = (hi - lo).as_dvec3();
+        d.x * d.y + d.y * d.z + d.z * d.x
+    };
+    let union = |node: &BvhNode| {
+        let [(_, l), (_, r)] = children(node);
+        (l.0.min(r.0), l.1.max(r.1))
+    };
+    let root_area = area(union(&root));
+    let mut cost = 1.0;
     for (i, stored) in order {
-        let [(_, l), (_, r)] = children(&nodes[i]);
-        assert_eq!(stored, (l.0.min(r.0), l.1.max(r.1)), "node {i}'s box");
+        assert_eq!(stored, union(&nodes[i]), "node {i}'s box");
+        cost += area(stored) / root_area;
     }
-    println!("{n} triangles: depth {deepest}");
+    (deepest, cost)
+}
+
+/// Builds the BVHs of `view`'s scene (a frame of hard shadows), rebuilds them with the rays' by `builder`,
+/// and checks both against the triangles; returns the linear one's cost and the rays' one's.
+fn check_hierarchies(device: &Device, view: &View, builder: BvhBuilder) -> (f64, f64) {
+    let mut r = ShadowRenderer::new(
+        device,
+        view,
+        ShadowConfig {
+            mode: ShadowMode::Hard,
+            ..ShadowConfig::default()
+        },
+    )
+    .expect("renderer");
+    r.render(device, &view.frame_inputs()).expect("render");
+    let shared = r.pipeline().shared_geometry();
+    device
+        .submit_and_wait(|enc| {
+            enc.barriers(&[Barrier::Uav]);
+            shared
+                .bvh()
+                .record_build(enc, builder)
+                .expect("record the build");
+            Ok(())
+        })
+        .expect("rebuild");
+    let triangles: Vec<GpuTriangle> = read_buffer(device, shared.prims());
+    assert_eq!(triangles.len(), shared.geometry().triangle_count() as usize);
+    let linear: Vec<BvhNode> = read_buffer(device, shared.bvh().nodes());
+    let rays: Vec<BvhNode> = read_buffer(device, shared.bvh().ray_nodes());
+    let (linear_depth, linear_cost) = check_nodes(&triangles, &linear);
+    let (ray_depth, ray_cost) = check_nodes(&triangles, &rays);
+    let copy =
+        bytemuck::cast_slice::<BvhNode, u8>(&rays) == bytemuck::cast_slice::<BvhNode, u8>(&linear);
+    if builder == BvhBuilder::Linear || triangles.len() < 2 {
+        assert!(copy, "the rays' hierarchy is not the linear one's copy");
+    } else if triangles.len() > 2 {
+        assert!(!copy, "the clustering did not build the rays' hierarchy");
+        // Depth first: each node's left child, where it is a node, right after it.
+        for (i, node) in rays.iter().enumerate() {
+            let left = node.left_lo.w.to_bits();
+            assert!(
+                left & BVH_LEAF != 0 || left as usize == i + 1,
+                "node {i}'s left child is node {left}"
+            );
+        }
+    }
+    println!(
+        "{} triangles, rays' hierarchy {builder:?}: linear depth {linear_depth}, cost {linear_cost:.1}; \
+         rays' depth {ray_depth}, cost {ray_cost:.1}",
+        triangles.len()
+    );
     assert_no_validation_errors(device);
+    (linear_cost, ray_cost)
 }
 
 #[test]
 fn the_bvh_holds_every_triangle_once_in_exact_boxes() {
     let device = device();
     let bunny = scene::load_obj(&model("02_stanford_bunny_69k.obj")).expect("bunny loads");
-    check_hierarchy(&device, &View::framed(bunny.with_ground_plane(), 64, 48));
+    let bunny = View::framed(bunny.with_ground_plane(), 64, 48);
+    check_hierarchies(&device, &bunny, BvhBuilder::Linear);
+    let (linear, clustered) = check_hierarchies(&device, &bunny, BvhBuilder::Clustered);
+    // The clustering builds a better hierarchy than the linear build (its copy did not take its place).
+    assert!(
+        clustered < 0.9 * linear,
+        "cost {clustered:.1} clustered, {linear:.1} linear"
+    );
     // 3,000 triangles around one centre: every Morton code equal, the split by position alone.
     let mut star = scene::MeshBuilder::new();
     for i in 0..3000 {
@@ -157,8 +215,10 @@ fn the_bvh_holds_every_triangle_once_in_exact_boxes() {
         let u = Vec3::new(a.cos(), 0.3, a.sin());
         star.add_triangle([u, -u, Vec3::new(0.0, 1.0 + i as f32 * 1e-3, 0.0)]);
     }
-    let star = star.into_scene("star");
-    check_hierarchy(&device, &View::framed(star, 32, 24));
+    let star = View::framed(star.into_scene("star"), 32, 24);
+    for builder in [BvhBuilder::Clustered, BvhBuilder::Linear] {
+        check_hierarchies(&device, &star, builder);
+    }
     for count in [1, 2] {
         let mut few = scene::MeshBuilder::new();
         for i in 0..count {
@@ -169,7 +229,10 @@ fn the_bvh_holds_every_triangle_once_in_exact_boxes() {
                 Vec3::new(0.0, y, 1.0),
             ]);
         }
-        check_hierarchy(&device, &View::framed(few.into_scene("few"), 16, 16));
+        let few = View::framed(few.into_scene("few"), 16, 16);
+        for builder in [BvhBuilder::Clustered, BvhBuilder::Linear] {
+            check_hierarchies(&device, &few, builder);
+        }
     }
 }
 

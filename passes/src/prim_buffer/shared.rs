@@ -3,7 +3,7 @@
 //! everything when the geometry changes every frame.
 
 use super::{DrawSource, Geometry, PrimBufferPass, VertexLayout};
-use crate::bvh::SceneBvh;
+use crate::bvh::{BvhBuilder, SceneBvh};
 use crate::primitive_map::MapScratchPool;
 use crate::retire::MAX_FRAMES_IN_FLIGHT;
 use crate::PassError;
@@ -87,6 +87,8 @@ struct PrimBufferState {
     frame_vertices: Vec<FrameVertices>,
     /// The triangles each recent frame's build rewrote.
     rebuilt: VecDeque<(u64, u32)>,
+    /// Whether a build clustered the rays' hierarchy: the first whose meshes were not deformed.
+    clustered: bool,
 }
 
 impl PrimBufferState {
@@ -112,6 +114,18 @@ impl PrimBufferState {
         self.dynamic || deformed || self.built_with[draw] != Some(self.models[draw])
     }
 
+    /// How a build in `frame` makes the rays' hierarchy: clustered by the geometry's first build whose meshes
+    /// are not deformed, a copy of the linear one by any later build (draws moved, meshes deformed), since
+    /// geometry that changes may change every frame and the clustering costs about ten times the linear
+    /// build (2.4-3.3 ms against 0.2-0.3 ms on an H200). Dynamic geometry has no clustering at all.
+    fn rays_builder(&self, frame: u64) -> BvhBuilder {
+        if self.clustered || !self.deformed_in(frame).is_empty() {
+            BvhBuilder::Linear
+        } else {
+            BvhBuilder::Clustered
+        }
+    }
+
     /// Whether `frame` must rebuild some of the prim buffer.
     fn stale(&self, frame: u64) -> bool {
         self.dynamic || !self.deformed_in(frame).is_empty() || !self.current()
@@ -123,7 +137,7 @@ impl SharedGeometry {
     /// so the prim buffer is rebuilt every frame (else what moved or deformed).
     pub fn new(device: &Device, geometry: Geometry, dynamic: bool) -> Result<Arc<Self>, PassError> {
         let pass = PrimBufferPass::new(device, &geometry)?;
-        let bvh = SceneBvh::new(device, pass.prims(), geometry.triangle_count())?;
+        let bvh = SceneBvh::new(device, pass.prims(), geometry.triangle_count(), !dynamic)?;
         let models: Vec<Mat4> = geometry.draws().map(|(_, d)| d.model).collect();
         Ok(Arc::new(Self {
             state: Mutex::new(PrimBufferState {
@@ -134,6 +148,7 @@ impl SharedGeometry {
                 frame_meshes: None,
                 frame_vertices: Vec::new(),
                 rebuilt: VecDeque::new(),
+                clustered: false,
             }),
             geometry,
             pass,
@@ -264,13 +279,15 @@ impl SharedGeometry {
                 })
             })?;
         if triangles > 0 {
+            let builder = s.rays_builder(frame);
             enc.barriers(&[rhi::Barrier::Uav]);
             enc.begin_pass("bvh build");
-            self.bvh.record_build(enc)?;
+            self.bvh.record_build(enc, builder)?;
             enc.end_pass();
         }
         let deformed_meshes: Vec<usize> = deformed.iter().map(|m| m.mesh).collect();
         let s = &mut *guard;
+        s.clustered |= triangles > 0 && deformed_meshes.is_empty();
         for ((draw, (mesh, _)), _) in self
             .geometry
             .draws()
@@ -404,7 +421,31 @@ mod tests {
             frame_meshes: None,
             frame_vertices: Vec::new(),
             rebuilt: VecDeque::new(),
+            clustered: false,
         }
+    }
+
+    #[test]
+    fn only_the_first_build_of_undeformed_meshes_clusters() {
+        let mut s = state(2);
+        assert_eq!(s.rays_builder(0), BvhBuilder::Clustered);
+        s.frame_meshes = Some((
+            0,
+            vec![FrameMesh {
+                mesh: 0,
+                entry: 0,
+                vertex: VertexLayout {
+                    offset: 0,
+                    stride: 12,
+                    count: 3,
+                    format: VertexFormat::Float3,
+                },
+            }],
+        ));
+        assert_eq!(s.rays_builder(0), BvhBuilder::Linear);
+        assert_eq!(s.rays_builder(1), BvhBuilder::Clustered);
+        s.clustered = true;
+        assert_eq!(s.rays_builder(1), BvhBuilder::Linear);
     }
 
     #[test]

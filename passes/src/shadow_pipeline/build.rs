@@ -177,6 +177,7 @@ impl ShadowPipeline {
                     map: m,
                     prims: need_prims()?,
                     bvh: shared.bvh().nodes(),
+                    ray_bvh: shared.bvh().ray_nodes(),
                 },
                 width,
                 height,
