@@ -1,10 +1,10 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 // The rays' hierarchy by locally-ordered clustering (PLOC, Meister and Bittner 2018) over the triangles
-// sorted by Morton code (passes::bvh). Clusters start as the sorted triangles; each iteration every cluster finds
-// its nearest neighbour among the RADIUS clusters on either side (the smallest surface area of the two
-// boxes' union; ties to the pair of lower indices, so the order is total and its least pair is always
-// mutual), mutual neighbours merge into a new node, and the clusters left are compacted in order.
+// sorted by Morton code (passes::bvh). Clusters start as the sorted triangles; each iteration every
+// cluster finds its nearest neighbour among the RADIUS clusters on either side (the smallest surface area
+// of the two boxes' union; ties to the pair of lower indices, so the order is total and its least pair is
+// always mutual), mutual neighbours merge into a new node, and the clusters left are compacted in order.
 // mode 0: one invocation per triangle: its leaf as a cluster; invocation 0 resets the state.
 // mode 1: one invocation per cluster: its nearest neighbour (with `forced`, its pair 2k, 2k + 1 instead:
 //         the iterations past the clustering's budget merge what is left pairwise, in order).
@@ -14,8 +14,8 @@
 // mode 4: one workgroup: the iterations of modes 1 to 3 over at most TAIL clusters, in place, until one is
 //         left (each iteration merges at least the least pair; at most TAIL_ITERATIONS).
 // mode 5: one invocation: whether the clustering built the whole hierarchy (one cluster left, node 0, no
-//         path 64 deep); if not (one triangle, or a pathological input), `linear` is set. With `forced`
-//         set (no clustering recorded), always.
+//         path 64 deep); if not (one triangle, more clusters left than the pairs could merge, a path
+//         too deep), `linear` is set. With `forced` set (no clustering recorded), always.
 // mode 6: one invocation per node: the hierarchy in depth-first order (each node's left child right after
 //         it, then the left subtree, then the right child), so that a walk reads neighbouring nodes: its
 //         place is found from its ancestors' (parent links) and the sizes of their left subtrees.
