@@ -25,7 +25,10 @@
 // buffer (bvh_traverse.glsl) with the bundle of its segments or rays, and tests each triangle met exactly as
 // a list entry: the same answer, bit for bit. A wide bundle that meets many triangles gives up past a
 // budget, and each of its open samples walks its own segment or ray (walk_sample): again the same answer.
-// Either way a pixel stops once every sample is blocked.
+// Either way a pixel stops once every sample is blocked. Where more than three quarters of a tile's pixels
+// gave up their bundle in the last frame having decided less than half their samples, the tile's wide pixels
+// skip their bundles and walk their samples at once for a few frames (the tile history): the cost is then
+// the samples' walks alone; the answer is the same.
 #include "triangle.glsl"
 #include "ray_trace_constants.glsl"
 #include "map_state.glsl"
@@ -53,6 +56,9 @@ layout(set = 0, binding = 11) readonly buffer Bvh { BvhNode bvh_nodes[]; };
 layout(set = 0, binding = 12) readonly buffer SampleBands { uvec4 sample_bands[]; };
 // The rays' BVH, which each sample's own walk takes (walk_sample).
 layout(set = 0, binding = 13) readonly buffer RayBvh { BvhNode ray_nodes[]; };
+// Per 8x8 tile of pixels (a workgroup): how many of its bundles gave up having decided little in the last
+// frame, and the frames for which it still skips them (passes::ray_trace::TILE_SKIP_FRAMES).
+layout(set = 0, binding = 14) buffer TileHistory { uint tile_history[]; };
 #include "shadow_ray.glsl"
 #include "trace_route.glsl"
 #define BVH_MASKED
@@ -263,6 +269,12 @@ bool all_blocked() {
     return blocked == all_samples;
 }
 
+// The samples still open.
+uint open_samples() {
+    uvec4 open = all_samples & ~blocked;
+    return bitCount(open.x) + bitCount(open.y) + bitCount(open.z) + bitCount(open.w);
+}
+
 void bvh_visit(uint index, uvec4 reach) {
     consider(index, reach);
 }
@@ -270,6 +282,47 @@ void bvh_visit(uint index, uvec4 reach) {
 bool bvh_done() {
     return all_blocked();
 }
+
+// Whether the workgroup's tile skips its wide bundles this frame (read_tile_history).
+shared bool tile_skip;
+// Per pixel of the workgroup, the samples open when its bundle began a walk with a budget.
+shared uint tile_open[64];
+
+#if SAMPLE_WALKS
+// Frames a tile skips its wide bundles once more than TILE_GIVE_UPS of its 64 pixels' bundles gave up having
+// decided less than half their samples (passes::ray_trace::{TILE_SKIP_FRAMES, TILE_GIVE_UPS}); after them it
+// tries them again.
+const uint TILE_SKIP_FRAMES = 16u;
+const uint TILE_GIVE_UPS = 48u;
+const uint TILE_FRAMES_SHIFT = 16u;
+uint tile;
+
+// Whether the workgroup's tile skips its wide bundles this frame, from its history (the last frame's count
+// of such bundles in the low half, the frames left to skip in the high half), which it then resets for this
+// frame's count.
+bool read_tile_history() {
+    if (tile >= uint(tile_history.length())) {
+        return false;
+    }
+    uint record = tile_history[tile];
+    uint frames = record >> TILE_FRAMES_SHIFT;
+    if (frames == 0u && (record & 0xFFFFu) > TILE_GIVE_UPS) {
+        frames = TILE_SKIP_FRAMES;
+    }
+    tile_history[tile] = frames > 0u ? (frames - 1u) << TILE_FRAMES_SHIFT : 0u;
+    memoryBarrierBuffer();
+    return frames > 0u;
+}
+
+// Counts, in its tile's history, a bundle that gave up having decided less than half its samples (once per
+// subgroup: a subgroup's pixels lie in one tile).
+void count_tile_give_up() {
+    uint count = subgroupAdd(2u * open_samples() > tile_open[gl_LocalInvocationIndex] ? 1u : 0u);
+    if (subgroupElect() && count > 0u && tile < uint(tile_history.length())) {
+        atomicAdd(tile_history[tile], count);
+    }
+}
+#endif
 
 #if SAMPLE_WALKS
 // One sample's own segment (a spot or point light) or ray (a directional light) from the origin, walked
@@ -445,16 +498,21 @@ void walk_bvh() {
         budget = 0xFFFFFFFFu;   // a directional light never wide, with a budget: its bundle walks to the end
     } else if (k.misc.z == 0u) {
         budget = 0u;
+    } else if (width > WIDE_BUNDLE && k.misc.z != 0xFFFFFFFFu && tile_skip) {
+        budget = 0u;
     } else if (width > WIDE_BUNDLE && k.misc.z != 0xFFFFFFFFu) {
-        uvec4 open = all_samples & ~blocked;
-        uint open_count = bitCount(open.x) + bitCount(open.y) + bitCount(open.z) + bitCount(open.w);
+        uint open_count = open_samples();
+        tile_open[gl_LocalInvocationIndex] = open_count;
         float scale = min(BUDGET_WIDTH * BUDGET_WIDTH / (width * width), 64.0);
-        budget = uint(min(float(k.misc.z) * scale * float(open_count) / 64.0, 4.0e9));
+        budget = uint(max(min(float(k.misc.z) * scale * float(open_count) / 64.0, 4.0e9), 1.0));
     }
     bool finished = bvh_walk(k.misc.y, all_samples, budget);
 #if SAMPLE_WALKS
     if (finished && bvh_over_budget) {
         count_sample_walks();
+        if (bvh_spent > 0u) {
+            count_tile_give_up();
+        }
         for (uint w = 0u; w < 4u && finished; ++w) {
             for (uint bits = all_samples[w] & ~blocked[w]; bits != 0u && finished; bits &= bits - 1u) {
                 uint bit = findLSB(bits);
@@ -474,6 +532,12 @@ void main() {
     for (uint i = lid; i < sample_count; i += 64u) {
         sample_dirs[i] = samples.dirs[i].xyz;
     }
+#if SAMPLE_WALKS
+    tile = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+    if (lid == 0u) {
+        tile_skip = read_tile_history();
+    }
+#endif
     barrier();
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (px.x >= int(k.dims.x) || px.y >= int(k.dims.y)) {

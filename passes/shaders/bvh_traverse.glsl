@@ -102,8 +102,9 @@ uint bvh_stack[BVH_STACK];
 #ifdef BVH_MASKED
 uvec4 bvh_stack_samples[BVH_STACK];
 #endif
-// Whether the last walk stopped at its step budget.
+// Whether the last walk stopped at its step budget, and the steps it had taken then.
 bool bvh_over_budget;
+uint bvh_spent;
 
 // Walks the hierarchy over `triangles` triangles for `samples` (the hard trace's one ray: any non-zero
 // mask) until the includer is done, no node is left, or it has visited `budget` nodes and leaves
@@ -124,6 +125,7 @@ bool bvh_walk(uint triangles, uvec4 samples, uint budget) {
         for (uint step = 0u; step < 64u && walking; ++step) {
             if (spent >= budget) {
                 bvh_over_budget = true;
+                bvh_spent = spent;
                 return true;
             }
             BvhNode nd = bvh_nodes[node];

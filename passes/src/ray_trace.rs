@@ -37,6 +37,17 @@ const ENTRIES_BINDING: u32 = 6;
 /// Binding of the visibility in `ray_trace.comp`.
 const VISIBILITY_BINDING: u32 = 8;
 
+/// Frames for which an area trace's tile of 8×8 pixels skips its wide bundles once more than
+/// [`TILE_GIVE_UPS`] of its pixels' bundles gave up their walk in a frame having decided less than half
+/// their samples: its wide pixels then walk each sample at once (`area_trace.glsl`, the tile history),
+/// since such a bundle cost its budget for little. After them the tile tries its bundles again. The answer
+/// is the same either way; only the cost follows the history. (On an H200 at 1080p, lights of 8 % of the
+/// scene's extent traced 18-38 % faster, those of 2-4 % up to 6 % slower.)
+pub const TILE_SKIP_FRAMES: u32 = 16;
+
+/// The give-ups of a tile's 64 pixels past which it skips its wide bundles ([`TILE_SKIP_FRAMES`]).
+pub const TILE_GIVE_UPS: u32 = 48;
+
 /// Inputs of the ray trace.
 pub struct RayTraceInputs<'a> {
     /// Depth (`ShaderResource` state).
@@ -84,8 +95,9 @@ pub struct RayTracePass {
     /// every pixel.
     narrow: Option<(ComputePipeline, BindGroup)>,
     constants: Buffer,
-    /// The area trace's light samples, its edge tables and its sample bands (area shadows only).
-    samples: Option<(Buffer, Buffer, Buffer)>,
+    /// The area trace's light samples, its edge tables, its sample bands and its tile history (one word per
+    /// 8×8 tile; area shadows only).
+    samples: Option<(Buffer, Buffer, Buffer, Buffer)>,
     /// `R32_SFLOAT` visibility, 1 = lit.
     pub visibility: Image,
     /// `R32_SFLOAT` distance from the ray origin to the nearest blocker; 0 where the receiver faces away
@@ -168,6 +180,11 @@ impl RayTracePass {
                     ),
                     BufferUsage::STORAGE,
                 )?,
+                device.create_buffer_init(
+                    "area trace tile history",
+                    &vec![0; 4 * width.div_ceil(8) as usize * height.div_ceil(8) as usize],
+                    BufferUsage::STORAGE,
+                )?,
             )),
             RayTraceKind::Hard { .. } => None,
         };
@@ -196,7 +213,7 @@ impl RayTracePass {
             Resource::Image(&visibility),
         ];
         match (&samples, &blocker_distance, &unused_blocker) {
-            (Some((samples, table, _)), _, _) => {
+            (Some((samples, table, _, _)), _, _) => {
                 kinds.extend([BindingKind::UniformBuffer, BindingKind::StorageBuffer]);
                 resources.extend([b(samples), b(table)]);
             }
@@ -209,9 +226,9 @@ impl RayTracePass {
             }
         }
         kinds.push(BindingKind::StorageBuffer);
-        if let Some((_, _, bands)) = &samples {
-            kinds.extend([BindingKind::StorageBuffer; 2]);
-            resources.extend([b(inputs.bvh), b(bands), b(inputs.ray_bvh)]);
+        if let Some((_, _, bands, history)) = &samples {
+            kinds.extend([BindingKind::StorageBuffer; 3]);
+            resources.extend([b(inputs.bvh), b(bands), b(inputs.ray_bvh), b(history)]);
         } else {
             resources.push(b(inputs.ray_bvh));
         }
@@ -324,7 +341,7 @@ impl RayTracePass {
         }
         enc.update_buffer(&self.constants, 0, bytemuck::bytes_of(&constants))?;
         match (&self.samples, samples) {
-            (Some((buffer, _, _)), Some(samples)) => {
+            (Some((buffer, _, _, _)), Some(samples)) => {
                 enc.update_buffer(buffer, 0, bytemuck::bytes_of(samples))?;
             }
             (None, None) => {}
@@ -361,5 +378,19 @@ impl RayTracePass {
         enc.dispatch(pipeline, group, &[], groups)?;
         enc.end_pass();
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_tile_history_constants_are_the_shaders() {
+        let source = include_str!("../shaders/area_trace.glsl");
+        assert!(source.contains(&format!(
+            "const uint TILE_SKIP_FRAMES = {TILE_SKIP_FRAMES}u;"
+        )));
+        assert!(source.contains(&format!("const uint TILE_GIVE_UPS = {TILE_GIVE_UPS}u;")));
     }
 }

@@ -159,9 +159,8 @@ pub struct PrimitiveMapConfig {
     pub initial_pairs: u32,
     /// A texel whose list would hold more than this many entries keeps none: its pixels walk the BVH over
     /// the prim buffer (`crate::bvh`), which then costs less than the list. 0 (the default): the plugin's
-    /// choice, [`HARD_LIST_LIMIT`] for hard shadows and the hybrid (a nearest-hit walk costs more than a
-    /// long list), [`AREA_LIST_LIMIT`] for area shadows (whose walk carries its samples); `u32::MAX`: no
-    /// limit.
+    /// choice, [`HARD_LIST_LIMIT`] for hard shadows and the hybrid, [`AREA_LIST_LIMIT`] for area shadows
+    /// (each measured for its own trace); `u32::MAX`: no limit.
     pub list_limit: u32,
     /// Bin items (4×4-texel tiles of the triangles' footprints, widened by their penumbrae for area
     /// shadows) per pixel with a shadow ray, past which a frame builds no list and every pixel walks the
@@ -178,9 +177,11 @@ pub struct PrimitiveMapConfig {
 /// Default [`PrimitiveMapConfig::list_limit`]: the plugin's choice by mode.
 pub const DEFAULT_LIST_LIMIT: u32 = 0;
 
-/// The list limit of hard shadows and the hybrid under [`DEFAULT_LIST_LIMIT`] (on an H100, lists up to
-/// 581 entries around the conference room's chairs traced 25% faster than the walk at a limit of 256).
-pub const HARD_LIST_LIMIT: u32 = 1024;
+/// The list limit of hard shadows and the hybrid under [`DEFAULT_LIST_LIMIT`]. On an H200 at 1080p with the
+/// rays' BVH (`crate::bvh`), the conference room's point lights traced 5-33 % faster at 256 than at 1024
+/// (the lists of up to 613 entries around its chairs walk the BVH instead), 16 of them 11 % faster; Sponza
+/// did not change; 128 was slower in both. (With the linear BVH alone, 1024 had been the faster.)
+pub const HARD_LIST_LIMIT: u32 = 256;
 
 /// The list limit of area shadows under [`DEFAULT_LIST_LIMIT`] (on an H100, the 240K bunny's area sun
 /// took 7.2 ms and 6.9 MiB at 256, 7.6 ms and 42 MiB at 1024).
