@@ -530,8 +530,9 @@ pub struct HrtsConfig {
     /// to 5.4.
     pub area_samples: u32,
     /// A texel whose list would hold more than this many entries keeps none: its pixels walk the BVH over
-    /// the prim buffer instead, which then costs less (default 0: the plugin's choice, 256 entries in
-    /// every mode; `0xFFFFFFFF`: no limit). It moves cost, never exactness. API 5.9: older callers get the default.
+    /// the prim buffer instead, which then costs less (default 0: the plugin's choice, 256 entries, 1024
+    /// for the hybrid, whose trace finds the nearest blocker; `0xFFFFFFFF`: no limit). It moves cost, never
+    /// exactness. API 5.9: older callers get the default.
     pub map_list_limit: u32,
     /// Bin items (4x4-texel tiles of the triangles' footprints, widened by their penumbrae for area
     /// shadows) per pixel with a shadow ray past which a frame builds no list and every pixel walks the

@@ -288,6 +288,14 @@ shared bool tile_skip;
 // Per pixel of the workgroup, the samples open when its bundle began a walk with a budget.
 shared uint tile_open[64];
 
+// Counts a pixel whose tile skipped its bundle (once per subgroup of such pixels).
+void count_bundle_skip() {
+    uint count = subgroupAdd(1u);
+    if (subgroupElect()) {
+        atomicAdd(ms.walks.w, count);
+    }
+}
+
 #if SAMPLE_WALKS
 // Frames a tile skips its wide bundles once more than TILE_GIVE_UPS of its 64 pixels' bundles gave up having
 // decided less than half their samples (passes::ray_trace::{TILE_SKIP_FRAMES, TILE_GIVE_UPS}); after them it
@@ -500,6 +508,7 @@ void walk_bvh() {
         budget = 0u;
     } else if (width > WIDE_BUNDLE && k.misc.z != 0xFFFFFFFFu && tile_skip) {
         budget = 0u;
+        count_bundle_skip();
     } else if (width > WIDE_BUNDLE && k.misc.z != 0xFFFFFFFFu) {
         uint open_count = open_samples();
         tile_open[gl_LocalInvocationIndex] = open_count;

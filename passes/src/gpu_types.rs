@@ -167,7 +167,8 @@ pub struct MapState {
     pub routes: UVec4,
     /// First state only, written by the trace: x: pixels that walked the BVH, y: walks that could not
     /// finish (never on a conforming device), z: the area trace's pixels whose bundle passed its walk
-    /// budget ([`crate::area::AreaConfig::bundle_walk_budget`]).
+    /// budget ([`crate::area::AreaConfig::bundle_walk_budget`]), w: those of them whose tile skipped their
+    /// bundle ([`crate::ray_trace::TILE_SKIP_FRAMES`]).
     pub walks: UVec4,
 }
 
@@ -226,6 +227,9 @@ pub struct MapStats {
     /// ([`crate::area::AreaConfig::bundle_walk_budget`]), so that each of their open samples walked the
     /// BVH on its own (the same answer, for less than the bundle's wide walk).
     pub pixels_walked_per_sample: u32,
+    /// Area shadows: of [`MapStats::pixels_walked_per_sample`], the pixels that skipped their bundle, since
+    /// most of their tile's gave up in an earlier frame ([`crate::ray_trace::TILE_SKIP_FRAMES`]).
+    pub pixels_skipping_bundle: u32,
     /// A point light's (triangle, face) pairs kept by the setup (0 for a light of one frustum). Past the
     /// pairs the map held (`pair_capacity`), the frame traced every ray exhaustively (exact, slower), and
     /// the map grows for the next.
@@ -254,6 +258,7 @@ impl MapStats {
             pixels_walked: s.walks.x,
             walks_unfinished: s.walks.y,
             pixels_walked_per_sample: s.walks.z,
+            pixels_skipping_bundle: s.walks.w,
             pairs: s.grid.z,
             pair_capacity: s.grid.w,
         }

@@ -391,3 +391,61 @@ fn area_shadows_through_the_bvh_equal_the_lists_bit_for_bit() {
     }
     assert_no_validation_errors(&device);
 }
+
+/// A tile of pixels most of whose bundles gave up in the last frame skips them (the tile history,
+/// `passes::ray_trace::TILE_SKIP_FRAMES`): its pixels walk each sample at once, and the counts stay those
+/// of the lists and the reference.
+#[test]
+fn area_tiles_whose_bundles_gave_up_skip_them_with_the_same_counts() {
+    let device = device();
+    let view = plate_and_box_view(96, 72);
+    let rs = RefScene::new(&view.scene);
+    let (radius, samples) = (0.15, 64);
+    let config = |map: PrimitiveMapConfig, bundle_walk_budget| ShadowConfig {
+        mode: ShadowMode::Area,
+        antialiasing: false,
+        map: PrimitiveMapConfig {
+            size: 128,
+            binning: BinningRequest::Compute,
+            ..map
+        },
+        pcss: PcssConfig {
+            angular_radius: radius,
+            ..PcssConfig::default()
+        },
+        area: AreaConfig {
+            samples,
+            bundle_walk_budget,
+        },
+        ..ShadowConfig::default()
+    };
+    let [(_, lists), (_, bvh), _] = routes(PrimitiveMapConfig::default());
+    let (_, listed) = render_with(&device, &view, config(lists, DEFAULT_BUNDLE_WALK_BUDGET));
+    // Every pixel walks the BVH, and a bundle gives up after one step: the second frame skips.
+    let mut r = ShadowRenderer::new(&device, &view, config(bvh, 1)).expect("renderer");
+    for frame in 0..3 {
+        let st = r
+            .render(&device, &view.frame_inputs())
+            .expect("render")
+            .stats;
+        let images = r.read_back(&device, false).expect("read back");
+        let c = compare_area(&rs, &view, radius, samples, &images.output);
+        println!("frame {frame}: {c:?}, {st:?}");
+        assert_exact_area("tile history", &c, 30, 25);
+        assert_eq!(st.walks_unfinished, 0, "frame {frame}: {st:?}");
+        assert!(st.pixels_walked_per_sample > 0, "frame {frame}: {st:?}");
+        match frame {
+            0 => assert_eq!(st.pixels_skipping_bundle, 0, "{st:?}"),
+            _ => assert!(
+                st.pixels_skipping_bundle > 0
+                    && st.pixels_skipping_bundle <= st.pixels_walked_per_sample,
+                "frame {frame}: {st:?}"
+            ),
+        }
+        assert!(
+            images.output == listed.output,
+            "frame {frame}: the counts differ from the lists'"
+        );
+    }
+    assert_no_validation_errors(&device);
+}

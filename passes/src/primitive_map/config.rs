@@ -159,8 +159,9 @@ pub struct PrimitiveMapConfig {
     pub initial_pairs: u32,
     /// A texel whose list would hold more than this many entries keeps none: its pixels walk the BVH over
     /// the prim buffer (`crate::bvh`), which then costs less than the list. 0 (the default): the plugin's
-    /// choice, [`HARD_LIST_LIMIT`] for hard shadows and the hybrid, [`AREA_LIST_LIMIT`] for area shadows
-    /// (each measured for its own trace); `u32::MAX`: no limit.
+    /// choice, [`HARD_LIST_LIMIT`] for hard shadows, [`NEAREST_HIT_LIST_LIMIT`] for the hybrid (through
+    /// [`PrimitiveMapConfig::for_nearest_hit`]), [`AREA_LIST_LIMIT`] for area shadows (each measured for
+    /// its own trace); `u32::MAX`: no limit.
     pub list_limit: u32,
     /// Bin items (4×4-texel tiles of the triangles' footprints, widened by their penumbrae for area
     /// shadows) per pixel with a shadow ray, past which a frame builds no list and every pixel walks the
@@ -177,11 +178,16 @@ pub struct PrimitiveMapConfig {
 /// Default [`PrimitiveMapConfig::list_limit`]: the plugin's choice by mode.
 pub const DEFAULT_LIST_LIMIT: u32 = 0;
 
-/// The list limit of hard shadows and the hybrid under [`DEFAULT_LIST_LIMIT`]. On an H200 at 1080p with the
-/// rays' BVH (`crate::bvh`), the conference room's point lights traced 5-33 % faster at 256 than at 1024
-/// (the lists of up to 613 entries around its chairs walk the BVH instead), 16 of them 11 % faster; Sponza
-/// did not change; 128 was slower in both. (With the linear BVH alone, 1024 had been the faster.)
+/// The list limit of hard shadows (a ray's first blocker decides it) under [`DEFAULT_LIST_LIMIT`]. On an
+/// H200 at 1080p with the rays' BVH (`crate::bvh`), the conference room's point lights traced 5-33 % faster
+/// at 256 than at 1024 (the lists of up to 613 entries around its chairs walk the BVH instead), 16 of them
+/// 11 % faster; Sponza did not change; 128 was slower in both.
 pub const HARD_LIST_LIMIT: u32 = 256;
+
+/// The list limit of traces that find each ray's nearest blocker (the hybrid's blocker distance) under
+/// [`DEFAULT_LIST_LIMIT`]: a nearest-hit walk of the BVH costs more than long lists (on an H200 at 1080p
+/// the conference room's sun in the hybrid traced 0.318 ms at 1024, 0.370 ms at 256).
+pub const NEAREST_HIT_LIST_LIMIT: u32 = 1024;
 
 /// The list limit of area shadows under [`DEFAULT_LIST_LIMIT`] (on an H100, the 240K bunny's area sun
 /// took 7.2 ms and 6.9 MiB at 256, 7.6 ms and 42 MiB at 1024).
@@ -275,6 +281,16 @@ impl PrimitiveMapConfig {
             )));
         }
         Ok(())
+    }
+
+    /// This configuration for a map whose trace finds each ray's nearest blocker (the hybrid's blocker
+    /// distance): the plugin's choice of list limit is then [`NEAREST_HIT_LIST_LIMIT`].
+    pub fn for_nearest_hit(self) -> Self {
+        let list_limit = match self.list_limit {
+            DEFAULT_LIST_LIMIT => NEAREST_HIT_LIST_LIMIT,
+            limit => limit,
+        };
+        Self { list_limit, ..self }
     }
 
     /// The list limit in effect for hard shadows, or for area shadows if `area`.
@@ -389,6 +405,23 @@ mod tests {
                 Err(PassError::Unsupported(what)) if what.contains("subgroup")
             ));
         }
+    }
+
+    #[test]
+    fn each_trace_gets_its_list_limit() {
+        let default = PrimitiveMapConfig::default();
+        assert_eq!(default.list_limit_for(false), HARD_LIST_LIMIT);
+        assert_eq!(default.list_limit_for(true), AREA_LIST_LIMIT);
+        assert_eq!(
+            default.for_nearest_hit().list_limit_for(false),
+            NEAREST_HIT_LIST_LIMIT
+        );
+        let chosen = PrimitiveMapConfig {
+            list_limit: 7,
+            ..default
+        };
+        assert_eq!(chosen.for_nearest_hit().list_limit_for(false), 7);
+        assert_eq!(chosen.list_limit_for(true), 7);
     }
 
     #[test]

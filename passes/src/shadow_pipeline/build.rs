@@ -143,7 +143,16 @@ impl ShadowPipeline {
                 occupancy_view: plan.resources().contains(ResourceId::Occupancy),
                 scratch: shared.map_scratch(scratch_set),
             };
-            Some(PrimitiveMap::new(device, &map_inputs, config.map)?)
+            // A trace that finds the nearest blocker takes longer lists before it walks the BVH.
+            let nearest_hit = plan
+                .writes(PassId::RayTrace)
+                .contains(ResourceId::BlockerDistance);
+            let map_config = if nearest_hit {
+                config.map.for_nearest_hit()
+            } else {
+                config.map
+            };
+            Some(PrimitiveMap::new(device, &map_inputs, map_config)?)
         } else {
             None
         };
