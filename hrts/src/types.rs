@@ -965,8 +965,9 @@ pub struct HrtsFrameReport {
     pub walks_unfinished: u32,
     /// Reserved, written 0: API 5.9's report ends with this padding, which no later field may take.
     pub reserved_5_9: u32,
-    /// Area shadows: pixels whose bundle passed `area_walk_budget`, so that each of their open samples
-    /// walked the BVH on its own. API 5.10: written for callers of 5.10 and later.
+    /// Area shadows: pixels whose bundle passed `area_walk_budget`, or whose tile skipped it since most of
+    /// its bundles gave up in an earlier frame, so that each of their open samples walked the BVH on its
+    /// own. API 5.10: written for callers of 5.10 and later.
     pub pixels_walked_per_sample: u32,
 }
 

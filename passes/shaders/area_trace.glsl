@@ -58,7 +58,7 @@ layout(set = 0, binding = 12) readonly buffer SampleBands { uvec4 sample_bands[]
 layout(set = 0, binding = 13) readonly buffer RayBvh { BvhNode ray_nodes[]; };
 // Per 8x8 tile of pixels (a workgroup): how many of its bundles gave up having decided little in the last
 // frame, and the frames for which it still skips them (passes::ray_trace::TILE_SKIP_FRAMES).
-layout(set = 0, binding = 14) buffer TileHistory { uint tile_history[]; };
+layout(set = 0, binding = 14) coherent buffer TileHistory { uint tile_history[]; };
 #include "shadow_ray.glsl"
 #include "trace_route.glsl"
 #define BVH_MASKED
@@ -283,9 +283,11 @@ bool bvh_done() {
     return all_blocked();
 }
 
+#if SAMPLE_WALKS
 // Whether the workgroup's tile skips its wide bundles this frame (read_tile_history).
 shared bool tile_skip;
-// Per pixel of the workgroup, the samples open when its bundle began a walk with a budget.
+// Per pixel of the workgroup, the samples open when its bundle began a walk with a budget (in shared
+// memory rather than a register held through the walk, which measured slower).
 shared uint tile_open[64];
 
 // Counts a pixel whose tile skipped its bundle (once per subgroup of such pixels).
@@ -296,12 +298,14 @@ void count_bundle_skip() {
     }
 }
 
-#if SAMPLE_WALKS
 // Frames a tile skips its wide bundles once more than TILE_GIVE_UPS of its 64 pixels' bundles gave up having
 // decided less than half their samples (passes::ray_trace::{TILE_SKIP_FRAMES, TILE_GIVE_UPS}); after them it
 // tries them again.
 const uint TILE_SKIP_FRAMES = 16u;
 const uint TILE_GIVE_UPS = 48u;
+// The frames a tile skips are TILE_SKIP_FRAMES less 0 to TILE_SKIP_STAGGER, by tile, so that the tiles of
+// a light that skip from the same frame do not all try their bundles again in one frame.
+const uint TILE_SKIP_STAGGER = 7u;
 const uint TILE_FRAMES_SHIFT = 16u;
 uint tile;
 
@@ -315,10 +319,13 @@ bool read_tile_history() {
     uint record = tile_history[tile];
     uint frames = record >> TILE_FRAMES_SHIFT;
     if (frames == 0u && (record & 0xFFFFu) > TILE_GIVE_UPS) {
-        frames = TILE_SKIP_FRAMES;
+        frames = TILE_SKIP_FRAMES - (tile * 0x9E3779B1u >> 29u) % (TILE_SKIP_STAGGER + 1u);
     }
-    tile_history[tile] = frames > 0u ? (frames - 1u) << TILE_FRAMES_SHIFT : 0u;
-    memoryBarrierBuffer();
+    uint next = frames > 0u ? (frames - 1u) << TILE_FRAMES_SHIFT : 0u;
+    if (next != record) {
+        tile_history[tile] = next;
+        memoryBarrierBuffer();
+    }
     return frames > 0u;
 }
 
@@ -332,14 +339,24 @@ void count_tile_give_up() {
 }
 #endif
 
+// Whether the workgroup's tile skips its wide bundles this frame (never in the variant without the samples'
+// own walks).
+bool tile_skips() {
+#if SAMPLE_WALKS
+    return tile_skip;
+#else
+    return false;
+#endif
+}
+
 #if SAMPLE_WALKS
 // One sample's own segment (a spot or point light) or ray (a directional light) from the origin, walked
 // through the BVH alone: `offsets`, the sample's unit-disc offsets or direction (sample_dirs), `d` the
 // segment's or ray's direction, `t_end` its end. Each triangle met is decided for every sample at once
 // where quick() can, else for this sample by its own test, exactly as resolve() would decide it; one that
 // blocks the sample is then resolved for all the others. It walks the rays' BVH (passes::bvh), whose
-// single segments and rays meet fewer nodes than the linear one's, on the stack of the bundle's walk,
-// which has given up. It is a loop of its own rather than bvh_walk: that walk's per-node sample masks (a
+// single segments and rays meet fewer nodes than the linear one's, on the stack of the bundle's walk
+// (which has given up, or never ran where the tile skips its bundles). It is a loop of its own rather than bvh_walk: that walk's per-node sample masks (a
 // box projection per child, a mask per stacked node) cost more than they save for one sample: walking
 // the samples through it made 8 % lights about 1.2x slower on an H100. False when the walk could not
 // finish (never on a conforming device).
@@ -468,9 +485,9 @@ uvec4 bvh_box_samples(vec3 lo, vec3 hi, uvec4 reach, bool leaf) {
 
 // The pixel's walk of the BVH with its bundle: the segments from the origin to the emitter's disc (whose
 // axes' combined reach bounds u U + v V over the unit disc), or the rays within the light's cone. (Walking
-// each sample's segment on its own once the bundle met many nodes was measured slower on an H100 at every
-// light size: a node's test costs less, but the samples' walks meet the nodes near the origin again and
-// again.)
+// every pixel's samples on their own from the start was measured slower on an H100 at every light size: a
+// node's test costs less, but the samples' walks meet the nodes near the origin again and again. Hence
+// the budget below, and the tile history for the tiles whose bundles mostly give up.)
 void walk_bvh() {
     if (local) {
         float reach = max(dot(disc_u, disc_u), dot(disc_v, disc_v)) + abs(dot(disc_u, disc_v));
@@ -499,21 +516,23 @@ void walk_bvh() {
     // (BUDGET_WIDTH / width)^2, about what the samples' own walks would cost; past them each open sample
     // still undecided walks its own segment or ray, so that a pixel costs at most about twice the cheaper
     // way. The answer is the same either way, bit for bit. (`k.misc.z` 0: each sample's own walk at once;
-    // 0xFFFFFFFF: the bundle always.)
+    // 0xFFFFFFFF: the bundle always.) A wide pixel whose tile skips its bundles this frame (the tile
+    // history) walks its samples at once.
     float width = local ? length(disc_u) / max(length(disc_c), 1e-30) : samples.center.w;
     uint budget = 0xFFFFFFFFu;
     if (SAMPLE_WALKS == 0) {
         budget = 0xFFFFFFFFu;   // a directional light never wide, with a budget: its bundle walks to the end
     } else if (k.misc.z == 0u) {
         budget = 0u;
-    } else if (width > WIDE_BUNDLE && k.misc.z != 0xFFFFFFFFu && tile_skip) {
+    } else if (width > WIDE_BUNDLE && k.misc.z != 0xFFFFFFFFu && tile_skips()) {
         budget = 0u;
-        count_bundle_skip();
     } else if (width > WIDE_BUNDLE && k.misc.z != 0xFFFFFFFFu) {
         uint open_count = open_samples();
+#if SAMPLE_WALKS
         tile_open[gl_LocalInvocationIndex] = open_count;
+#endif
         float scale = min(BUDGET_WIDTH * BUDGET_WIDTH / (width * width), 64.0);
-        budget = uint(max(min(float(k.misc.z) * scale * float(open_count) / 64.0, 4.0e9), 1.0));
+        budget = uint(min(float(k.misc.z) * scale * float(open_count) / 64.0, 4.0e9));
     }
     bool finished = bvh_walk(k.misc.y, all_samples, budget);
 #if SAMPLE_WALKS
@@ -521,6 +540,8 @@ void walk_bvh() {
         count_sample_walks();
         if (bvh_spent > 0u) {
             count_tile_give_up();
+        } else if (tile_skips() && k.misc.z != 0u) {
+            count_bundle_skip();
         }
         for (uint w = 0u; w < 4u && finished; ++w) {
             for (uint bits = all_samples[w] & ~blocked[w]; bits != 0u && finished; bits &= bits - 1u) {

@@ -27,7 +27,7 @@ struct MapState {
     uvec4 walks;        // first state only, written by the trace: x: pixels that walked the BVH, y: walks
                         // that could not finish (never on a conforming device), z: area trace: pixels
                         // whose bundle passed its walk budget, their open samples walked one by one,
-                        // w: unused
+                        // w: area trace: those of them whose tile skipped their bundle
 };
 
 // The texel index of texel `t` of the grid whose state's `grid` is `grid`.

@@ -224,8 +224,9 @@ pub struct MapStats {
     /// BVH walks that could not finish (never on a conforming device: a failure the tests check for).
     pub walks_unfinished: u32,
     /// Area shadows: pixels whose bundle of segments or rays passed its walk budget
-    /// ([`crate::area::AreaConfig::bundle_walk_budget`]), so that each of their open samples walked the
-    /// BVH on its own (the same answer, for less than the bundle's wide walk).
+    /// ([`crate::area::AreaConfig::bundle_walk_budget`]), or whose tile skipped it
+    /// ([`MapStats::pixels_skipping_bundle`]), so that each of their open samples walked the BVH on its
+    /// own (the same answer, for less than the bundle's wide walk).
     pub pixels_walked_per_sample: u32,
     /// Area shadows: of [`MapStats::pixels_walked_per_sample`], the pixels that skipped their bundle, since
     /// most of their tile's gave up in an earlier frame ([`crate::ray_trace::TILE_SKIP_FRAMES`]).

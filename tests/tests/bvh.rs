@@ -322,6 +322,30 @@ fn hard_shadows_through_the_bvh_equal_the_lists_bit_for_bit() {
     assert_no_validation_errors(&device);
 }
 
+/// Area shadows of a sun of `radius` with `samples` samples through `map`, with the bundles' walk budget
+/// `bundle_walk_budget`, without antialiasing.
+fn area_config(
+    map: PrimitiveMapConfig,
+    radius: f32,
+    samples: u32,
+    bundle_walk_budget: u32,
+) -> ShadowConfig {
+    ShadowConfig {
+        mode: ShadowMode::Area,
+        antialiasing: false,
+        map,
+        pcss: PcssConfig {
+            angular_radius: radius,
+            ..PcssConfig::default()
+        },
+        area: AreaConfig {
+            samples,
+            bundle_walk_budget,
+        },
+        ..ShadowConfig::default()
+    }
+}
+
 #[test]
 fn area_shadows_through_the_bvh_equal_the_lists_bit_for_bit() {
     let device = device();
@@ -346,20 +370,7 @@ fn area_shadows_through_the_bvh_equal_the_lists_bit_for_bit() {
         let mut first: Option<Vec<f32>> = None;
         for (name, map) in routes(map) {
             for (walk, bundle_walk_budget) in walks {
-                let config = ShadowConfig {
-                    mode: ShadowMode::Area,
-                    antialiasing: false,
-                    map,
-                    pcss: PcssConfig {
-                        angular_radius: radius,
-                        ..PcssConfig::default()
-                    },
-                    area: AreaConfig {
-                        samples,
-                        bundle_walk_budget,
-                    },
-                    ..ShadowConfig::default()
-                };
+                let config = area_config(map, radius, samples, bundle_walk_budget);
                 let (report, images) = render_with(&device, &view, config);
                 assert_route(name, &report);
                 let st = report.stats;
@@ -401,25 +412,12 @@ fn area_tiles_whose_bundles_gave_up_skip_them_with_the_same_counts() {
     let view = plate_and_box_view(96, 72);
     let rs = RefScene::new(&view.scene);
     let (radius, samples) = (0.15, 64);
-    let config = |map: PrimitiveMapConfig, bundle_walk_budget| ShadowConfig {
-        mode: ShadowMode::Area,
-        antialiasing: false,
-        map: PrimitiveMapConfig {
-            size: 128,
-            binning: BinningRequest::Compute,
-            ..map
-        },
-        pcss: PcssConfig {
-            angular_radius: radius,
-            ..PcssConfig::default()
-        },
-        area: AreaConfig {
-            samples,
-            bundle_walk_budget,
-        },
-        ..ShadowConfig::default()
-    };
-    let [(_, lists), (_, bvh), _] = routes(PrimitiveMapConfig::default());
+    let config = |map, budget| area_config(map, radius, samples, budget);
+    let [(_, lists), (_, bvh), _] = routes(PrimitiveMapConfig {
+        size: 128,
+        binning: BinningRequest::Compute,
+        ..PrimitiveMapConfig::default()
+    });
     let (_, listed) = render_with(&device, &view, config(lists, DEFAULT_BUNDLE_WALK_BUDGET));
     // Every pixel walks the BVH, and a bundle gives up after one step: the second frame skips.
     let mut r = ShadowRenderer::new(&device, &view, config(bvh, 1)).expect("renderer");

@@ -84,7 +84,8 @@ pub struct Config {
     pub map_initial_pairs: u32,
     /// Area shadows: light samples per pixel, 1..=128 (default 64).
     pub area_samples: u32,
-    /// Longest list a texel keeps; longer ones walk the BVH (default 1024; `u32::MAX`: no limit).
+    /// Longest list a texel keeps; longer ones walk the BVH (default 0: the plugin's choice, 256 entries,
+    /// 1024 for the hybrid; `u32::MAX`: no limit).
     pub map_list_limit: u32,
     /// Bin items per pixel with a shadow ray past which a frame walks the BVH instead of building lists
     /// (default 8; infinity: always lists; 0: always the BVH).

@@ -96,8 +96,9 @@ pub struct MapStats {
     pub pixels_walked: u32,
     /// BVH walks that could not finish (0 on a conforming device).
     pub walks_unfinished: u32,
-    /// Area shadows: pixels whose bundle passed the configuration's `area_walk_budget`, so that each of
-    /// their open samples walked the BVH on its own.
+    /// Area shadows: pixels whose bundle passed the configuration's `area_walk_budget`, or whose tile
+    /// skipped it since most of its bundles gave up in an earlier frame, so that each of their open samples
+    /// walked the BVH on its own.
     pub pixels_walked_per_sample: u32,
 }
 

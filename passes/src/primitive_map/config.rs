@@ -180,13 +180,13 @@ pub const DEFAULT_LIST_LIMIT: u32 = 0;
 
 /// The list limit of hard shadows (a ray's first blocker decides it) under [`DEFAULT_LIST_LIMIT`]. On an
 /// H200 at 1080p with the rays' BVH (`crate::bvh`), the conference room's point lights traced 5-33 % faster
-/// at 256 than at 1024 (the lists of up to 613 entries around its chairs walk the BVH instead), 16 of them
-/// 11 % faster; Sponza did not change; 128 was slower in both.
+/// at 256 than at 1024 (the lists of up to 846 entries around its chairs walk the BVH instead), the trace
+/// of 16 of them 11 % faster (the frame 7 %); Sponza did not change; 128 was slower in both.
 pub const HARD_LIST_LIMIT: u32 = 256;
 
 /// The list limit of traces that find each ray's nearest blocker (the hybrid's blocker distance) under
 /// [`DEFAULT_LIST_LIMIT`]: a nearest-hit walk of the BVH costs more than long lists (on an H200 at 1080p
-/// the conference room's sun in the hybrid traced 0.318 ms at 1024, 0.370 ms at 256).
+/// the conference room's sun in the hybrid traced 0.318 ms at 1024 and 0.370 ms at 256, in two runs).
 pub const NEAREST_HIT_LIST_LIMIT: u32 = 1024;
 
 /// The list limit of area shadows under [`DEFAULT_LIST_LIMIT`] (on an H100, the 240K bunny's area sun

@@ -134,6 +134,10 @@ impl ShadowPipeline {
             None
         };
         let scratch_set = inputs.scratch_set % crate::MAP_SCRATCH_SETS;
+        // Whether the ray trace finds each ray's nearest blocker (the hybrid's blocker distance).
+        let nearest_hit = plan
+            .writes(PassId::RayTrace)
+            .contains(ResourceId::BlockerDistance);
         let map = if runs(PassId::PrimitiveMap) {
             let map_inputs = PrimitiveMapInputs {
                 prims: need_prims()?,
@@ -144,9 +148,6 @@ impl ShadowPipeline {
                 scratch: shared.map_scratch(scratch_set),
             };
             // A trace that finds the nearest blocker takes longer lists before it walks the BVH.
-            let nearest_hit = plan
-                .writes(PassId::RayTrace)
-                .contains(ResourceId::BlockerDistance);
             let map_config = if nearest_hit {
                 config.map.for_nearest_hit()
             } else {
@@ -197,9 +198,7 @@ impl ShadowPipeline {
                     }
                 } else {
                     RayTraceKind::Hard {
-                        blocker_distance: plan
-                            .writes(PassId::RayTrace)
-                            .contains(ResourceId::BlockerDistance),
+                        blocker_distance: nearest_hit,
                     }
                 },
                 ray_visibility,
