@@ -88,6 +88,19 @@ pub enum RayTraceKind {
     },
 }
 
+/// The buffers an area trace reads besides the map and the prim buffer.
+struct AreaBuffers {
+    /// The light's samples, updated each frame.
+    samples: Buffer,
+    /// A directional light's edge table, then a spot or point light's (each variant of `area_trace.glsl`
+    /// reads its own).
+    edge_tables: Buffer,
+    /// Likewise for the BVH walk's sample bands.
+    sample_bands: Buffer,
+    /// One word per 8×8 tile ([`TILE_SKIP_FRAMES`]).
+    tile_history: Buffer,
+}
+
 /// The ray-trace pass and its outputs.
 pub struct RayTracePass {
     /// The trace's pipeline and bind group (an area trace's for directional lights).
@@ -101,9 +114,8 @@ pub struct RayTracePass {
     /// every pixel.
     narrow: Option<(ComputePipeline, BindGroup)>,
     constants: Buffer,
-    /// The area trace's light samples, its edge tables, its sample bands and its tile history (one word per
-    /// 8×8 tile; area shadows only).
-    samples: Option<(Buffer, Buffer, Buffer, Buffer)>,
+    /// The area trace's own buffers (area shadows only).
+    area: Option<AreaBuffers>,
     /// The light's kind and size whose tile history the area trace holds (the bits of the constants' light
     /// position w and emitter radius, and of the samples' angular bound): a change clears it.
     history_of: Option<[u32; 3]>,
@@ -158,15 +170,13 @@ impl RayTracePass {
                 (None, Some(device.create_image(&unused)?))
             }
         };
-        let samples = match kind {
+        let area = match kind {
             RayTraceKind::Area {
                 angular_radius,
                 samples,
-            } => Some((
-                constant_buffer::<AreaSamples>(device, "area light samples")?,
-                // A directional light's table, then a spot or point light's (each variant of
-                // area_trace.glsl reads its own).
-                device.create_buffer_init(
+            } => Some(AreaBuffers {
+                samples: constant_buffer::<AreaSamples>(device, "area light samples")?,
+                edge_tables: device.create_buffer_init(
                     "area edge tables",
                     bytemuck::cast_slice(
                         &[
@@ -177,8 +187,7 @@ impl RayTracePass {
                     ),
                     BufferUsage::STORAGE,
                 )?,
-                // Likewise for the BVH walk's sample bands.
-                device.create_buffer_init(
+                sample_bands: device.create_buffer_init(
                     "area sample bands",
                     bytemuck::cast_slice(
                         &[
@@ -189,12 +198,12 @@ impl RayTracePass {
                     ),
                     BufferUsage::STORAGE,
                 )?,
-                device.create_buffer_init(
+                tile_history: device.create_buffer_init(
                     "area trace tile history",
                     &vec![0; 4 * width.div_ceil(8) as usize * height.div_ceil(8) as usize],
                     BufferUsage::STORAGE | BufferUsage::COPY_DST,
                 )?,
-            )),
+            }),
             RayTraceKind::Hard { .. } => None,
         };
         let constants = constant_buffer::<RayTraceConstants>(device, "ray trace constants")?;
@@ -221,10 +230,10 @@ impl RayTracePass {
             b(inputs.prims),
             Resource::Image(&visibility),
         ];
-        match (&samples, &blocker_distance, &unused_blocker) {
-            (Some((samples, table, _, _)), _, _) => {
+        match (&area, &blocker_distance, &unused_blocker) {
+            (Some(area), _, _) => {
                 kinds.extend([BindingKind::UniformBuffer, BindingKind::StorageBuffer]);
-                resources.extend([b(samples), b(table)]);
+                resources.extend([b(&area.samples), b(&area.edge_tables)]);
             }
             (None, Some(image), _) | (None, None, Some(image)) => {
                 kinds.push(BindingKind::StorageImage);
@@ -235,9 +244,14 @@ impl RayTracePass {
             }
         }
         kinds.push(BindingKind::StorageBuffer);
-        if let Some((_, _, bands, history)) = &samples {
+        if let Some(area) = &area {
             kinds.extend([BindingKind::StorageBuffer; 3]);
-            resources.extend([b(inputs.bvh), b(bands), b(inputs.ray_bvh), b(history)]);
+            resources.extend([
+                b(inputs.bvh),
+                b(&area.sample_bands),
+                b(inputs.ray_bvh),
+                b(&area.tile_history),
+            ]);
         } else {
             resources.push(b(inputs.ray_bvh));
         }
@@ -281,7 +295,7 @@ impl RayTracePass {
             local,
             narrow,
             constants,
-            samples,
+            area,
             history_of: None,
             visibility,
             blocker_distance,
@@ -350,9 +364,9 @@ impl RayTracePass {
             constants.misc.z = u32::from(self.blocker_distance.is_some());
         }
         enc.update_buffer(&self.constants, 0, bytemuck::bytes_of(&constants))?;
-        match (&self.samples, samples) {
-            (Some((buffer, _, _, history)), Some(samples)) => {
-                enc.update_buffer(buffer, 0, bytemuck::bytes_of(samples))?;
+        match (&self.area, samples) {
+            (Some(area), Some(samples)) => {
+                enc.update_buffer(&area.samples, 0, bytemuck::bytes_of(samples))?;
                 let light = [
                     constants.light_pos.w.to_bits(),
                     constants.light_dir.w.to_bits(),
@@ -364,7 +378,7 @@ impl RayTracePass {
                         before: S::UnorderedAccess,
                         after: S::CopyDest,
                     }]);
-                    enc.fill_buffer(history, 0);
+                    enc.fill_buffer(&area.tile_history, 0);
                     enc.barriers(&[Barrier::Global {
                         before: S::CopyDest,
                         after: S::UnorderedAccess,
