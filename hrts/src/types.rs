@@ -540,9 +540,9 @@ pub struct HrtsConfig {
     /// 5.9: older callers get the default.
     pub map_bin_budget: f32,
     /// Area shadows: where a pixel walks the BVH with a wide bundle of segments or rays (an emitter's radius
-    /// over a tenth of its distance), the nodes and triangles the bundle's walk may visit per 64 samples
-    /// still open, scaled by (0.3 / width)^2 (width: radius over distance), before each open sample walks
-    /// its own segment or ray (default 256; 0: each sample's own walk at once; `0xFFFFFFFF`: the bundle
+    /// over a twentieth of its distance; a directional light's angular bound over a tenth), the nodes and
+    /// triangles the bundle's walk may visit per 64 samples still open, scaled by (0.3 / width)^2 (width:
+    /// radius over distance), before each open sample walks its own segment or ray (default 64; 0: each sample's own walk at once; `0xFFFFFFFF`: the bundle
     /// always). The bundle costs less where few triangles straddle it (small lights), the samples' own
     /// walks where many do (large lights). It moves cost, never exactness. API 5.10: older callers get the
     /// default.

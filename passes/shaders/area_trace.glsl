@@ -350,19 +350,79 @@ bool tile_skips() {
 }
 
 #if SAMPLE_WALKS
+// One sample's segment or ray for walk_sample: per axis, the reciprocal of its direction and the origin's
+// coordinate times it, the growth of every box in units of t, and its end.
+vec3 segment_inv, segment_origin_inv, segment_grow;
+float segment_end;
+// The rounding scale of the sample's edge functions over a triangle's two vertices (sample_misses).
+float segment_scale;
+
+// Sets the segment or ray from the origin along `d` to `t_end`, `reach` the largest coordinate of the
+// direction's terms (a local light: |C| + |U| + |V|): every box is grown by 1e-5 of the largest coordinate
+// of the hierarchy's root box and the origin, plus 1e-4 of `reach` at the farthest t any box can be met,
+// as bvh_cone_meets grows each box and widens the bundle, so that a box the exact segment meets is met. A
+// component of d that vanishes is replaced by one of 1e-15 |d|, which moves the segment far less than
+// the growth.
+void set_segment(vec3 d, float t_end, float reach) {
+    vec3 root_lo = min(ray_nodes[0].left_lo.xyz, ray_nodes[0].right_lo.xyz);
+    vec3 root_hi = max(ray_nodes[0].left_hi.xyz, ray_nodes[0].right_hi.xyz);
+    vec3 big = max(max(abs(root_lo), abs(root_hi)), abs(origin));
+    float far = length(max(abs(root_lo - origin), abs(root_hi - origin))) / max(length(d), 1e-30);
+    float t_far = min(t_end, far * (1.0 + 1e-3));
+    float grow = 1e-5 * max(max(big.x, big.y), big.z) + 1e-4 * reach * t_far + 1e-30;
+    float tiny = 1e-15 * max(max(abs(d.x), abs(d.y)), abs(d.z));
+    vec3 sign_d = mix(vec3(1.0), vec3(-1.0), lessThan(d, vec3(0.0)));
+    vec3 safe = mix(d, sign_d * tiny, lessThan(abs(d), vec3(tiny)));
+    segment_inv = 1.0 / safe;
+    segment_origin_inv = origin * segment_inv;
+    segment_grow = grow * abs(segment_inv);
+    segment_end = t_end;
+    segment_scale = 1e-4 * reach;
+}
+
+// Whether the segment set_segment set meets the box [lo, hi] (a slab test), and the first t at which it
+// may. A box it meets is always met; an empty box may be met too (its triangle's own test rejects it).
+bool segment_meets(vec3 lo, vec3 hi, out float t_enter) {
+    vec3 ta = fma(lo, segment_inv, -segment_origin_inv);
+    vec3 tb = fma(hi, segment_inv, -segment_origin_inv);
+    vec3 t_near = min(ta, tb) - segment_grow;
+    vec3 t_far = max(ta, tb) + segment_grow;
+    t_enter = max(max(t_near.x, t_near.y), max(t_near.z, 0.0));
+    return t_enter <= min(min(t_far.x, t_far.y), min(t_far.z, segment_end));
+}
+
+// Whether the sample's segment or ray along `d` misses triangle `index` beyond all rounding: two of its
+// three edge functions (b x c).d, (c x a).d, (a x b).d have opposite signs by more than 1e-4 of their
+// scale, far past the rounding of both this evaluation and sample_hit's. quick() would then find the
+// sample unblocked (it cannot block every sample, and sample_hit is false for it), so skipping the
+// triangle changes nothing.
+bool sample_misses(uint index, vec3 d) {
+    if (index >= uint(tris.length())) {
+        return true;
+    }
+    vec3 a = tris[index].v[0].xyz - origin;
+    vec3 b = tris[index].v[1].xyz - origin;
+    vec3 c = tris[index].v[2].xyz - origin;
+    vec3 e = vec3(dot(cross(b, c), d), dot(cross(c, a), d), dot(cross(a, b), d));
+    vec3 la = abs(a), lb = abs(b), lc = abs(c);
+    vec3 size = vec3(max(max(la.x, la.y), la.z), max(max(lb.x, lb.y), lb.z), max(max(lc.x, lc.y), lc.z));
+    vec3 margin = segment_scale * size.yzx * size.zxy;
+    return any(lessThan(e, -margin)) && any(greaterThan(e, margin));
+}
+
 // One sample's own segment (a spot or point light) or ray (a directional light) from the origin, walked
 // through the BVH alone: `offsets`, the sample's unit-disc offsets or direction (sample_dirs), `d` the
-// segment's or ray's direction, `t_end` its end. Each triangle met is decided for every sample at once
-// where quick() can, else for this sample by its own test, exactly as resolve() would decide it; one that
-// blocks the sample is then resolved for all the others. It walks the rays' BVH (passes::bvh), whose
-// single segments and rays meet fewer nodes than the linear one's, on the stack of the bundle's walk
-// (which has given up, or never ran where the tile skips its bundles). It is a loop of its own rather than bvh_walk: that walk's per-node sample masks (a
-// box projection per child, a mask per stacked node) cost more than they save for one sample: walking
-// the samples through it made 8 % lights about 1.2x slower on an H100. False when the walk could not
-// finish (never on a conforming device).
-bool walk_sample(uvec4 bit, vec3 offsets, vec3 d, float t_end) {
-    float big = max(max(abs(d.x), abs(d.y)), abs(d.z)) + (local ? length(disc_u) : 0.0);
-    bvh_set_cone(origin, d, 1e-4 * big, t_end);
+// segment's or ray's direction, `t_end` its end, `reach` as set_segment takes it. Each triangle met that
+// the sample does not clearly miss is decided for every sample at once where quick() can, else for this
+// sample by its own test, exactly as resolve() would decide it; one that blocks the sample is then
+// resolved for all the others. It walks the rays' BVH (passes::bvh), whose single segments and rays meet
+// fewer nodes than the linear one's, on the stack of the bundle's walk (which has given up, or never ran
+// where the tile skips its bundles). It is a loop of its own rather than bvh_walk: that walk's per-node
+// sample masks (a box projection per child, a mask per stacked node) cost more than they save for one
+// sample: walking the samples through it made 8 % lights about 1.2x slower on an H100. False when the
+// walk could not finish (never on a conforming device).
+bool walk_sample(uvec4 bit, vec3 offsets, vec3 d, float t_end, float reach) {
+    set_segment(d, t_end, reach);
     uint sp = 0u;
     uint node = 0u;
     for (uint round = 0u; round < 65535u; ++round) {
@@ -370,12 +430,16 @@ bool walk_sample(uvec4 bit, vec3 offsets, vec3 d, float t_end) {
             BvhNode nd = ray_nodes[node];
             uint children[2] = uint[2](floatBitsToUint(nd.left_lo.w), floatBitsToUint(nd.right_lo.w));
             float t_left, t_right;
-            bool met[2] = bool[2](bvh_cone_meets(nd.left_lo.xyz, nd.left_hi.xyz, t_left),
-                                  bvh_cone_meets(nd.right_lo.xyz, nd.right_hi.xyz, t_right));
+            bool met[2] = bool[2](segment_meets(nd.left_lo.xyz, nd.left_hi.xyz, t_left),
+                                  segment_meets(nd.right_lo.xyz, nd.right_hi.xyz, t_right));
             for (uint c = 0u; c < 2u; ++c) {
                 if (met[c] && children[c] >= BVH_LEAF) {
                     met[c] = false;
-                    uint q = quick(children[c] & ~BVH_LEAF);
+                    uint index = children[c] & ~BVH_LEAF;
+                    if (sample_misses(index, d)) {
+                        continue;
+                    }
+                    uint q = quick(index);
                     if (q == BLOCKS_ALL) {
                         blocked = all_samples;
                     } else if (q == UNDECIDED && sample_hit(offsets)) {
@@ -413,13 +477,17 @@ bool walk_one(uint word, uint bit) {
     mask[word] = 1u << bit;
     vec3 offsets = sample_dirs[word * 32u + bit];
     vec3 d = local ? disc_c + offsets.x * disc_u + offsets.y * disc_v : offsets;
-    return walk_sample(mask, offsets, d, local ? 1.0 : 1.0 / 0.0);
+    vec3 span = local ? abs(disc_c) + abs(disc_u) + abs(disc_v) : abs(offsets);
+    return walk_sample(mask, offsets, d, local ? 1.0 : 1.0 / 0.0, max(max(span.x, span.y), span.z));
 }
 #endif
 
-// A bundle whose emitter's radius passes this share of its distance (a directional light: its angular
-// bound) is wide: its walk may give up for its samples' own walks (passes::area::WIDE_BUNDLE).
+// A directional light's bundle whose angular bound passes WIDE_BUNDLE, a spot or point light's whose
+// emitter's radius passes WIDE_LOCAL_BUNDLE of its distance, is wide: its walk may give up for its samples'
+// own walks (passes::area::WIDE_BUNDLE, WIDE_LOCAL_BUNDLE).
 const float WIDE_BUNDLE = 0.1;
+const float WIDE_LOCAL_BUNDLE = 0.05;
+const float WIDE = local ? WIDE_LOCAL_BUNDLE : WIDE_BUNDLE;
 // The width at which a wide bundle's walk budget is the configured one; it grows with the inverse square
 // of the width below it (a narrower bundle meets fewer triangles that its samples' walks would miss) and
 // shrinks above it.
@@ -524,9 +592,9 @@ void walk_bvh() {
         budget = 0xFFFFFFFFu;   // a directional light never wide, with a budget: its bundle walks to the end
     } else if (k.misc.z == 0u) {
         budget = 0u;
-    } else if (width > WIDE_BUNDLE && k.misc.z != 0xFFFFFFFFu && tile_skips()) {
+    } else if (width > WIDE && k.misc.z != 0xFFFFFFFFu && tile_skips()) {
         budget = 0u;
-    } else if (width > WIDE_BUNDLE && k.misc.z != 0xFFFFFFFFu) {
+    } else if (width > WIDE && k.misc.z != 0xFFFFFFFFu) {
         uint open_count = open_samples();
 #if SAMPLE_WALKS
         tile_open[gl_LocalInvocationIndex] = open_count;

@@ -33,12 +33,16 @@ pub use crate::gpu_types::MAX_AREA_SAMPLES;
 pub const DEFAULT_AREA_SAMPLES: u32 = 64;
 
 /// [`AreaConfig::bundle_walk_budget`] by default.
-pub const DEFAULT_BUNDLE_WALK_BUDGET: u32 = 256;
+pub const DEFAULT_BUNDLE_WALK_BUDGET: u32 = 64;
 
-/// A pixel's bundle of segments or rays is wide when its emitter's radius over its distance (a directional
-/// light: its angular bound) passes this: only a wide bundle's walk of the BVH may give up for its samples'
-/// own walks ([`AreaConfig::bundle_walk_budget`]; `WIDE_BUNDLE` in `area_trace.glsl`).
+/// A directional light's bundle of rays is wide when its angular bound passes this: only a wide bundle's
+/// walk of the BVH may give up for its samples' own walks ([`AreaConfig::bundle_walk_budget`];
+/// `WIDE_BUNDLE` in `area_trace.glsl`).
 pub const WIDE_BUNDLE: f32 = 0.1;
+
+/// A spot or point light's bundle of segments from a pixel is wide when its emitter's radius over its
+/// distance passes this (`WIDE_LOCAL_BUNDLE` in `area_trace.glsl`).
+pub const WIDE_LOCAL_BUNDLE: f32 = 0.05;
 
 /// Settings of the area mode. The light's size is the one PCSS and the hybrid use
 /// ([`PcssConfig::angular_radius`](crate::PcssConfig::angular_radius)): every mode shadows the same light.
@@ -47,8 +51,9 @@ pub struct AreaConfig {
     /// Light samples per pixel, in `1..=`[`MAX_AREA_SAMPLES`] (default [`DEFAULT_AREA_SAMPLES`]). Visibility
     /// takes the values `k / samples`.
     pub samples: u32,
-    /// Where a pixel walks the BVH with a wide bundle of segments or rays (an emitter's radius over a tenth
-    /// of its distance), the nodes and triangles the bundle's walk may visit per 64 samples still open,
+    /// Where a pixel walks the BVH with a wide bundle of segments or rays (an emitter's radius over a
+    /// twentieth of its distance, [`WIDE_LOCAL_BUNDLE`]; a directional light's angular bound over a tenth,
+    /// [`WIDE_BUNDLE`]), the nodes and triangles the bundle's walk may visit per 64 samples still open,
     /// scaled by `(0.3 / width)²` (width: the radius over the distance), before each open sample walks its
     /// own segment or ray instead (default [`DEFAULT_BUNDLE_WALK_BUDGET`]). Both give the same answer bit
     /// for bit; the bundle costs less while few triangles straddle it (small lights), the samples' own
@@ -529,8 +534,8 @@ pub fn local_sample_bands(samples: u32) -> SampleBands {
 mod tests {
     use super::*;
 
-    /// The trace's variant without the samples' own walks is chosen by [`WIDE_BUNDLE`]: the shader must
-    /// call the same bundles wide.
+    /// The trace's variant without the samples' own walks is chosen by [`WIDE_BUNDLE`], and the docs name
+    /// both widths: the shader must call the same bundles wide.
     #[test]
     fn the_trace_calls_the_same_bundles_wide() {
         let source = std::fs::read_to_string(concat!(
@@ -538,12 +543,17 @@ mod tests {
             "/shaders/area_trace.glsl"
         ))
         .expect("area_trace.glsl");
-        let value = source
-            .lines()
-            .find_map(|l| l.strip_prefix("const float WIDE_BUNDLE = "))
-            .and_then(|v| v.strip_suffix(';'))
-            .expect("area_trace.glsl defines WIDE_BUNDLE");
-        assert_eq!(value.parse::<f32>(), Ok(WIDE_BUNDLE));
+        for (name, width) in [
+            ("WIDE_BUNDLE", WIDE_BUNDLE),
+            ("WIDE_LOCAL_BUNDLE", WIDE_LOCAL_BUNDLE),
+        ] {
+            let value = source
+                .lines()
+                .find_map(|l| l.strip_prefix(&format!("const float {name} = ")))
+                .and_then(|v| v.strip_suffix(';'))
+                .unwrap_or_else(|| panic!("area_trace.glsl defines {name}"));
+            assert_eq!(value.parse::<f32>(), Ok(width), "{name}");
+        }
     }
 
     #[test]
