@@ -294,6 +294,65 @@ struct PeerCost {
     /// Pixels whose visible sample count differs from the plugin's layer. Both test the same segments;
     /// they may differ only where a segment passes within rounding of a triangle's edge or plane.
     differing: usize,
+    /// Of those, the pixels the exact reference of the same samples calls stable whose count differs from
+    /// its count: the plugin's, then the peer's (`None` without the reference).
+    wrong: Option<(usize, usize)>,
+}
+
+/// The pixels `pixels` of the frame whose counts differ from the exact reference of the same samples of
+/// `light` of size `size` (emitter radius, or angular radius) on stable pixels: the plugin's `ours`, then
+/// the peer's `peer` (visibility images of `samples` samples).
+fn wrong_on_stable(
+    scene: &Scene,
+    camera: &Camera,
+    (light, size): (&Light, f32),
+    (ours, peer): (&[f32], &[f32]),
+    args: &BenchArgs,
+) -> (usize, usize) {
+    let samples = args.area_samples;
+    let count = |v: f32| (v * samples as f32).round() as u32;
+    let differing: Vec<usize> = (0..ours.len())
+        .filter(|&i| count(ours[i]) != count(peer[i]))
+        .collect();
+    if differing.is_empty() {
+        return (0, 0);
+    }
+    let lights: Vec<reference::Light> = match *light {
+        Light::Directional { direction, .. } => {
+            passes::area::area_sample_directions(direction, size, samples)
+                .iter()
+                .map(|w| reference::Light::Directional {
+                    direction: -w.as_dvec3(),
+                })
+                .collect()
+        }
+        Light::Spot { position, .. } | Light::Point { position, .. } => {
+            passes::area::local_area_offsets(samples)
+                .iter()
+                .map(|offset| reference::Light::DiscSample {
+                    centre: position.as_dvec3(),
+                    radius: f64::from(size),
+                    offset: offset.as_dvec2(),
+                })
+                .collect()
+        }
+    };
+    let pixels: Vec<(u32, u32)> = differing
+        .iter()
+        .map(|&i| (i as u32 % args.width, i as u32 / args.width))
+        .collect();
+    let params =
+        crate::accuracy::scene_visibility_params(scene, camera, args.width, args.height, lights[0]);
+    let rs = reference::RefScene::new(scene);
+    let exact = reference::area_counts_at(&rs, &params, &lights, &pixels);
+    let wrong = |image: &[f32]| {
+        differing
+            .iter()
+            .zip(&exact)
+            .filter(|(&i, &(visible, stable))| stable && count(image[i]) != visible)
+            .count()
+    };
+    (wrong(ours), wrong(peer))
 }
 
 /// The pixels of two visibility images of `samples` samples whose visible counts differ.
@@ -338,9 +397,19 @@ fn peer_cost(
         args.area_samples,
         args.frames,
     )?;
+    let wrong = (!args.no_reference).then(|| {
+        wrong_on_stable(
+            scene,
+            camera,
+            (&light, size),
+            (layer, &run.visibility),
+            args,
+        )
+    });
     Ok(Some(PeerCost {
         trace_ms: run.trace_ms,
         differing: differing_counts(&run.visibility, layer, args.area_samples),
+        wrong,
     }))
 }
 
@@ -565,8 +634,8 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
          below); frusta = recorded / built (the plugin skips those holding no receiver in view).\n\n\
          | scene | light | emitter | frusta | GPU ms | max ms | × sun | map ms | ray trace ms | RT peer trace ms | \
          MiB | entries | mean list | longest | bin items | lists | past limit | past capacity | BVH pixels | \
-         per-sample pixels | ≠ peer |\n\
-         |---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|\n",
+         per-sample pixels | ≠ peer | wrong: ours / peer |\n\
+         |---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|\n",
         caps.device_name,
         caps.driver,
         args.width,
@@ -722,7 +791,7 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
             for c in &costs {
                 let _ = writeln!(
                     out,
-                    "| {} | {} | {size_cell} | {} / {} | {:.3} | {:.3} | {:.1} | {:.3} | {:.3} | {} | {:.1} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                    "| {} | {} | {size_cell} | {} / {} | {:.3} | {:.3} | {:.1} | {:.3} | {:.3} | {} | {:.1} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                     scene_case.file.trim_end_matches(".obj"),
                     c.name,
                     c.frusta.0,
@@ -752,6 +821,10 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
                     c.peer
                         .as_ref()
                         .map_or("—".to_owned(), |p| p.differing.to_string()),
+                    c.peer
+                        .as_ref()
+                        .and_then(|p| p.wrong)
+                        .map_or("—".to_owned(), |(ours, peer)| format!("{ours} / {peer}")),
                 );
                 let passes: Vec<String> = c
                     .passes
@@ -776,7 +849,9 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
          walk the BVH); BVH pixels: pixels that walked the BVH; per-sample pixels: those of them whose \
          bundle of segments or rays passed its walk budget, each open sample then walking its own; ≠ peer: pixels \
          whose visible sample count differs from the peer's (the same segments: they may differ only where \
-         one passes within rounding of a triangle's edge or plane). RT peer: the same samples of every pixel as \
+         one passes within rounding of a triangle's edge or plane); wrong: of those, the stable pixels (every \
+         sample decided beyond the tolerance by the exact f64 reference of the same samples) whose count \
+         differs from the reference's, the plugin's then the peer's (— with --no-reference). RT peer: the same samples of every pixel as \
          any-hit rays through the driver's ray-tracing pipeline, trace only (— for hard shadows, a spot \
          light of several frusta, several lights at once, or a device without ray tracing).\n",
     );

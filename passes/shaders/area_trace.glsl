@@ -88,11 +88,13 @@ uvec4 blocked;      // bit i: sample i is blocked
 const float DECIDE_MARGIN = 1e-5;
 
 // rp x rq for the edge from world vertex p to q (rp, rq: relative to the ray origin), computed in an order
-// fixed by p and q, so that the edge from q to p gives exactly the opposite vector.
+// fixed by p and q, so that the edge from q to p gives exactly the opposite vector. It is computed as
+// rp x (q - p) with the edge's own world vector: it errs by a few ulps of |rp| |q - p|, where rp x rq errs
+// by a few ulps of |rp| |rq|, far more for a small triangle far away.
 vec3 edge_normal(vec3 p, vec3 q, vec3 rp, vec3 rq) {
     bool swap = p.x > q.x || (p.x == q.x && (p.y > q.y || (p.y == q.y && p.z > q.z)));
     vec3 u = swap ? rq : rp;
-    vec3 v = swap ? rp : rq;
+    precise vec3 v = swap ? p - q : q - p;
     precise vec3 n = vec3(u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x);
     return swap ? -n : n;
 }
@@ -177,13 +179,25 @@ uint quick(uint index) {
     vec3 na = edge_normal(p1, p2, b, c);
     vec3 nb = edge_normal(p2, p0, c, a);
     vec3 nc = edge_normal(p0, p1, a, b);
-    precise float det = dot(a, na);
+    // D = a.(b x c) = N.a, with N = (p1 - p0) x (p2 - p0) the normal of the triangle's own edges, taken as
+    // the cross product of its two shorter edges: N.a errs by a few ulps of |N| |a|, where a.na errs by a
+    // few ulps of |a| |b| |c|, which for a small triangle far away or a long sliver can pass D itself when
+    // the origin lies near the triangle's plane (and the two longer edges of a sliver, nearly parallel,
+    // give N far less precisely). A wrong sign of D would turn every test of the triangle around.
+    precise vec3 e0 = p1 - p0;
+    precise vec3 e1 = p2 - p1;
+    precise vec3 e2 = p0 - p2;
+    vec3 lengths = vec3(dot(e0, e0), dot(e1, e1), dot(e2, e2));
+    precise vec3 face = lengths.x >= max(lengths.y, lengths.z) ? cross(e1, e2)
+                      : lengths.y >= lengths.z                ? cross(e2, e0)
+                                                              : cross(e0, e1);
+    precise float det = dot(face, a);
     if (det == 0.0) {
         return MISSES_ALL;
     }
     float orient = det < 0.0 ? -1.0 : 1.0;
     if (local) {
-        precise vec3 normal = orient * cross(p1 - p0, p2 - p0);
+        precise vec3 normal = orient * face;
         line_a = orient * affine(na);
         line_b = orient * affine(nb);
         line_c = orient * affine(nc);

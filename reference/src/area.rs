@@ -6,7 +6,10 @@
 
 use glam::{DVec2, DVec3};
 
-use crate::{reference_visibility_with_progress, Light, PixelClass, RefScene, VisibilityParams};
+use crate::{
+    reference_pixel_classes, reference_visibility_with_progress, Light, PixelClass, RefScene,
+    VisibilityParams,
+};
 
 /// Visible sample counts of every pixel; row-major with `y = 0` the top row, like
 /// [`crate::VisibilityReference`].
@@ -76,6 +79,35 @@ pub fn local_area_reference(
         }),
         &|| {},
     )
+}
+
+/// The visible count of each pixel of `pixels` ((x, y) of `params`' view) over `lights`, one per sample
+/// (a directional light along the opposite of each direction towards the light, as [`area_reference`]
+/// takes them, or a [`Light::DiscSample`] of a sized spot or point light), and whether every sample is
+/// decided beyond the tolerance (stable): [`area_reference`] or [`local_area_reference`] at those pixels
+/// alone.
+pub fn area_counts_at(
+    scene: &RefScene,
+    params: &VisibilityParams,
+    lights: &[Light],
+    pixels: &[(u32, u32)],
+) -> Vec<(u32, bool)> {
+    let mut counts = vec![(0, true); pixels.len()];
+    for &light in lights {
+        let per_sample = VisibilityParams { light, ..*params };
+        for (count, class) in
+            counts
+                .iter_mut()
+                .zip(reference_pixel_classes(scene, &per_sample, pixels))
+        {
+            match class {
+                PixelClass::Background | PixelClass::Lit => count.0 += 1,
+                PixelClass::Shadowed => {}
+                PixelClass::Ambiguous => count.1 = false,
+            }
+        }
+    }
+    counts
 }
 
 /// Counts, per pixel, the `lights` (one per sample) that reach it, calling `row_done` per row of each.

@@ -44,7 +44,10 @@ mod visibility;
 #[cfg(test)]
 mod tests;
 
-pub use area::{area_reference, area_reference_with_progress, local_area_reference, AreaReference};
+pub use area::{
+    area_counts_at, area_reference, area_reference_with_progress, local_area_reference,
+    AreaReference,
+};
 pub use geometry::{intersect_watertight, line_segment_distance};
 pub use predicates::{certainly_blocked, contact_shadow_start};
 pub use ref_scene::RefScene;
@@ -54,6 +57,6 @@ pub use soft::{
 };
 pub use texels::{conservative_texel_sets, overlaps_texel_with_margin, FaceSelection, TexelSets};
 pub use visibility::{
-    disc_basis, reference_visibility, reference_visibility_with_progress, Light, PixelClass,
-    VisibilityParams, VisibilityReference, DISC_BASIS_POLE,
+    disc_basis, reference_pixel_classes, reference_visibility, reference_visibility_with_progress,
+    Light, PixelClass, VisibilityParams, VisibilityReference, DISC_BASIS_POLE,
 };

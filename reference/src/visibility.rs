@@ -175,6 +175,20 @@ pub fn reference_visibility(scene: &RefScene, params: &VisibilityParams) -> Visi
     reference_visibility_with_progress(scene, params, &|| {})
 }
 
+/// The classes [`reference_visibility`] gives the pixels `pixels` ((x, y), `y = 0` the top row) of `params`'
+/// view, without the rest of the frame.
+pub fn reference_pixel_classes(
+    scene: &RefScene,
+    params: &VisibilityParams,
+    pixels: &[(u32, u32)],
+) -> Vec<PixelClass> {
+    let camera = Camera::new(params);
+    pixels
+        .par_iter()
+        .map(|&(x, y)| shade_pixel(scene, params, &camera, x, y).class)
+        .collect()
+}
+
 /// [`reference_visibility`], calling `row_done` once per row it finishes (from any thread of its pool),
 /// for a caller's progress display: `params.height` calls in all.
 pub fn reference_visibility_with_progress(
