@@ -299,9 +299,10 @@ struct PeerCost {
     wrong: Option<(usize, usize)>,
 }
 
-/// The pixels `pixels` of the frame whose counts differ from the exact reference of the same samples of
-/// `light` of size `size` (emitter radius, or angular radius) on stable pixels: the plugin's `ours`, then
-/// the peer's `peer` (visibility images of `samples` samples).
+/// Of the pixels where the plugin's image `ours` and the peer's `peer` (visibility of `args.area_samples`
+/// samples) differ, those the exact reference of the same samples of `light` of size `size` (emitter
+/// radius, or angular radius) calls stable whose count differs from its count: the plugin's, then the
+/// peer's. The reference runs on those pixels alone.
 fn wrong_on_stable(
     scene: &Scene,
     camera: &Camera,

@@ -10,9 +10,10 @@
 // direction w reaches the triangle (at a positive distance) iff w = alpha a + beta b + gamma c with alpha,
 // beta, gamma >= 0, i.e. iff the three edge functions (b x c).w = alpha D, (c x a).w = beta D and
 // (a x b).w = gamma D all have the sign of D (Cramer's rule). Each edge's normal is computed from its two
-// vertices in an order fixed by their world positions, so a shared edge gets exactly opposite normals in
-// its two triangles, and a direction exactly through the edge counts as blocked by both (>= 0): no leak
-// through a closed mesh. D = 0 (o in the triangle's plane, or a degenerate triangle) blocks nothing.
+// vertices in an order both triangles of the edge choose alike, so a shared edge gets exactly opposite
+// normals in its two triangles, and a direction exactly through the edge counts as blocked by both (>= 0):
+// no leak through a closed mesh. D = 0 within its rounding (o in the triangle's plane, or a degenerate
+// triangle) blocks nothing.
 // Each edge function is linear in w, and every sample lies within `spread` of the centre direction C, so
 // E(w) lies within |n| spread of E(C): a triangle is rejected for every sample, or taken as blocking every
 // sample, with one evaluation, exactly as the per-sample evaluation would decide (the margin covers the
@@ -87,16 +88,20 @@ uvec4 blocked;      // bit i: sample i is blocked
 // Relative margin of the one-evaluation decisions: far above the f32 rounding of the edge functions.
 const float DECIDE_MARGIN = 1e-5;
 
-// rp x rq for the edge from world vertex p to q (rp, rq: relative to the ray origin), computed in an order
-// fixed by p and q, so that the edge from q to p gives exactly the opposite vector. It is computed as
-// rp x (q - p) with the edge's own world vector: it errs by a few ulps of |rp| |q - p|, where rp x rq errs
-// by a few ulps of |rp| |rq|, far more for a small triangle far away.
+// rp x rq for the edge from world vertex p to q (rp, rq: relative to the ray origin), computed from the
+// endpoint nearer the origin (ties: the first in world order) as r_near x (far - near), with the edge's own
+// world vector: it errs by a few ulps of |r_near| |q - p|, at most about twice |rp| |rq|, where rp x rq
+// errs by a few ulps of |rp| |rq| (far more than the value for a small triangle far away). Both triangles
+// of an edge choose the same endpoint, so the edge from q to p gives exactly the opposite vector.
 vec3 edge_normal(vec3 p, vec3 q, vec3 rp, vec3 rq) {
-    bool swap = p.x > q.x || (p.x == q.x && (p.y > q.y || (p.y == q.y && p.z > q.z)));
-    vec3 u = swap ? rq : rp;
-    precise vec3 v = swap ? p - q : q - p;
+    precise float lp = dot(rp, rp);
+    precise float lq = dot(rq, rq);
+    bool q_first = p.x > q.x || (p.x == q.x && (p.y > q.y || (p.y == q.y && p.z > q.z)));
+    bool from_q = lq < lp || (lq == lp && q_first);
+    vec3 u = from_q ? rq : rp;
+    precise vec3 v = from_q ? p - q : q - p;
     precise vec3 n = vec3(u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x);
-    return swap ? -n : n;
+    return from_q ? -n : n;
 }
 
 // The edge table's samples for the line a x + b y + c >= 0 (`line`) in the samples' plane (a directional
@@ -184,6 +189,8 @@ uint quick(uint index) {
     // few ulps of |a| |b| |c|, which for a small triangle far away or a long sliver can pass D itself when
     // the origin lies near the triangle's plane (and the two longer edges of a sliver, nearly parallel,
     // give N far less precisely). A wrong sign of D would turn every test of the triangle around.
+    // A plane within that rounding of the origin counts as D = 0: it blocks nothing (any segment it could
+    // block runs within the reference's tolerance of the plane, which calls such a sample ambiguous).
     precise vec3 e0 = p1 - p0;
     precise vec3 e1 = p2 - p1;
     precise vec3 e2 = p0 - p2;
@@ -192,7 +199,10 @@ uint quick(uint index) {
                       : lengths.y >= lengths.z                ? cross(e2, e0)
                                                               : cross(e0, e1);
     precise float det = dot(face, a);
-    if (det == 0.0) {
+    vec3 shorter = lengths.x >= max(lengths.y, lengths.z) ? lengths.yzx
+                 : lengths.y >= lengths.z                ? lengths.zxy
+                                                         : lengths.xyz;
+    if (!(abs(det) > 2e-6 * sqrt(shorter.x * shorter.y * dot(a, a)))) {
         return MISSES_ALL;
     }
     float orient = det < 0.0 ? -1.0 : 1.0;
@@ -370,20 +380,29 @@ vec3 segment_inv, segment_origin_inv, segment_grow;
 float segment_end;
 // The rounding scale of the sample's edge functions over a triangle's two vertices (sample_misses).
 float segment_scale;
+// The pixel's part of every sample's growth, and the distance from the origin to the farthest corner of
+// the hierarchy's root box (set_segment_origin).
+float segment_grow_base, segment_far;
 
-// Sets the segment or ray from the origin along `d` to `t_end`, `reach` the largest coordinate of the
-// direction's terms (a local light: |C| + |U| + |V|): every box is grown by 1e-5 of the largest coordinate
-// of the hierarchy's root box and the origin, plus 1e-4 of `reach` at the farthest t any box can be met,
-// as bvh_cone_meets grows each box and widens the bundle, so that a box the exact segment meets is met. A
-// component of d that vanishes is replaced by one of 1e-15 |d|, which moves the segment far less than
-// the growth.
-void set_segment(vec3 d, float t_end, float reach) {
+// Sets what every sample's segment of the pixel shares: 1e-5 of the largest coordinate of the hierarchy's
+// root box and the origin, and the distance to the root box's farthest corner.
+void set_segment_origin() {
     vec3 root_lo = min(ray_nodes[0].left_lo.xyz, ray_nodes[0].right_lo.xyz);
     vec3 root_hi = max(ray_nodes[0].left_hi.xyz, ray_nodes[0].right_hi.xyz);
     vec3 big = max(max(abs(root_lo), abs(root_hi)), abs(origin));
-    float far = length(max(abs(root_lo - origin), abs(root_hi - origin))) / max(length(d), 1e-30);
-    float t_far = min(t_end, far * (1.0 + 1e-3));
-    float grow = 1e-5 * max(max(big.x, big.y), big.z) + 1e-4 * reach * t_far + 1e-30;
+    segment_grow_base = 1e-5 * max(max(big.x, big.y), big.z) + 1e-30;
+    segment_far = length(max(abs(root_lo - origin), abs(root_hi - origin)));
+}
+
+// Sets the segment or ray from the origin along `d` to `t_end`, `dir_scale` the largest coordinate of the
+// direction's terms (a local light: |C| + |U| + |V|). Every box is grown by the pixel's base
+// (set_segment_origin) plus 1e-4 of `dir_scale` at the farthest t any box can be met: far beyond the
+// rounding of the box's coordinates, of the origin and of d against the segment sample_hit tests, so that
+// a box the segment meets is met. A component of d that vanishes is replaced by one of 1e-15 of d's
+// largest, which moves the segment far less than the growth.
+void set_segment(vec3 d, float t_end, float dir_scale) {
+    float t_far = min(t_end, segment_far / max(length(d), 1e-30) * (1.0 + 1e-3));
+    float grow = segment_grow_base + 1e-4 * dir_scale * t_far;
     float tiny = 1e-15 * max(max(abs(d.x), abs(d.y)), abs(d.z));
     vec3 sign_d = mix(vec3(1.0), vec3(-1.0), lessThan(d, vec3(0.0)));
     vec3 safe = mix(d, sign_d * tiny, lessThan(abs(d), vec3(tiny)));
@@ -391,7 +410,7 @@ void set_segment(vec3 d, float t_end, float reach) {
     segment_origin_inv = origin * segment_inv;
     segment_grow = grow * abs(segment_inv);
     segment_end = t_end;
-    segment_scale = 1e-4 * reach;
+    segment_scale = 1e-4 * dir_scale;
 }
 
 // Whether the segment set_segment set meets the box [lo, hi] (a slab test), and the first t at which it
@@ -426,7 +445,7 @@ bool sample_misses(uint index, vec3 d) {
 
 // One sample's own segment (a spot or point light) or ray (a directional light) from the origin, walked
 // through the BVH alone: `offsets`, the sample's unit-disc offsets or direction (sample_dirs), `d` the
-// segment's or ray's direction, `t_end` its end, `reach` as set_segment takes it. Each triangle met that
+// segment's or ray's direction, `t_end` its end, `dir_scale` as set_segment takes it. Each triangle met that
 // the sample does not clearly miss is decided for every sample at once where quick() can, else for this
 // sample by its own test, exactly as resolve() would decide it; one that blocks the sample is then
 // resolved for all the others. It walks the rays' BVH (passes::bvh), whose single segments and rays meet
@@ -435,8 +454,8 @@ bool sample_misses(uint index, vec3 d) {
 // sample masks (a box projection per child, a mask per stacked node) cost more than they save for one
 // sample: walking the samples through it made 8 % lights about 1.2x slower on an H100. False when the
 // walk could not finish (never on a conforming device).
-bool walk_sample(uvec4 bit, vec3 offsets, vec3 d, float t_end, float reach) {
-    set_segment(d, t_end, reach);
+bool walk_sample(uvec4 bit, vec3 offsets, vec3 d, float t_end, float dir_scale) {
+    set_segment(d, t_end, dir_scale);
     uint sp = 0u;
     uint node = 0u;
     for (uint round = 0u; round < 65535u; ++round) {
@@ -620,6 +639,7 @@ void walk_bvh() {
 #if SAMPLE_WALKS
     if (finished && bvh_over_budget) {
         count_sample_walks();
+        set_segment_origin();
         if (bvh_spent > 0u) {
             count_tile_give_up();
         } else if (tile_skips() && k.misc.z != 0u) {
