@@ -183,6 +183,28 @@ fn tiny_and_large_lights() {
     assert!(large.penumbra > 0 && tiny.penumbra > 0);
 }
 
+/// Suns over the floor of long thin strips ([`common::long_thin_strips`]): of 0.1 rad (the trace without
+/// the samples' own walks) and 0.2 rad (with them), each strip oriented by its own edges.
+#[test]
+fn suns_over_a_floor_of_long_thin_strips() {
+    let device = device();
+    let (scene, camera) = common::long_thin_strips();
+    let mut view = View::framed(scene, WIDTH, HEIGHT);
+    view.camera = camera;
+    view.light =
+        DirectionalLight::new(common::strips_turn() * Vec3::new(0.3, -1.0, 0.2)).expect("light");
+    for radius in [0.1, 0.2] {
+        check(
+            &device,
+            &format!("sun of {radius} rad over long thin strips"),
+            &view,
+            (radius, 32),
+            FaceMode::Both,
+            20,
+        );
+    }
+}
+
 #[test]
 fn the_demo_scene_1e4_from_the_origin() {
     check_hard_case(Family::Scale, "translated by 1e4", (0.3, 32));

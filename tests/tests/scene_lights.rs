@@ -1048,66 +1048,21 @@ fn a_sized_point_light_inside_a_closed_room_matches_the_reference_sample_for_sam
     }
 }
 
-/// A floor of long thin strips (triangles 200 m long and 20 cm wide) under a table and a plate, lit by a
-/// sized lamp, the whole turned to no axis: each pixel's ray origin lies a hair above its own strip, which
-/// seen from there is a sliver reaching 100 m either way. The sign of the trace's D = a.(b x c) must come
-/// from the strip's own edges (N.a): from the vertices relative to the origin it rounds by more than D
-/// itself, which turns the strip's test around and blocks the samples towards the lamp.
+/// The floor of long thin strips ([`common::long_thin_strips`]) lit by a sized lamp: the sign of the
+/// trace's D = a.(b x c) must come from each strip's own edges (N.a): from the vertices relative to the
+/// origin it rounds by more than D itself, which turns the strip's test around and blocks the samples
+/// towards the lamp.
 #[test]
 fn a_floor_of_long_thin_strips_matches_the_reference_sample_for_sample() {
     let device = device();
-    let turn = glam::Quat::from_axis_angle(Vec3::new(1.0, 2.0, 3.0).normalize(), 0.5);
-    let lamp = turn * Vec3::new(0.15, 2.5, 0.1);
-    let mut scene = scene::Scene::default();
-    let (half_length, width, strips) = (100.0f32, 0.2f32, 30u32);
-    let mut positions = Vec::new();
-    let mut indices = Vec::new();
-    for i in 0..strips {
-        let z0 = -3.0 + i as f32 * width;
-        let base = positions.len() as u32;
-        positions.extend([
-            Vec3::new(-half_length, 0.0, z0),
-            Vec3::new(half_length, 0.0, z0),
-            Vec3::new(half_length, 0.0, z0 + width),
-            Vec3::new(-half_length, 0.0, z0 + width),
-        ]);
-        indices.extend([base, base + 2, base + 1, base, base + 3, base + 2]);
-    }
-    scene.append(&scene::Scene::single_object(
-        positions,
-        indices,
-        "floor strips",
-    ));
-    for (name, min, max) in [
-        (
-            "table",
-            Vec3::new(-1.2, 0.7, -0.8),
-            Vec3::new(0.4, 0.76, 0.6),
-        ),
-        (
-            "plate",
-            Vec3::new(-0.3, 2.2, 0.9),
-            Vec3::new(0.9, 2.23, 1.9),
-        ),
-    ] {
-        scene.append(&scene::Scene::axis_box(name, min, max));
-    }
-    for p in &mut scene.positions {
-        *p = turn * *p;
-    }
-    scene.validate().expect("valid scene");
+    let lamp = common::strips_turn() * Vec3::new(0.15, 2.5, 0.1);
+    let (scene, camera) = common::long_thin_strips();
     let file = SceneFile {
         static_objects: vec![true; scene.objects.len()],
         shadow_casters: vec![true; scene.objects.len()],
         scene,
         lights: vec![point_light("lamp", lamp)],
-        camera: Some(Camera {
-            position: turn * Vec3::new(2.4, 2.2, 2.6),
-            target: turn * Vec3::new(-0.5, 0.0, -0.6),
-            up: turn * Vec3::Y,
-            fov_y_radians: 70f32.to_radians(),
-            near: 0.05,
-        }),
+        camera: Some(camera),
         skipped_primitives: 0,
     };
     check_local_area(

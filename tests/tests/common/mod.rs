@@ -115,6 +115,58 @@ pub fn plate_and_box_view(width: u32, height: u32) -> View {
     view
 }
 
+/// The turn of the strips scene ([`long_thin_strips`]): about no axis.
+pub fn strips_turn() -> glam::Quat {
+    glam::Quat::from_axis_angle(Vec3::new(1.0, 2.0, 3.0).normalize(), 0.5)
+}
+
+/// A floor of long thin strips (triangles 200 m long and 20 cm wide, 6 m of them side by side) under a
+/// table and a plate, the whole turned by [`strips_turn`]: a ray origin a hair above its own strip sees a
+/// sliver reaching 100 m either way, whose orientation the rounding of an origin-relative determinant
+/// gets wrong. The camera looks down at the table from 3.5 m.
+pub fn long_thin_strips() -> (Scene, Camera) {
+    let turn = strips_turn();
+    let (half_length, width, strips) = (100.0f32, 0.2f32, 30u32);
+    let mut positions = Vec::new();
+    let mut indices = Vec::new();
+    for i in 0..strips {
+        let z0 = -3.0 + i as f32 * width;
+        let base = positions.len() as u32;
+        positions.extend([
+            Vec3::new(-half_length, 0.0, z0),
+            Vec3::new(half_length, 0.0, z0),
+            Vec3::new(half_length, 0.0, z0 + width),
+            Vec3::new(-half_length, 0.0, z0 + width),
+        ]);
+        indices.extend([base, base + 2, base + 1, base, base + 3, base + 2]);
+    }
+    let mut scene = Scene::single_object(positions, indices, "floor strips");
+    scene.append(&axis_boxes(&[
+        (
+            "table",
+            Vec3::new(-1.2, 0.7, -0.8),
+            Vec3::new(0.4, 0.76, 0.6),
+        ),
+        (
+            "plate",
+            Vec3::new(-0.3, 2.2, 0.9),
+            Vec3::new(0.9, 2.23, 1.9),
+        ),
+    ]));
+    for p in &mut scene.positions {
+        *p = turn * *p;
+    }
+    scene.validate().expect("valid test scene");
+    let camera = Camera {
+        position: turn * Vec3::new(2.4, 2.2, 2.6),
+        target: turn * Vec3::new(-0.5, 0.0, -0.6),
+        up: turn * Vec3::Y,
+        fov_y_radians: 70f32.to_radians(),
+        near: 0.05,
+    };
+    (scene, camera)
+}
+
 /// Asserts an area-shadow comparison with the exact reference of the same samples (`name` in messages):
 /// every value a whole count, 0 mismatched counts on stable pixels, at least `min_penumbra` stable
 /// penumbra pixels judged (a test that cannot fail is no test), at most `max_unstable_percent` of the
