@@ -299,25 +299,18 @@ struct PeerCost {
     wrong: Option<(usize, usize)>,
 }
 
-/// Of the pixels where the plugin's image `ours` and the peer's `peer` (visibility of `args.area_samples`
-/// samples) differ, those the exact reference of the same samples of `light` of size `size` (emitter
-/// radius, or angular radius) calls stable whose count differs from its count: the plugin's, then the
-/// peer's. The reference runs on those pixels alone.
+/// Of the pixels `differing` ([`differing_pixels`] of the plugin's image `ours` and the peer's `peer`,
+/// visibility of `args.area_samples` samples), those the exact reference of the same samples of `light` of
+/// size `size` (emitter radius, or angular radius) calls stable whose count differs from its count: the
+/// plugin's, then the peer's. The reference runs on those pixels alone.
 fn wrong_on_stable(
     scene: &Scene,
     camera: &Camera,
     (light, size): (&Light, f32),
-    (ours, peer): (&[f32], &[f32]),
+    (ours, peer, differing): (&[f32], &[f32], &[usize]),
     args: &BenchArgs,
 ) -> (usize, usize) {
     let samples = args.area_samples;
-    let count = |v: f32| (v * samples as f32).round() as u32;
-    let differing: Vec<usize> = (0..ours.len())
-        .filter(|&i| count(ours[i]) != count(peer[i]))
-        .collect();
-    if differing.is_empty() {
-        return (0, 0);
-    }
     let lights: Vec<reference::Light> = match *light {
         Light::Directional { direction, .. } => {
             passes::area::area_sample_directions(direction, size, samples)
@@ -338,31 +331,39 @@ fn wrong_on_stable(
                 .collect()
         }
     };
+    let Some(&first) = lights.first().filter(|_| !differing.is_empty()) else {
+        return (0, 0);
+    };
     let pixels: Vec<(u32, u32)> = differing
         .iter()
         .map(|&i| (i as u32 % args.width, i as u32 / args.width))
         .collect();
     let params =
-        crate::accuracy::scene_visibility_params(scene, camera, args.width, args.height, lights[0]);
+        crate::accuracy::scene_visibility_params(scene, camera, args.width, args.height, first);
     let rs = reference::RefScene::new(scene);
     let exact = reference::area_counts_at(&rs, &params, &lights, &pixels);
     let wrong = |image: &[f32]| {
         differing
             .iter()
             .zip(&exact)
-            .filter(|(&i, &(visible, stable))| stable && count(image[i]) != visible)
+            .filter(|(&i, &(visible, stable))| {
+                stable && sample_count(image[i], samples) != i64::from(visible)
+            })
             .count()
     };
     (wrong(ours), wrong(peer))
 }
 
-/// The pixels of two visibility images of `samples` samples whose visible counts differ.
-fn differing_counts(a: &[f32], b: &[f32], samples: u32) -> usize {
-    let count = |v: f32| (v * samples as f32).round() as i64;
-    a.iter()
-        .zip(b)
-        .filter(|(x, y)| count(**x) != count(**y))
-        .count()
+/// The visible sample count of a visibility `v` of `samples` samples.
+fn sample_count(v: f32, samples: u32) -> i64 {
+    (v * samples as f32).round() as i64
+}
+
+/// The indices of the pixels of two visibility images of `samples` samples whose visible counts differ.
+fn differing_pixels(a: &[f32], b: &[f32], samples: u32) -> Vec<usize> {
+    (0..a.len().min(b.len()))
+        .filter(|&i| sample_count(a[i], samples) != sample_count(b[i], samples))
+        .collect()
 }
 
 /// The peer's trace-only ms for `light` of size `size` (angular radius or emitter radius) on the frame
@@ -398,18 +399,19 @@ fn peer_cost(
         args.area_samples,
         args.frames,
     )?;
+    let differing = differing_pixels(layer, &run.visibility, args.area_samples);
     let wrong = (!args.no_reference).then(|| {
         wrong_on_stable(
             scene,
             camera,
             (&light, size),
-            (layer, &run.visibility),
+            (layer, &run.visibility, &differing),
             args,
         )
     });
     Ok(Some(PeerCost {
         trace_ms: run.trace_ms,
-        differing: differing_counts(&run.visibility, layer, args.area_samples),
+        differing: differing.len(),
         wrong,
     }))
 }
