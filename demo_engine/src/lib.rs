@@ -16,4 +16,4 @@ pub mod view;
 
 pub use device::{check_validation, open_device, Device, DeviceSummary};
 pub use frame_images::{read_images, FrameImages, FrameOutput};
-pub use view::{focus_bounds, frame_origin, CameraMatrices, View};
+pub use view::{frame_origin, CameraMatrices, View};

@@ -2,7 +2,7 @@
 //! engine draws its G-buffer with them and hands them to the plugin ([`CameraMatrices`]).
 
 use glam::{DVec3, Mat4, Vec3};
-use scene::{Aabb, Camera, DirectionalLight, Scene};
+use scene::{Camera, DirectionalLight, Scene};
 
 /// A scene with its camera and light, ready to render.
 #[derive(Debug, Clone)]
@@ -24,7 +24,7 @@ impl View {
     /// elevated direction, and a slanted directional light shines on it.
     pub fn framed(scene: Scene, width: u32, height: u32) -> Self {
         let aspect = width as f32 / height.max(1) as f32;
-        let camera = Camera::frame(&focus_bounds(&scene), aspect);
+        let camera = Camera::frame(&scene.focus_bounds(), aspect);
         Self {
             scene,
             camera,
@@ -81,22 +81,3 @@ impl CameraMatrices {
         }
     }
 }
-
-/// Bounds of every object but one named "ground" (all of the scene if that is all there is).
-pub fn focus_bounds(scene: &Scene) -> Aabb {
-    let mut b = Aabb::empty();
-    for o in scene.objects.iter().filter(|o| o.name != GROUND) {
-        for t in o.first_triangle..o.first_triangle + o.triangle_count {
-            for v in scene.triangle(t as usize) {
-                b.extend(v);
-            }
-        }
-    }
-    if b.min.cmple(b.max).all() {
-        b
-    } else {
-        scene.bounds()
-    }
-}
-
-const GROUND: &str = "ground";

@@ -3,7 +3,7 @@
 //! the check of it.
 
 use crate::parse_vec3;
-use anyhow::{bail, Result};
+use anyhow::{Context, Result};
 use glam::Vec3;
 use scene::{Aabb, Camera};
 use std::any::TypeId;
@@ -58,34 +58,20 @@ impl CameraArgs {
     }
 }
 
-/// `camera` moved to `position` and looking at `target` where given (the target defaults to the centre
-/// of `bounds` when only the position is given).
+/// `camera` moved to `position` and looking at `target` where given ([`Camera::placed`]).
+///
+/// # Errors
+///
+/// The position and the target coincide.
 pub fn camera_with(
     camera: Camera,
     bounds: &Aabb,
     position: Option<Vec3>,
     target: Option<Vec3>,
 ) -> Result<Camera> {
-    if position.is_none() && target.is_none() {
-        return Ok(camera);
-    }
-    let position = position.unwrap_or(camera.position);
-    let target = target.unwrap_or(bounds.center());
-    if (position - target).length() == 0.0 {
-        bail!("camera position and target coincide");
-    }
-    let forward = (target - position).normalize();
-    let up = if forward.cross(Vec3::Y).length() < 1e-3 {
-        Vec3::Z
-    } else {
-        Vec3::Y
-    };
-    Ok(Camera {
-        position,
-        target,
-        up,
-        ..camera
-    })
+    camera
+        .placed(bounds, position, target)
+        .context("camera position and target coincide")
 }
 
 /// `command` and its subcommands with negative values allowed on the options of numbers: an option of

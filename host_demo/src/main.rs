@@ -7,14 +7,13 @@ use glam::Vec3;
 use host_demo::interior::Enclosure;
 use host_demo::parse_vec3;
 use host_demo::render::{
-    parse_binning, parse_faces, render_to_folder, world_space_scale_of, RenderOptions,
-    SoftShadowArgs,
+    parse_binning, parse_faces, render_to_folder, RenderOptions, SoftShadowArgs,
 };
-use host_demo::scene_plan::{held_still, plan_view, PlanSettings};
+use host_demo::scene_plan::{load_and_plan, plan_file, PlanRequest, PlannedScene};
 use host_demo::scene_render::render_scene_to_folder;
 use hrts::{BinningPath, Faces, ShadowMode};
 use reference::RefScene;
-use scene::{Camera, DirectionalLight, LightSize, Scene, SceneFile, SceneLight};
+use scene::{Camera, DirectionalLight, LightSize, Scene, SceneLight};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -147,44 +146,7 @@ struct PlanArgs {
     still: bool,
 }
 
-/// Loads a glTF scene for `--scene`, held still with `still`; an OBJ file is pointed to `--obj`.
-fn load_scene(path: &Path, still: bool) -> Result<SceneFile> {
-    if path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("obj"))
-    {
-        bail!(
-            "{}: --scene takes a glTF 2.0 scene (.gltf or .glb); load an OBJ model with --obj",
-            path.display()
-        );
-    }
-    let file = scene::load_gltf(path)?;
-    if still {
-        println!("--still: every object and light of the scene counts as static");
-        return Ok(held_still(&file));
-    }
-    Ok(file)
-}
-
-/// The plan settings of `file` for a `width` x `height` frame, with the command line's configuration.
-fn scene_settings(
-    file: &SceneFile,
-    (width, height): (u32, u32),
-    map: hrts::Config,
-    soft: &SoftShadowArgs,
-) -> Result<PlanSettings> {
-    if width == 0 || height == 0 {
-        bail!("--width and --height must be positive");
-    }
-    Ok(PlanSettings {
-        base: soft.config(map, world_space_scale_of(&file.scene)),
-        width,
-        height,
-    })
-}
-
 fn plan(args: &PlanArgs) -> Result<()> {
-    let file = load_scene(&args.scene, args.still)?;
     let soft = SoftShadowArgs {
         shadow_map_size: args.shadow_map_size,
         no_antialiasing: args.no_antialiasing,
@@ -194,22 +156,24 @@ fn plan(args: &PlanArgs) -> Result<()> {
         map_size: args.map_size,
         ..hrts::Config::default()
     };
-    let settings = scene_settings(&file, (args.size.width, args.size.height), map, &soft)?;
-    let (_, plan) = plan_view(
-        &file,
-        &settings,
-        args.camera.camera_pos,
-        args.camera.camera_target,
-    )
-    .with_context(|| format!("planning {}", args.scene.display()))?;
+    let base = |world_space_scale| soft.config(map, world_space_scale);
+    let request = PlanRequest {
+        width: args.size.width,
+        height: args.size.height,
+        camera_position: args.camera.camera_pos,
+        camera_target: args.camera.camera_target,
+        still: args.still,
+        base: &base,
+    };
+    let planned = load_and_plan(&args.scene, &request)?;
     println!(
         "scene {}: {} triangles, {}x{} px, camera {}",
         args.scene.display(),
-        file.scene.triangle_count(),
+        planned.file.scene.triangle_count(),
         args.size.width,
         args.size.height,
         match (
-            &file.camera,
+            &planned.file.camera,
             args.camera.camera_pos.or(args.camera.camera_target)
         ) {
             (_, Some(_)) => "from the command line",
@@ -217,43 +181,40 @@ fn plan(args: &PlanArgs) -> Result<()> {
             (None, None) => "framed by the demo",
         }
     );
-    print!("{}", plan.describe());
+    print!("{}", planned.plan.describe());
     Ok(())
 }
 
+/// `render --scene`: the glTF file at `path` loaded and planned ([`load_and_plan`]), then rendered
+/// ([`render_scene_to_folder`]).
 fn render_scene(cli: &Cli, args: &RenderArgs, path: &Path) -> Result<()> {
     if args.frames < 2 {
         bail!("--frames must be at least 2 with --scene: the second frame's report shows what was kept");
     }
-    let file = load_scene(path, args.still)?;
-    render_scene_file(cli, args, &file, path)
+    let base = |world_space_scale| args.soft.config(map_config(args), world_space_scale);
+    let planned = load_and_plan(path, &scene_request(args, &base))?;
+    if args.still {
+        println!("--still: every object and light of the scene counts as static");
+    }
+    render_planned(cli, args, path, &planned)
 }
 
-/// Renders `file` (read from `path`) as `render --scene` does, with the command line's view and settings.
-fn render_scene_file(cli: &Cli, args: &RenderArgs, file: &SceneFile, path: &Path) -> Result<()> {
-    let settings = scene_settings(
-        file,
-        (args.size.width, args.size.height),
-        map_config(args),
-        &args.soft,
-    )?;
-    let (camera, plan) = plan_view(
-        file,
-        &settings,
-        args.camera.camera_pos,
-        args.camera.camera_target,
-    )
-    .with_context(|| format!("planning {}", path.display()))?;
+/// The plan request of `render`'s command line, with the base configuration `base`.
+fn scene_request<'a>(args: &RenderArgs, base: &'a dyn Fn(f32) -> hrts::Config) -> PlanRequest<'a> {
+    PlanRequest {
+        width: args.size.width,
+        height: args.size.height,
+        camera_position: args.camera.camera_pos,
+        camera_target: args.camera.camera_target,
+        still: args.still,
+        base,
+    }
+}
+
+/// Renders `planned` (read from `path`) into `--out` on the command line's device.
+fn render_planned(cli: &Cli, args: &RenderArgs, path: &Path, planned: &PlannedScene) -> Result<()> {
     let device = device(cli)?;
-    render_scene_to_folder(
-        &device,
-        file,
-        path,
-        (&camera, &plan),
-        (settings.width, settings.height),
-        args.frames,
-        &args.out,
-    )?;
+    render_scene_to_folder(&device, path, planned, args.frames, &args.out)?;
     demo_engine::check_validation(&device)
 }
 
@@ -396,7 +357,9 @@ fn render_closed(
     interior: Interior,
 ) -> Result<()> {
     let file = host_demo::interior::scene_file(model, interior.light, interior.camera);
-    render_scene_file(cli, args, &file, path)
+    let base = |world_space_scale| args.soft.config(map_config(args), world_space_scale);
+    let planned = plan_file(file, &scene_request(args, &base))?;
+    render_planned(cli, args, path, &planned)
 }
 
 /// The primitive map the command line asks for.

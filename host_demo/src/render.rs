@@ -6,12 +6,11 @@ use crate::report_text::{resource_bytes, routes_line, tier_name};
 use anyhow::{Context, Result};
 use demo_engine::gbuffer::GBufferLayout;
 use demo_engine::plugin::PluginRenderer;
-use demo_engine::{focus_bounds, Device, DeviceSummary, View};
+use demo_engine::{Device, DeviceSummary, View};
 use hrts::{
     BinningPath, Faces, FrameReport, Pass, PassStatus, PenumbraFilter, Resource, ResourceSet,
     ShadowMode,
 };
-use scene::Scene;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -87,18 +86,6 @@ pub struct RenderOptions {
     pub occupancy_view: bool,
 }
 
-/// The world-space scale of a view's model: the bounding radius of its objects (the ground plane
-/// aside), at least a millimetre.
-pub fn default_world_space_scale(view: &View) -> f32 {
-    world_space_scale_of(&view.scene)
-}
-
-/// The world-space scale of a scene's model: the bounding radius of its objects (the ground plane
-/// aside), at least a millimetre.
-pub fn world_space_scale_of(scene: &Scene) -> f32 {
-    focus_bounds(scene).radius().max(1e-3)
-}
-
 impl SoftShadowArgs {
     /// The configuration these options describe over the primitive-map settings of `map`, with the
     /// hybrid's WSS `default_world_space_scale` unless `--wss` sets it; static geometry, a moving light, no
@@ -129,7 +116,7 @@ impl RenderOptions {
     pub fn config(&self, view: &View) -> hrts::Config {
         hrts::Config {
             extra_outputs: demo_outputs(self.soft.mode, self.occupancy_view),
-            ..self.soft.config(self.map, default_world_space_scale(view))
+            ..self.soft.config(self.map, view.scene.world_space_scale())
         }
     }
 }

@@ -5,7 +5,7 @@
 
 use crate::output::{write_exr_rgba, write_exr_scalar, write_png};
 use crate::report_text::{resource_bytes, routes_line};
-use crate::scene_plan::ScenePlan;
+use crate::scene_plan::{PlannedScene, ScenePlan};
 use crate::shading::{shade, tone_map};
 use anyhow::{Context, Result};
 use demo_engine::gbuffer::GBufferLayout;
@@ -470,20 +470,23 @@ pub fn visibility_file_names(index: usize, name: &str) -> (String, String) {
     (format!("{stem}.png"), format!("{stem}.exr"))
 }
 
-/// Renders `frames` frames of `file` (from `source`, for messages) at `width` x `height` seen through
-/// `camera` as `plan` (its [`ScenePlan`] through that camera) says, prints the plan and each frame's
-/// per-light report, and writes into `out`: `shaded.png` and `shaded.exr`
-/// (linear radiance), each light's visibility (`visibility_<i>_<name>.png` and `.exr`) and
-/// `scene_report.json`.
+/// Renders `frames` frames of `planned` (from `source`, for messages) as its plan says, prints the plan
+/// and each frame's per-light report, and writes into `out`: `shaded.png` and `shaded.exr` (linear
+/// radiance), each light's visibility (`visibility_<i>_<name>.png` and `.exr`) and `scene_report.json`.
 pub fn render_scene_to_folder(
     device: &Device,
-    file: &SceneFile,
     source: &Path,
-    (camera, plan): (&Camera, &ScenePlan),
-    (width, height): (u32, u32),
+    planned: &PlannedScene,
     frames: u32,
     out: &Path,
 ) -> Result<()> {
+    let PlannedScene {
+        file,
+        camera,
+        settings,
+        plan,
+    } = planned;
+    let (width, height) = (settings.width, settings.height);
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     println!("{}", demo_engine::device::device_banner(device));
     println!(

@@ -11,7 +11,7 @@ use glam::Vec3;
 use host_demo::images::{lerp_factor_preview, write_png_compact, Canvas};
 use host_demo::output::{shade_preview, write_png};
 use host_demo::parse_vec3;
-use host_demo::render::{default_world_space_scale, median_timings};
+use host_demo::render::median_timings;
 use hrts::passes_bridge;
 use passes::{
     HybridConfig, PcssConfig, PenumbraFilter, PrimitiveMapConfig, ResourceId, ResourceSet,
@@ -229,7 +229,7 @@ pub fn compare_to_folder(device: &Device, args: &CompareArgs) -> Result<()> {
         Vec3::new(1.9, 0.1, 1.3),
         (args.close_up_pos, args.close_up_target),
     )?;
-    let wss = default_world_space_scale(&view);
+    let wss = view.scene.world_space_scale();
     let (w, h) = (args.width, args.height);
     let to_light = -view.light.direction;
     let mut pictures = Vec::new();

@@ -319,7 +319,7 @@ pub struct Sweep {
 
 /// Renders every method of [`methods`] on `view` and measures it against the ground truth.
 pub fn run_sweep(device: &Device, view: &View, scene: &str, args: &TradeoffArgs) -> Result<Sweep> {
-    let wss = host_demo::render::default_world_space_scale(view);
+    let wss = view.scene.world_space_scale();
     let methods = methods(args.angular_radius, wss);
     let bar = host_demo::progress(methods.len() as u64 + 1, "tradeoff");
     bar.set_message("ground truth");

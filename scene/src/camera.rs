@@ -38,6 +38,37 @@ impl Camera {
         self.proj(aspect) * self.view()
     }
 
+    /// This camera moved to `position` and looking at `target` where given (the target defaults to the
+    /// centre of `bounds` when only the position is given; a camera looking straight up or down takes +Z
+    /// as its up). `None` if the position and the target coincide.
+    pub fn placed(
+        self,
+        bounds: &Aabb,
+        position: Option<Vec3>,
+        target: Option<Vec3>,
+    ) -> Option<Camera> {
+        if position.is_none() && target.is_none() {
+            return Some(self);
+        }
+        let position = position.unwrap_or(self.position);
+        let target = target.unwrap_or(bounds.center());
+        if (position - target).length() == 0.0 {
+            return None;
+        }
+        let forward = (target - position).normalize();
+        let up = if forward.cross(Vec3::Y).length() < 1e-3 {
+            Vec3::Z
+        } else {
+            Vec3::Y
+        };
+        Some(Camera {
+            position,
+            target,
+            up,
+            ..self
+        })
+    }
+
     /// A camera with a 45° vertical field of view looking at the centre of `bounds` from a
     /// slanted, elevated direction, far enough that the bounding sphere fits both the vertical
     /// and the horizontal field of view for `aspect` (width / height; invalid values count as 1).
@@ -69,6 +100,30 @@ impl Camera {
 mod tests {
     use super::*;
     use crate::procedural_default;
+
+    #[test]
+    fn placed_moves_the_camera_where_asked() {
+        let bounds = Aabb {
+            min: Vec3::splat(-1.0),
+            max: Vec3::new(1.0, 3.0, 1.0),
+        };
+        let camera = Camera::frame(&bounds, 1.5);
+        assert_eq!(camera.placed(&bounds, None, None), Some(camera));
+        let moved = camera
+            .placed(&bounds, Some(Vec3::new(-5.0, 2.0, 3.0)), None)
+            .expect("placed");
+        assert_eq!(
+            (moved.position, moved.target, moved.up),
+            (Vec3::new(-5.0, 2.0, 3.0), bounds.center(), Vec3::Y)
+        );
+        assert_eq!(moved.fov_y_radians, camera.fov_y_radians);
+        let above = camera
+            .placed(&bounds, Some(Vec3::new(0.0, 9.0, 0.0)), Some(Vec3::ZERO))
+            .expect("placed");
+        assert_eq!(above.up, Vec3::Z, "looking straight down");
+        let target = Some(camera.position);
+        assert_eq!(camera.placed(&bounds, None, target), None);
+    }
 
     fn assert_frames(bounds: &Aabb, aspect: f32) {
         let camera = Camera::frame(bounds, aspect);

@@ -6,6 +6,9 @@ use glam::Vec3;
 
 use crate::{error::MEMORY_PATH, Aabb, SceneError};
 
+/// The name of the ground plane [`Scene::with_ground_plane`] adds.
+const GROUND: &str = "ground";
+
 /// A named contiguous range of triangles (one OBJ object/group, or one procedural part).
 /// A draw call.
 #[derive(Debug, Clone, PartialEq)]
@@ -90,6 +93,25 @@ impl Scene {
             }
         }
         bounds
+    }
+
+    /// Bounds of every object but the ground plane (an object named `"ground"`, as
+    /// [`with_ground_plane`](Scene::with_ground_plane) adds it): what a camera frames. All of the scene
+    /// if the ground is all there is.
+    pub fn focus_bounds(&self) -> Aabb {
+        let focus: Vec<bool> = self.objects.iter().map(|o| o.name != GROUND).collect();
+        let bounds = self.objects_bounds(&focus);
+        if bounds.is_valid() {
+            bounds
+        } else {
+            self.bounds()
+        }
+    }
+
+    /// The world-space scale of the scene's model: the bounding radius of its
+    /// [`focus_bounds`](Scene::focus_bounds), at least a millimetre (the hybrid's default WSS).
+    pub fn world_space_scale(&self) -> f32 {
+        self.focus_bounds().radius().max(1e-3)
     }
 
     /// Checks the invariants listed on [`Scene`], reporting problems against the path `<memory>`.
@@ -188,7 +210,7 @@ impl Scene {
             (Vec3::ZERO, 1.0)
         };
         let mut scene = self.clone();
-        scene.append(&ground_square("ground", center, side));
+        scene.append(&ground_square(GROUND, center, side));
         scene
     }
 
@@ -268,6 +290,17 @@ mod tests {
     }
 
     use crate::mesh_builder::signed_volume;
+
+    #[test]
+    fn focus_bounds_leave_the_ground_aside() {
+        let model = tetrahedron();
+        let grounded = model.with_ground_plane();
+        assert_eq!(grounded.focus_bounds(), model.bounds());
+        assert!(grounded.bounds().radius() > 2.0 * model.bounds().radius());
+        assert_eq!(model.world_space_scale(), model.bounds().radius());
+        let ground_only = Scene::default().with_ground_plane();
+        assert_eq!(ground_only.focus_bounds(), ground_only.bounds());
+    }
 
     #[test]
     fn basic_queries() {

@@ -40,12 +40,13 @@
 //! Caching: a light marked static sets `static_light`; any shadow caster that is not static makes the
 //! geometry dynamic for every light (the plugin shares one prim buffer between its lights).
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use glam::{DVec4, Vec3};
 use hrts::{Config, Faces, ShadowMode};
 use hrts::{SpotFrustum, HRTS_MAX_LIGHTS};
 use scene::{Camera, LightKind, LightSize, SceneFile, SceneLight};
 use std::fmt::Write as _;
+use std::path::Path;
 
 /// What the plan needs besides the scene and the camera.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -372,6 +373,94 @@ pub fn describe_light(light: &SceneLight) -> String {
     )
 }
 
+/// What `render --scene` and `plan --scene` ask of a scene: the frame, the configuration, the camera the
+/// command line places, and whether to hold the scene still.
+pub struct PlanRequest<'a> {
+    /// Frame width in pixels.
+    pub width: u32,
+    /// Frame height in pixels.
+    pub height: u32,
+    /// Where the command line places the camera (else the file's camera, else one framing the objects).
+    pub camera_position: Option<Vec3>,
+    /// Where the command line points the camera.
+    pub camera_target: Option<Vec3>,
+    /// Hold the scene still ([`held_still`]).
+    pub still: bool,
+    /// The configuration every shadowed light starts from ([`PlanSettings::base`]), given the scene's
+    /// world-space scale ([`scene::Scene::world_space_scale`]).
+    pub base: &'a dyn Fn(f32) -> Config,
+}
+
+/// A scene ready to render: the file as loaded (held still if asked), the camera it is seen through and
+/// its plan through that camera.
+#[derive(Debug, Clone)]
+pub struct PlannedScene {
+    /// The scene, its lights and flags.
+    pub file: SceneFile,
+    /// The camera.
+    pub camera: Camera,
+    /// The settings the plan was made with (frame size and base configuration).
+    pub settings: PlanSettings,
+    /// The plan of every light.
+    pub plan: ScenePlan,
+}
+
+/// Loads the glTF 2.0 scene at `path` ([`scene::load_gltf`]) and plans it as `request` asks
+/// ([`plan_file`]).
+///
+/// # Errors
+///
+/// An OBJ file (the demo loads those with `--obj`), what the loader refuses, or what [`plan_file`]
+/// refuses.
+pub fn load_and_plan(path: &Path, request: &PlanRequest) -> Result<PlannedScene> {
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"))
+    {
+        bail!(
+            "{}: --scene takes a glTF 2.0 scene (.gltf or .glb); load an OBJ model with --obj",
+            path.display()
+        );
+    }
+    let file = scene::load_gltf(path)?;
+    plan_file(file, request).with_context(|| format!("planning {}", path.display()))
+}
+
+/// Plans `file` as `request` asks: held still if asked ([`held_still`]), seen through the request's
+/// camera or the scene's own ([`plan_view`]), with the base configuration for the scene's world-space
+/// scale.
+///
+/// # Errors
+///
+/// A frame size of zero, a camera position equal to its target, or what [`plan_scene`] refuses.
+pub fn plan_file(file: SceneFile, request: &PlanRequest) -> Result<PlannedScene> {
+    if request.width == 0 || request.height == 0 {
+        bail!("--width and --height must be positive");
+    }
+    let file = if request.still {
+        held_still(&file)
+    } else {
+        file
+    };
+    let settings = PlanSettings {
+        base: (request.base)(file.scene.world_space_scale()),
+        width: request.width,
+        height: request.height,
+    };
+    let (camera, plan) = plan_view(
+        &file,
+        &settings,
+        request.camera_position,
+        request.camera_target,
+    )?;
+    Ok(PlannedScene {
+        file,
+        camera,
+        settings,
+        plan,
+    })
+}
+
 /// `file` held still: every object and light marked static. The demo does not animate its scenes, so
 /// rendering a scene held still shows what a scene that does not move keeps from frame to frame.
 pub fn held_still(file: &SceneFile) -> SceneFile {
@@ -385,7 +474,7 @@ pub fn held_still(file: &SceneFile) -> SceneFile {
 /// every scene.
 pub fn scene_camera(file: &SceneFile, aspect: f32) -> Camera {
     file.camera
-        .unwrap_or_else(|| Camera::frame(&demo_engine::focus_bounds(&file.scene), aspect))
+        .unwrap_or_else(|| Camera::frame(&file.scene.focus_bounds(), aspect))
 }
 
 /// The camera `file` is seen through (its own, else one framing its objects; moved to `position` and
@@ -401,12 +490,9 @@ pub fn plan_view(
     target: Option<Vec3>,
 ) -> Result<(Camera, ScenePlan)> {
     let aspect = settings.width as f32 / settings.height.max(1) as f32;
-    let camera = crate::cli::camera_with(
-        scene_camera(file, aspect),
-        &file.scene.bounds(),
-        position,
-        target,
-    )?;
+    let camera = scene_camera(file, aspect)
+        .placed(&file.scene.bounds(), position, target)
+        .context("camera position and target coincide")?;
     let plan = plan_scene(file, &camera, settings)?;
     Ok((camera, plan))
 }
