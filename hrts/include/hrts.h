@@ -986,7 +986,10 @@ typedef struct HrtsFrameReport {
   uint32_t entries;
   // `HrtsPassStatus` of each `HrtsPass` this frame.
   uint32_t pass_status[HRTS_PASS_COUNT];
-  // Bytes of each `HrtsResource` the plugin allocated (0: not allocated).
+  // Bytes of each `HrtsResource` the plugin allocated (0: not allocated), with the buffers that serve
+  // it: `HRTS_RESOURCE_PRIM_LIST_OFFSETS` counts the primitive map's other buffers,
+  // `HRTS_RESOURCE_RT_VISIBILITY` an area trace's own buffers (light samples, edge tables, sample bands,
+  // tile history; those alone when the image is shared scratch: `map_scratch_bytes`).
   uint64_t resource_bytes[HRTS_RESOURCE_COUNT];
   // The `HrtsResource` copied into the output image (or written into it directly: `output_direct`).
   uint32_t output_resource;

@@ -889,7 +889,10 @@ pub struct HrtsFrameReport {
     pub entries: u32,
     /// `HrtsPassStatus` of each `HrtsPass` this frame.
     pub pass_status: [u32; HRTS_PASS_COUNT],
-    /// Bytes of each `HrtsResource` the plugin allocated (0: not allocated).
+    /// Bytes of each `HrtsResource` the plugin allocated (0: not allocated), with the buffers that serve
+    /// it: `HRTS_RESOURCE_PRIM_LIST_OFFSETS` counts the primitive map's other buffers,
+    /// `HRTS_RESOURCE_RT_VISIBILITY` an area trace's own buffers (light samples, edge tables, sample bands,
+    /// tile history; those alone when the image is shared scratch: `map_scratch_bytes`).
     pub resource_bytes: [u64; HRTS_RESOURCE_COUNT],
     /// The `HrtsResource` copied into the output image (or written into it directly: `output_direct`).
     pub output_resource: u32,

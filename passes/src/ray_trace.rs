@@ -129,6 +129,14 @@ pub struct RayTracePass {
 }
 
 impl RayTracePass {
+    /// Bytes of an area trace's own buffers besides its images: the light samples, the edge tables, the
+    /// sample bands and the tile history (0 for a hard trace).
+    pub fn area_buffer_bytes(&self) -> u64 {
+        self.area.as_ref().map_or(0, |a| {
+            a.samples.size() + a.edge_tables.size() + a.sample_bands.size() + a.tile_history.size()
+        })
+    }
+
     /// Creates `width` x `height` outputs: the visibility (`visibility` when given), and the blocker distance
     /// if `kind` asks for it.
     pub fn new(

@@ -1339,6 +1339,12 @@ fn mode_auto_shadows_a_zero_size_sun_hard_and_a_sized_lamp_area() {
         "{}",
         lamp_report.decision_reason
     );
+    // The visibility's bytes: its R32F image, and for the area trace its own buffers too (light samples,
+    // edge tables, sample bands and one word per 8x8 tile of history).
+    let image = u64::from(WIDTH * HEIGHT) * 4;
+    let tiles = u64::from(WIDTH.div_ceil(8) * HEIGHT.div_ceil(8)) * 4;
+    assert_eq!(sun.resource_bytes(hrts::Resource::RtVisibility), image);
+    assert!(lamp_report.resource_bytes(hrts::Resource::RtVisibility) > image + tiles);
     for report in &reports {
         let has = |r: hrts::Resource| report.resource_bytes(r) > 0;
         assert!(has(hrts::Resource::RtVisibility) && !has(hrts::Resource::ShadowMap));

@@ -125,7 +125,8 @@ pub struct FrameReport {
     /// The status of each pass this frame, indexed by `Pass as usize` ([`FrameReport::status`]).
     pub pass_status: [PassStatus; HRTS_PASS_COUNT],
     /// Bytes of each resource the plugin allocated (0: not allocated), indexed by `Resource as usize`
-    /// ([`FrameReport::resource_bytes`]).
+    /// ([`FrameReport::resource_bytes`]), with the buffers that serve it (the list offsets count the
+    /// primitive map's other buffers, the ray-traced visibility an area trace's own).
     pub resource_bytes: [u64; HRTS_RESOURCE_COUNT],
     /// The resource copied into the output image (or written into it directly: `output_direct`).
     pub output_resource: Resource,

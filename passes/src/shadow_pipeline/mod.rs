@@ -220,12 +220,18 @@ impl ShadowPipeline {
         resource == ResourceId::RtVisibility && self.rt_shared
     }
 
-    /// Bytes of `resource` if the pipeline allocated it.
+    /// Bytes of `resource` if the pipeline allocated it, with the buffers that serve it: the list offsets
+    /// count the map's other buffers, the ray trace's visibility an area trace's own buffers
+    /// ([`RayTracePass::area_buffer_bytes`]).
     fn resource_bytes(&self, resource: ResourceId) -> Option<u64> {
         match resource {
             ResourceId::PrimListOffsets => self.map.as_ref().map(|m| {
                 m.bytes() - m.entries.size() - m.occupancy_view().map_or(0, Image::byte_size)
             }),
+            ResourceId::RtVisibility => self
+                .ray
+                .as_ref()
+                .map(|r| r.visibility.byte_size() + r.area_buffer_bytes()),
             r => self
                 .buffer(r)
                 .map(Buffer::size)
