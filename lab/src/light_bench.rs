@@ -23,8 +23,10 @@ use passes::{
     directional_light_frustum, spot_light_frusta, FrameInputs, Light, PrimitiveMapConfig,
     ShadowConfig, ShadowMode,
 };
+use reference::RefScene;
 use rhi::Device;
 use scene::{Aabb, Camera, LightKind, LightSize, Scene, SceneFile, SceneLight};
+use std::cell::OnceCell;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -302,9 +304,10 @@ struct PeerCost {
 /// Of the pixels `differing` ([`differing_pixels`] of the plugin's image `ours` and the peer's `peer`,
 /// visibility of `args.area_samples` samples), those the exact reference of the same samples of `light` of
 /// size `size` (emitter radius, or angular radius) calls stable whose count differs from its count: the
-/// plugin's, then the peer's. The reference runs on those pixels alone.
+/// plugin's, then the peer's. The reference runs on those pixels alone, over the scene's reference
+/// `reference` (built on first use, once per scene).
 fn wrong_on_stable(
-    scene: &Scene,
+    (scene, reference): (&Scene, &OnceCell<RefScene>),
     camera: &Camera,
     (light, size): (&Light, f32),
     (ours, peer, differing): (&[f32], &[f32], &[usize]),
@@ -340,8 +343,8 @@ fn wrong_on_stable(
         .collect();
     let params =
         crate::accuracy::scene_visibility_params(scene, camera, args.width, args.height, first);
-    let rs = reference::RefScene::new(scene);
-    let exact = reference::area_counts_at(&rs, &params, &lights, &pixels);
+    let rs = reference.get_or_init(|| RefScene::new(scene));
+    let exact = reference::area_counts_at(rs, &params, &lights, &pixels);
     let wrong = |image: &[f32]| {
         differing
             .iter()
@@ -372,7 +375,7 @@ fn differing_pixels(a: &[f32], b: &[f32], samples: u32) -> Vec<usize> {
 fn peer_cost(
     device: &Device,
     plugin: &PluginRenderer,
-    scene: &Scene,
+    scene: (&Scene, &OnceCell<RefScene>),
     camera: &Camera,
     light: Option<Light>,
     size: f32,
@@ -393,7 +396,7 @@ fn peer_cost(
     let run = crate::peer::run_area_peer(
         device,
         plugin,
-        scene,
+        scene.0,
         &inputs,
         size,
         args.area_samples,
@@ -418,7 +421,7 @@ fn peer_cost(
 
 fn measure_light(
     device: &Device,
-    file: &SceneFile,
+    (file, reference): (&SceneFile, &OnceCell<RefScene>),
     camera: &Camera,
     (name, peer): (&str, Option<(Light, f32)>),
     args: &BenchArgs,
@@ -459,7 +462,7 @@ fn measure_light(
         Some((light, size)) => peer_cost(
             device,
             renderer.plugin(),
-            &file.scene,
+            (&file.scene, reference),
             camera,
             Some(light),
             size,
@@ -696,6 +699,8 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
             skipped_primitives: 0,
         };
         let extent = (bounds.max - bounds.min).length();
+        // The exact reference of the scene, for the wrong-pixel checks of all its lights.
+        let reference = OnceCell::new();
         let mut sun = None;
         for &fraction in &sizes {
             let emitter_radius = (fraction > 0.0).then_some(fraction * extent);
@@ -723,7 +728,7 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
                 };
                 costs.push(measure_light(
                     device,
-                    &file_with(vec![light]),
+                    (&file_with(vec![light]), &reference),
                     &camera,
                     (&name, peer),
                     args,
