@@ -3,7 +3,7 @@
 //! the check of it.
 
 use crate::parse_vec3;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use glam::Vec3;
 use scene::{Aabb, Camera};
 use std::any::TypeId;
@@ -46,7 +46,8 @@ pub struct CameraArgs {
     /// outside, or inside a closed model, in a corner at eye height looking across the room).
     #[arg(long, value_parser = parse_vec3)]
     pub camera_pos: Option<Vec3>,
-    /// Camera target "x,y,z" (default: the scene file's camera's, else the scene centre).
+    /// Camera target "x,y,z" (default: the centre of the scene's bounds where --camera-pos is given, else
+    /// the scene file's camera's, else the framed camera's).
     #[arg(long, value_parser = parse_vec3)]
     pub camera_target: Option<Vec3>,
 }
@@ -69,9 +70,7 @@ pub fn camera_with(
     position: Option<Vec3>,
     target: Option<Vec3>,
 ) -> Result<Camera> {
-    camera
-        .placed(bounds, position, target)
-        .context("camera position and target coincide")
+    Ok(camera.placed(bounds, position, target)?)
 }
 
 /// `command` and its subcommands with negative values allowed on the options of numbers: an option of

@@ -146,6 +146,9 @@ struct PlanArgs {
     still: bool,
 }
 
+/// What `--still` prints.
+const STILL: &str = "--still: every object and light of the scene counts as static";
+
 fn plan(args: &PlanArgs) -> Result<()> {
     let soft = SoftShadowArgs {
         shadow_map_size: args.shadow_map_size,
@@ -166,6 +169,9 @@ fn plan(args: &PlanArgs) -> Result<()> {
         base: &base,
     };
     let planned = load_and_plan(&args.scene, &request)?;
+    if args.still {
+        println!("{STILL}");
+    }
     println!(
         "scene {}: {} triangles, {}x{} px, camera {}",
         args.scene.display(),
@@ -194,7 +200,7 @@ fn render_scene(cli: &Cli, args: &RenderArgs, path: &Path) -> Result<()> {
     let base = |world_space_scale| args.soft.config(map_config(args), world_space_scale);
     let planned = load_and_plan(path, &scene_request(args, &base))?;
     if args.still {
-        println!("--still: every object and light of the scene counts as static");
+        println!("{STILL}");
     }
     render_planned(cli, args, path, &planned)
 }
@@ -358,7 +364,8 @@ fn render_closed(
 ) -> Result<()> {
     let file = host_demo::interior::scene_file(model, interior.light, interior.camera);
     let base = |world_space_scale| args.soft.config(map_config(args), world_space_scale);
-    let planned = plan_file(file, &scene_request(args, &base))?;
+    let planned = plan_file(file, &scene_request(args, &base))
+        .with_context(|| format!("planning {}", path.display()))?;
     render_planned(cli, args, path, &planned)
 }
 

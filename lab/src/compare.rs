@@ -194,7 +194,7 @@ fn camera(
         ..view.camera
     };
     if (c.position - c.target).length() == 0.0 {
-        bail!("camera position and target coincide");
+        return Err(scene::CoincidentCamera.into());
     }
     Ok(c)
 }

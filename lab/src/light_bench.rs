@@ -304,10 +304,9 @@ struct PeerCost {
 /// Of the pixels `differing` ([`differing_pixels`] of the plugin's image `ours` and the peer's `peer`,
 /// visibility of `args.area_samples` samples), those the exact reference of the same samples of `light` of
 /// size `size` (emitter radius, or angular radius) calls stable whose count differs from its count: the
-/// plugin's, then the peer's. The reference runs on those pixels alone, over the scene's reference
-/// `reference` (built on first use, once per scene).
+/// plugin's, then the peer's. The reference runs on those pixels alone.
 fn wrong_on_stable(
-    (scene, reference): (&Scene, &OnceCell<RefScene>),
+    scene: &SceneReference,
     camera: &Camera,
     (light, size): (&Light, f32),
     (ours, peer, differing): (&[f32], &[f32], &[usize]),
@@ -341,10 +340,14 @@ fn wrong_on_stable(
         .iter()
         .map(|&i| (i as u32 % args.width, i as u32 / args.width))
         .collect();
-    let params =
-        crate::accuracy::scene_visibility_params(scene, camera, args.width, args.height, first);
-    let rs = reference.get_or_init(|| RefScene::new(scene));
-    let exact = reference::area_counts_at(rs, &params, &lights, &pixels);
+    let params = crate::accuracy::scene_visibility_params(
+        scene.scene,
+        camera,
+        args.width,
+        args.height,
+        first,
+    );
+    let exact = reference::area_counts_at(scene.reference(), &params, &lights, &pixels);
     let wrong = |image: &[f32]| {
         differing
             .iter()
@@ -355,6 +358,26 @@ fn wrong_on_stable(
             .count()
     };
     (wrong(ours), wrong(peer))
+}
+
+/// A scene and its exact reference, built on first use: once per scene for the wrong-pixel checks of all
+/// its lights.
+struct SceneReference<'a> {
+    scene: &'a Scene,
+    reference: OnceCell<RefScene>,
+}
+
+impl<'a> SceneReference<'a> {
+    fn new(scene: &'a Scene) -> Self {
+        Self {
+            scene,
+            reference: OnceCell::new(),
+        }
+    }
+
+    fn reference(&self) -> &RefScene {
+        self.reference.get_or_init(|| RefScene::new(self.scene))
+    }
 }
 
 /// The visible sample count of a visibility `v` of `samples` samples.
@@ -375,7 +398,7 @@ fn differing_pixels(a: &[f32], b: &[f32], samples: u32) -> Vec<usize> {
 fn peer_cost(
     device: &Device,
     plugin: &PluginRenderer,
-    scene: (&Scene, &OnceCell<RefScene>),
+    scene: &SceneReference,
     camera: &Camera,
     light: Option<Light>,
     size: f32,
@@ -396,7 +419,7 @@ fn peer_cost(
     let run = crate::peer::run_area_peer(
         device,
         plugin,
-        scene.0,
+        scene.scene,
         &inputs,
         size,
         args.area_samples,
@@ -421,7 +444,7 @@ fn peer_cost(
 
 fn measure_light(
     device: &Device,
-    (file, reference): (&SceneFile, &OnceCell<RefScene>),
+    (file, reference): (&SceneFile, &SceneReference),
     camera: &Camera,
     (name, peer): (&str, Option<(Light, f32)>),
     args: &BenchArgs,
@@ -462,7 +485,7 @@ fn measure_light(
         Some((light, size)) => peer_cost(
             device,
             renderer.plugin(),
-            (&file.scene, reference),
+            reference,
             camera,
             Some(light),
             size,
@@ -699,8 +722,7 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
             skipped_primitives: 0,
         };
         let extent = (bounds.max - bounds.min).length();
-        // The exact reference of the scene, for the wrong-pixel checks of all its lights.
-        let reference = OnceCell::new();
+        let reference = SceneReference::new(&scene);
         let mut sun = None;
         for &fraction in &sizes {
             let emitter_radius = (fraction > 0.0).then_some(fraction * extent);

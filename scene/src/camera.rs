@@ -4,6 +4,11 @@ use glam::{Mat4, Vec3};
 
 use crate::Aabb;
 
+/// A camera placed at its target: it looks nowhere.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("camera position and target coincide")]
+pub struct CoincidentCamera;
+
 /// Perspective camera with a reversed-Z infinite projection (Vulkan depth range `[0, 1]`,
 /// near plane at depth 1, infinity at depth 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -40,20 +45,24 @@ impl Camera {
 
     /// This camera moved to `position` and looking at `target` where given (the target defaults to the
     /// centre of `bounds` when only the position is given; a camera looking straight up or down takes +Z
-    /// as its up). `None` if the position and the target coincide.
+    /// as its up).
+    ///
+    /// # Errors
+    ///
+    /// The position and the target coincide.
     pub fn placed(
         self,
         bounds: &Aabb,
         position: Option<Vec3>,
         target: Option<Vec3>,
-    ) -> Option<Camera> {
+    ) -> Result<Camera, CoincidentCamera> {
         if position.is_none() && target.is_none() {
-            return Some(self);
+            return Ok(self);
         }
         let position = position.unwrap_or(self.position);
         let target = target.unwrap_or(bounds.center());
         if (position - target).length() == 0.0 {
-            return None;
+            return Err(CoincidentCamera);
         }
         let forward = (target - position).normalize();
         let up = if forward.cross(Vec3::Y).length() < 1e-3 {
@@ -61,7 +70,7 @@ impl Camera {
         } else {
             Vec3::Y
         };
-        Some(Camera {
+        Ok(Camera {
             position,
             target,
             up,
@@ -108,7 +117,7 @@ mod tests {
             max: Vec3::new(1.0, 3.0, 1.0),
         };
         let camera = Camera::frame(&bounds, 1.5);
-        assert_eq!(camera.placed(&bounds, None, None), Some(camera));
+        assert_eq!(camera.placed(&bounds, None, None), Ok(camera));
         let moved = camera
             .placed(&bounds, Some(Vec3::new(-5.0, 2.0, 3.0)), None)
             .expect("placed");
@@ -122,7 +131,7 @@ mod tests {
             .expect("placed");
         assert_eq!(above.up, Vec3::Z, "looking straight down");
         let target = Some(camera.position);
-        assert_eq!(camera.placed(&bounds, None, target), None);
+        assert_eq!(camera.placed(&bounds, None, target), Err(CoincidentCamera));
     }
 
     fn assert_frames(bounds: &Aabb, aspect: f32) {

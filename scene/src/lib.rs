@@ -37,7 +37,7 @@ mod scene;
 mod scene_light;
 
 pub use aabb::Aabb;
-pub use camera::Camera;
+pub use camera::{Camera, CoincidentCamera};
 pub use error::SceneError;
 pub use gltf_scene::{load_gltf, SceneFile};
 pub use hard_cases::HardCase;

@@ -84,9 +84,10 @@ impl Scene {
     pub fn objects_bounds(&self, which: &[bool]) -> Aabb {
         let mut bounds = Aabb::empty();
         for (object, _) in self.objects.iter().zip(which).filter(|(_, &marked)| marked) {
-            let first = object.first_triangle as usize * 3;
-            let last = first + object.triangle_count as usize * 3;
-            for &i in self.indices.get(first..last).unwrap_or_default() {
+            let len = self.indices.len();
+            let first = (object.first_triangle as usize * 3).min(len);
+            let last = (first + object.triangle_count as usize * 3).min(len);
+            for &i in &self.indices[first..last] {
                 if let Some(&p) = self.positions.get(i as usize) {
                     bounds.extend(p);
                 }

@@ -1190,7 +1190,22 @@ fn native_frame(
     lights: Vec<hrts::Light>,
     frames: usize,
 ) -> (Vec<hrts::FrameReport>, Vec<Vec<f32>>) {
+    native_frame_to(device, file, (configs, lights), frames, false)
+}
+
+/// [`native_frame`], each light writing its layer of the output directly where `direct`
+/// ([`PluginRenderer::write_outputs_directly`]).
+fn native_frame_to(
+    device: &Device,
+    file: &SceneFile,
+    (configs, lights): (&[Config], Vec<hrts::Light>),
+    frames: usize,
+    direct: bool,
+) -> (Vec<hrts::FrameReport>, Vec<Vec<f32>>) {
     let mut plugin = plugin_for(device, file);
+    if direct {
+        plugin.write_outputs_directly();
+    }
     plugin.configure_lights(device, configs).expect("configure");
     let matrices = CameraMatrices::of_camera(&camera(file), WIDTH, HEIGHT);
     let mut reports = Vec::new();
@@ -1344,7 +1359,31 @@ fn mode_auto_shadows_a_zero_size_sun_hard_and_a_sized_lamp_area() {
     let image = u64::from(WIDTH * HEIGHT) * 4;
     let tiles = u64::from(WIDTH.div_ceil(8) * HEIGHT.div_ceil(8)) * 4;
     assert_eq!(sun.resource_bytes(hrts::Resource::RtVisibility), image);
-    assert!(lamp_report.resource_bytes(hrts::Resource::RtVisibility) > image + tiles);
+    let area_buffers = lamp_report.resource_bytes(hrts::Resource::RtVisibility) - image;
+    assert!(area_buffers > tiles, "{area_buffers}");
+    // Written directly, the layers are the engine's: the same visibility, and the area trace's buffers
+    // alone in the lamp's count.
+    let (direct_reports, direct_layers) = native_frame_to(
+        &device,
+        &file,
+        (
+            &[config, config],
+            vec![
+                plugin_directional_light(direction, None),
+                plugin_point_light(lamp),
+            ],
+        ),
+        2,
+        true,
+    );
+    assert!(direct_reports.iter().all(|r| r.output_direct));
+    assert!(
+        direct_layers == layers,
+        "direct output differs from the copy"
+    );
+    let direct_bytes = |r: &hrts::FrameReport| r.resource_bytes(hrts::Resource::RtVisibility);
+    assert_eq!(direct_bytes(&direct_reports[0]), 0);
+    assert_eq!(direct_bytes(&direct_reports[1]), area_buffers);
     for report in &reports {
         let has = |r: hrts::Resource| report.resource_bytes(r) > 0;
         assert!(has(hrts::Resource::RtVisibility) && !has(hrts::Resource::ShadowMap));

@@ -373,8 +373,8 @@ pub fn describe_light(light: &SceneLight) -> String {
     )
 }
 
-/// What `render --scene` and `plan --scene` ask of a scene: the frame, the configuration, the camera the
-/// command line places, and whether to hold the scene still.
+/// What `render --scene`, `plan --scene` and `render --obj` of a closed model ask of a scene: the frame, the
+/// configuration, the camera the command line places, and whether to hold the scene still.
 pub struct PlanRequest<'a> {
     /// Frame width in pixels.
     pub width: u32,
@@ -490,9 +490,7 @@ pub fn plan_view(
     target: Option<Vec3>,
 ) -> Result<(Camera, ScenePlan)> {
     let aspect = settings.width as f32 / settings.height.max(1) as f32;
-    let camera = scene_camera(file, aspect)
-        .placed(&file.scene.bounds(), position, target)
-        .context("camera position and target coincide")?;
+    let camera = scene_camera(file, aspect).placed(&file.scene.bounds(), position, target)?;
     let plan = plan_scene(file, &camera, settings)?;
     Ok((camera, plan))
 }

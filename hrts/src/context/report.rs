@@ -163,12 +163,20 @@ impl Context {
         let output = planned.final_output();
         // A layer written directly is the engine's memory, not the plugin's.
         let engine_owned = |r: ResourceId| passes.direct && passes.combine.is_none() && r == output;
-        for r in passes.frusta.iter().flat_map(|p| p.resources()) {
-            if engine_owned(r.resource) {
-                continue;
-            }
+        for (pipeline, r) in passes
+            .frusta
+            .iter()
+            .flat_map(|p| p.resources().into_iter().map(move |r| (p, r)))
+        {
+            // The engine's layer is not counted; the buffers that serve it (an area trace's) are.
+            let bytes = if engine_owned(r.resource) {
+                let image = pipeline.image(r.resource).map_or(0, rhi::Image::byte_size);
+                r.bytes.saturating_sub(image)
+            } else {
+                r.bytes
+            };
             if let Some(i) = RESOURCES.iter().position(|&id| id == r.resource) {
-                out.resource_bytes[i] += r.bytes;
+                out.resource_bytes[i] += bytes;
             } else if r.resource == ResourceId::PrimBuffer {
                 out.prim_buffer_bytes = r.bytes;
             }

@@ -73,14 +73,10 @@ impl ShadowPipeline {
         self.plan
             .resources()
             .iter()
+            .filter(|&r| !self.is_shared(r))
             .filter_map(|r| {
-                let bytes = if self.is_shared(r) {
-                    // The shared image is scratch; an area trace's own buffers stay the light's.
-                    Some(self.ray.as_ref()?.area_buffer_bytes()).filter(|&b| b > 0)
-                } else {
-                    self.resource_bytes(r)
-                };
-                bytes.map(|bytes| ResourceReport { resource: r, bytes })
+                self.resource_bytes(r)
+                    .map(|bytes| ResourceReport { resource: r, bytes })
             })
             .collect()
     }

@@ -4,7 +4,7 @@
 use glam::Vec3;
 
 use super::{case, Check, Family, HardCase, MapSpec, Overflow, FRAME};
-use crate::{procedural_default, Aabb, Camera, DirectionalLight};
+use crate::{procedural_default, Camera, DirectionalLight};
 
 /// Largest number of pixels of a translated copy whose visibility may differ from the original's, for
 /// translations by 1e3, 1e4 and 1e5 (0.05%, 0.15% and 0.5% of the frame). The passes work relative to the
@@ -20,15 +20,10 @@ const SCALED_DIFFERING_PIXELS: usize = 0;
 /// The cases of the `scale` family, in table order.
 pub(super) fn scale() -> Vec<HardCase> {
     let base = procedural_default();
-    let mut focus = Aabb::empty();
-    for o in base.objects.iter().filter(|o| o.name != "ground") {
-        for t in o.first_triangle..o.first_triangle + o.triangle_count {
-            base.triangle(t as usize)
-                .into_iter()
-                .for_each(|p| focus.extend(p));
-        }
-    }
-    let camera = Camera::frame(&focus, FRAME.width as f32 / FRAME.height as f32);
+    let camera = Camera::frame(
+        &base.focus_bounds(),
+        FRAME.width as f32 / FRAME.height as f32,
+    );
     let light = DirectionalLight::slanted().direction;
     let map = MapSpec {
         overflow: Overflow::Allowed,
