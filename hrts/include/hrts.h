@@ -989,7 +989,7 @@ typedef struct HrtsFrameReport {
   // Bytes of each `HrtsResource` the plugin allocated (0: not allocated), with the buffers that serve
   // it: `HRTS_RESOURCE_PRIM_LIST_OFFSETS` counts the primitive map's other buffers,
   // `HRTS_RESOURCE_RT_VISIBILITY` an area trace's own buffers (light samples, edge tables, sample bands,
-  // tile history; those alone when the image is shared scratch: `map_scratch_bytes`).
+  // tile history; those alone when the light writes its layer of the output directly: `output_direct`).
   uint64_t resource_bytes[HRTS_RESOURCE_COUNT];
   // The `HrtsResource` copied into the output image (or written into it directly: `output_direct`).
   uint32_t output_resource;
@@ -999,7 +999,7 @@ typedef struct HrtsFrameReport {
   // Bytes of the scratch shared by the context's lights and frusta: the primitive map's (per-triangle bin
   // items, per-texel counts and receivers, and the screen-size texel of each pixel's ray origin; 0 if the
   // light has no primitive map), and the ray trace's visibility that the lights' FXAA read in the same
-  // recording call (hard or area shadows with antialiasing, its `HRTS_RESOURCE_RT_VISIBILITY` not in
+  // recording call (hard shadows with antialiasing, its `HRTS_RESOURCE_RT_VISIBILITY` not in
   // `extra_outputs`: it is then no resource of the light's own, and cannot be read back; a call that
   // records a light's ray trace without its FXAA gives the light an image of its own from then on).
   uint64_t map_scratch_bytes;
