@@ -1324,17 +1324,16 @@ fn mode_auto_shadows_a_zero_size_sun_hard_and_a_sized_lamp_area() {
     };
     config.pcss_angular_radius = 0.0;
     config.pcss_spot_radius = radius;
-    // The second frame: the first one's lists grow to what it needed.
-    let (reports, layers) = native_frame(
-        &device,
-        &file,
-        &[config, config],
-        vec![
+    // The second frame: the first one's lists grow to what it needed. Each light's layer copied into the
+    // output, or written into it directly.
+    let frame = |direct| {
+        let lights = vec![
             plugin_directional_light(direction, None),
             plugin_point_light(lamp),
-        ],
-        2,
-    );
+        ];
+        native_frame_to(&device, &file, (&[config, config], lights), 2, direct)
+    };
+    let (reports, layers) = frame(false);
     let (sun, lamp_report) = (&reports[0], &reports[1]);
     println!(
         "sun: {}\nlamp: {}",
@@ -1363,19 +1362,7 @@ fn mode_auto_shadows_a_zero_size_sun_hard_and_a_sized_lamp_area() {
     assert!(area_buffers > tiles, "{area_buffers}");
     // Written directly, the layers are the engine's: the same visibility, and the area trace's buffers
     // alone in the lamp's count.
-    let (direct_reports, direct_layers) = native_frame_to(
-        &device,
-        &file,
-        (
-            &[config, config],
-            vec![
-                plugin_directional_light(direction, None),
-                plugin_point_light(lamp),
-            ],
-        ),
-        2,
-        true,
-    );
+    let (direct_reports, direct_layers) = frame(true);
     assert!(direct_reports.iter().all(|r| r.output_direct));
     assert!(
         direct_layers == layers,
