@@ -406,14 +406,23 @@ fn area_shadows_through_the_bvh_equal_the_lists_bit_for_bit() {
 /// A tile of pixels most of whose bundles gave up in the last frame skips them (the tile history,
 /// `passes::ray_trace::TILE_SKIP_FRAMES`): its pixels walk each sample at once, and the counts stay those
 /// of the lists and the reference. A tile skips 9 to 16 frames, by tile, then tries its bundles again for a
-/// frame: the skipping pixels dip in frames 10 to 17, never all at once, and are back in frame 18.
+/// frame: the skipping pixels dip in frames 10 to 17, never all at once, and are back in frame 18. A spot
+/// light given to the same pipeline next clears the history: its first frame skips nothing, its second
+/// skips where its own bundles gave up, and both count as its lists do.
 #[test]
 fn area_tiles_whose_bundles_gave_up_skip_them_with_the_same_counts() {
     let device = device();
     let view = plate_and_box_view(96, 72);
     let rs = RefScene::new(&view.scene);
     let (radius, samples) = (0.15, 64);
-    let config = |map, budget| area_config(map, radius, samples, budget);
+    let config = |map, budget| ShadowConfig {
+        pcss: PcssConfig {
+            // The spot light's emitter, a quarter of its distance to the plate: its bundles are wide.
+            spot_radius: 1.0,
+            ..area_config(map, radius, samples, budget).pcss
+        },
+        ..area_config(map, radius, samples, budget)
+    };
     let [(_, lists), (_, bvh), _] = routes(PrimitiveMapConfig {
         size: 128,
         binning: BinningRequest::Compute,
@@ -452,5 +461,32 @@ fn area_tiles_whose_bundles_gave_up_skip_them_with_the_same_counts() {
         "{skipping:?}"
     );
     assert_eq!(skipping[18], all, "{skipping:?}");
+    let mut spot_inputs = view.frame_inputs();
+    spot_inputs.light =
+        passes::spot_light_frusta(Vec3::new(0.0, 4.0, 0.4), Vec3::NEG_Y, 0.8, None)[0];
+    let mut spot_lists =
+        ShadowRenderer::new(&device, &view, config(lists, DEFAULT_BUNDLE_WALK_BUDGET))
+            .expect("renderer");
+    spot_lists.render(&device, &spot_inputs).expect("render");
+    let spot_listed = spot_lists.read_back(&device, false).expect("read back");
+    let mut spot_skipping = Vec::new();
+    for frame in 0..2 {
+        let st = r.render(&device, &spot_inputs).expect("render").stats;
+        println!("spot frame {frame}: {st:?}");
+        assert!(
+            st.pixels_walked_per_sample > 0,
+            "spot frame {frame}: {st:?}"
+        );
+        let images = r.read_back(&device, false).expect("read back");
+        assert!(
+            images.output == spot_listed.output,
+            "spot frame {frame}: the counts differ from the lists'"
+        );
+        spot_skipping.push(st.pixels_skipping_bundle);
+    }
+    assert!(
+        spot_skipping[0] == 0 && spot_skipping[1] > 0,
+        "the sun's tile history was not cleared: {spot_skipping:?}"
+    );
     assert_no_validation_errors(&device);
 }
