@@ -288,9 +288,11 @@ fn run_gbuffer_bench(device: &Device, args: &BenchArgs, models: &[BenchModel]) -
     Ok(out)
 }
 
-/// Renders the built-in scene at the benchmark's size for about a second of GPU work, so that the first
-/// configuration measured does not pay for a GPU still clocking up (seen on an H100: the first light 4x
-/// slower than the same light measured later).
+/// Renders the built-in scene at the benchmark's size for two seconds of frames (and at least
+/// [`WARM_UP_FRAMES`]) once its pipelines exist, so that the first configuration measured does not pay for
+/// a GPU still clocking up (seen on an H100: the first light 4x slower than the same light measured later;
+/// on an H200 freshly started, the first light 4x slower while the clock ran from before the pipelines
+/// were built).
 fn warm_up(device: &Device, args: &BenchArgs) -> Result<()> {
     let bar = host_demo::progress(1, "bench warm-up");
     bar.set_message(format!(
@@ -298,14 +300,19 @@ fn warm_up(device: &Device, args: &BenchArgs) -> Result<()> {
         args.width, args.height
     ));
     let view = View::framed(scene::procedural_default(), args.width, args.height);
-    let started = std::time::Instant::now();
     let (mut renderer, _) = frames_of(device, &view, ShadowConfig::default(), 2)?;
     let inputs = view.frame_inputs();
-    while started.elapsed() < std::time::Duration::from_secs(1) {
+    let started = std::time::Instant::now();
+    let mut frames = 0;
+    while frames < WARM_UP_FRAMES || started.elapsed() < std::time::Duration::from_secs(2) {
         renderer.render(device, &inputs)?;
+        frames += 1;
     }
     Ok(())
 }
+
+/// The fewest frames of the benchmark's warm-up ([`warm_up`]).
+const WARM_UP_FRAMES: u32 = 20;
 
 /// Entry point of the subcommand on the device the command line names (a name filter, validation
 /// layers): prints the tables and writes them to `out` if given. What to measure is settled first, so
