@@ -53,24 +53,10 @@ pub struct CameraArgs {
 }
 
 impl CameraArgs {
-    /// `camera` moved as these options say ([`camera_with`]).
+    /// `camera` moved as these options say ([`Camera::placed`]).
     pub fn apply(&self, camera: Camera, bounds: &Aabb) -> Result<Camera> {
-        camera_with(camera, bounds, self.camera_pos, self.camera_target)
+        Ok(camera.placed(bounds, self.camera_pos, self.camera_target)?)
     }
-}
-
-/// `camera` moved to `position` and looking at `target` where given ([`Camera::placed`]).
-///
-/// # Errors
-///
-/// The position and the target coincide.
-pub fn camera_with(
-    camera: Camera,
-    bounds: &Aabb,
-    position: Option<Vec3>,
-    target: Option<Vec3>,
-) -> Result<Camera> {
-    Ok(camera.placed(bounds, position, target)?)
 }
 
 /// `command` and its subcommands with negative values allowed on the options of numbers: an option of

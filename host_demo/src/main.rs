@@ -197,15 +197,19 @@ fn render_scene(cli: &Cli, args: &RenderArgs, path: &Path) -> Result<()> {
     if args.frames < 2 {
         bail!("--frames must be at least 2 with --scene: the second frame's report shows what was kept");
     }
-    let base = |world_space_scale| args.soft.config(map_config(args), world_space_scale);
-    let planned = load_and_plan(path, &scene_request(args, &base))?;
+    let planned = load_and_plan(path, &scene_request(args, &render_base(args)))?;
     if args.still {
         println!("{STILL}");
     }
     render_planned(cli, args, path, &planned)
 }
 
-/// The plan request of `render`'s command line, with the base configuration `base`.
+/// The base configuration of `render`'s command line for a scene of the given world-space scale.
+fn render_base(args: &RenderArgs) -> impl Fn(f32) -> hrts::Config + '_ {
+    move |world_space_scale| args.soft.config(map_config(args), world_space_scale)
+}
+
+/// The plan request of `render`'s command line, with the base configuration `base` ([`render_base`]).
 fn scene_request<'a>(args: &RenderArgs, base: &'a dyn Fn(f32) -> hrts::Config) -> PlanRequest<'a> {
     PlanRequest {
         width: args.size.width,
@@ -266,12 +270,7 @@ fn render(cli: &Cli, args: &RenderArgs) -> Result<()> {
         view.light =
             DirectionalLight::new(d).context("--light-dir must be a non-zero finite vector")?;
     }
-    view.camera = host_demo::cli::camera_with(
-        view.camera,
-        &view.scene.bounds(),
-        args.camera.camera_pos,
-        args.camera.camera_target,
-    )?;
+    view.camera = args.camera.apply(view.camera, &view.scene.bounds())?;
     let device = device(cli)?;
     let options = RenderOptions {
         map: map_config(args),
@@ -363,8 +362,7 @@ fn render_closed(
     interior: Interior,
 ) -> Result<()> {
     let file = host_demo::interior::scene_file(model, interior.light, interior.camera);
-    let base = |world_space_scale| args.soft.config(map_config(args), world_space_scale);
-    let planned = plan_file(file, &scene_request(args, &base))
+    let planned = plan_file(file, &scene_request(args, &render_base(args)))
         .with_context(|| format!("planning {}", path.display()))?;
     render_planned(cli, args, path, &planned)
 }
