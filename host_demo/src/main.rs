@@ -80,8 +80,8 @@ struct RenderArgs {
     #[command(flatten)]
     camera: host_demo::cli::CameraArgs,
     /// Primitive map size N: texels per side of the light-space grid fitted to the visible receivers (moves
-    /// cost, never exactness).
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::MAP_SIZE)))]
+    /// cost, never exactness); 0: the plugin's choice (512 for hard and area shadows, 1024 for the hybrid).
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=i64::from(host_demo::limits::MAP_SIZE)))]
     map_size: u32,
     /// Largest memory of the primitive map's list entries, in MiB (the lists grow to what frames need).
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..))]
@@ -132,8 +132,8 @@ struct PlanArgs {
     size: host_demo::cli::FrameSizeArgs,
     #[command(flatten)]
     camera: host_demo::cli::CameraArgs,
-    /// Primitive map size N.
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::MAP_SIZE)))]
+    /// Primitive map size N; 0: the plugin's choice (512 for hard and area shadows, 1024 for the hybrid).
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=i64::from(host_demo::limits::MAP_SIZE)))]
     map_size: u32,
     /// Shadow map size (square) of the sized lights.
     #[arg(long, default_value_t = 3072, value_parser = clap::value_parser!(u32).range(1..=i64::from(host_demo::limits::FRAME_SIDE)))]

@@ -323,7 +323,8 @@ pub fn render_to_folder(
     }
     bar.set_message("reading back and writing the outputs");
     let images = renderer.read_back(device, false).context("reading back")?;
-    let (w, h, n) = (view.width, view.height, options.map.map_size);
+    let last = reports.last().context("no frame rendered")?;
+    let (w, h, n) = (view.width, view.height, last.stats.map_size);
     write_exr_rgba(&out.join("position.exr"), w, h, &images.position)?;
     write_exr_rgba(&out.join("normal.exr"), w, h, &images.normal)?;
     let scalars = [

@@ -382,7 +382,11 @@ fn out_of_range_options_name_the_flag_and_the_range() {
                 "--map-budget-mb",
                 "1..",
             ),
-            (&["render", "--map-size", "0"], "--map-size", "1..=65535"),
+            (
+                &["render", "--map-size", "65536"],
+                "--map-size",
+                "0..=65535",
+            ),
             (&["render", "--width", "0"], "--width", "1..=16384"),
             (&["render", "--width", "-5"], "--width", "1..=16384"),
         ],

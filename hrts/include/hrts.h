@@ -28,7 +28,7 @@
 // - `hrts_context_create` refuses (`HRTS_RESULT_ERROR_VERSION`) another major version, a minor version
 //   newer than the library's, and 5.0, whose headers changed layouts without changing the version
 //   (`HrtsDraw` 72 then 76 bytes): its structs cannot be told apart.
-#define HRTS_API_VERSION ((5 << 22) | (10 << 12))
+#define HRTS_API_VERSION ((5 << 22) | (11 << 12))
 
 // The most lights one context shades (`hrts_configure_lights`); a point light counts once.
 #define HRTS_MAX_LIGHTS 64
@@ -558,7 +558,9 @@ typedef struct HrtsConfig {
   // follows the camera and is rebuilt every frame.
   HrtsBool static_light;
   // Primitive map N: texels per side of the light-space grid fitted to the receivers each frame,
-  // 1..=max_map_size (default 1024). It moves cost, never exactness.
+  // 1..=max_map_size, or 0 (the default) for the plugin's choice by trace: 512 for hard and area
+  // shadows, 1024 for the hybrid (`HrtsFrameReport::map_size` and `HrtsLightPlan::map_size` say which).
+  // It moves cost, never exactness. API 5.11: 0 was refused before, and the default was 1024.
   uint32_t map_size;
   // Largest memory of the primitive map's list entries in KiB, at least 4 (default 262144 = 256 MiB,
   // capped by the device's largest storage buffer). The lists take what the frame needs and grow to
@@ -953,6 +955,10 @@ typedef struct HrtsLightPlan {
   // what its passes write, held by the light or shared by the context's lights (the report's
   // `resource_bytes` counts those the light holds). 0 when out of view.
   uint32_t resources;
+  // N of the light's primitive map (`HrtsFrameReport::map_size`): the configuration's, or the plugin's
+  // choice for the trace of its mode; 0 when its plan has no primitive map or it is out of view. API
+  // 5.11: written for callers of 5.11 and later.
+  uint32_t map_size;
 } HrtsLightPlan;
 
 // GPU time of one pass.
@@ -1069,6 +1075,13 @@ typedef struct HrtsFrameReport {
   // its bundles gave up in an earlier frame, so that each of their open samples walked the BVH on its
   // own. API 5.10: written for callers of 5.10 and later.
   uint32_t pixels_walked_per_sample;
+  // Reserved, written 0: API 5.10's report ends with this padding, which no later field may take.
+  uint32_t reserved_5_10;
+  // N of the light's primitive map (`HrtsConfig::map_size`, or the plugin's choice for the light's
+  // trace); 0 if its passes have none. API 5.11: written for callers of 5.11 and later.
+  uint32_t map_size;
+  // Reserved, written 0: keeps the report a multiple of 8 bytes, which no later field may take.
+  uint32_t reserved_5_11;
 } HrtsFrameReport;
 
 // Every result, in value order.

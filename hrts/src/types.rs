@@ -26,7 +26,7 @@ use std::ffi::c_char;
 /// - `hrts_context_create` refuses (`HRTS_RESULT_ERROR_VERSION`) another major version, a minor version
 ///   newer than the library's, and 5.0, whose headers changed layouts without changing the version
 ///   (`HrtsDraw` 72 then 76 bytes): its structs cannot be told apart.
-pub const HRTS_API_VERSION: u32 = 5 << 22 | 10 << 12;
+pub const HRTS_API_VERSION: u32 = 5 << 22 | 11 << 12;
 
 /// A flag in the C structs: 0 is false, any other value true. (A Rust `bool` would make any byte but 0
 /// and 1 undefined behaviour when the engine writes it.)
@@ -467,7 +467,9 @@ pub struct HrtsConfig {
     /// follows the camera and is rebuilt every frame.
     pub static_light: HrtsBool,
     /// Primitive map N: texels per side of the light-space grid fitted to the receivers each frame,
-    /// 1..=max_map_size (default 1024). It moves cost, never exactness.
+    /// 1..=max_map_size, or 0 (the default) for the plugin's choice by trace: 512 for hard and area
+    /// shadows, 1024 for the hybrid (`HrtsFrameReport::map_size` and `HrtsLightPlan::map_size` say which).
+    /// It moves cost, never exactness. API 5.11: 0 was refused before, and the default was 1024.
     pub map_size: u32,
     /// Largest memory of the primitive map's list entries in KiB, at least 4 (default 262144 = 256 MiB,
     /// capped by the device's largest storage buffer). The lists take what the frame needs and grow to
@@ -972,6 +974,13 @@ pub struct HrtsFrameReport {
     /// its bundles gave up in an earlier frame, so that each of their open samples walked the BVH on its
     /// own. API 5.10: written for callers of 5.10 and later.
     pub pixels_walked_per_sample: u32,
+    /// Reserved, written 0: API 5.10's report ends with this padding, which no later field may take.
+    pub reserved_5_10: u32,
+    /// N of the light's primitive map (`HrtsConfig::map_size`, or the plugin's choice for the light's
+    /// trace); 0 if its passes have none. API 5.11: written for callers of 5.11 and later.
+    pub map_size: u32,
+    /// Reserved, written 0: keeps the report a multiple of 8 bytes, which no later field may take.
+    pub reserved_5_11: u32,
 }
 
 /// What the plugin would do with one light in a view, decided without a context or a device
@@ -1001,6 +1010,10 @@ pub struct HrtsLightPlan {
     /// what its passes write, held by the light or shared by the context's lights (the report's
     /// `resource_bytes` counts those the light holds). 0 when out of view.
     pub resources: u32,
+    /// N of the light's primitive map (`HrtsFrameReport::map_size`): the configuration's, or the plugin's
+    /// choice for the trace of its mode; 0 when its plan has no primitive map or it is out of view. API
+    /// 5.11: written for callers of 5.11 and later.
+    pub map_size: u32,
 }
 
 /// A copy of a plugin resource into an engine buffer, recorded after a complete frame.

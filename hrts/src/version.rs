@@ -74,8 +74,8 @@ versions! {
     HrtsFrame => [(240, 1), (256, 8)] versioned;
     HrtsResourceInfo => [(32, 1)] versioned;
     HrtsResourceReadback => [(48, 1)] versioned;
-    HrtsFrameReport => [(5560, 1), (5568, 4), (5592, 9), (5600, 10)] versioned;
-    HrtsLightPlan => [(156, 10)] versioned;
+    HrtsFrameReport => [(5560, 1), (5568, 4), (5592, 9), (5600, 10), (5608, 11)] versioned;
+    HrtsLightPlan => [(156, 10), (160, 11)] versioned;
     HrtsDraw => [(76, 1)];
     HrtsLight => [(100, 1)];
     HrtsMeshVertices => [(32, 1)];
@@ -115,6 +115,8 @@ const _: () = {
     assert!(offset_of!(HrtsConfig, map_list_limit) == 112);
     assert!(offset_of!(HrtsFrameReport, texels_past_limit) == 5568);
     assert!(offset_of!(HrtsFrameReport, pixels_walked_per_sample) == 5592);
+    assert!(offset_of!(HrtsFrameReport, map_size) == 5600);
+    assert!(offset_of!(HrtsLightPlan, map_size) == 156);
     assert!(offset_of!(HrtsConfig, area_walk_budget) == 120);
 };
 

@@ -198,7 +198,7 @@ fn run_bench(device: &Device, args: &BenchArgs, models: &[BenchModel]) -> Result
         caps.driver,
         args.width,
         args.height,
-        PrimitiveMapConfig::default().size,
+        PrimitiveMapConfig::default().for_nearest_hit().size,
         passes::ShadowMapConfig::default().size,
         args.frames.max(2) - 1
     );

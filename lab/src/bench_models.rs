@@ -103,8 +103,9 @@ pub struct BenchArgs {
     /// the bench measured, through the scene's plan.
     #[arg(long, requires = "point_lights")]
     pub write_scenes: Option<std::path::PathBuf>,
-    /// With --lights: the primitive map's N (texels per side; a point light's cube faces share N²).
-    #[arg(long, default_value_t = hrts::Config::default().map_size, requires = "lights", value_parser = clap::value_parser!(u32).range(1..=i64::from(u16::MAX)))]
+    /// With --lights: the primitive map's N (texels per side; a point light's cube faces share N²); 0: the
+    /// plugin's choice (512 for hard and area shadows, 1024 for the hybrid).
+    #[arg(long, default_value_t = hrts::Config::default().map_size, requires = "lights", value_parser = clap::value_parser!(u32).range(0..=i64::from(u16::MAX)))]
     pub map_size: u32,
 }
 

@@ -678,7 +678,13 @@ pub fn run_light_bench(device: &Device, args: &BenchArgs, scenes: &LightScenes) 
         } else {
             "hard shadows (zero-size lights)".to_owned()
         },
-        args.map_size,
+        match args.map_size {
+            0 => format!(
+                "{} (the plugin's choice for hard and area shadows)",
+                passes::TRACED_MAP_SIZE
+            ),
+            n => n.to_string(),
+        },
         args.frames.max(2) - 1,
         match (args.copied_output, args.output_format.to_uppercase()) {
             (true, format) if format == "R32F" =>

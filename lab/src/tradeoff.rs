@@ -174,7 +174,10 @@ pub fn methods(angular_radius: f32, wss: f32) -> Vec<Method> {
             config: ShadowConfig {
                 mode: ShadowMode::Hard,
                 antialiasing,
-                map: PrimitiveMapConfig::default(),
+                map: PrimitiveMapConfig {
+                    size: 1024,
+                    ..PrimitiveMapConfig::default()
+                },
                 ..base
             },
             output: Output::Final,
@@ -215,7 +218,10 @@ pub fn methods(angular_radius: f32, wss: f32) -> Vec<Method> {
             name: format!("{samples} samples, 1024² map"),
             config: ShadowConfig {
                 mode: ShadowMode::Area,
-                map: PrimitiveMapConfig::default(),
+                map: PrimitiveMapConfig {
+                    size: 1024,
+                    ..PrimitiveMapConfig::default()
+                },
                 pcss: pcss(PenumbraFilter::Standard, 16, 32),
                 area: AreaConfig {
                     samples,

@@ -348,14 +348,16 @@ fn ray_dump_writes_what_the_embree_script_reads() {
     }
 }
 
-/// The sizes the help quotes for `bench` are the plugin's defaults.
+/// The sizes the help quotes for `bench` are the plugin's defaults (its choice of N for the default mode,
+/// the hybrid).
 #[test]
 fn bench_help_quotes_the_default_sizes() {
     let output = hrts_lab(&["--help"]);
     let help = String::from_utf8_lossy(&output.stdout).replace('\n', " ");
     let defaults = hrts::Config::default();
+    assert_eq!(defaults.mode, hrts::ShadowMode::Hybrid);
     for figure in [
-        format!("primitive map {}²", defaults.map_size),
+        format!("primitive map {}²", passes::NEAREST_HIT_MAP_SIZE),
         format!("shadow map {}²", defaults.shadow_map_size),
     ] {
         assert!(help.contains(&figure), "hrts_lab --help lacks '{figure}'");

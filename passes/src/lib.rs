@@ -48,7 +48,8 @@ pub use prim_buffer::{
 pub use primitive_map::{
     choose_binning_path, packed_offset_words, packed_texels, unpack_list_offsets, BinningPath,
     BinningRequest, FaceMode, ListOffsets, PrimitiveMapConfig, DEFAULT_ENTRY_BUDGET, GUARD_VALUE,
-    GUARD_WORDS, MIN_ENTRY_BUDGET, MIN_FITTED_ENTRIES,
+    GUARD_WORDS, MIN_ENTRY_BUDGET, MIN_FITTED_ENTRIES, NEAREST_HIT_MAP_SIZE, PLUGINS_CHOICE_SIZE,
+    TRACED_MAP_SIZE,
 };
 pub use retire::MAX_FRAMES_IN_FLIGHT;
 pub use shadow_map::ShadowMapConfig;

@@ -35,7 +35,7 @@ enum {
     CREATE_NULL_INFO, CREATE_NULL_OUT, CREATE_STRUCT_SIZE, CREATE_VERSION, CREATE_NULL_DEVICE, CREATE_NULL_GIPA,
     CREATE_DEVICE_STRUCT_SIZE, CREATE_FRAMES_IN_FLIGHT, CREATE_UNSUPPORTED_EXTENSION, CREATE_NO_SUCH_QUEUE_FAMILY,
     CREATE_NO_SUCH_QUEUE, CREATE_MISALIGNED_DEVICE, CREATE_MISALIGNED_EXTENSIONS, CREATE_NEWER_MINOR,
-    CREATE_VERSION_5_0, CAPS_NULL_CONTEXT, CAPS_NULL_OUT, CAPS_STRUCT_SIZE, CONFIG_N_ZERO, CONFIG_N_ABSURD,
+    CREATE_VERSION_5_0, CAPS_NULL_CONTEXT, CAPS_NULL_OUT, CAPS_STRUCT_SIZE, CONFIG_N_PAST_MAX, CONFIG_N_ABSURD,
     CONFIG_BUDGET_ZERO, CONFIG_BUDGET_SMALL, CONFIG_FACES, CONFIG_BINNING, CONFIG_STRUCT_SIZE, CONFIG_OLDER_SMALLER, CONFIG_MISALIGNED, CONFIG_MODE,
     CONFIG_NAN_LIGHT_SIZE, CONFIG_NEGATIVE_WSS, CONFIG_PCF_TAPS, CONFIG_SHADOW_MAP_ZERO, CONFIG_DEFAULTS_NULL,
     CONFIG_FILTER, CONFIG_EXTRA_OUTPUT, CONFIG_FILTER_RADII, CONFIG_SLOPE_BIAS, LIGHTS_ZERO, LIGHTS_TOO_MANY,
@@ -78,7 +78,7 @@ static const struct {
     [CAPS_NULL_CONTEXT] = {"capabilities(NULL context)", HRTS_RESULT_ERROR_NULL_POINTER},
     [CAPS_NULL_OUT] = {"capabilities(NULL out)", HRTS_RESULT_ERROR_NULL_POINTER},
     [CAPS_STRUCT_SIZE] = {"capabilities(wrong size)", HRTS_RESULT_ERROR_STRUCT_SIZE},
-    [CONFIG_N_ZERO] = {"configure(N = 0)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
+    [CONFIG_N_PAST_MAX] = {"configure(N = max_map_size + 1)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [CONFIG_N_ABSURD] = {"configure(absurd N)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [CONFIG_BUDGET_ZERO] = {"configure(entry budget 0)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
     [CONFIG_BUDGET_SMALL] = {"configure(entry budget below 4 KiB)", HRTS_RESULT_ERROR_INVALID_ARGUMENT},
@@ -249,7 +249,10 @@ static HrtsResult misuse_call(int id, Misuse *m) {
     case CAPS_NULL_CONTEXT: return hrts_get_capabilities(NULL, &caps);
     case CAPS_NULL_OUT: return hrts_get_capabilities(ctx, NULL);
     case CAPS_STRUCT_SIZE: caps.struct_size = 4; return hrts_get_capabilities(ctx, &caps);
-    case CONFIG_N_ZERO: c.map_size = 0; return hrts_configure(ctx, &c);
+    case CONFIG_N_PAST_MAX:
+        if (hrts_get_capabilities(ctx, &caps) != HRTS_RESULT_OK) return HRTS_RESULT_ERROR_INTERNAL;
+        c.map_size = caps.max_map_size + 1;
+        return hrts_configure(ctx, &c);
     case CONFIG_N_ABSURD: c.map_size = 1u << 30; return hrts_configure(ctx, &c);
     case CONFIG_BUDGET_ZERO: c.map_entry_budget_kib = 0; return hrts_configure(ctx, &c);
     case CONFIG_BUDGET_SMALL: c.map_entry_budget_kib = 3; return hrts_configure(ctx, &c);

@@ -125,8 +125,9 @@ fn both(
     )
 }
 
-/// The statistics of the Rust passes' report, in the order of the plugin's [`hrts::MapStats`].
-fn direct_stats(r: &FrameReport) -> hrts::MapStats {
+/// The statistics of the Rust passes' report for `config`, in the order of the plugin's
+/// [`hrts::MapStats`].
+fn direct_stats(r: &FrameReport, config: &ShadowConfig) -> hrts::MapStats {
     let st = &r.stats;
     hrts::MapStats {
         receiver_pixels: st.receiver_pixels,
@@ -145,6 +146,7 @@ fn direct_stats(r: &FrameReport) -> hrts::MapStats {
         pixels_walked: st.pixels_walked,
         walks_unfinished: st.walks_unfinished,
         pixels_walked_per_sample: st.pixels_walked_per_sample,
+        map_size: config.built_map().map_or(0, |m| m.size),
     }
 }
 
@@ -175,7 +177,11 @@ fn check(name: &str, view: &View, config: ShadowConfig, frames: usize, with_indi
         plugin_report.binning_path.name(),
         "{name}"
     );
-    assert_eq!(direct_stats(&direct_report), plugin_report.stats, "{name}");
+    assert_eq!(
+        direct_stats(&direct_report, &config),
+        plugin_report.stats,
+        "{name}"
+    );
     // The Rust demo renderer keeps the prim buffer for its G-buffer in every mode; the plugin builds it
     // only when a pass of its plan reads it (the demo, as an engine, draws from its own buffers). The
     // output copy is the plugin's own.

@@ -99,6 +99,8 @@ pub struct ShadowedLight {
     pub passes: hrts::PassMask,
     /// The resources of the light's plan, as the plugin plans them ([`hrts::LightPlan::resources`]).
     pub resources: hrts::ResourceSet,
+    /// N of its primitive map, as the plugin chooses it ([`hrts::LightPlan::map_size`]; 0 without one).
+    pub map_size: u32,
     /// The light as the plugin takes it.
     pub light: hrts::Light,
     /// The frusta the plugin shadows it through, by name: "whole" for one, else cube faces ("+X" ...
@@ -302,7 +304,7 @@ impl ScenePlan {
             let c = &shadowed.resolved_config();
             let _ = writeln!(
                 s,
-                "      config: {}, FXAA {}, static_light {}, dynamic_geometry {}, map {}², shadow map {}",
+                "      config: {}, FXAA {}, static_light {}, dynamic_geometry {}, primitive map {}, shadow map {}",
                 match (shadowed.config.mode, c.mode) {
                     (ShadowMode::Auto, ShadowMode::Area) => "auto: area (sized light)".to_owned(),
                     (ShadowMode::Auto, _) => "auto: hard (zero-size light)".to_owned(),
@@ -315,7 +317,11 @@ impl ScenePlan {
                 },
                 c.static_light,
                 c.dynamic_geometry,
-                c.map_size,
+                match (shadowed.map_size, c.map_size) {
+                    (0, _) => "none".to_owned(),
+                    (n, 0) => format!("{n}x{n} (the plugin's choice)"),
+                    (n, _) => format!("{n}x{n}"),
+                },
                 if shadowed.resources.contains(hrts::Resource::ShadowMap) {
                     format!("{0}x{0}", c.shadow_map_size)
                 } else {
@@ -684,6 +690,7 @@ fn shadowed(config: Config, plugin_light: hrts::Light, plan: &hrts::LightPlan) -
         mode: plan.mode,
         passes: plan.passes,
         resources: plan.resources,
+        map_size: plan.map_size,
         light: plugin_light,
         frusta: plan.frustum_names,
     }))

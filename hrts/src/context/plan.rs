@@ -37,9 +37,13 @@ pub(crate) fn plan_lights(configs: &[HrtsConfig], f: &HrtsFrame) -> ApiResult<Ve
             let (decision, reason) = schedule.decision();
             let recorded = schedule.recorded.iter().filter(|&&r| r).count() as u32;
             let config = light.shape().config(config);
-            let (passes, resources) = match decision {
-                HrtsLightDecision::Shadowed => plan_bits(&FramePlan::derive(config.plan_request())),
-                HrtsLightDecision::OutOfView => (0, 0),
+            let (passes, resources, map_size) = match decision {
+                HrtsLightDecision::Shadowed => {
+                    let (passes, resources) = plan_bits(&FramePlan::derive(config.plan_request()));
+                    let map_size = config.built_map().map_or(0, |m| m.size);
+                    (passes, resources, map_size)
+                }
+                HrtsLightDecision::OutOfView => (0, 0, 0),
             };
             HrtsLightPlan {
                 struct_size: 0,
@@ -50,6 +54,7 @@ pub(crate) fn plan_lights(configs: &[HrtsConfig], f: &HrtsFrame) -> ApiResult<Ve
                 decision_reason: reason_to_c(&reason),
                 passes,
                 resources,
+                map_size,
             }
         })
         .collect())

@@ -56,6 +56,9 @@ impl Context {
         let first_pipeline = &passes.frusta[0];
         out.binning_path = binning_path_to_c(first_pipeline.binning_path()) as u32;
         out.tier = first_pipeline.binning_path().tier() as u32;
+        out.map_size = first_pipeline
+            .primitive_map()
+            .map_or(0, |m| m.config().size);
         let sum = |f: fn(&FrameReport) -> u32| {
             reports.iter().map(f).fold(0u32, |a, b| a.saturating_add(b))
         };

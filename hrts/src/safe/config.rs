@@ -6,8 +6,8 @@ use crate::types::HrtsConfig;
 
 /// One light's configuration: what the plugin computes and with which settings. Each field is the
 /// `HrtsConfig` field of the same name (its documentation in `hrts.h` states ranges and versions).
-/// [`Config::default`] is what `hrts_config_defaults` fills: hybrid shadows with FXAA, primitive map
-/// 1024×1024, both faces, automatic binning, 3K shadow map, shrinking PCSS. A configuration is checked
+/// [`Config::default`] is what `hrts_config_defaults` fills: hybrid shadows with FXAA, the plugin's choice
+/// of primitive map N (1024 for the hybrid), both faces, automatic binning, 3K shadow map, shrinking PCSS. A configuration is checked
 /// when it is given to [`Context::configure_lights`](crate::Context::configure_lights).
 ///
 /// ```
@@ -31,8 +31,9 @@ pub struct Config {
     /// The light does not move between frames: the shadow map is kept (default false).
     pub static_light: bool,
     /// Primitive map N: texels per side of the light-space grid fitted to the receivers each frame,
-    /// 1..=[`Capabilities::max_map_size`](crate::Capabilities::max_map_size) (default 1024). It moves
-    /// cost, never exactness.
+    /// 1..=[`Capabilities::max_map_size`](crate::Capabilities::max_map_size), or 0 (the default) for the
+    /// plugin's choice by trace: 512 for hard and area shadows, 1024 for the hybrid
+    /// ([`MapStats::map_size`](crate::MapStats::map_size) says which). It moves cost, never exactness.
     pub map_size: u32,
     /// Largest memory of the primitive map's list entries in KiB, at least 4 (default 262144).
     pub map_entry_budget_kib: u32,

@@ -7,7 +7,7 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 /// A call into the plugin that failed: the C function that failed, its `HrtsResult` and the message the
 /// plugin gave (`hrts_get_last_error`). Shown as `hrts_configure_lights: HRTS_RESULT_ERROR_INVALID_ARGUMENT
-/// (map_size 0 must be ...)`.
+/// (primitive map size 70000 must be ...)`.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("{call}: {} ({message})", code.c_name())]
 pub struct Error {

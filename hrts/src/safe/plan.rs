@@ -41,6 +41,9 @@ pub struct LightPlan {
     /// The resources of its plan (held by the light or shared by the context's lights); none when out of
     /// view.
     pub resources: ResourceSet,
+    /// N of its primitive map: the configuration's [`Config::map_size`](crate::Config::map_size), or the
+    /// plugin's choice for the trace of its mode; 0 when its plan has none or it is out of view.
+    pub map_size: u32,
     /// The names of the frusta it is planned through (shadowed and skipped), as reports name them: "cube"
     /// for a point light shadowed as one cube map, its faces ("+X" ... "-Z") for one shadowed face by face,
     /// a wide spot light's faces ("front", "right", "left", "up", "down"), else "whole".
@@ -72,6 +75,11 @@ pub struct LightPlan {
 /// assert!(hybrid.iter().all(|&p| plans[1].passes.contains(p)));
 /// assert!(plans[1].resources.contains(Resource::PrimListEntries));
 /// assert_eq!(plans[1].passes.iter().next().map(Pass::name), Some("prim buffer"));
+/// // The plugin's choice of the primitive map's N: 1024 for the hybrid's nearest-hit lists, 512 for
+/// // hard shadows.
+/// assert_eq!(plans[1].map_size, 1024);
+/// let hard = Config { mode: hrts::ShadowMode::Hard, ..Config::default() };
+/// assert_eq!(plan_lights(&[hard], &[near], &view)?[0].map_size, 512);
 /// # Ok::<(), hrts::Error>(())
 /// ```
 pub fn plan_lights(
@@ -123,6 +131,7 @@ pub fn plan_lights(
             decision_reason: [0; 128],
             passes: 0,
             resources: 0,
+            map_size: 0,
         };
         c_lights.len()
     ];
@@ -147,6 +156,7 @@ pub fn plan_lights(
                 reason: c_chars(&p.decision_reason),
                 passes: PassMask::from_bits(CALL, "passes", p.passes)?,
                 resources: ResourceSet::from_bits(CALL, "resources", p.resources)?,
+                map_size: p.map_size,
                 frustum_names: match light {
                     _ if frusta == 0 => &[],
                     Light::Point { .. } if frusta == 1 => &passes::CUBE_MAP_NAME,

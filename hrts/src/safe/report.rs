@@ -100,6 +100,9 @@ pub struct MapStats {
     /// skipped it since most of its bundles gave up in an earlier frame, so that each of their open samples
     /// walked the BVH on its own.
     pub pixels_walked_per_sample: u32,
+    /// N of the light's primitive map ([`Config::map_size`](crate::Config::map_size), or the plugin's
+    /// choice for the light's trace); 0 if its passes have none.
+    pub map_size: u32,
 }
 
 impl MapStats {
@@ -217,6 +220,7 @@ impl FrameReport {
                 pixels_walked: r.pixels_walked,
                 walks_unfinished: r.walks_unfinished,
                 pixels_walked_per_sample: r.pixels_walked_per_sample,
+                map_size: r.map_size,
             },
             map_to_texels: Mat4::from_cols_array(&r.map_to_texels),
             light_builds: r.light_builds,

@@ -129,7 +129,9 @@ pub fn choose_binning_path(
 /// Size and behaviour of the primitive map. No setting trades exactness: every one only moves cost.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PrimitiveMapConfig {
-    /// N: texels per side of the light-space grid fitted to the receivers (default 1024).
+    /// N: texels per side of the light-space grid fitted to the receivers. 0 (the default,
+    /// [`PLUGINS_CHOICE_SIZE`]): the plugin's choice by trace, [`TRACED_MAP_SIZE`] for hard and area
+    /// shadows, [`NEAREST_HIT_MAP_SIZE`] for the hybrid (through [`PrimitiveMapConfig::for_nearest_hit`]).
     pub size: u32,
     /// Faces stored.
     pub faces: FaceMode,
@@ -178,6 +180,22 @@ pub struct PrimitiveMapConfig {
 /// Default [`PrimitiveMapConfig::list_limit`]: the plugin's choice by mode.
 pub const DEFAULT_LIST_LIMIT: u32 = 0;
 
+/// Default [`PrimitiveMapConfig::size`]: the plugin's choice by trace.
+pub const PLUGINS_CHOICE_SIZE: u32 = 0;
+
+/// N for traces that stop at a ray's first blocker (hard and area shadows) under [`PLUGINS_CHOICE_SIZE`].
+/// On an H200 at 1080p, against 1024: 16 hard point lights 15 % faster in Sponza and 6 % in the conference
+/// room (64 lights 14 and 4 %), each single hard light as fast or faster with 40-60 % less memory, an area
+/// sun 7-19 % faster, sized point lights either way (16 of them 19 and 6 % faster, one of 11.7 m in the
+/// conference room 8 % slower); at 4K, 16 point lights 6 % faster and 1 % slower (docs/h200/map_size,
+/// docs/h200/map_choice).
+pub const TRACED_MAP_SIZE: u32 = 512;
+
+/// N for traces that find each ray's nearest blocker (the hybrid's blocker distance) under
+/// [`PLUGINS_CHOICE_SIZE`]: their longer lists gain from the finer grid (on an H200 at 1080p the hybrid's
+/// sun and hard shadows with the blocker distance took up to 2 % and 7 % longer at 512).
+pub const NEAREST_HIT_MAP_SIZE: u32 = 1024;
+
 /// The list limit of hard shadows (a ray's first blocker decides it) under [`DEFAULT_LIST_LIMIT`]. On an
 /// H200 at 1080p with the rays' BVH (`crate::bvh`), the conference room's point lights traced 5-33 % faster
 /// at 256 than at 1024 (the lists of up to 846 entries around its chairs walk the BVH instead), the trace
@@ -214,7 +232,7 @@ const MIN_GRID: u32 = 16;
 impl Default for PrimitiveMapConfig {
     fn default() -> Self {
         Self {
-            size: Self::DEFAULT_SIZE,
+            size: PLUGINS_CHOICE_SIZE,
             faces: FaceMode::Both,
             binning: BinningRequest::Auto,
             entry_budget: DEFAULT_ENTRY_BUDGET,
@@ -231,25 +249,25 @@ impl Default for PrimitiveMapConfig {
 }
 
 impl PrimitiveMapConfig {
-    /// The default N: texels per side.
-    pub const DEFAULT_SIZE: u32 = 1024;
-
-    /// Checks the configuration against the device limits.
+    /// Checks the configuration against the device limits (under [`PLUGINS_CHOICE_SIZE`], the sizes the
+    /// plugin may choose).
     pub fn validate(&self, caps: &Capabilities) -> Result<(), PassError> {
         let max = caps.max_image_dimension_2d.min(u32::from(u16::MAX));
-        if self.size == 0 || self.size > max {
+        if self.size > max {
             return Err(PassError::InvalidConfig(format!(
-                "primitive map size {} must be in 1..={max}",
+                "primitive map size {} must be in 1..={max}, or 0 for the plugin's choice",
                 self.size
             )));
         }
-        let grid = (self.texels() + 1) * 4;
-        if grid > caps.max_storage_buffer_range {
-            return Err(PassError::InvalidConfig(format!(
-                "primitive map size {}: its {} bytes of list offsets exceed the device's largest storage \
-                 buffer ({} bytes)",
-                self.size, grid, caps.max_storage_buffer_range
-            )));
+        for chosen in [self.with_size_for(false), self.with_size_for(true)] {
+            let grid = (chosen.texels() + 1) * 4;
+            if grid > caps.max_storage_buffer_range {
+                return Err(PassError::InvalidConfig(format!(
+                    "primitive map size {}: its {} bytes of list offsets exceed the device's largest \
+                     storage buffer ({} bytes)",
+                    chosen.size, grid, caps.max_storage_buffer_range
+                )));
+            }
         }
         if self.cube && !matches!(self.binning, BinningRequest::Auto | BinningRequest::Compute) {
             return Err(PassError::InvalidConfig(
@@ -284,13 +302,28 @@ impl PrimitiveMapConfig {
     }
 
     /// This configuration for a map whose trace finds each ray's nearest blocker (the hybrid's blocker
-    /// distance): the plugin's choice of list limit is then [`NEAREST_HIT_LIST_LIMIT`].
+    /// distance): the plugin's choices of list limit and N are then [`NEAREST_HIT_LIST_LIMIT`] and
+    /// [`NEAREST_HIT_MAP_SIZE`].
     pub fn for_nearest_hit(self) -> Self {
         let list_limit = match self.list_limit {
             DEFAULT_LIST_LIMIT => NEAREST_HIT_LIST_LIMIT,
             limit => limit,
         };
-        Self { list_limit, ..self }
+        Self {
+            list_limit,
+            ..self.with_size_for(true)
+        }
+    }
+
+    /// This configuration with N resolved: under [`PLUGINS_CHOICE_SIZE`], [`NEAREST_HIT_MAP_SIZE`] for a
+    /// trace that finds each ray's `nearest_hit`, else [`TRACED_MAP_SIZE`]; a given N is kept.
+    pub fn with_size_for(self, nearest_hit: bool) -> Self {
+        let size = match (self.size, nearest_hit) {
+            (PLUGINS_CHOICE_SIZE, true) => NEAREST_HIT_MAP_SIZE,
+            (PLUGINS_CHOICE_SIZE, false) => TRACED_MAP_SIZE,
+            (size, _) => size,
+        };
+        Self { size, ..self }
     }
 
     /// The list limit in effect for hard shadows, or for area shadows if `area`.
@@ -311,11 +344,13 @@ impl PrimitiveMapConfig {
         }
     }
 
-    /// Texels of the map's grids together: N², and for a cube the minimum grid of each face besides.
+    /// Texels of the map's grids together: N², and for a cube the minimum grid of each face besides (N as
+    /// [`PrimitiveMapConfig::with_size_for`] a first-blocker trace resolves it).
     pub fn texels(&self) -> u64 {
-        let n2 = u64::from(self.size) * u64::from(self.size);
+        let n = self.with_size_for(false).size;
+        let n2 = u64::from(n) * u64::from(n);
         if self.cube {
-            let min_grid = u64::from(MIN_GRID.min(self.size)) + 1;
+            let min_grid = u64::from(MIN_GRID.min(n)) + 1;
             n2 + 6 * min_grid * min_grid
         } else {
             n2
@@ -348,7 +383,8 @@ impl PrimitiveMapConfig {
     /// The entry capacity a map starts with for `triangles`: [`PrimitiveMapConfig::initial_entries`], else
     /// two entries per texel (a ground plane under everything) plus four per triangle; within the budget.
     pub fn starting_entries(&self, caps: &Capabilities, triangles: u32) -> u32 {
-        let n2 = u64::from(self.size) * u64::from(self.size);
+        let n = self.with_size_for(false).size;
+        let n2 = u64::from(n) * u64::from(n);
         let estimate = match self.initial_entries {
             0 => (2 * n2 + 4 * u64::from(triangles)).max(65536),
             given => u64::from(given),
@@ -405,6 +441,30 @@ mod tests {
                 Err(PassError::Unsupported(what)) if what.contains("subgroup")
             ));
         }
+    }
+
+    #[test]
+    fn each_trace_gets_its_size_unless_one_is_given() {
+        let default = PrimitiveMapConfig::default();
+        assert_eq!(default.size, PLUGINS_CHOICE_SIZE);
+        assert_eq!(default.with_size_for(false).size, TRACED_MAP_SIZE);
+        assert_eq!(default.for_nearest_hit().size, NEAREST_HIT_MAP_SIZE);
+        let given = PrimitiveMapConfig {
+            size: 300,
+            ..default
+        };
+        assert_eq!(given.with_size_for(false).size, 300);
+        assert_eq!(given.for_nearest_hit().size, 300);
+        let c = caps(ConservativeRasterTier::Tier3, true);
+        assert!(default.validate(&c).is_ok());
+        let too_big = PrimitiveMapConfig {
+            size: c.max_image_dimension_2d + 1,
+            ..default
+        };
+        assert!(matches!(
+            too_big.validate(&c),
+            Err(PassError::InvalidConfig(_))
+        ));
     }
 
     #[test]
@@ -502,12 +562,16 @@ mod tests {
         let c = caps(ConservativeRasterTier::Tier3, true);
         let cube = PrimitiveMapConfig {
             cube: true,
+            size: 1024,
             ..PrimitiveMapConfig::default()
         };
         assert!(cube.validate(&c).is_ok());
         assert_eq!(cube.frusta(), 6);
         assert_eq!(cube.texels(), 1024 * 1024 + 6 * 17 * 17);
-        assert_eq!(PrimitiveMapConfig::default().texels(), 1024 * 1024);
+        assert_eq!(
+            PrimitiveMapConfig::default().texels(),
+            u64::from(TRACED_MAP_SIZE).pow(2)
+        );
         // Two (triangle, face) pairs per triangle, at least 1024, unless given.
         assert_eq!(cube.starting_pairs(10_000), 20_000);
         assert_eq!(cube.starting_pairs(10), 1024);
@@ -539,9 +603,12 @@ mod tests {
     #[test]
     fn config_limits() {
         let c = caps(ConservativeRasterTier::NotSupported, true);
-        let ok = PrimitiveMapConfig::default();
+        let ok = PrimitiveMapConfig {
+            size: 1024,
+            ..PrimitiveMapConfig::default()
+        };
         assert!(ok.validate(&c).is_ok());
-        assert!(PrimitiveMapConfig { size: 0, ..ok }.validate(&c).is_err());
+        assert!(PrimitiveMapConfig::default().validate(&c).is_ok());
         // 8192² offsets need 256 MiB: more than this device's 128 MiB storage buffers.
         assert!(PrimitiveMapConfig { size: 8192, ..ok }
             .validate(&c)

@@ -39,7 +39,7 @@ mod scratch;
 pub use config::{
     choose_binning_path, BinningPath, BinningRequest, FaceMode, PrimitiveMapConfig,
     DEFAULT_BIN_BUDGET, DEFAULT_ENTRY_BUDGET, DEFAULT_LIST_LIMIT, GUARD_VALUE, GUARD_WORDS,
-    MIN_ENTRY_BUDGET,
+    MIN_ENTRY_BUDGET, NEAREST_HIT_MAP_SIZE, PLUGINS_CHOICE_SIZE, TRACED_MAP_SIZE,
 };
 pub use offsets::{
     packed_offset_words, packed_texels, unpack_list_offsets, ListOffsets, OFFSET_GROUP,
@@ -211,6 +211,7 @@ impl PrimitiveMap {
     ) -> Result<Self, PassError> {
         let caps = device.capabilities();
         config.validate(caps)?;
+        let config = config.with_size_for(false);
         let path = choose_binning_path(caps, config.binning)?;
         let n = config.size;
         let texels = config.texels();

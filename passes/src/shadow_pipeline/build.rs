@@ -134,11 +134,7 @@ impl ShadowPipeline {
             None
         };
         let scratch_set = inputs.scratch_set % crate::MAP_SCRATCH_SETS;
-        // Whether the ray trace finds each ray's nearest blocker (the hybrid's blocker distance).
-        let nearest_hit = plan
-            .writes(PassId::RayTrace)
-            .contains(ResourceId::BlockerDistance);
-        let map = if runs(PassId::PrimitiveMap) {
+        let map = if let Some(map_config) = config.built_map() {
             let map_inputs = PrimitiveMapInputs {
                 prims: need_prims()?,
                 triangles: geometry.triangle_count(),
@@ -146,12 +142,6 @@ impl ShadowPipeline {
                 normal: inputs.normal,
                 occupancy_view: plan.resources().contains(ResourceId::Occupancy),
                 scratch: shared.map_scratch(scratch_set),
-            };
-            // A trace that finds the nearest blocker takes longer lists before it walks the BVH.
-            let map_config = if nearest_hit {
-                config.map.for_nearest_hit()
-            } else {
-                config.map
             };
             Some(PrimitiveMap::new(device, &map_inputs, map_config)?)
         } else {
@@ -198,7 +188,9 @@ impl ShadowPipeline {
                     }
                 } else {
                     RayTraceKind::Hard {
-                        blocker_distance: nearest_hit,
+                        blocker_distance: plan
+                            .writes(PassId::RayTrace)
+                            .contains(ResourceId::BlockerDistance),
                     }
                 },
                 ray_visibility,

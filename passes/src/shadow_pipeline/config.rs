@@ -2,7 +2,7 @@
 //! from which engine images ([`ShadowInputs`]).
 
 use crate::area::AreaConfig;
-use crate::frame_plan::{PlanRequest, ResourceSet, ShadowMode};
+use crate::frame_plan::{FramePlan, PassId, PlanRequest, ResourceId, ResourceSet, ShadowMode};
 use crate::hybrid::HybridConfig;
 use crate::light::Light;
 use crate::pcss::PcssConfig;
@@ -154,6 +154,23 @@ impl ShadowConfig {
         })
     }
 
+    /// The primitive map a pipeline of this (resolved) configuration builds, with the plugin's choices of N
+    /// and list limit made for its trace ([`PrimitiveMapConfig::for_nearest_hit`] where the trace finds
+    /// each ray's nearest blocker, the hybrid's blocker distance); `None` if its plan has no primitive map.
+    pub fn built_map(&self) -> Option<PrimitiveMapConfig> {
+        let plan = FramePlan::derive(self.plan_request());
+        let nearest_hit = plan
+            .writes(PassId::RayTrace)
+            .contains(ResourceId::BlockerDistance);
+        plan.runs(PassId::PrimitiveMap).then(|| {
+            if nearest_hit {
+                self.map.for_nearest_hit()
+            } else {
+                self.map.with_size_for(false)
+            }
+        })
+    }
+
     /// The frame-plan request of this configuration.
     pub fn plan_request(&self) -> PlanRequest {
         PlanRequest {
@@ -223,5 +240,33 @@ mod tests {
             assert_eq!(hybrid.auto_reason(directional), None);
         }
         assert!(auto.shadows_point_as_cube() && auto.resolved(false).shadows_point_as_cube());
+    }
+
+    /// Under the plugin's choice of N, a trace that stops at the first blocker (hard, area) gets the
+    /// coarser grid, the hybrid's nearest-hit trace the finer one; a given N is kept; a mode without a
+    /// primitive map builds none.
+    #[test]
+    fn the_built_map_takes_the_size_its_trace_chooses() {
+        use crate::primitive_map::{NEAREST_HIT_MAP_SIZE, TRACED_MAP_SIZE};
+        let with = |mode, size| ShadowConfig {
+            mode,
+            map: PrimitiveMapConfig {
+                size,
+                ..PrimitiveMapConfig::default()
+            },
+            ..ShadowConfig::default()
+        };
+        let size = |c: ShadowConfig| c.built_map().map(|m| m.size);
+        assert_eq!(size(with(ShadowMode::Hard, 0)), Some(TRACED_MAP_SIZE));
+        assert_eq!(size(with(ShadowMode::Area, 0)), Some(TRACED_MAP_SIZE));
+        assert_eq!(
+            size(with(ShadowMode::Hybrid, 0)),
+            Some(NEAREST_HIT_MAP_SIZE)
+        );
+        assert_eq!(size(ShadowConfig::default()), Some(NEAREST_HIT_MAP_SIZE));
+        assert_eq!(size(with(ShadowMode::Soft, 0)), None);
+        for mode in [ShadowMode::Hard, ShadowMode::Area, ShadowMode::Hybrid] {
+            assert_eq!(size(with(mode, 300)), Some(300));
+        }
     }
 }
