@@ -164,18 +164,23 @@ fn parse_document(
     if is_glb {
         check_glb_header(bytes).map_err(error)?;
     }
-    let gltf::Gltf { document, blob } =
-        gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| {
-            error(match e {
-                gltf::Error::Binary(e) => format!("malformed GLB: {e}"),
-                gltf::Error::Deserialize(e) if is_glb => format!("GLB JSON chunk: {e}"),
-                gltf::Error::Deserialize(e) => {
-                    format!("neither GLB nor glTF JSON: {e}")
-                }
-                e => e.to_string(),
-            })
-        })?;
-    let root = document.into_json();
+    let (json, blob) = if is_glb {
+        let glb = gltf::binary::Glb::from_slice(bytes)
+            .map_err(|e| error(format!("malformed GLB: {e}")))?;
+        (glb.json.into_owned(), glb.bin.map(|b| b.into_owned()))
+    } else {
+        (bytes.to_vec(), None)
+    };
+    let deserialize = |e: serde_json::Error| {
+        error(if is_glb {
+            format!("GLB JSON chunk: {e}")
+        } else {
+            format!("neither GLB nor glTF JSON: {e}")
+        })
+    };
+    let mut value: serde_json::Value = serde_json::from_slice(&json).map_err(deserialize)?;
+    without_unread_parts(&mut value);
+    let root: gltf::json::Root = serde_json::from_value(value).map_err(deserialize)?;
     let version = &root.asset.version;
     if version.split('.').next() != Some("2") {
         return Err(error(format!(
@@ -210,6 +215,27 @@ fn parse_document(
         return Err(error(format!("invalid glTF: {}", problems.join("; "))));
     }
     Ok((gltf::Document::from_json_without_validation(root), blob))
+}
+
+/// Removes what is not read and that the gltf crate's schema would refuse although a file may hold it
+/// (a texture without `source`, whose image an extension gives): images, textures, samplers, materials
+/// and each primitive's material.
+fn without_unread_parts(value: &mut serde_json::Value) {
+    let Some(root) = value.as_object_mut() else {
+        return;
+    };
+    for key in ["images", "textures", "samplers", "materials"] {
+        root.remove(key);
+    }
+    let meshes = root.get_mut("meshes").and_then(|m| m.as_array_mut());
+    for mesh in meshes.into_iter().flatten() {
+        let primitives = mesh.get_mut("primitives").and_then(|p| p.as_array_mut());
+        for primitive in primitives.into_iter().flatten() {
+            if let Some(primitive) = primitive.as_object_mut() {
+                primitive.remove("material");
+            }
+        }
+    }
 }
 
 /// Extensions whose content is read.

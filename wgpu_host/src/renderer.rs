@@ -3,12 +3,13 @@
 
 use crate::conventions::{Conventions, IndexType};
 use crate::meshes::{meshes_of, Mesh};
-use crate::shadows::{
-    self, shared_buffer, ShadowFrame, ShadowMesh, ShadowTargets, Shadows, SharedBuffer,
-};
 use anyhow::{bail, Context as _, Result};
 use glam::Mat4;
 use hrts::{FrameReport, NormalEncoding, NormalSpace, ShadowMode};
+use hrts_wgpu::{
+    self as shadows, shared_buffer, ReadBack, ShadowFrame, ShadowMesh, ShadowTargets, Shadows,
+    SharedBuffer,
+};
 use scene::{Aabb, Camera, DirectionalLight, Scene};
 
 /// The wgpu device, opened with what the plugin adopts.
@@ -31,13 +32,13 @@ impl Gpu {
         } else {
             wgpu::InstanceFlags::empty()
         };
-        let instance = wgpu::Instance::new(&wgpu::InstanceDescriptor {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
             backends: wgpu::Backends::VULKAN,
             flags,
-            ..Default::default()
+            ..wgpu::InstanceDescriptor::new_without_display_handle()
         });
         let filter = std::env::var("HRTS_DEVICE").unwrap_or_default();
-        let adapters = instance.enumerate_adapters(wgpu::Backends::VULKAN);
+        let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::VULKAN));
         let names: Vec<String> = adapters.iter().map(|a| a.get_info().name).collect();
         let adapter = adapters
             .into_iter()
@@ -370,13 +371,16 @@ impl Renderer {
         );
         let mut gbuffer = device.create_command_encoder(&Default::default());
         self.record_gbuffer(&mut gbuffer);
+        let lights = [hrts::Light::Directional {
+            direction: light.direction,
+            view_proj: Some(light.view_proj(&bounds)),
+        }];
         let frame = ShadowFrame {
             index: self.frame,
             view,
             proj,
             camera_position: camera.position,
-            light_direction: light.direction,
-            light_view_proj: light.view_proj(&bounds),
+            lights: &lights,
             bounds: [bounds.min, bounds.max],
         };
         let plugin = self
@@ -533,8 +537,8 @@ fn gbuffer_pipeline(
         primitive: wgpu::PrimitiveState::default(),
         depth_stencil: Some(wgpu::DepthStencilState {
             format: conventions.depth_format,
-            depth_write_enabled: true,
-            depth_compare: conventions.depth.compare(),
+            depth_write_enabled: Some(true),
+            depth_compare: Some(conventions.depth.compare()),
             stencil: Default::default(),
             bias: Default::default(),
         }),
@@ -552,7 +556,7 @@ fn gbuffer_pipeline(
                 conventions.view_z.map(Into::into),
             ],
         }),
-        multiview: None,
+        multiview_mask: None,
         cache: None,
     });
     let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -598,7 +602,7 @@ fn shade_pipeline(
             compilation_options: Default::default(),
             targets: &[Some(wgpu::TextureFormat::Rgba8Unorm.into())],
         }),
-        multiview: None,
+        multiview_mask: None,
         cache: None,
     });
     let depth_view = depth.create_view(&wgpu::TextureViewDescriptor {
@@ -630,82 +634,4 @@ fn shade_pipeline(
         ],
     });
     (pipeline, group)
-}
-
-/// A texture copied into a mappable buffer.
-struct ReadBack {
-    buffer: wgpu::Buffer,
-    width: u32,
-    height: u32,
-    texel: u32,
-    row_pitch: u32,
-}
-
-impl ReadBack {
-    fn record(
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        texture: &wgpu::Texture,
-    ) -> Self {
-        let texel = texture.format().block_copy_size(None).unwrap_or(4);
-        let (width, height) = (texture.width(), texture.height());
-        let row_pitch = (width * texel).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("read-back"),
-            size: u64::from(row_pitch * height),
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        encoder.copy_texture_to_buffer(
-            texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row_pitch),
-                    rows_per_image: None,
-                },
-            },
-            texture.size(),
-        );
-        Self {
-            buffer,
-            width,
-            height,
-            texel,
-            row_pitch,
-        }
-    }
-
-    /// The texels' bytes, tightly packed (after the submission completed).
-    fn bytes(&self, device: &wgpu::Device) -> Result<Vec<u8>> {
-        let slice = self.buffer.slice(..);
-        slice.map_async(wgpu::MapMode::Read, |_| {});
-        device.poll(wgpu::PollType::wait_indefinitely())?;
-        let mapped = slice.get_mapped_range();
-        let row = (self.width * self.texel) as usize;
-        let bytes = (0..self.height as usize)
-            .flat_map(|y| {
-                let start = y * self.row_pitch as usize;
-                mapped[start..start + row].to_vec()
-            })
-            .collect();
-        drop(mapped);
-        self.buffer.unmap();
-        Ok(bytes)
-    }
-
-    /// The texels of a one-channel `format` as f32.
-    fn texels(&self, device: &wgpu::Device, format: wgpu::TextureFormat) -> Result<Vec<f32>> {
-        let bytes = self.bytes(device)?;
-        Ok(match format {
-            wgpu::TextureFormat::R8Unorm => bytes.iter().map(|&b| f32::from(b) / 255.0).collect(),
-            wgpu::TextureFormat::R16Float => bytes
-                .chunks_exact(2)
-                .map(|c| half::f16::from_le_bytes([c[0], c[1]]).to_f32())
-                .collect(),
-            wgpu::TextureFormat::R32Float => bytemuck::pod_collect_to_vec(&bytes),
-            other => bail!("shadow format {other:?} is not R8Unorm, R16Float or R32Float"),
-        })
-    }
 }

@@ -1,9 +1,9 @@
-//! Everything this renderer needed to add the plugin's shadows, in one file: the device wgpu opens with
-//! what the plugin adopts, the context, the renderer's meshes and images handed over as they are, and the
-//! frame recorded into a wgpu command encoder through wgpu-hal's Vulkan interop, all through the plugin's
-//! safe API ([`hrts`]).
+//! The plugin on a wgpu device, in one file: the device wgpu opens with what the plugin adopts, the
+//! context, the host's meshes and images handed over as they are, and the frame recorded into a wgpu
+//! command encoder through wgpu-hal's Vulkan interop, all through the plugin's safe API ([`hrts`]). What a
+//! renderer on wgpu (`wgpu_host`, `bevy_hrts`) writes to add the plugin.
 
-use anyhow::{Context as _, Result};
+use anyhow::{bail, Context as _, Result};
 use ash::vk::{self, Handle};
 use glam::Mat4;
 use hrts::{NormalEncoding, NormalSpace, ShadowMode};
@@ -16,6 +16,18 @@ pub struct EnabledFeatures {
     geometry_shader: bool,
     fragment_stores_and_atomics: bool,
     depth_clamp: bool,
+}
+
+impl EnabledFeatures {
+    /// What the plugin reads of the core features a device is created with (a `CreateDeviceCallback`'s
+    /// `device_features.get_core()`).
+    pub fn of(core: &vk::PhysicalDeviceFeatures) -> Self {
+        Self {
+            geometry_shader: core.geometry_shader == vk::TRUE,
+            fragment_stores_and_atomics: core.fragment_stores_and_atomics == vk::TRUE,
+            depth_clamp: core.depth_clamp == vk::TRUE,
+        }
+    }
 }
 
 /// Opens a wgpu device on `adapter` with `features`, adding the two Vulkan 1.3 features the plugin records
@@ -34,18 +46,18 @@ pub fn open_device(
         let (sync2, dynamic_rendering, enabled) =
             (&mut sync2, &mut dynamic_rendering, &mut enabled);
         let callback: Box<wgpu::hal::vulkan::CreateDeviceCallback<'_>> = Box::new(move |args| {
-            let core = args.device_features.get_core();
-            *enabled = EnabledFeatures {
-                geometry_shader: core.geometry_shader == vk::TRUE,
-                fragment_stores_and_atomics: core.fragment_stores_and_atomics == vk::TRUE,
-                depth_clamp: core.depth_clamp == vk::TRUE,
-            };
+            *enabled = EnabledFeatures::of(&args.device_features.get_core());
             let info = std::mem::take(args.create_info);
             *args.create_info = info.push_next(sync2).push_next(dynamic_rendering);
         });
         // SAFETY: the features are supported by every Vulkan 1.3 device, which the plugin requires.
         unsafe {
-            hal.open_with_callback(features, &wgpu::MemoryHints::Performance, Some(callback))
+            hal.open_with_callback(
+                features,
+                &adapter.limits(),
+                &wgpu::MemoryHints::Performance,
+                Some(callback),
+            )
         }?
     };
     let desc = wgpu::DeviceDescriptor {
@@ -163,8 +175,8 @@ pub struct ShadowMesh<'a> {
     pub bounds: [glam::Vec3; 2],
 }
 
-/// A frame's camera, in wgpu's conventions, and its directional light.
-pub struct ShadowFrame {
+/// A frame's camera, in wgpu's conventions, and its lights.
+pub struct ShadowFrame<'a> {
     /// Increasing frame counter.
     pub index: u64,
     /// World to view.
@@ -173,10 +185,8 @@ pub struct ShadowFrame {
     pub proj: Mat4,
     /// Camera position.
     pub camera_position: glam::Vec3,
-    /// Direction the light travels.
-    pub light_direction: glam::Vec3,
-    /// Orthographic light view-projection enclosing the scene (Vulkan clip conventions).
-    pub light_view_proj: Mat4,
+    /// The lights, one per configured light (Vulkan clip conventions for their matrices).
+    pub lights: &'a [hrts::Light],
     /// World-space bounds of the scene this frame (min, max): the plugin culls by them as instances move.
     pub bounds: [glam::Vec3; 2],
 }
@@ -196,6 +206,24 @@ impl Shadows {
         enabled: EnabledFeatures,
         frames_in_flight: u32,
         mode: ShadowMode,
+    ) -> Result<Self> {
+        let shadows = Self::adopt(adapter, device, enabled, frames_in_flight)?;
+        shadows.context.configure(&hrts::Config {
+            mode,
+            // Hard shadows as the rays give them, without FXAA: exact per pixel.
+            antialiasing: mode != ShadowMode::Hard,
+            ..hrts::Config::default()
+        })?;
+        Ok(shadows)
+    }
+
+    /// Adopts `device`, opened on `adapter` with the plugin's features added (as [`open_device`] adds
+    /// them) and `enabled` among its core features, with the plugin's default configuration.
+    pub fn adopt(
+        adapter: &wgpu::Adapter,
+        device: &wgpu::Device,
+        enabled: EnabledFeatures,
+        frames_in_flight: u32,
     ) -> Result<Self> {
         // SAFETY: the guard is dropped at the end of this function; the handles stay valid as long as
         // `device`, which the caller keeps beyond the context.
@@ -230,16 +258,15 @@ impl Shadows {
         // SAFETY: wgpu's live device, opened with the features stated, which the caller keeps beyond the
         // context.
         let context = unsafe { hrts::Context::adopt(&vulkan, frames_in_flight) }?;
-        context.configure(&hrts::Config {
-            mode,
-            // Hard shadows as the rays give them, without FXAA: exact per pixel.
-            antialiasing: mode != ShadowMode::Hard,
-            ..hrts::Config::default()
-        })?;
         Ok(Self {
             context,
             adapter: adapter.clone(),
         })
+    }
+
+    /// The plugin's context, for what this file does not wrap (lights, CPU geometry, reports).
+    pub fn context(&self) -> &hrts::Context {
+        &self.context
     }
 
     /// Hands the meshes to the plugin: their buffers as they are, one draw per instance.
@@ -350,10 +377,6 @@ impl Shadows {
             ]
             .into_iter(),
         );
-        let light = hrts::Light::Directional {
-            direction: frame.light_direction,
-            view_proj: Some(frame.light_view_proj),
-        };
         let vulkan_clip = Mat4::from_scale(glam::Vec3::new(1.0, -1.0, 1.0));
         // The layouts wgpu gives a sampled texture: depth formats are read in a depth read-only layout.
         let depth_layout = if targets.depth.format().is_depth_stencil_format() {
@@ -368,7 +391,7 @@ impl Shadows {
             view: frame.view,
             proj: vulkan_clip * frame.proj,
             camera_position: frame.camera_position,
-            lights: std::slice::from_ref(&light),
+            lights: frame.lights,
             depth_layout: depth_layout.as_raw(),
             normal_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL.as_raw(),
             output_layout_before: transfer_dst,
@@ -434,4 +457,105 @@ fn vulkan_usage(texture: &wgpu::Texture) -> u32 {
         }
     }
     flags.as_raw()
+}
+
+/// One layer of a texture copied into a mappable buffer.
+pub struct ReadBack {
+    buffer: wgpu::Buffer,
+    width: u32,
+    height: u32,
+    texel: u32,
+    row_pitch: u32,
+}
+
+impl ReadBack {
+    /// Records the copy of `texture`'s first layer.
+    pub fn record(
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        texture: &wgpu::Texture,
+    ) -> Self {
+        Self::record_layer(device, encoder, texture, 0)
+    }
+
+    /// Records the copy of layer `layer` of `texture` (a single-sample colour texture with `COPY_SRC`).
+    pub fn record_layer(
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        texture: &wgpu::Texture,
+        layer: u32,
+    ) -> Self {
+        let texel = texture.format().block_copy_size(None).unwrap_or(4);
+        let (width, height) = (texture.width(), texture.height());
+        let row_pitch = (width * texel).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("read-back"),
+            size: u64::from(row_pitch * height),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                origin: wgpu::Origin3d {
+                    x: 0,
+                    y: 0,
+                    z: layer,
+                },
+                ..texture.as_image_copy()
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row_pitch),
+                    rows_per_image: None,
+                },
+            },
+            wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+        );
+        Self {
+            buffer,
+            width,
+            height,
+            texel,
+            row_pitch,
+        }
+    }
+
+    /// The texels' bytes, tightly packed (after the submission completed).
+    pub fn bytes(&self, device: &wgpu::Device) -> Result<Vec<u8>> {
+        let slice = self.buffer.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |_| {});
+        device.poll(wgpu::PollType::wait_indefinitely())?;
+        let mapped = slice.get_mapped_range();
+        let row = (self.width * self.texel) as usize;
+        let bytes = (0..self.height as usize)
+            .flat_map(|y| {
+                let start = y * self.row_pitch as usize;
+                mapped[start..start + row].to_vec()
+            })
+            .collect();
+        drop(mapped);
+        self.buffer.unmap();
+        Ok(bytes)
+    }
+
+    /// The texels of a one-channel `format` as f32 (after the submission completed), row by row from the
+    /// top.
+    pub fn texels(&self, device: &wgpu::Device, format: wgpu::TextureFormat) -> Result<Vec<f32>> {
+        let bytes = self.bytes(device)?;
+        Ok(match format {
+            wgpu::TextureFormat::R8Unorm => bytes.iter().map(|&b| f32::from(b) / 255.0).collect(),
+            wgpu::TextureFormat::R16Float => bytes
+                .chunks_exact(2)
+                .map(|c| half::f16::from_le_bytes([c[0], c[1]]).to_f32())
+                .collect(),
+            wgpu::TextureFormat::R32Float => bytemuck::pod_collect_to_vec(&bytes),
+            other => bail!("shadow format {other:?} is not R8Unorm, R16Float or R32Float"),
+        })
+    }
 }
