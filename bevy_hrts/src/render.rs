@@ -258,11 +258,25 @@ fn lit_array(
 }
 
 /// A `Depth32Float` array Bevy's PBR shader may read and a render pass may write.
-fn depth_array(
+fn depth_array(device: &RenderDevice, label: &str, size: (u32, u32), layers: u32) -> Texture {
+    array_texture(
+        device,
+        label,
+        size,
+        layers,
+        wgpu::TextureFormat::Depth32Float,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+    )
+}
+
+/// A single-sample 2D array texture of `layers` layers.
+fn array_texture(
     device: &RenderDevice,
     label: &str,
     (width, height): (u32, u32),
     layers: u32,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
 ) -> Texture {
     device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
@@ -274,8 +288,8 @@ fn depth_array(
         mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Depth32Float,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        format,
+        usage,
         view_formats: &[],
     })
 }
@@ -636,22 +650,16 @@ impl Mask {
         (width, height): (u32, u32),
         layers: u32,
     ) -> Self {
-        let visibility = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("hrts visibility"),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: layers,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::R32Float,
-            usage: wgpu::TextureUsages::COPY_DST
+        let visibility = array_texture(
+            device,
+            "hrts visibility",
+            (width, height),
+            layers,
+            wgpu::TextureFormat::R32Float,
+            wgpu::TextureUsages::COPY_DST
                 | wgpu::TextureUsages::COPY_SRC
                 | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
+        );
         let depth = depth_array(device, "hrts visibility as depth", (width, height), layers);
         clear_layers(device, queue, &depth, layers);
         let array = wgpu::TextureViewDescriptor {
