@@ -66,6 +66,8 @@ pub(crate) struct MeshData {
     pub(crate) id: AssetId<Mesh>,
     pub(crate) positions: Vec<glam::Vec3>,
     pub(crate) indices: Vec<u32>,
+    /// Object-space bounds of the positions (min, max), taken once per extraction of the mesh.
+    pub(crate) bounds: [glam::Vec3; 2],
 }
 
 /// A light the plugin shadows, as extracted.
@@ -168,6 +170,10 @@ fn extract_scene(
             match meshes.get(id).map(mesh_data) {
                 Some(Ok((positions, indices))) => data.push(MeshData {
                     id,
+                    bounds: positions.iter().fold(
+                        [glam::Vec3::INFINITY, glam::Vec3::NEG_INFINITY],
+                        |[min, max], &p| [min.min(p), max.max(p)],
+                    ),
                     positions,
                     indices,
                 }),

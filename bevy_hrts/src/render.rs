@@ -472,8 +472,15 @@ fn scene_bounds(scene: &ExtractedScene) -> [glam::Vec3; 2] {
         glam::Vec3::splat(f32::INFINITY),
         glam::Vec3::splat(f32::NEG_INFINITY),
     ];
+    // Each draw's object-space box, its eight corners transformed: a bound of the transformed vertices.
     for &(mesh, transform) in &scene.draws {
-        for &p in &scene.meshes[mesh].positions {
+        let [min, max] = scene.meshes[mesh].bounds;
+        for corner in 0..8 {
+            let p = glam::Vec3::select(
+                glam::BVec3::new(corner & 1 != 0, corner & 2 != 0, corner & 4 != 0),
+                max,
+                min,
+            );
             let p = transform.transform_point3(p);
             bounds = [bounds[0].min(p), bounds[1].max(p)];
         }
