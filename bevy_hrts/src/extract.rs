@@ -2,12 +2,16 @@
 //! and each frame's meshes, instances and lights extracted into the render world.
 
 use crate::HrtsShadowMode;
+use bevy::camera::visibility::{
+    CascadesVisibleEntities, CubemapVisibleEntities, VisibleMeshEntities,
+};
 use bevy::core_pipeline::prepass::{DepthPrepass, NormalPrepass};
 use bevy::light::NotShadowCaster;
 use bevy::mesh::{Indices, PrimitiveTopology, VertexAttributeValues};
 use bevy::prelude::*;
 use bevy::render::{Extract, RenderApp};
 use bevy::shader::Shader;
+use std::collections::{HashMap, HashSet};
 
 /// The source of the `bevy_pbr::shadows` module the plugin puts in place of Bevy's.
 const SHADOWS_WGSL: &str = include_str!("shadows.wgsl");
@@ -31,6 +35,57 @@ pub(crate) fn prepare_cameras(
         commands
             .entity(camera)
             .insert((DepthPrepass, NormalPrepass, Msaa::Off, HrtsCamera));
+    }
+}
+
+/// Empties the casters Bevy found for each light's shadow maps, so that Bevy draws no mesh into maps its
+/// shader no longer reads (the plugin's module answers every shadow fetch). Bevy still clears the maps.
+pub(crate) fn drop_shadow_map_casters(
+    mut suns: Query<&mut CascadesVisibleEntities, With<DirectionalLight>>,
+    mut points: Query<&mut CubemapVisibleEntities, With<PointLight>>,
+    mut spots: Query<&mut VisibleMeshEntities, With<SpotLight>>,
+) {
+    for mut cascades in &mut suns {
+        if cascades
+            .entities
+            .values()
+            .flatten()
+            .any(|c| !c.entities.is_empty())
+        {
+            cascades
+                .entities
+                .values_mut()
+                .flatten()
+                .for_each(|c| c.entities.clear());
+        }
+    }
+    for mut faces in &mut points {
+        if faces.iter().any(|f| !f.entities.is_empty()) {
+            faces.iter_mut().for_each(|f| f.entities.clear());
+        }
+    }
+    for mut casters in &mut spots {
+        if !casters.entities.is_empty() {
+            casters.entities.clear();
+        }
+    }
+}
+
+/// Texels per side of the shadow maps Bevy still allocates and clears for shadowed lights, which its
+/// shader no longer reads.
+const UNREAD_SHADOW_MAP_SIZE: usize = 16;
+
+/// Keeps Bevy's (unread) shadow maps at [`UNREAD_SHADOW_MAP_SIZE`]: Bevy clears every cascade and cube face
+/// each frame.
+pub(crate) fn shrink_shadow_maps(
+    mut directional: ResMut<bevy::light::DirectionalLightShadowMap>,
+    mut point: ResMut<bevy::light::PointLightShadowMap>,
+) {
+    if directional.size != UNREAD_SHADOW_MAP_SIZE {
+        directional.size = UNREAD_SHADOW_MAP_SIZE;
+    }
+    if point.size != UNREAD_SHADOW_MAP_SIZE {
+        point.size = UNREAD_SHADOW_MAP_SIZE;
     }
 }
 
@@ -154,11 +209,12 @@ fn extract_scene(
     keys.sort_by_key(|&(e, ..)| e);
     let draw_keys: Vec<(Entity, AssetId<Mesh>)> = keys.iter().map(|&(e, id, _)| (e, id)).collect();
     // A mesh that was not loaded at the last extraction casts once it is.
-    let newly_loaded = draw_keys.iter().any(|&(_, id)| {
-        !scene.meshes.iter().any(|m| m.id == id)
-            && !scene.skipped.iter().any(|(skipped, _)| *skipped == id)
-            && meshes.contains(id)
-    });
+    let known: HashSet<AssetId<Mesh>> = (scene.meshes.iter().map(|m| m.id))
+        .chain(scene.skipped.iter().map(|&(id, _)| id))
+        .collect();
+    let newly_loaded = draw_keys
+        .iter()
+        .any(|&(_, id)| !known.contains(&id) && meshes.contains(id));
     scene.geometry_changed = draw_keys != scene.draw_keys || meshes.is_changed() || newly_loaded;
     if scene.geometry_changed {
         let mut unique: Vec<AssetId<Mesh>> = draw_keys.iter().map(|&(_, id)| id).collect();
@@ -186,14 +242,11 @@ fn extract_scene(
         scene.draw_keys = draw_keys;
     }
     let ExtractedScene { meshes, draws, .. } = &mut *scene;
+    let index: HashMap<AssetId<Mesh>, usize> =
+        meshes.iter().enumerate().map(|(i, m)| (m.id, i)).collect();
     *draws = keys
         .iter()
-        .filter_map(|&(_, id, transform)| {
-            meshes
-                .iter()
-                .position(|m| m.id == id)
-                .map(|mesh| (mesh, transform))
-        })
+        .filter_map(|&(_, id, transform)| index.get(&id).map(|&mesh| (mesh, transform)))
         .collect();
     let mut lights = Vec::new();
     for (entity, light, t, mode, visible) in &directional {

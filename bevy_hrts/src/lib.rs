@@ -23,10 +23,10 @@
 //! - the meshes' positions and indices from their `Mesh` assets, and each entity's `GlobalTransform`
 //!   every frame (a moved entity moves its shadow).
 //!
-//! Limits of this version: one camera (of the 3D cameras with the prepasses, the first in entity order; the
-//! others, and views with a `Viewport`, read these lights as unshadowed); skinned and morphed meshes cast
-//! their rest pose; Bevy still renders its own shadow maps for these lights (its shader no longer reads
-//! them); volumetric fog is not lit by these lights.
+//! Limits of this version: one camera (of the 3D cameras with the prepasses and no `Viewport`, the one with
+//! the lowest `Camera::order`; the others read these lights as unshadowed); skinned and morphed meshes
+//! cast their rest pose; Bevy draws no mesh into its own shadow maps of these lights, but still allocates
+//! (at 16² texels) and clears them; volumetric fog is not lit by these lights.
 
 mod device;
 mod extract;
@@ -57,6 +57,14 @@ pub struct HrtsStatus {
     pub lights: Vec<Entity>,
     /// The last error, if the plugin could not shadow a frame (its lights are then lit).
     pub error: Option<String>,
+    /// GPU milliseconds of the plugin's passes (all lights) in the last frame the GPU completed and the
+    /// plugin could read the timings of (`None` before, or on a device without timestamp queries).
+    pub gpu_milliseconds: Option<f64>,
+    /// GPU milliseconds from a timestamp before the plugin's first pass to one after the copy into the
+    /// depth array Bevy's shader reads, in the last frame timed: the passes, the waits between them and
+    /// the copy (the first timestamp also waits for the GPU work before it). `None` before, or on a
+    /// device that writes no timestamps inside command encoders.
+    pub gpu_span_milliseconds: Option<f64>,
     /// Meshes that cast no shadow because the plugin could not read them (not a triangle list, or no
     /// positions kept in the main world), and why.
     pub skipped_meshes: Vec<String>,
@@ -101,7 +109,13 @@ impl Plugin for HrtsShadowsPlugin {
             })
             .add_systems(
                 PostUpdate,
-                (extract::prepare_cameras, render::publish_status(status)),
+                (
+                    extract::prepare_cameras,
+                    render::publish_status(status),
+                    extract::drop_shadow_map_casters
+                        .after(bevy::light::SimulationLightSystems::CheckLightVisibility),
+                    extract::shrink_shadow_maps,
+                ),
             );
     }
 

@@ -13,12 +13,13 @@ use bevy::pbr::{
     prepare_lights, ExtractedDirectionalLight, ExtractedPointLight, ViewShadowBindings,
 };
 use bevy::prelude::*;
+use bevy::render::camera::ExtractedCamera;
 use bevy::render::render_resource::{Texture, TextureView};
 use bevy::render::renderer::{RenderAdapter, RenderContext, RenderDevice, RenderQueue, ViewQuery};
 use bevy::render::sync_world::MainEntity;
 use bevy::render::view::ExtractedView;
 use bevy::render::{Render, RenderApp, RenderSystems};
-use hrts_wgpu::{ShadowFrame, ShadowTargets, Shadows};
+use hrts_wgpu::{ShadowFrame, ShadowTargets, Shadows, SpanTimer};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
@@ -89,6 +90,10 @@ pub(crate) struct RenderState {
     frames: u64,
     /// Frames completed on the GPU (every frame below this one has).
     completed: Arc<AtomicU64>,
+    /// The frames in flight: each one's index and number of lights, oldest first.
+    in_flight: std::collections::VecDeque<(u64, u32)>,
+    /// Times each frame's span on the GPU, from the plugin's first pass to the end of the copy.
+    span: Option<SpanTimer>,
     /// The meshes changed since the plugin last took them.
     geometry_dirty: bool,
     /// A 1×1 depth array of 1.0 (lit), one layer per light: what the views read when the plugin does not
@@ -129,7 +134,7 @@ pub(crate) fn add_render_systems(app: &mut App) {
                 prepare_shadows
                     .in_set(RenderSystems::PrepareResources)
                     .after(prepare_prepass_textures),
-                capture_visibility.in_set(RenderSystems::Cleanup),
+                (capture_visibility, span_submitted).in_set(RenderSystems::Cleanup),
             ),
         )
         .add_systems(
@@ -201,6 +206,7 @@ type ShadowedViews<'w, 's> = Query<
         Entity,
         &'static ViewPrepassTextures,
         &'static mut ViewShadowBindings,
+        Option<&'static ExtractedCamera>,
     ),
     (With<DepthPrepass>, With<NormalPrepass>),
 >;
@@ -225,7 +231,7 @@ fn prepare_shadows(
         state.lit = Some(lit_array(&device, &queue, layers));
     }
     if let Some((_, texture, view)) = &state.lit {
-        for (_, _, mut bindings) in &mut views {
+        for (_, _, mut bindings, _) in &mut views {
             bindings.directional_light_depth_texture = texture.clone();
             bindings.directional_light_depth_texture_view = view.clone();
         }
@@ -343,7 +349,13 @@ fn prepare(
     adapter: &RenderAdapter,
     views: &mut ShadowedViews,
 ) -> Result<()> {
-    let Some((entity, prepass, mut bindings)) = views.iter_mut().min_by_key(|(e, ..)| *e) else {
+    // The camera Bevy renders first (the lowest `Camera::order`, then the lowest entity) of those that
+    // render their whole target: the plugin's passes cover the prepasses' whole extent.
+    let Some((entity, prepass, mut bindings, _)) = views
+        .iter_mut()
+        .filter(|(_, _, _, camera)| camera.is_none_or(|c| c.viewport.is_none()))
+        .min_by_key(|(e, _, _, camera)| (camera.map_or(isize::MAX, |c| c.order), *e))
+    else {
         return Ok(());
     };
     let (Some(depth), Some(normal)) = (&prepass.depth, &prepass.normal) else {
@@ -373,6 +385,7 @@ fn prepare(
             .context("adopting Bevy's device")?;
         state.shadows = Some(Mutex::new(shadows));
         state.device = Some(wgpu_device.clone());
+        state.span = SpanTimer::new(wgpu_device, queue);
     }
     let configs: Vec<hrts::Config> = scene
         .lights
@@ -514,7 +527,9 @@ fn record_shadows(
     let result = record(&mut state, extracted, prepass, &device, &queue, &mut ctx);
     let mut status = settings.status.lock();
     match result {
-        Ok(()) => {
+        Ok(times) => {
+            status.gpu_milliseconds = times.passes.or(status.gpu_milliseconds);
+            status.gpu_span_milliseconds = times.span.or(status.gpu_span_milliseconds);
             status.frames = state.frames;
             status.lights = state.lights.iter().map(|l| l.entity).collect();
             status.error = None;
@@ -530,9 +545,9 @@ fn record(
     device: &RenderDevice,
     queue: &RenderQueue,
     ctx: &mut RenderContext,
-) -> Result<()> {
+) -> Result<GpuTimes> {
     let (Some(shadows), Some(mask), Some(fill)) = (&state.shadows, &state.mask, &state.fill) else {
-        return Ok(());
+        return Ok(GpuTimes::default());
     };
     // The frame takes its index now: one that fails while recording has used it.
     let index = state.frames;
@@ -551,7 +566,17 @@ fn record(
             .context("waiting for the frame in flight before the last ones")?;
     }
     let (Some(depth), Some(normal)) = (&prepass.depth, &prepass.normal) else {
-        return Ok(());
+        return Ok(GpuTimes::default());
+    };
+    // The newest frame in flight the GPU completed (read before this frame takes the oldest one's place).
+    let gpu_milliseconds = {
+        let shadows = shadows.lock().unwrap_or_else(|e| e.into_inner());
+        state
+            .in_flight
+            .iter()
+            .rev()
+            .find_map(|&(frame, lights)| shadows.gpu_milliseconds(frame, lights).ok())
+            .flatten()
     };
     let world_from_view = view.world_from_view.to_matrix();
     let lights: Vec<hrts::Light> = state.lights.iter().map(|l| l.light).collect();
@@ -570,6 +595,11 @@ fn record(
         normal_space: hrts::NormalSpace::World,
         shadow: &mask.visibility,
     };
+    let mut span = None;
+    if let Some(timer) = &mut state.span {
+        timer.begin(device.wgpu_device(), ctx.command_encoder());
+        span = timer.take().last().copied();
+    }
     let commands = shadows.lock().unwrap_or_else(|e| e.into_inner()).record(
         device.wgpu_device(),
         ctx.command_encoder(),
@@ -578,9 +608,35 @@ fn record(
     )?;
     ctx.add_command_buffer(commands);
     fill.record(ctx.command_encoder(), mask);
+    if let Some(timer) = &mut state.span {
+        timer.end(ctx.command_encoder());
+    }
     let vulkan_clip = Mat4::from_scale(Vec3::new(1.0, -1.0, 1.0));
     state.matrices = Some((world_from_view.inverse(), vulkan_clip * view.clip_from_view));
-    Ok(())
+    state.in_flight.push_back((index, lights.len() as u32));
+    if state.in_flight.len() > FRAMES_IN_FLIGHT as usize {
+        state.in_flight.pop_front();
+    }
+    Ok(GpuTimes {
+        passes: gpu_milliseconds,
+        span,
+    })
+}
+
+/// The GPU times of the last frame the GPU completed that the plugin could read.
+#[derive(Default)]
+struct GpuTimes {
+    /// The plugin's passes, over all lights.
+    passes: Option<f64>,
+    /// From the plugin's first pass to the end of the copy into the depth array.
+    span: Option<f64>,
+}
+
+/// Once Bevy submitted the frame: reads its span back when the GPU completes it.
+fn span_submitted(mut state: ResMut<RenderState>) {
+    if let Some(timer) = &mut state.span {
+        timer.submitted();
+    }
 }
 
 impl Fill {

@@ -3,6 +3,10 @@
 //! command encoder through wgpu-hal's Vulkan interop, all through the plugin's safe API ([`hrts`]). What a
 //! renderer on wgpu (`wgpu_host`, `bevy_hrts`) writes to add the plugin.
 
+mod span_timer;
+
+pub use span_timer::SpanTimer;
+
 use anyhow::{bail, Context as _, Result};
 use ash::vk::{self, Handle};
 use glam::Mat4;
@@ -419,6 +423,19 @@ impl Shadows {
     pub fn report(&self, frame_index: u64) -> Result<hrts::FrameReport> {
         Ok(self.context.frame_report(frame_index, 0)?)
     }
+
+    /// GPU milliseconds of the passes of frame `frame_index`'s `lights` lights (completed on the GPU);
+    /// `None` if the frame has no timings (a device without timestamps).
+    pub fn gpu_milliseconds(&self, frame_index: u64, lights: u32) -> Result<Option<f64>> {
+        let mut sum = 0.0;
+        let mut timed = false;
+        for light in 0..lights {
+            let report = self.context.frame_report(frame_index, light)?;
+            sum += report.gpu_milliseconds;
+            timed |= !report.timings.is_empty();
+        }
+        Ok(timed.then_some(sum))
+    }
 }
 
 /// The `VkImageUsageFlags` of a texture's wgpu usages.
@@ -490,7 +507,7 @@ impl ReadBack {
         let row_pitch = (width * texel).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("read-back"),
-            size: u64::from(row_pitch * height),
+            size: u64::from(row_pitch) * u64::from(height),
             usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
             mapped_at_creation: false,
         });
@@ -529,8 +546,15 @@ impl ReadBack {
     /// The texels' bytes, tightly packed (after the submission completed).
     pub fn bytes(&self, device: &wgpu::Device) -> Result<Vec<u8>> {
         let slice = self.buffer.slice(..);
-        slice.map_async(wgpu::MapMode::Read, |_| {});
+        let (sender, receiver) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |result| {
+            let _ = sender.send(result);
+        });
         device.poll(wgpu::PollType::wait_indefinitely())?;
+        receiver
+            .recv()
+            .context("the read-back's mapping was dropped")?
+            .context("mapping the read-back")?;
         let mapped = slice.get_mapped_range();
         let row = (self.width * self.texel) as usize;
         let bytes = (0..self.height as usize)

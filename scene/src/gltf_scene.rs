@@ -180,7 +180,15 @@ fn parse_document(
     };
     let mut value: serde_json::Value = serde_json::from_slice(&json).map_err(deserialize)?;
     without_unread_parts(&mut value);
-    let root: gltf::json::Root = serde_json::from_value(value).map_err(deserialize)?;
+    let root: gltf::json::Root = serde_json::from_value(value).map_err(|e| {
+        // The same problem in the file's own text gives its line and column.
+        let whole = serde_json::from_slice::<gltf::json::Root>(&json).err();
+        deserialize(
+            whole
+                .filter(|w| w.to_string().starts_with(&e.to_string()))
+                .unwrap_or(e),
+        )
+    })?;
     let version = &root.asset.version;
     if version.split('.').next() != Some("2") {
         return Err(error(format!(

@@ -474,6 +474,16 @@ fn malformed_containers_and_buffers() {
             "{error}"
         );
     }
+    // A schema error says where in the file it is.
+    let mut typo = document.clone();
+    typo["asset"]["version"] = 2.into();
+    let error = dir.load_embedded("typo.gltf", &typo, &bin).unwrap_err();
+    let message = error.to_string();
+    assert!(
+        message.contains("invalid type: integer `2`, expected a string at line ")
+            && message.contains(" column "),
+        "{error}"
+    );
     let mut old = document.clone();
     old["asset"]["version"] = "1.0".into();
     let error = dir.load_embedded("old.gltf", &old, &bin).unwrap_err();
