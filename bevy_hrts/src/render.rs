@@ -349,8 +349,8 @@ fn prepare(
     adapter: &RenderAdapter,
     views: &mut ShadowedViews,
 ) -> Result<()> {
-    // The camera Bevy renders first (the lowest `Camera::order`, then the lowest entity) of those that
-    // render their whole target: the plugin's passes cover the prepasses' whole extent.
+    // The camera with the lowest `Camera::order` (then the lowest render-world entity) of those that render
+    // their whole target: the plugin's passes cover the prepasses' whole extent.
     let Some((entity, prepass, mut bindings, _)) = views
         .iter_mut()
         .filter(|(_, _, _, camera)| camera.is_none_or(|c| c.viewport.is_none()))
